@@ -1,0 +1,3525 @@
+/* fogvol.h - v0.1.0 - mesh-shaped fog and light volumes for real-time engines
+   MIT or public domain (see the end of this file).
+
+   fogvol.h renders ordinary closed polygon meshes (convex or concave, animated,
+   any number of them) as thick volumes of fog or light, with exact edges,
+   opaque objects cutting through, and the camera free to stand inside. It is
+   the technique of the NVIDIA SDK white paper "Fog Polygon Volumes" (2004) and
+   Dan Baker's DirectX 8.1 "VolumeFog" sample, made into a drop-in library.
+
+   For every pixel:  thickness = sum(depth of back faces) - sum(depth of front
+   faces), with depth = view-space w mapped to [0,1] from the near to the far
+   plane, and each face's depth clamped to the depth of the nearest opaque
+   object. On RGBA8 targets depths are "RGB-encoded" (L low bits per channel,
+   8-L carry bits on top) so that additive blending sums up to 2^(8-L) faces
+   exactly; a colour ramp maps thickness to colour, blended over the scene.
+
+   BUILDING
+   ========
+   In exactly one C or C++ file:
+
+       #define FOGVOL_IMPLEMENTATION
+       #include "fogvol.h"
+
+   Everywhere else just #include "fogvol.h". Nothing to link but the C library
+   (and libm). The GL backend reaches OpenGL only through function pointers that
+   your loader hands it; fogvol.h includes no GL header and links no GL library.
+
+   CONFIGURATION MACROS (define before the #include that has the implementation)
+   ====================
+     FOGVOL_STATIC          all functions static (implementation private to one TU)
+     FOGVOL_API             decoration of every public function (default extern)
+     FOGVOL_NO_GL           leave out the GL backend (math, textures, shaders,
+                            renderer and the null backend remain)
+     FOGVOL_ASSERT(x)       assertion (default: assert from <assert.h>)
+     FOGVOL_SQRT, FOGVOL_EXP, FOGVOL_FLOOR, FOGVOL_FABS, FOGVOL_POW
+                            maths hooks (default: <math.h>)
+     FOGVOL_MALLOC, FOGVOL_FREE
+                            default allocator when a desc leaves it empty
+     FOGVOL_GLAPIENTRY      calling convention of GL entry points
+                            (default __stdcall on _WIN32, nothing elsewhere)
+
+   QUICK START (default GL backend, any GL 2.1+ / 3.x core / GLES2+ context)
+   ===========
+       fogvol_context_desc cd;  memset(&cd, 0, sizeof cd);   // 0 = default
+       cd.gl.get_proc_address = my_get_proc;                  // e.g. glfwGetProcAddress wrapper
+       fogvol_context *fv;
+       if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) ...;
+
+       fogvol_mesh_desc md;  memset(&md, 0, sizeof md);
+       md.positions = verts; md.vertex_count = nv;            // xyz floats
+       md.indices = idx;     md.index_count = ni;             // CCW seen from outside
+       fogvol_mesh *blob;   fogvol_create_mesh(fv, &md, &blob);
+
+       fogvol_ramp_desc rd;  memset(&rd, 0, sizeof rd);       // extinction model
+       rd.color[0] = rd.color[1] = rd.color[2] = 0.8f; rd.density = 0.5f;
+       fogvol_ramp *fog;    fogvol_create_ramp(fv, &rd, &fog);
+
+       // every frame, after the engine drew its opaque scene into the bound framebuffer:
+       fogvol_frame_desc fd;  memset(&fd, 0, sizeof fd);
+       memcpy(fd.view, view, 64); memcpy(fd.projection, proj, 64);
+       fd.znear = 0.1f; fd.zfar = 100.0f;
+       fd.viewport[2] = width; fd.viewport[3] = height;
+       fogvol_begin_frame(fv, &fd);
+       fogvol_add_occluder(fv, ground_mesh, ground_model);    // opaque things that cut fog
+       fogvol_volume_desc vd;  memset(&vd, 0, sizeof vd);
+       vd.mesh = blob; vd.ramp = fog; memcpy(vd.model, model, 64);
+       fogvol_add_volume(fv, &vd);
+       fogvol_end_frame(fv);           // renders and composites; GL state restored
+
+   Matrices are column-major float[16] (m[col*4+row]), OpenGL conventions: the
+   camera looks down -z in view space, clip w = view depth.
+
+   RESULT CODES AND LOGGING
+   ========================
+   Every function that can fail returns fogvol_result (0 success, negative
+   errors); fogvol_result_string() names them. Details go to the logger of the
+   desc (shader info logs included). The library never prints by itself.
+
+   CUSTOM BACKENDS
+   ===============
+   The renderer talks to the GPU only through fogvol_backend, a table of
+   function pointers whose first argument is the table's user_data. Fill the
+   table yourself to render through your own engine layer; see the contract
+   next to the struct declaration below. fogvol_null_backend_init() gives a
+   recording backend that needs no GPU.
+
+   GL <-> GLSL (dialect chosen from the context, overridable)
+   ============
+       GL 2.0 -> 110   GL 2.1 -> 120   GL 3.0/3.1 -> 130   GL 3.2 -> 150
+       GL 3.3+ -> 330 core   GLES 2 / WebGL 1 -> 100   GLES 3 / WebGL 2 -> 300 es
+
+   SECTIONS (search for the markers)
+   ========
+       >>declarations  >>cpu  >>shaders  >>null backend  >>renderer  >>gl backend
+*/
+
+#ifndef FOGVOL_H
+#define FOGVOL_H
+
+#define FOGVOL_VERSION_MAJOR 0
+#define FOGVOL_VERSION_MINOR 1
+#define FOGVOL_VERSION_PATCH 0
+#define FOGVOL_VERSION_STRING "0.1.0"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifndef FOGVOL_API
+#  ifdef FOGVOL_STATIC
+#    if defined(__GNUC__) || defined(__clang__)
+#      define FOGVOL_API static __attribute__((unused))
+#    else
+#      define FOGVOL_API static
+#    endif
+#  else
+#    define FOGVOL_API extern
+#  endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* >>declarations ========================================================== */
+
+typedef enum fogvol_result {
+    FOGVOL_SUCCESS = 0,
+    FOGVOL_ERROR_INVALID_ARGUMENT = -1,   /* NULL, out of range, non-finite, near >= far ... */
+    FOGVOL_ERROR_OUT_OF_MEMORY = -2,      /* the allocator returned NULL */
+    FOGVOL_ERROR_BUFFER_TOO_SMALL = -3,   /* caller buffer smaller than the size reported */
+    FOGVOL_ERROR_UNSUPPORTED = -4,        /* the combination or the context cannot do it */
+    FOGVOL_ERROR_INVALID_MESH = -5,       /* mesh is not a closed, consistently oriented hull */
+    FOGVOL_ERROR_INVALID_STATE = -6,      /* call out of order (e.g. add outside a frame) */
+    FOGVOL_ERROR_MISSING_FUNCTION = -7,   /* a required GL entry point was not found */
+    FOGVOL_ERROR_SHADER_COMPILE = -8,     /* info log went to the logger */
+    FOGVOL_ERROR_SHADER_LINK = -9,        /* info log went to the logger */
+    FOGVOL_ERROR_FRAMEBUFFER = -10,       /* render target format refused by the driver */
+    FOGVOL_ERROR_BACKEND = -11,           /* the backend reported another failure */
+    FOGVOL_ERROR_DEPTH_OVERFLOW = -12,    /* more faces along a ray than the encoding holds */
+    FOGVOL_RESULT_MAX_ENUM = 0x7fffffff
+} fogvol_result;
+
+FOGVOL_API const char *fogvol_result_string(fogvol_result result);
+
+typedef enum fogvol_log_level {
+    FOGVOL_LOG_ERROR = 0,
+    FOGVOL_LOG_WARNING = 1,
+    FOGVOL_LOG_INFO = 2,
+    FOGVOL_LOG_DEBUG = 3,
+    FOGVOL_LOG_MAX_ENUM = 0x7fffffff
+} fogvol_log_level;
+
+/* Allocator: alloc == NULL means FOGVOL_MALLOC/FOGVOL_FREE (malloc/free). */
+typedef struct fogvol_allocator {
+    void *(*alloc)(size_t size, void *user_data);
+    void (*free)(void *ptr, void *user_data);
+    void *user_data;
+} fogvol_allocator;
+
+/* Logger: func == NULL means silent. message is NUL-terminated, no newline. */
+typedef struct fogvol_logger {
+    void (*func)(void *user_data, fogvol_log_level level, const char *message);
+    void *user_data;
+} fogvol_logger;
+
+/* ---- encoding ------------------------------------------------------------
+   A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
+   L-bit digits: red (most significant), green, blue, each stored in the low L
+   bits of an 8-bit channel. Additive blending then sums up to 2^(8-L) encoded
+   values with no loss (the 8-L high bits take the carries).
+
+   Dithering (on by default): the blue digit comes from a 2D ramp whose rows
+   hold different rounding thresholds; a pixel picks its row from an 8x8
+   ordered pattern. Row 0 rounds to nearest (no dither). Where a dithered row
+   rounds below the start of a blue period the texel holds blue = 2^L - 1 and
+   alpha = 1, meaning "minus one green step"; the alpha channel sums these
+   borrows and the decode weights carry -2^-L for alpha, so every channel of a
+   single encoded face stays <= 2^L - 1 and the sum stays exact and unbiased.
+
+   decode(RGBA bytes) = R/N + G/N^2 + B/N^3 - A/N^2   (N = 2^L, in units of far-near)
+*/
+typedef struct fogvol_encoding {
+    int bits;             /* L: low bits used per channel, 1..8 */
+    int levels;           /* N = 2^L */
+    int precision_bits;   /* 3L */
+    int max_faces;        /* faces summable without error per target: 2^(8-L) */
+    int max_faces_single; /* single-target variant with mid-range bias: 2^(7-L) (0 for L = 8) */
+    int dither_steps;     /* D: blue-ramp texels per blue LSB = dither rows (32, fewer for L >= 7) */
+} fogvol_encoding;
+
+#define FOGVOL_DEFAULT_BITS 4
+#define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
+
+/* Fill *out for L = bits (1..8). */
+FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits);
+/* Most precise encoding that sums at least max_faces faces (1..128). */
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces);
+/* Encoding with the most faces that still gives at least precision_bits (1..24). */
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits);
+/* The table of every L = 1..8 (the seed's Figure 3). Returns the row count (8);
+   writes min(count, capacity) rows when rows != NULL. */
+FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
+
+/* Constants a shader needs (all float, ready for uniforms). */
+typedef struct fogvol_constants {
+    float near_far[2];    /* (1/(far-near), -near/(far-near)): d = w*near_far[0] + near_far[1] */
+    float ramp_scale[4];  /* (1, 2^L, 2^2L, 0): texture coordinates of the red, green, blue ramps */
+    float depth_offset;   /* 2^-3L: added to the clamped d before the ramp lookups (one blue LSB;
+                             it pairs with the "-1" of the blue ramp's borrow convention) */
+    float depth_max;      /* d is clamped to [0, depth_max] = 1 - 1.5 * 2^-3L */
+    float decode[4];      /* scale * (1, 2^-L, 2^-2L, -2^-L): dot with RGBA normalised to [0,1] */
+    float scale;          /* the scale used: default (far-near) * 255 / 2^L (world units) */
+    float bias[4];        /* mid-range bias of the single-target variant, normalised (128/255 in RGB) */
+    float bias_decoded;   /* dot(bias, decode) */
+    float lsb;            /* one blue LSB in decoded units: scale / (255 * 2^2L) (world units by default) */
+    float dither_rows;    /* D */
+} fogvol_constants;
+
+/* scale == 0 means "decode to world units" ((far-near) * 255 / 2^L). */
+FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar,
+                                                  float scale, fogvol_constants *out);
+
+/* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
+   depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
+   row 0 is the undithered (round-to-nearest) row. */
+FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
+                                             unsigned char out_rgba[4]);
+/* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
+   Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
+FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4]);
+/* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
+   tells whether any channel saturated. */
+FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
+                                            int *saturated);
+/* Decoded value in units of (far - near): R/N + G/N^2 + B/N^3 - A/N^2. */
+FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4]);
+/* decode(a) - decode(b), computed as decode of the channel differences. */
+FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
+                                           const unsigned char b[4]);
+
+/* ---- textures (caller-owned RGBA8 buffers, rows bottom to top) -----------
+   Each generator fills *info (width, height, size in bytes) and writes the
+   texels when pixels != NULL. pixels == NULL is a size query. A capacity
+   smaller than info->size gives FOGVOL_ERROR_BUFFER_TOO_SMALL. */
+typedef struct fogvol_image {
+    int width, height;
+    size_t size; /* width * height * 4 */
+} fogvol_image;
+
+/* N x N: texel (x, y) = (x, y, 0, 0). Sampled NEAREST + REPEAT at (u, u*N). */
+FOGVOL_API fogvol_result fogvol_make_rg_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                             fogvol_image *info);
+/* (N*D) x D: row r, texel x -> blue digit with the dither threshold of row r
+   and the borrow in alpha. Sampled NEAREST + REPEAT(x) at (u*N^2, (row+0.5)/D). */
+FOGVOL_API fogvol_result fogvol_make_blue_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                               fogvol_image *info);
+/* 8 x 8: red = blue-ramp row for the pixel (an ordered pattern over the
+   thresholds). Sampled NEAREST + REPEAT at gl_FragCoord.xy / 8. */
+FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, unsigned char *pixels,
+                                                  size_t capacity, fogvol_image *info);
+/* Rounding threshold of blue-ramp row r, in blue LSBs (row 0: 0.5). */
+FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row);
+
+/* Thickness -> colour ramps. */
+typedef enum fogvol_ramp_model {
+    FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
+    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, seeds/002) */
+    FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
+    FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
+} fogvol_ramp_model;
+
+typedef enum fogvol_blend {
+    FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
+    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, seeds/004) */
+    FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
+} fogvol_blend;
+
+typedef struct fogvol_color_key {
+    float thickness; /* world units */
+    float rgba[4];   /* [0,1] */
+} fogvol_color_key;
+
+typedef struct fogvol_ramp_desc {
+    fogvol_ramp_model model;
+    float color[3];
+    float density;               /* per world unit (extinction, linear) */
+    float max_thickness;         /* thickness of the last texel; 0 = auto: extinction 7/density,
+                                    linear 1/density, gradient the last key */
+    const fogvol_color_key *keys; /* gradient: key_count >= 1, any order */
+    int key_count;
+    int width;                   /* texels, 0 = 256, 2..4096 */
+    fogvol_blend blend;          /* used by the renderer */
+} fogvol_ramp_desc;
+
+/* width x 1 texels; texel i holds thickness i/(width-1) * max_thickness.
+   *max_thickness_out (may be NULL) receives the resolved max_thickness. */
+FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, unsigned char *pixels,
+                                                size_t capacity, fogvol_image *info, float *max_thickness_out);
+
+/* ---- meshes --------------------------------------------------------------
+   Volumes are closed hulls: every undirected edge used by exactly two
+   triangles, in opposite directions; triangles counter-clockwise seen from
+   outside. */
+typedef struct fogvol_mesh_desc {
+    const float *positions;    /* x, y, z floats per vertex */
+    int vertex_count;
+    int stride;                /* bytes between vertices, 0 = 12 */
+    const uint32_t *indices;   /* 3 per triangle */
+    int index_count;
+    int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
+} fogvol_mesh_desc;
+
+typedef struct fogvol_mesh_report {
+    int vertices, triangles;
+    int open_edges;            /* undirected edges used by one triangle */
+    int nonmanifold_edges;     /* used by more than two */
+    int inconsistent_edges;    /* used by two triangles in the same direction */
+    int flipped_faces;         /* triangles whose winding disagrees with the majority of their part */
+    int degenerate_triangles;  /* repeated index or (near) zero area */
+    int nonfinite_vertices;    /* NaN or infinite coordinate */
+    int out_of_range_indices;  /* index >= vertex_count */
+    int components;            /* edge-connected parts */
+    double volume;             /* signed volume (positive for outward winding) */
+    int closed;                /* no open and no non-manifold edges */
+    int consistent;            /* no inconsistent edge, no flipped face */
+    int inverted;              /* closed, consistent, but wound inward (volume < 0) */
+    int valid;                 /* usable as a fog volume */
+} fogvol_mesh_report;
+
+/* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
+   hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
+   (about 40 bytes per triangle) comes from alloc (NULL = default). Never
+   reads outside positions[0 .. vertex_count) or indices[0 .. index_count). */
+FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                              fogvol_mesh_report *report);
+
+/* ---- shaders ------------------------------------------------------------- */
+typedef enum fogvol_dialect {
+    FOGVOL_GLSL_AUTO = 0,
+    FOGVOL_GLSL_110 = 1,
+    FOGVOL_GLSL_120 = 2,
+    FOGVOL_GLSL_130 = 3,
+    FOGVOL_GLSL_150 = 4,
+    FOGVOL_GLSL_330 = 5, /* 330 core */
+    FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
+    FOGVOL_GLSL_300ES = 7,
+    FOGVOL_GLSL_COUNT = 8,
+    FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
+} fogvol_dialect;
+
+typedef enum fogvol_tier {
+    FOGVOL_TIER_AUTO = 0,
+    FOGVOL_TIER_PS20 = 2, /* RGBA8, O/B/F targets, decoded compare, 5 steps */
+    FOGVOL_TIER_MAX_ENUM = 0x7fffffff
+} fogvol_tier;
+
+typedef enum fogvol_program {
+    FOGVOL_PROGRAM_ENCODE = 0,         /* opaque depth into O */
+    FOGVOL_PROGRAM_FACE = 1,           /* volume faces into B / F, min with O */
+    FOGVOL_PROGRAM_COMPOSITE = 2,      /* full-screen triangle: thickness -> ramp -> blend */
+    FOGVOL_PROGRAM_COMPOSITE_MESH = 3, /* the same, driven by the volume geometry */
+    FOGVOL_PROGRAM_COUNT = 4,
+    FOGVOL_PROGRAM_MAX_ENUM = 0x7fffffff
+} fogvol_program;
+
+typedef enum fogvol_stage {
+    FOGVOL_STAGE_VERTEX = 0,
+    FOGVOL_STAGE_FRAGMENT = 1,
+    FOGVOL_STAGE_MAX_ENUM = 0x7fffffff
+} fogvol_stage;
+
+#define FOGVOL_MAX_SHADER_STRINGS 4
+
+/* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
+   Unknown or unsupported combinations return FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
+                                              fogvol_stage stage, const char **strings, int *count);
+FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
+
+/* ---- backend table -------------------------------------------------------
+   Contract. Every entry gets the table's user_data first. Handles are
+   non-zero on success; 0 means "none". The renderer calls begin_frame, then
+   passes (begin_pass, draws, end_pass), then end_frame; create/destroy calls
+   may come inside or outside a frame. A backend must leave the engine's
+   state as it found it at begin_frame when end_frame returns, and resource
+   entries called outside a frame must not change engine state either.
+   NULL optional entries (marked) are skipped. */
+typedef uintptr_t fogvol_handle;
+
+typedef enum fogvol_uniform {
+    FOGVOL_U_ENC = 0,    /* "fv_enc":    (N, N^2, depth_offset, depth_max) */
+    FOGVOL_U_DITHER = 1, /* "fv_dith":   (255 or 0 = dither off, 1/D, 0, 0) */
+    FOGVOL_U_SCREEN = 2, /* "fv_screen": (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1] */
+    FOGVOL_U_DECODE = 3, /* "fv_dec":    decode weights (world units) */
+    FOGVOL_U_RAMP = 4,   /* "fv_rampmap": (slope, offset, overflow flag, 0): thickness -> ramp s */
+    FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, 0, 0) */
+    FOGVOL_U_COUNT = 6
+} fogvol_uniform;
+FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
+
+/* Sampler units, fixed per program:
+   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3 (FACE only)
+   COMPOSITE*:    fv_back 0, fv_front 1, fv_colors 2
+   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))).
+   Vertex attribute 0: "fv_position" (vec3). */
+#define FOGVOL_MAX_TEXTURE_UNITS 4
+
+typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
+typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
+
+typedef struct fogvol_texture_desc {
+    int width, height;
+    const unsigned char *pixels; /* RGBA8, rows bottom to top */
+    fogvol_filter filter;
+    fogvol_wrap wrap;
+    const char *label;
+} fogvol_texture_desc;
+
+typedef struct fogvol_target_desc {
+    int width, height; /* RGBA8 colour texture, NEAREST, CLAMP */
+    int depth;         /* 1: with a depth buffer */
+    const char *label;
+} fogvol_target_desc;
+
+typedef struct fogvol_program_desc {
+    const char *vs[FOGVOL_MAX_SHADER_STRINGS];
+    int vs_count;
+    const char *fs[FOGVOL_MAX_SHADER_STRINGS];
+    int fs_count;
+    const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
+    const char *label;
+} fogvol_program_desc;
+
+typedef struct fogvol_mesh_data {
+    const float *positions; /* tightly packed xyz */
+    int vertex_count;
+    const uint32_t *indices;
+    int index_count;
+} fogvol_mesh_data;
+
+typedef enum fogvol_pass_blend {
+    FOGVOL_PASS_BLEND_NONE = 0,
+    FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
+    FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
+    FOGVOL_PASS_BLEND_LIGHT = 3  /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
+} fogvol_pass_blend;
+
+typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
+
+typedef struct fogvol_pass {
+    fogvol_handle target;   /* 0 = the framebuffer bound when begin_frame was called */
+    int viewport[4];        /* x, y, w, h */
+    int clear;              /* clear colour (and depth to 1 when the target has one) */
+    float clear_color[4];
+    fogvol_pass_blend blend;
+    fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
+    int depth_test;         /* LESS */
+    int depth_write;
+    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
+                               stencil buffer; the bit is zero before and after the pass */
+    unsigned stencil_bit;
+    fogvol_handle program;
+    fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
+                                                         sampled as its colour texture) */
+    float uniforms[FOGVOL_U_COUNT][4];
+} fogvol_pass;
+
+typedef struct fogvol_draw {
+    float mvp[16];
+    float depth[4];
+    int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
+} fogvol_draw;
+
+typedef struct fogvol_frame_info {
+    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
+} fogvol_frame_info;
+
+typedef struct fogvol_backend {
+    void *user_data;
+    fogvol_dialect dialect; /* shader dialect the backend compiles */
+    /* optional: save engine state, report the engine framebuffer */
+    fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
+    void (*end_frame)(void *user_data);                      /* optional: restore engine state */
+    fogvol_result (*create_texture)(void *user_data, const fogvol_texture_desc *desc, fogvol_handle *out);
+    void (*destroy_texture)(void *user_data, fogvol_handle texture);
+    fogvol_result (*create_target)(void *user_data, const fogvol_target_desc *desc, fogvol_handle *out);
+    void (*destroy_target)(void *user_data, fogvol_handle target);
+    fogvol_result (*create_program)(void *user_data, const fogvol_program_desc *desc, fogvol_handle *out);
+    void (*destroy_program)(void *user_data, fogvol_handle program);
+    fogvol_result (*create_mesh)(void *user_data, const fogvol_mesh_data *data, fogvol_handle *out);
+    void (*destroy_mesh)(void *user_data, fogvol_handle mesh);
+    void (*begin_pass)(void *user_data, const fogvol_pass *pass);
+    void (*set_draw)(void *user_data, const fogvol_draw *draw); /* per-draw uniforms, for engine draws */
+    void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
+    void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
+    void (*end_pass)(void *user_data);        /* optional */
+    /* read the whole target as RGBA8, rows bottom to top; size >= w*h*4 */
+    fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
+    void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
+} fogvol_backend;
+
+/* Recording null backend: no GPU, every call counted and the passes kept. */
+#define FOGVOL_NULL_MAX_PASSES 64
+typedef struct fogvol_null_backend {
+    int creates, destroys;  /* live handles = creates - destroys */
+    int frames_begun, frames_ended;
+    int pass_count;         /* passes in the current/last frame */
+    fogvol_pass passes[FOGVOL_NULL_MAX_PASSES];
+    int draws[FOGVOL_NULL_MAX_PASSES];    /* mesh draws per pass */
+    int fullscreen[FOGVOL_NULL_MAX_PASSES];
+    int in_pass;
+    fogvol_handle next_handle;
+    int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
+    int create_calls;
+    int stencil_bits;       /* reported by begin_frame */
+} fogvol_null_backend;
+FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
+
+/* ---- renderer ------------------------------------------------------------ */
+typedef struct fogvol_context fogvol_context;
+typedef struct fogvol_mesh fogvol_mesh;
+typedef struct fogvol_ramp fogvol_ramp;
+
+typedef void (*fogvol_gl_proc)(void);
+typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
+
+typedef struct fogvol_gl_desc {
+    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    void *user_data;
+    fogvol_dialect dialect;   /* 0 = from the context */
+    int version_major;        /* 0 = from the context; else treat the context as this GL version */
+    int version_minor;
+    int gles;                 /* with version_major: 1 = treat as OpenGL ES */
+    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
+} fogvol_gl_desc;
+
+typedef enum fogvol_composite {
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the volume geometry, guarded by one stencil bit */
+} fogvol_composite;
+
+typedef struct fogvol_context_desc {
+    fogvol_allocator allocator;
+    fogvol_logger logger;
+    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces) */
+    fogvol_tier tier;      /* 0 = best for the backend */
+    int disable_dither;    /* dithering is on by default */
+    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
+    fogvol_gl_desc gl;     /* for the GL backend */
+} fogvol_context_desc;
+
+FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
+FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx);
+FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
+
+/* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
+   open (desc->allow_open). *report (may be NULL) receives the check. */
+FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
+                                            fogvol_mesh_report *report);
+FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
+
+FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
+FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
+
+typedef struct fogvol_frame_stats {
+    int passes;             /* passes issued this frame */
+    int volumes, occluders; /* drawn */
+    int groups;             /* colour-ramp groups composited */
+    int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
+} fogvol_frame_stats;
+
+typedef struct fogvol_frame_desc {
+    float view[16];
+    float projection[16];
+    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    fogvol_composite composite;
+    unsigned stencil_bit;   /* geometry composite: 0 = 0x80 */
+    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta */
+    /* Debug read-back of the decoded thickness (world units) per pixel of the
+       viewport, rows bottom to top, for the group of debug_ramp (NULL = the
+       first group). Set debug_thickness to a width*height float buffer. */
+    float *debug_thickness;
+    const fogvol_ramp *debug_ramp;
+} fogvol_frame_desc;
+
+/* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
+   the GPU before end_frame. A begin_frame while a frame is open discards the
+   open frame (logged as a warning). */
+FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
+FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
+/* The callback runs inside the O pass with the depth-encode program bound:
+   for each engine draw call fogvol_occluder_transform(ctx, model) first and
+   keep the position in vertex attribute 0; change no other state. */
+typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
+FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
+FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
+
+typedef struct fogvol_volume_desc {
+    const fogvol_mesh *mesh;
+    float model[16];
+    const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
+    int negative;             /* 1: subtracts thickness from the volumes of its ramp */
+} fogvol_volume_desc;
+FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
+FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
+FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
+
+#ifndef FOGVOL_NO_GL
+/* The default GL backend on its own (fogvol_create_context makes one when the
+   desc's backend table is empty). destroy it with table->destroy(table->user_data). */
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out);
+#endif
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FOGVOL_H */
+
+/* ========================================================================== */
+/*                              IMPLEMENTATION                                */
+/* ========================================================================== */
+#ifdef FOGVOL_IMPLEMENTATION
+#ifndef FOGVOL_IMPLEMENTATION_DONE
+#define FOGVOL_IMPLEMENTATION_DONE
+
+#include <string.h>
+#include <stdarg.h>
+#include <stdio.h>  /* vsnprintf only: the library never prints */
+
+#ifndef FOGVOL_ASSERT
+#include <assert.h>
+#define FOGVOL_ASSERT(x) assert(x)
+#endif
+#if !defined(FOGVOL_SQRT) || !defined(FOGVOL_EXP) || !defined(FOGVOL_FLOOR) || !defined(FOGVOL_FABS) || \
+    !defined(FOGVOL_POW)
+#include <math.h>
+#endif
+#ifndef FOGVOL_SQRT
+#define FOGVOL_SQRT(x) sqrt(x)
+#endif
+#ifndef FOGVOL_EXP
+#define FOGVOL_EXP(x) exp(x)
+#endif
+#ifndef FOGVOL_FLOOR
+#define FOGVOL_FLOOR(x) floor(x)
+#endif
+#ifndef FOGVOL_FABS
+#define FOGVOL_FABS(x) fabs(x)
+#endif
+#ifndef FOGVOL_POW
+#define FOGVOL_POW(x, y) pow(x, y)
+#endif
+#if !defined(FOGVOL_MALLOC) || !defined(FOGVOL_FREE)
+#include <stdlib.h>
+#define FOGVOL_MALLOC(sz) malloc(sz)
+#define FOGVOL_FREE(p) free(p)
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* >>cpu =================================================================== */
+
+FOGVOL_API const char *fogvol_result_string(fogvol_result result)
+{
+    switch (result) {
+    case FOGVOL_SUCCESS: return "success";
+    case FOGVOL_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case FOGVOL_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case FOGVOL_ERROR_BUFFER_TOO_SMALL: return "buffer too small";
+    case FOGVOL_ERROR_UNSUPPORTED: return "unsupported";
+    case FOGVOL_ERROR_INVALID_MESH: return "invalid mesh";
+    case FOGVOL_ERROR_INVALID_STATE: return "invalid state";
+    case FOGVOL_ERROR_MISSING_FUNCTION: return "missing GL function";
+    case FOGVOL_ERROR_SHADER_COMPILE: return "shader compile failed";
+    case FOGVOL_ERROR_SHADER_LINK: return "shader link failed";
+    case FOGVOL_ERROR_FRAMEBUFFER: return "framebuffer incomplete";
+    case FOGVOL_ERROR_BACKEND: return "backend error";
+    case FOGVOL_ERROR_DEPTH_OVERFLOW: return "depth complexity overflow";
+    default: return "unknown result";
+    }
+}
+
+static void *fogvol__alloc(const fogvol_allocator *a, size_t size)
+{
+    if (size == 0) size = 1;
+    if (a && a->alloc) return a->alloc(size, a->user_data);
+    return FOGVOL_MALLOC(size);
+}
+
+static void fogvol__free(const fogvol_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a && a->alloc) {
+        if (a->free) a->free(p, a->user_data);
+        return;
+    }
+    FOGVOL_FREE(p);
+}
+
+static void fogvol__log(const fogvol_logger *lg, fogvol_log_level level, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    if (!lg || !lg->func) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    lg->func(lg->user_data, level, buf);
+}
+
+static int fogvol__finite(double x) { return x == x && x - x == 0.0; }
+
+static int fogvol__finite_n(const float *v, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (!fogvol__finite(v[i])) return 0;
+    return 1;
+}
+
+/* ---- encoding ---- */
+
+FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits)
+{
+    if (!out || bits < 1 || bits > 8) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    out->bits = bits;
+    out->levels = 1 << bits;
+    out->precision_bits = 3 * bits;
+    out->max_faces = 1 << (8 - bits);
+    out->max_faces_single = bits <= 7 ? 1 << (7 - bits) : 0;
+    /* D texels per blue LSB; keep the blue ramp <= 2048 texels wide (GLES2 minimum max size). */
+    out->dither_steps = 32;
+    while (out->levels * out->dither_steps > 2048 && out->dither_steps > 8) out->dither_steps /= 2;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces)
+{
+    int bits;
+    if (!out || max_faces < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (max_faces > 128) return FOGVOL_ERROR_UNSUPPORTED;
+    for (bits = 8; bits >= 1; --bits)
+        if ((1 << (8 - bits)) >= max_faces) return fogvol_encoding_init(out, bits);
+    return FOGVOL_ERROR_UNSUPPORTED;
+}
+
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits)
+{
+    int bits;
+    if (!out || precision_bits < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (precision_bits > 24) return FOGVOL_ERROR_UNSUPPORTED;
+    for (bits = 1; bits <= 8; ++bits)
+        if (3 * bits >= precision_bits) return fogvol_encoding_init(out, bits);
+    return FOGVOL_ERROR_UNSUPPORTED;
+}
+
+FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity)
+{
+    int i;
+    for (i = 0; rows && i < 8 && i < capacity; ++i) fogvol_encoding_init(&rows[i], i + 1);
+    return 8;
+}
+
+static int fogvol__enc_ok(const fogvol_encoding *e)
+{
+    fogvol_encoding ref;
+    if (!e || fogvol_encoding_init(&ref, e->bits) != FOGVOL_SUCCESS) return 0;
+    return ref.levels == e->levels && ref.dither_steps == e->dither_steps;
+}
+
+FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar, float scale,
+                                                  fogvol_constants *out)
+{
+    double n, range;
+    if (!out || !fogvol__enc_ok(enc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite(znear) || !fogvol__finite(zfar) || !fogvol__finite(scale) || !(zfar > znear) || scale < 0)
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    n = enc->levels;
+    range = (double)zfar - (double)znear;
+    memset(out, 0, sizeof *out);
+    out->near_far[0] = (float)(1.0 / range);
+    out->near_far[1] = (float)(-(double)znear / range);
+    out->ramp_scale[0] = 1.0f;
+    out->ramp_scale[1] = (float)n;
+    out->ramp_scale[2] = (float)(n * n);
+    out->ramp_scale[3] = 0.0f;
+    out->depth_offset = (float)(1.0 / (n * n * n));
+    out->depth_max = (float)(1.0 - 1.5 / (n * n * n));
+    out->scale = scale > 0 ? scale : (float)(range * 255.0 / n);
+    out->decode[0] = out->scale;
+    out->decode[1] = (float)(out->scale / n);
+    out->decode[2] = (float)(out->scale / (n * n));
+    out->decode[3] = (float)(-out->scale / n);
+    out->bias[0] = out->bias[1] = out->bias[2] = 128.0f / 255.0f;
+    out->bias[3] = 0.0f;
+    out->bias_decoded = out->bias[0] * (out->decode[0] + out->decode[1] + out->decode[2]);
+    out->lsb = (float)(out->scale / (255.0 * n * n));
+    out->dither_rows = (float)enc->dither_steps;
+    return FOGVOL_SUCCESS;
+}
+
+/* The texel of the blue ramp: x in [0, N*D), row in [0, D). */
+static void fogvol__blue_texel(const fogvol_encoding *e, int x, int row, unsigned char out[4])
+{
+    int d = e->dither_steps;
+    int k = (row + d / 2) % d;  /* threshold k/D: row 0 -> 1/2 */
+    int q = (x + k) / d - 1;    /* floor(x/D + k/D) - 1, in [-1, N-1] */
+    if (q < 0) {
+        out[2] = (unsigned char)(q + e->levels);
+        out[3] = 1;
+    } else {
+        out[2] = (unsigned char)q;
+        out[3] = 0;
+    }
+    out[0] = out[1] = 0;
+}
+
+FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row)
+{
+    int d;
+    if (!fogvol__enc_ok(enc) || row < 0 || row >= enc->dither_steps) return 0.0;
+    d = enc->dither_steps;
+    return (double)((row + d / 2) % d) / d;
+}
+
+FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
+                                             unsigned char out_rgba[4])
+{
+    double n, n3, u, t1, dmax;
+    long long h, x, nd;
+    unsigned char b[4];
+    if (!fogvol__enc_ok(enc) || !out_rgba || dither_row < 0 || dither_row >= enc->dither_steps ||
+        !fogvol__finite(d))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    n = enc->levels;
+    n3 = n * n * n;
+    dmax = 1.0 - 1.5 / n3;
+    u = d < 0 ? 0 : (d > dmax ? dmax : d);
+    u += 1.0 / n3;
+    t1 = u * n3;                 /* blue units, exact scaling by a power of two */
+    h = (long long)FOGVOL_FLOOR(t1 / n);            /* rg texel: red = h / N, green = h % N */
+    nd = (long long)enc->levels * enc->dither_steps;
+    x = (long long)FOGVOL_FLOOR(t1 * enc->dither_steps) % nd; /* blue texel column */
+    fogvol__blue_texel(enc, (int)x, dither_row, b);
+    out_rgba[0] = (unsigned char)((h / enc->levels) % enc->levels);
+    out_rgba[1] = (unsigned char)(h % enc->levels);
+    out_rgba[2] = b[2];
+    out_rgba[3] = b[3];
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4])
+{
+    int i, sat = 0;
+    for (i = 0; i < 4; ++i) {
+        int s = acc[i] + value[i];
+        if (s > 255) {
+            s = 255;
+            sat = 1;
+        }
+        acc[i] = (unsigned char)s;
+    }
+    return sat;
+}
+
+FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
+                                            int *saturated)
+{
+    int i, sat = 0;
+    if (!out_rgba || count < 0 || (count > 0 && !values)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out_rgba, 0, 4);
+    for (i = 0; i < count; ++i) sat |= fogvol_sum_rgba8(out_rgba, values + 4 * i);
+    if (saturated) *saturated = sat;
+    return FOGVOL_SUCCESS;
+}
+
+static double fogvol__decode_i(const fogvol_encoding *e, double r, double g, double b, double a)
+{
+    double n = e->levels;
+    return r / n + g / (n * n) + b / (n * n * n) - a / (n * n);
+}
+
+FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4])
+{
+    if (!fogvol__enc_ok(enc) || !rgba) return 0.0;
+    return fogvol__decode_i(enc, rgba[0], rgba[1], rgba[2], rgba[3]);
+}
+
+FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
+                                           const unsigned char b[4])
+{
+    if (!fogvol__enc_ok(enc) || !a || !b) return 0.0;
+    return fogvol__decode_i(enc, (double)a[0] - b[0], (double)a[1] - b[1], (double)a[2] - b[2],
+                            (double)a[3] - b[3]);
+}
+
+/* ---- textures ---- */
+
+static fogvol_result fogvol__image_check(int w, int h, unsigned char *pixels, size_t capacity, fogvol_image *info)
+{
+    if (!info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    info->width = w;
+    info->height = h;
+    info->size = (size_t)w * (size_t)h * 4u;
+    if (pixels && capacity < info->size) return FOGVOL_ERROR_BUFFER_TOO_SMALL;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_make_rg_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                             fogvol_image *info)
+{
+    int x, y, n;
+    fogvol_result r;
+    if (!fogvol__enc_ok(enc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    n = enc->levels;
+    r = fogvol__image_check(n, n, pixels, capacity, info);
+    if (r != FOGVOL_SUCCESS || !pixels) return r;
+    for (y = 0; y < n; ++y)
+        for (x = 0; x < n; ++x) {
+            unsigned char *p = pixels + ((size_t)y * n + x) * 4;
+            p[0] = (unsigned char)x;
+            p[1] = (unsigned char)y;
+            p[2] = 0;
+            p[3] = 0;
+        }
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_make_blue_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                               fogvol_image *info)
+{
+    int x, y, w, h;
+    fogvol_result r;
+    if (!fogvol__enc_ok(enc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    w = enc->levels * enc->dither_steps;
+    h = enc->dither_steps;
+    r = fogvol__image_check(w, h, pixels, capacity, info);
+    if (r != FOGVOL_SUCCESS || !pixels) return r;
+    for (y = 0; y < h; ++y)
+        for (x = 0; x < w; ++x) fogvol__blue_texel(enc, x, y, pixels + ((size_t)y * w + x) * 4);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, unsigned char *pixels,
+                                                  size_t capacity, fogvol_image *info)
+{
+    int x, y, d;
+    fogvol_result r;
+    if (!fogvol__enc_ok(enc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol__image_check(FOGVOL_DITHER_PATTERN, FOGVOL_DITHER_PATTERN, pixels, capacity, info);
+    if (r != FOGVOL_SUCCESS || !pixels) return r;
+    d = enc->dither_steps;
+    for (y = 0; y < 8; ++y)
+        for (x = 0; x < 8; ++x) {
+            /* 8x8 Bayer index by bit interleaving, 0..63 */
+            int v = 0, bit, xy = x ^ y, k, row;
+            unsigned char *p = pixels + ((size_t)y * 8 + x) * 4;
+            for (bit = 0; bit < 3; ++bit) {
+                v |= ((xy >> bit) & 1) << (5 - 2 * bit);
+                v |= ((y >> bit) & 1) << (4 - 2 * bit);
+            }
+            k = v * d / 64;          /* wanted threshold k/D */
+            row = (k + d / 2) % d;   /* the row holding it */
+            p[0] = (unsigned char)row;
+            p[1] = p[2] = 0;
+            p[3] = 255;
+        }
+    return FOGVOL_SUCCESS;
+}
+
+static unsigned char fogvol__unorm8(double v)
+{
+    v = v < 0 ? 0 : (v > 1 ? 1 : v);
+    return (unsigned char)(v * 255.0 + 0.5);
+}
+
+static float fogvol__ramp_max_thickness(const fogvol_ramp_desc *d)
+{
+    int i;
+    float m = 0;
+    if (d->max_thickness > 0) return d->max_thickness;
+    switch (d->model) {
+    case FOGVOL_RAMP_EXTINCTION: return 7.0f / d->density; /* 1 - e^-7 = 0.99909 */
+    case FOGVOL_RAMP_LINEAR: return 1.0f / d->density;
+    case FOGVOL_RAMP_GRADIENT:
+        for (i = 0; i < d->key_count; ++i)
+            if (d->keys[i].thickness > m) m = d->keys[i].thickness;
+        return m > 0 ? m : 1.0f;
+    default: return 0;
+    }
+}
+
+static fogvol_result fogvol__ramp_check(const fogvol_ramp_desc *d)
+{
+    int i, j;
+    if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (d->width != 0 && (d->width < 2 || d->width > 4096)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite(d->max_thickness) || d->max_thickness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (d->blend != FOGVOL_BLEND_FOG && d->blend != FOGVOL_BLEND_LIGHT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    switch (d->model) {
+    case FOGVOL_RAMP_EXTINCTION:
+    case FOGVOL_RAMP_LINEAR:
+        if (!fogvol__finite_n(d->color, 3) || !fogvol__finite(d->density) || !(d->density > 0))
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        return FOGVOL_SUCCESS;
+    case FOGVOL_RAMP_GRADIENT:
+        if (!d->keys || d->key_count < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < d->key_count; ++i) {
+            if (!fogvol__finite(d->keys[i].thickness) || d->keys[i].thickness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
+            for (j = 0; j < 4; ++j)
+                if (!fogvol__finite(d->keys[i].rgba[j])) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
+        return FOGVOL_SUCCESS;
+    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+}
+
+/* Gradient at thickness t: keys in any order; below the first / above the last key, clamp. */
+static void fogvol__gradient(const fogvol_color_key *keys, int count, double t, double out[4])
+{
+    int i, j, lo = -1, hi = -1;
+    for (i = 0; i < count; ++i) {
+        if (keys[i].thickness <= t && (lo < 0 || keys[i].thickness >= keys[lo].thickness)) lo = i;
+        if (keys[i].thickness >= t && (hi < 0 || keys[i].thickness < keys[hi].thickness)) hi = i;
+    }
+    if (lo < 0) lo = hi;
+    if (hi < 0) hi = lo;
+    for (j = 0; j < 4; ++j) {
+        double a = keys[lo].rgba[j], b = keys[hi].rgba[j];
+        double span = (double)keys[hi].thickness - keys[lo].thickness;
+        double f = span > 0 ? (t - keys[lo].thickness) / span : 0.0;
+        out[j] = a + (b - a) * f;
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, unsigned char *pixels,
+                                                size_t capacity, fogvol_image *info, float *max_thickness_out)
+{
+    int i, w;
+    double tmax;
+    fogvol_result r = fogvol__ramp_check(desc);
+    if (r != FOGVOL_SUCCESS) return r;
+    w = desc->width ? desc->width : 256;
+    tmax = fogvol__ramp_max_thickness(desc);
+    if (max_thickness_out) *max_thickness_out = (float)tmax;
+    r = fogvol__image_check(w, 1, pixels, capacity, info);
+    if (r != FOGVOL_SUCCESS || !pixels) return r;
+    for (i = 0; i < w; ++i) {
+        double t = tmax * i / (w - 1), c[4];
+        unsigned char *p = pixels + (size_t)i * 4;
+        if (desc->model == FOGVOL_RAMP_GRADIENT) {
+            fogvol__gradient(desc->keys, desc->key_count, t, c);
+        } else {
+            c[0] = desc->color[0];
+            c[1] = desc->color[1];
+            c[2] = desc->color[2];
+            c[3] = desc->model == FOGVOL_RAMP_EXTINCTION ? 1.0 - FOGVOL_EXP(-(double)desc->density * t)
+                                                         : t * desc->density;
+        }
+        p[0] = fogvol__unorm8(c[0]);
+        p[1] = fogvol__unorm8(c[1]);
+        p[2] = fogvol__unorm8(c[2]);
+        p[3] = fogvol__unorm8(c[3]);
+    }
+    return FOGVOL_SUCCESS;
+}
+
+/* ---- mesh validation ---- */
+
+typedef struct fogvol__edge {
+    uint32_t lo, hi; /* vertex indices, lo < hi */
+    uint32_t tri;    /* triangle */
+    uint32_t fwd;    /* 1: directed lo -> hi in the triangle */
+} fogvol__edge;
+
+static int fogvol__edge_less(const fogvol__edge *a, const fogvol__edge *b)
+{
+    if (a->lo != b->lo) return a->lo < b->lo;
+    if (a->hi != b->hi) return a->hi < b->hi;
+    return a->tri < b->tri;
+}
+
+/* Bottom-up merge sort (no recursion, stable, O(n log n)); tmp has n entries. */
+static void fogvol__sort_edges(fogvol__edge *e, fogvol__edge *tmp, size_t n)
+{
+    size_t width, i;
+    fogvol__edge *src = e, *dst = tmp;
+    for (width = 1; width < n; width *= 2) {
+        for (i = 0; i < n; i += 2 * width) {
+            size_t a = i, am = i + width < n ? i + width : n, b = am, bm = i + 2 * width < n ? i + 2 * width : n;
+            size_t o = i;
+            while (a < am && b < bm) dst[o++] = fogvol__edge_less(&src[b], &src[a]) ? src[b++] : src[a++];
+            while (a < am) dst[o++] = src[a++];
+            while (b < bm) dst[o++] = src[b++];
+        }
+        {
+            fogvol__edge *t = src;
+            src = dst;
+            dst = t;
+        }
+    }
+    if (src != e) memcpy(e, src, n * sizeof *e);
+}
+
+/* Union-find with parity: parity(t) = orientation of t relative to its root. */
+static uint32_t fogvol__uf_find(uint32_t *parent, unsigned char *parity, uint32_t t)
+{
+    uint32_t root = t, cur = t;
+    unsigned acc = 0;
+    while (parent[root] != root) {
+        acc ^= parity[root];
+        root = parent[root];
+    }
+    /* acc = parity of t relative to root; compress the path, keeping parities relative to root */
+    while (parent[cur] != cur) {
+        uint32_t next = parent[cur];
+        unsigned old = parity[cur];
+        parity[cur] = (unsigned char)acc;
+        parent[cur] = root;
+        acc ^= old;
+        cur = next;
+    }
+    return root;
+}
+
+FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                              fogvol_mesh_report *rep)
+{
+    int ntri, t, stride;
+    size_t ne = 0, i, j;
+    fogvol__edge *edges = NULL, *tmp = NULL;
+    uint32_t *parent = NULL, *cnt = NULL;
+    unsigned char *parity = NULL, *usable = NULL, *vbad = NULL;
+    const unsigned char *base;
+    double vol = 0;
+    if (!rep) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(rep, 0, sizeof *rep);
+    if (!desc || !desc->positions || !desc->indices || desc->vertex_count <= 0 || desc->index_count <= 0 ||
+        desc->index_count % 3 != 0 || desc->stride < 0 || (desc->stride != 0 && desc->stride < 12))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    stride = desc->stride ? desc->stride : 12;
+    base = (const unsigned char *)desc->positions;
+    ntri = desc->index_count / 3;
+    rep->vertices = desc->vertex_count;
+    rep->triangles = ntri;
+
+    edges = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * (size_t)ntri);
+    tmp = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * (size_t)ntri);
+    parent = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)ntri);
+    cnt = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * 2u * (size_t)ntri);
+    parity = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
+    usable = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
+    vbad = (unsigned char *)fogvol__alloc(alloc, (size_t)desc->vertex_count);
+    if (!edges || !tmp || !parent || !cnt || !parity || !usable || !vbad) {
+        fogvol__free(alloc, edges);
+        fogvol__free(alloc, tmp);
+        fogvol__free(alloc, parent);
+        fogvol__free(alloc, cnt);
+        fogvol__free(alloc, parity);
+        fogvol__free(alloc, usable);
+        fogvol__free(alloc, vbad);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+
+    for (i = 0; i < (size_t)desc->vertex_count; ++i) {
+        float v[3];
+        memcpy(v, base + i * (size_t)stride, sizeof v);
+        vbad[i] = !fogvol__finite_n(v, 3);
+        rep->nonfinite_vertices += vbad[i];
+    }
+
+    for (t = 0; t < ntri; ++t) {
+        uint32_t id[3];
+        int k, bad = 0;
+        parent[t] = (uint32_t)t;
+        parity[t] = 0;
+        usable[t] = 0;
+        for (k = 0; k < 3; ++k) {
+            id[k] = desc->indices[3 * t + k];
+            if (id[k] >= (uint32_t)desc->vertex_count) {
+                rep->out_of_range_indices++;
+                bad = 1;
+            }
+        }
+        if (bad) continue;
+        if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) {
+            rep->degenerate_triangles++;
+            continue; /* no area, no edges: left out of the topology */
+        }
+        usable[t] = 1;
+        if (!vbad[id[0]] && !vbad[id[1]] && !vbad[id[2]]) {
+            float a[3], b[3], c[3];
+            double e1[3], e2[3], cr[3], len2, l1, l2, l3;
+            memcpy(a, base + id[0] * (size_t)stride, sizeof a);
+            memcpy(b, base + id[1] * (size_t)stride, sizeof b);
+            memcpy(c, base + id[2] * (size_t)stride, sizeof c);
+            for (k = 0; k < 3; ++k) {
+                e1[k] = (double)b[k] - a[k];
+                e2[k] = (double)c[k] - a[k];
+            }
+            cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            len2 = cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2];
+            l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+            l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+            l3 = (e2[0] - e1[0]) * (e2[0] - e1[0]) + (e2[1] - e1[1]) * (e2[1] - e1[1]) +
+                 (e2[2] - e1[2]) * (e2[2] - e1[2]);
+            if (l2 > l1) l1 = l2;
+            if (l3 > l1) l1 = l3;
+            /* area below 1e-6 of the longest edge squared: a sliver that rasterises to nothing */
+            if (len2 <= 1e-12 * l1 * l1) rep->degenerate_triangles++;
+            vol += (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
+        }
+        for (k = 0; k < 3; ++k) {
+            uint32_t u = id[k], v = id[(k + 1) % 3];
+            fogvol__edge *e = &edges[ne++];
+            e->lo = u < v ? u : v;
+            e->hi = u < v ? v : u;
+            e->tri = (uint32_t)t;
+            e->fwd = u < v;
+        }
+    }
+
+    fogvol__sort_edges(edges, tmp, ne);
+    for (i = 0; i < ne; i = j) {
+        for (j = i + 1; j < ne && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi; ++j) {
+        }
+        if (j - i == 1) {
+            rep->open_edges++;
+        } else if (j - i > 2) {
+            rep->nonmanifold_edges++;
+        } else {
+            uint32_t a = edges[i].tri, b = edges[i + 1].tri;
+            unsigned want = edges[i].fwd == edges[i + 1].fwd; /* same direction: opposite orientation */
+            uint32_t ra = fogvol__uf_find(parent, parity, a), rb = fogvol__uf_find(parent, parity, b);
+            if (want) rep->inconsistent_edges++;
+            if (ra != rb) {
+                parent[rb] = ra;
+                parity[rb] = (unsigned char)(parity[a] ^ parity[b] ^ want);
+            }
+        }
+    }
+    /* flipped faces: per component, the minority orientation */
+    memset(cnt, 0, sizeof(uint32_t) * 2u * (size_t)ntri);
+    for (t = 0; t < ntri; ++t) {
+        uint32_t r;
+        if (!usable[t]) continue;
+        r = fogvol__uf_find(parent, parity, (uint32_t)t);
+        cnt[2 * r + parity[t]]++;
+    }
+    for (t = 0; t < ntri; ++t) {
+        uint32_t c0 = cnt[2 * t], c1 = cnt[2 * t + 1];
+        if (c0 + c1 == 0) continue;
+        rep->components++;
+        rep->flipped_faces += (int)(c0 < c1 ? c0 : c1);
+    }
+    rep->volume = vol;
+    rep->closed = rep->open_edges == 0 && rep->nonmanifold_edges == 0;
+    rep->consistent = rep->inconsistent_edges == 0 && rep->flipped_faces == 0;
+    rep->inverted = rep->closed && rep->consistent && vol < 0;
+    rep->valid = rep->closed && rep->consistent && !rep->inverted && rep->nonfinite_vertices == 0 &&
+                 rep->out_of_range_indices == 0 && vol > 0;
+
+    fogvol__free(alloc, edges);
+    fogvol__free(alloc, tmp);
+    fogvol__free(alloc, parent);
+    fogvol__free(alloc, cnt);
+    fogvol__free(alloc, parity);
+    fogvol__free(alloc, usable);
+    fogvol__free(alloc, vbad);
+    return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
+}
+
+/* >>shaders =============================================================== */
+/* One body per program; one prelude per dialect defines FV_ATTRIB,
+   FV_VARYING_OUT (vertex), FV_VARYING_IN, FV_TEXTURE, FV_FRAGCOLOR (fragment). */
+
+static const char *const fogvol__version[FOGVOL_GLSL_COUNT] = {
+    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
+    "#version 100\n", "#version 300 es\n"};
+
+static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
+static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
+static const char fogvol__vs_es[] = "precision highp float;\n";
+static const char fogvol__fs_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_es100[] =
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump float;\n#endif\n"
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_es300[] =
+    "precision highp float;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
+    "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+
+/* Mesh vertex shader: position, clip position, normalised depth d. With
+   fv_misc.y = 1 clip z is replaced by k*d - w: the near plane still clips
+   exactly (d >= 0) and nothing is clipped at the far plane. */
+static const char fogvol__vs_mesh[] =
+    "FV_ATTRIB vec3 fv_position;\n"
+    "uniform mat4 fv_mvp;\n"
+    "uniform vec4 fv_depth;\n"
+    "uniform vec4 fv_misc;\n"
+    "FV_VARYING_OUT float fv_d;\n"
+    "void main() {\n"
+    "    vec4 p = vec4(fv_position, 1.0);\n"
+    "    vec4 c = fv_mvp * p;\n"
+    "    fv_d = dot(fv_depth, p);\n"
+    "    c.z = mix(c.z, fv_d * fv_misc.x - c.w, fv_misc.y);\n"
+    "    gl_Position = c;\n"
+    "}\n";
+
+static const char fogvol__vs_fullscreen[] =
+    "FV_ATTRIB vec3 fv_position;\n"
+    "void main() {\n"
+    "    gl_Position = vec4(fv_position.xy, 0.0, 1.0);\n"
+    "}\n";
+
+/* RGB-encode d with the ramps: red+green from one N x N ramp, blue (dithered,
+   borrow in alpha) from the (N*D) x D ramp, row from the 8x8 index pattern. */
+#define FOGVOL__FS_ENCODE_COMMON \
+    "uniform vec4 fv_enc;\n" \
+    "uniform vec4 fv_dith;\n" \
+    "uniform vec4 fv_screen;\n" \
+    "uniform vec4 fv_dec;\n" \
+    "uniform sampler2D fv_rg;\n" \
+    "uniform sampler2D fv_blue;\n" \
+    "uniform sampler2D fv_dither;\n" \
+    "FV_VARYING_IN float fv_d;\n" \
+    "vec4 fv_encode(float d) {\n" \
+    "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n" \
+    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n" \
+    "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n" \
+    "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n" \
+    "    return rg + b;\n" \
+    "}\n"
+
+static const char fogvol__fs_encode[] = FOGVOL__FS_ENCODE_COMMON
+    "void main() {\n"
+    "    FV_FRAGCOLOR = fv_encode(fv_d);\n"
+    "}\n";
+
+/* PS 6: keep the lesser of the face depth and the opaque depth, compared decoded. */
+static const char fogvol__fs_face[] = FOGVOL__FS_ENCODE_COMMON
+    "uniform sampler2D fv_opaque;\n"
+    "void main() {\n"
+    "    vec4 e = fv_encode(fv_d);\n"
+    "    vec4 o = FV_TEXTURE(fv_opaque, gl_FragCoord.xy * fv_screen.xy + fv_screen.zw);\n"
+    "    FV_FRAGCOLOR = dot(e - o, fv_dec) >= 0.0 ? o : e;\n"
+    "}\n";
+
+/* PS 4: thickness = decode(B - F) -> colour ramp. */
+static const char fogvol__fs_composite[] =
+    "uniform vec4 fv_screen;\n"
+    "uniform vec4 fv_dec;\n"
+    "uniform vec4 fv_rampmap;\n"
+    "uniform sampler2D fv_back;\n"
+    "uniform sampler2D fv_front;\n"
+    "uniform sampler2D fv_colors;\n"
+    "void main() {\n"
+    "    vec2 st = gl_FragCoord.xy * fv_screen.xy + fv_screen.zw;\n"
+    "    vec4 b = FV_TEXTURE(fv_back, st);\n"
+    "    vec4 f = FV_TEXTURE(fv_front, st);\n"
+    "    if (b + f == vec4(0.0)) discard;\n"
+    "    float t = dot(b - f, fv_dec);\n"
+    "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "    vec4 m = max(b, f);\n"
+    "    if (fv_rampmap.z > 0.5 && max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0) c = vec4(1.0, 0.0, 1.0, 1.0);\n"
+    "    FV_FRAGCOLOR = c;\n"
+    "}\n";
+
+FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
+{
+    static const char *const names[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330 core", "100",
+                                                         "300 es"};
+    if ((int)dialect < 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return "invalid";
+    return names[dialect];
+}
+
+FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
+                                              fogvol_stage stage, const char **strings, int *count)
+{
+    int legacy, es;
+    if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *count = 0;
+    if (tier != FOGVOL_TIER_PS20 && tier != FOGVOL_TIER_AUTO) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((int)dialect <= 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((int)program < 0 || (int)program >= FOGVOL_PROGRAM_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
+    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
+    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
+    strings[0] = fogvol__version[dialect];
+    if (stage == FOGVOL_STAGE_VERTEX) {
+        strings[1] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
+        strings[2] = es ? fogvol__vs_es : "";
+        strings[3] = program == FOGVOL_PROGRAM_COMPOSITE ? fogvol__vs_fullscreen : fogvol__vs_mesh;
+    } else {
+        if (dialect == FOGVOL_GLSL_100) strings[1] = fogvol__fs_es100;
+        else if (dialect == FOGVOL_GLSL_300ES) strings[1] = fogvol__fs_es300;
+        else strings[1] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
+        strings[2] = "";
+        switch (program) {
+        case FOGVOL_PROGRAM_ENCODE: strings[3] = fogvol__fs_encode; break;
+        case FOGVOL_PROGRAM_FACE: strings[3] = fogvol__fs_face; break;
+        default: strings[3] = fogvol__fs_composite; break;
+        }
+    }
+    *count = 4;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
+{
+    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec", "fv_rampmap",
+                                                      "fv_misc"};
+    if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
+    return names[u];
+}
+
+/* >>null backend ========================================================== */
+
+static fogvol_result fogvol__null_create(void *u, fogvol_handle *out)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    s->create_calls++;
+    if (s->fail_create_at > 0 && s->create_calls == s->fail_create_at) return FOGVOL_ERROR_BACKEND;
+    *out = ++s->next_handle;
+    s->creates++;
+    return FOGVOL_SUCCESS;
+}
+static void fogvol__null_destroy(void *u, fogvol_handle h)
+{
+    if (h) ((fogvol_null_backend *)u)->destroys++;
+}
+static fogvol_result fogvol__null_begin_frame(void *u, fogvol_frame_info *info)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    s->frames_begun++;
+    s->pass_count = 0;
+    info->stencil_bits = s->stencil_bits;
+    return FOGVOL_SUCCESS;
+}
+static void fogvol__null_end_frame(void *u) { ((fogvol_null_backend *)u)->frames_ended++; }
+static fogvol_result fogvol__null_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
+{
+    (void)d;
+    return fogvol__null_create(u, out);
+}
+static fogvol_result fogvol__null_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+{
+    (void)d;
+    return fogvol__null_create(u, out);
+}
+static fogvol_result fogvol__null_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
+{
+    (void)d;
+    return fogvol__null_create(u, out);
+}
+static fogvol_result fogvol__null_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
+{
+    (void)d;
+    return fogvol__null_create(u, out);
+}
+static void fogvol__null_begin_pass(void *u, const fogvol_pass *p)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    if (s->pass_count < FOGVOL_NULL_MAX_PASSES) {
+        s->passes[s->pass_count] = *p;
+        s->draws[s->pass_count] = 0;
+        s->fullscreen[s->pass_count] = 0;
+    }
+    s->pass_count++;
+    s->in_pass = 1;
+}
+static void fogvol__null_set_draw(void *u, const fogvol_draw *d)
+{
+    (void)u;
+    (void)d;
+}
+static void fogvol__null_draw_mesh(void *u, fogvol_handle m, const fogvol_draw *d)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    (void)m;
+    (void)d;
+    if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->draws[s->pass_count - 1]++;
+}
+static void fogvol__null_draw_fullscreen(void *u)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->fullscreen[s->pass_count - 1]++;
+}
+static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
+static fogvol_result fogvol__null_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
+{
+    (void)u;
+    (void)t;
+    if (rgba) memset(rgba, 0, size);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table)
+{
+    if (!state || !table) return;
+    memset(state, 0, sizeof *state);
+    memset(table, 0, sizeof *table);
+    state->stencil_bits = 8;
+    table->user_data = state;
+    table->dialect = FOGVOL_GLSL_330;
+    table->begin_frame = fogvol__null_begin_frame;
+    table->end_frame = fogvol__null_end_frame;
+    table->create_texture = fogvol__null_create_texture;
+    table->destroy_texture = fogvol__null_destroy;
+    table->create_target = fogvol__null_create_target;
+    table->destroy_target = fogvol__null_destroy;
+    table->create_program = fogvol__null_create_program;
+    table->destroy_program = fogvol__null_destroy;
+    table->create_mesh = fogvol__null_create_mesh;
+    table->destroy_mesh = fogvol__null_destroy;
+    table->begin_pass = fogvol__null_begin_pass;
+    table->set_draw = fogvol__null_set_draw;
+    table->draw_mesh = fogvol__null_draw_mesh;
+    table->draw_fullscreen = fogvol__null_draw_fullscreen;
+    table->end_pass = fogvol__null_end_pass;
+    table->read_target = fogvol__null_read_target;
+}
+
+/* >>renderer ============================================================== */
+
+struct fogvol_mesh {
+    fogvol_handle handle;
+    int vertex_count, index_count;
+    int volume; /* 1: a valid closed hull (usable as a volume) */
+};
+
+struct fogvol_ramp {
+    fogvol_handle texture;
+    int width;
+    float max_thickness;
+    fogvol_blend blend;
+};
+
+typedef struct fogvol__volume {
+    const fogvol_mesh *mesh;
+    const fogvol_ramp *ramp;
+    float model[16];
+    int negative;
+} fogvol__volume;
+
+typedef struct fogvol__occluder {
+    const fogvol_mesh *mesh;
+    fogvol_occluder_fn fn;
+    void *user_data;
+    float model[16];
+} fogvol__occluder;
+
+struct fogvol_context {
+    fogvol_allocator alloc;
+    fogvol_logger log;
+    fogvol_backend be;
+    int owns_backend;
+    fogvol_encoding enc;
+    fogvol_tier tier;
+    int dither;
+    fogvol_handle tex_rg, tex_blue, tex_dither;
+    fogvol_handle prog[FOGVOL_PROGRAM_COUNT];
+    fogvol_handle tgt_o, tgt_b, tgt_f;
+    int target_w, target_h;
+    int in_frame, in_occluder_pass;
+    fogvol_frame_desc frame;
+    double viewproj[16];
+    fogvol__volume *vols;
+    int nvol, capvol;
+    fogvol__occluder *occ;
+    int nocc, capocc;
+    int live_meshes, live_ramps;
+};
+
+/* column-major 4x4 helpers in double */
+static void fogvol__mul4(double *out, const double *a, const double *b)
+{
+    int c, r, k;
+    double t[16];
+    for (c = 0; c < 4; ++c)
+        for (r = 0; r < 4; ++r) {
+            double s = 0;
+            for (k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+            t[c * 4 + r] = s;
+        }
+    memcpy(out, t, sizeof t);
+}
+
+static void fogvol__tod(double *out, const float *m)
+{
+    int i;
+    for (i = 0; i < 16; ++i) out[i] = m[i];
+}
+
+static double fogvol__det3(const double *m)
+{
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+           m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+static double fogvol__det4(const double *m)
+{
+    double s0 = m[0] * m[5] - m[4] * m[1], s1 = m[0] * m[9] - m[8] * m[1], s2 = m[0] * m[13] - m[12] * m[1];
+    double s3 = m[4] * m[9] - m[8] * m[5], s4 = m[4] * m[13] - m[12] * m[5], s5 = m[8] * m[13] - m[12] * m[9];
+    double c5 = m[10] * m[15] - m[14] * m[11], c4 = m[6] * m[15] - m[14] * m[7], c3 = m[6] * m[11] - m[10] * m[7];
+    double c2 = m[2] * m[15] - m[14] * m[3], c1 = m[2] * m[11] - m[10] * m[3], c0 = m[2] * m[7] - m[6] * m[3];
+    return s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0;
+}
+
+static void fogvol__destroy_targets(fogvol_context *ctx)
+{
+    if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
+    if (ctx->tgt_b) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_b);
+    if (ctx->tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_f);
+    ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = 0;
+    ctx->target_w = ctx->target_h = 0;
+}
+
+static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
+{
+    fogvol_target_desc td;
+    fogvol_result r;
+    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h) return FOGVOL_SUCCESS;
+    fogvol__destroy_targets(ctx);
+    memset(&td, 0, sizeof td);
+    td.width = w;
+    td.height = h;
+    td.depth = 1;
+    td.label = "fogvol O (opaque depth)";
+    r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+    if (r == FOGVOL_SUCCESS) {
+        td.depth = 0;
+        td.label = "fogvol B (back faces)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+    }
+    if (r == FOGVOL_SUCCESS) {
+        td.label = "fogvol F (front faces)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_f);
+    }
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create %dx%d render targets: %s", w, h,
+                    fogvol_result_string(r));
+        fogvol__destroy_targets(ctx);
+        return r;
+    }
+    ctx->target_w = w;
+    ctx->target_h = h;
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__release(fogvol_context *ctx)
+{
+    int i;
+    fogvol__destroy_targets(ctx);
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
+        if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
+    if (ctx->tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_rg);
+    if (ctx->tex_blue) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_blue);
+    if (ctx->tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_dither);
+    fogvol__free(&ctx->alloc, ctx->vols);
+    fogvol__free(&ctx->alloc, ctx->occ);
+    if (ctx->owns_backend && ctx->be.destroy) ctx->be.destroy(ctx->be.user_data);
+}
+
+static fogvol_result fogvol__make_texture(fogvol_context *ctx, int which, fogvol_handle *out)
+{
+    fogvol_image info;
+    fogvol_texture_desc td;
+    unsigned char *px;
+    fogvol_result r;
+    const char *const labels[3] = {"fogvol red+green ramp", "fogvol blue dither ramp", "fogvol dither index"};
+    r = which == 0 ? fogvol_make_rg_ramp(&ctx->enc, NULL, 0, &info)
+                   : which == 1 ? fogvol_make_blue_ramp(&ctx->enc, NULL, 0, &info)
+                                : fogvol_make_dither_index(&ctx->enc, NULL, 0, &info);
+    if (r != FOGVOL_SUCCESS) return r;
+    px = (unsigned char *)fogvol__alloc(&ctx->alloc, info.size);
+    if (!px) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    r = which == 0 ? fogvol_make_rg_ramp(&ctx->enc, px, info.size, &info)
+                   : which == 1 ? fogvol_make_blue_ramp(&ctx->enc, px, info.size, &info)
+                                : fogvol_make_dither_index(&ctx->enc, px, info.size, &info);
+    if (r == FOGVOL_SUCCESS) {
+        memset(&td, 0, sizeof td);
+        td.width = info.width;
+        td.height = info.height;
+        td.pixels = px;
+        td.filter = FOGVOL_FILTER_NEAREST;
+        td.wrap = FOGVOL_WRAP_REPEAT;
+        td.label = labels[which];
+        r = ctx->be.create_texture(ctx->be.user_data, &td, out);
+    }
+    fogvol__free(&ctx->alloc, px);
+    return r;
+}
+
+static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
+{
+    static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg", "fv_blue", "fv_dither", "fv_opaque"};
+    static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back", "fv_front", "fv_colors", NULL};
+    static const char *const labels[FOGVOL_PROGRAM_COUNT] = {"fogvol encode", "fogvol face", "fogvol composite",
+                                                             "fogvol composite (geometry)"};
+    fogvol_program_desc pd;
+    fogvol_result r;
+    int i;
+    memset(&pd, 0, sizeof pd);
+    r = fogvol_shader_source(ctx->tier, p, ctx->be.dialect, FOGVOL_STAGE_VERTEX, pd.vs, &pd.vs_count);
+    if (r == FOGVOL_SUCCESS)
+        r = fogvol_shader_source(ctx->tier, p, ctx->be.dialect, FOGVOL_STAGE_FRAGMENT, pd.fs, &pd.fs_count);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no shader for dialect %s",
+                    fogvol_dialect_name(ctx->be.dialect));
+        return r;
+    }
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
+        pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
+    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = NULL;
+    pd.label = labels[p];
+    return ctx->be.create_program(ctx->be.user_data, &pd, out);
+}
+
+FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
+{
+    fogvol_context *ctx;
+    fogvol_result r;
+    int i, bits;
+    const fogvol_allocator *a;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!desc) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    a = &desc->allocator;
+    if ((a->alloc != NULL) != (a->free != NULL)) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: allocator needs both alloc and free");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    bits = desc->encoding_bits ? desc->encoding_bits : FOGVOL_DEFAULT_BITS;
+    if (bits < 1 || bits > 8) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: encoding_bits %d outside 1..8", desc->encoding_bits);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->tier != FOGVOL_TIER_AUTO && desc->tier != FOGVOL_TIER_PS20) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: tier %d is not available", (int)desc->tier);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    ctx = (fogvol_context *)fogvol__alloc(a, sizeof *ctx);
+    if (!ctx) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: out of memory for the context");
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    memset(ctx, 0, sizeof *ctx);
+    ctx->alloc = *a;
+    ctx->log = desc->logger;
+    ctx->dither = !desc->disable_dither;
+    ctx->tier = FOGVOL_TIER_PS20;
+    fogvol_encoding_init(&ctx->enc, bits);
+    if (desc->backend.create_texture) {
+        const fogvol_backend *b = &desc->backend;
+        if (!b->destroy_texture || !b->create_target || !b->destroy_target || !b->create_program ||
+            !b->destroy_program || !b->create_mesh || !b->destroy_mesh || !b->begin_pass || !b->draw_mesh ||
+            !b->draw_fullscreen || !b->set_draw) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend table lacks a required entry");
+            fogvol__free(a, ctx);
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
+        ctx->be = *b;
+    } else {
+#ifndef FOGVOL_NO_GL
+        r = fogvol_gl_backend_create(&desc->gl, &ctx->alloc, &ctx->log, &ctx->be);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__free(a, ctx);
+            return r;
+        }
+        ctx->owns_backend = 1;
+#else
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no backend table and FOGVOL_NO_GL is defined");
+        fogvol__free(a, ctx);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+#endif
+    }
+    r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
+    if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
+    if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
+        r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
+        fogvol__release(ctx);
+        fogvol__free(a, ctx);
+        return r;
+    }
+    fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: tier PS20, %d-bit encoding (%d faces), GLSL %s, dither %s",
+                ctx->enc.precision_bits, ctx->enc.max_faces, fogvol_dialect_name(ctx->be.dialect),
+                ctx->dither ? "on" : "off");
+    *out = ctx;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx)
+{
+    fogvol_allocator a;
+    if (!ctx) return;
+    if (ctx->live_meshes || ctx->live_ramps)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: context destroyed with %d meshes and %d ramps alive (their GPU objects leak)",
+                    ctx->live_meshes, ctx->live_ramps);
+    a = ctx->alloc;
+    fogvol__release(ctx);
+    fogvol__free(&a, ctx);
+}
+
+FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx)
+{
+    return ctx ? &ctx->enc : NULL;
+}
+
+FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
+{
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    ctx->dither = enabled != 0;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
+                                            fogvol_mesh_report *report)
+{
+    fogvol_mesh_report rep;
+    fogvol_mesh_data md;
+    fogvol_mesh *m;
+    float *packed = NULL;
+    fogvol_result r;
+    int i;
+    if (out) *out = NULL;
+    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol_validate_mesh(desc, &ctx->alloc, &rep);
+    if (report) *report = rep;
+    if (r == FOGVOL_ERROR_INVALID_ARGUMENT || r == FOGVOL_ERROR_OUT_OF_MEMORY) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s", fogvol_result_string(r));
+        return r;
+    }
+    if (rep.nonfinite_vertices || rep.out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: mesh rejected: %d open edges, %d non-manifold edges, %d inconsistent edges, "
+                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s",
+                    rep.open_edges, rep.nonmanifold_edges, rep.inconsistent_edges, rep.flipped_faces,
+                    rep.nonfinite_vertices, rep.out_of_range_indices,
+                    rep.inverted ? ", wound inward (reverse the triangles)" : "");
+        return FOGVOL_ERROR_INVALID_MESH;
+    }
+    if (rep.degenerate_triangles)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh has %d degenerate triangles",
+                    rep.degenerate_triangles);
+    m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
+    if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(m, 0, sizeof *m);
+    md.positions = desc->positions;
+    if (desc->stride && desc->stride != 12) {
+        packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
+        if (!packed) {
+            fogvol__free(&ctx->alloc, m);
+            return FOGVOL_ERROR_OUT_OF_MEMORY;
+        }
+        for (i = 0; i < desc->vertex_count; ++i)
+            memcpy(packed + 3 * i, (const unsigned char *)desc->positions + (size_t)i * desc->stride, 12);
+        md.positions = packed;
+    }
+    md.vertex_count = desc->vertex_count;
+    md.indices = desc->indices;
+    md.index_count = desc->index_count;
+    r = ctx->be.create_mesh(ctx->be.user_data, &md, &m->handle);
+    fogvol__free(&ctx->alloc, packed);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
+        fogvol__free(&ctx->alloc, m);
+        return r;
+    }
+    m->vertex_count = desc->vertex_count;
+    m->index_count = desc->index_count;
+    m->volume = rep.valid;
+    ctx->live_meshes++;
+    *out = m;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
+{
+    if (!ctx || !mesh) return;
+    if (ctx->in_frame) fogvol_cancel_frame(ctx); /* the frame may reference it */
+    ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
+    ctx->live_meshes--;
+    fogvol__free(&ctx->alloc, mesh);
+}
+
+FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out)
+{
+    fogvol_image info;
+    fogvol_texture_desc td;
+    unsigned char *px;
+    fogvol_ramp *rp;
+    float tmax;
+    fogvol_result r;
+    if (out) *out = NULL;
+    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol_make_color_ramp(desc, NULL, 0, &info, &tmax);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: invalid ramp description");
+        return r;
+    }
+    px = (unsigned char *)fogvol__alloc(&ctx->alloc, info.size);
+    rp = (fogvol_ramp *)fogvol__alloc(&ctx->alloc, sizeof *rp);
+    if (!px || !rp) {
+        fogvol__free(&ctx->alloc, px);
+        fogvol__free(&ctx->alloc, rp);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    memset(rp, 0, sizeof *rp);
+    fogvol_make_color_ramp(desc, px, info.size, &info, &tmax);
+    memset(&td, 0, sizeof td);
+    td.width = info.width;
+    td.height = 1;
+    td.pixels = px;
+    td.filter = FOGVOL_FILTER_LINEAR;
+    td.wrap = FOGVOL_WRAP_CLAMP;
+    td.label = "fogvol colour ramp";
+    r = ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture);
+    fogvol__free(&ctx->alloc, px);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(&ctx->alloc, rp);
+        return r;
+    }
+    rp->width = info.width;
+    rp->max_thickness = tmax;
+    rp->blend = desc->blend;
+    ctx->live_ramps++;
+    *out = rp;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
+{
+    if (!ctx || !ramp) return;
+    if (ctx->in_frame) fogvol_cancel_frame(ctx);
+    ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
+    ctx->live_ramps--;
+    fogvol__free(&ctx->alloc, ramp);
+}
+
+FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
+{
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    ctx->in_frame = 0;
+    ctx->nvol = ctx->nocc = 0;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    double v[16], p[16];
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (ctx->in_frame) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: begin_frame without end_frame: the open frame is discarded");
+        fogvol_cancel_frame(ctx);
+    }
+    if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite view or projection matrix");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: need 0 < znear < zfar (got %g, %g)", (double)d->znear,
+                    (double)d->zfar);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->viewport[2] <= 0 || d->viewport[3] <= 0 || d->viewport[2] > 16384 || d->viewport[3] > 16384) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport %dx%d outside 1..16384", d->viewport[2],
+                    d->viewport[3]);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    ctx->frame = *d;
+    fogvol__tod(v, d->view);
+    fogvol__tod(p, d->projection);
+    fogvol__mul4(ctx->viewproj, p, v);
+    ctx->nvol = ctx->nocc = 0;
+    ctx->in_frame = 1;
+    return FOGVOL_SUCCESS;
+}
+
+static fogvol_result fogvol__grow(fogvol_context *ctx, void **arr, int *cap, int need, size_t elem)
+{
+    void *n;
+    int nc;
+    if (need <= *cap) return FOGVOL_SUCCESS;
+    nc = *cap ? *cap * 2 : 16;
+    while (nc < need) nc *= 2;
+    n = fogvol__alloc(&ctx->alloc, (size_t)nc * elem);
+    if (!n) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: out of memory for the frame's lists");
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    if (*arr) memcpy(n, *arr, (size_t)*cap * elem);
+    fogvol__free(&ctx->alloc, *arr);
+    *arr = n;
+    *cap = nc;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16])
+{
+    fogvol__occluder *o;
+    void *arr;
+    fogvol_result r;
+    if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!fogvol__finite_n(model, 16)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    arr = ctx->occ;
+    r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
+    ctx->occ = (fogvol__occluder *)arr;
+    if (r != FOGVOL_SUCCESS) return r;
+    o = &ctx->occ[ctx->nocc++];
+    memset(o, 0, sizeof *o);
+    o->mesh = mesh;
+    memcpy(o->model, model, sizeof o->model);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data)
+{
+    fogvol__occluder *o;
+    void *arr;
+    fogvol_result r;
+    if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    arr = ctx->occ;
+    r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
+    ctx->occ = (fogvol__occluder *)arr;
+    if (r != FOGVOL_SUCCESS) return r;
+    o = &ctx->occ[ctx->nocc++];
+    memset(o, 0, sizeof *o);
+    o->fn = fn;
+    o->user_data = user_data;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
+{
+    fogvol__volume *v;
+    void *arr;
+    fogvol_result r;
+    if (!ctx || !desc || !desc->mesh || !desc->ramp) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!desc->mesh->volume) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
+        return FOGVOL_ERROR_INVALID_MESH;
+    }
+    if (!fogvol__finite_n(desc->model, 16)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    arr = ctx->vols;
+    r = fogvol__grow(ctx, &arr, &ctx->capvol, ctx->nvol + 1, sizeof *v);
+    ctx->vols = (fogvol__volume *)arr;
+    if (r != FOGVOL_SUCCESS) return r;
+    v = &ctx->vols[ctx->nvol++];
+    v->mesh = desc->mesh;
+    v->ramp = desc->ramp;
+    memcpy(v->model, desc->model, sizeof v->model);
+    v->negative = desc->negative != 0;
+    return FOGVOL_SUCCESS;
+}
+
+/* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
+static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
+{
+    double m[16], v[16], vm[16], mvp[16], p[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
+    int j;
+    fogvol__tod(m, model);
+    fogvol__tod(v, ctx->frame.view);
+    fogvol__tod(p, ctx->frame.projection);
+    fogvol__mul4(vm, v, m);
+    fogvol__mul4(mvp, ctx->viewproj, m);
+    for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
+    /* view depth e = -(VM row 2) . p;  d = (e - near) / (far - near) */
+    for (j = 0; j < 4; ++j) dr->depth[j] = (float)(-vm[j * 4 + 2] / range);
+    dr->depth[3] = (float)((-vm[14] - ctx->frame.znear) / range);
+    /* standard projections have det < 0 (z flips); mirroring flips the winding */
+    dr->front_cw = (fogvol__det3(vm) < 0) != (fogvol__det4(p) > 0);
+}
+
+FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
+{
+    fogvol_draw dr;
+    if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
+    if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    fogvol__draw_for(ctx, model, &dr);
+    ctx->be.set_draw(ctx->be.user_data, &dr);
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__end_pass(fogvol_context *ctx)
+{
+    if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
+}
+
+/* Draw the volumes of one ramp group with the given sign into the current pass. */
+static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int negative)
+{
+    int i, n = 0;
+    fogvol_draw dr;
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        if (v->ramp != ramp || v->negative != negative) continue;
+        fogvol__draw_for(ctx, v->model, &dr);
+        ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
+        ++n;
+    }
+    return n;
+}
+
+/* Sum pass into B (back = 1) or F: positive volumes' back (front) faces, then
+   negative volumes' front (back) faces. */
+static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, const fogvol_ramp *ramp, int back, int has_neg)
+{
+    int passes = 1;
+    ps->target = back ? ctx->tgt_b : ctx->tgt_f;
+    ps->clear = 1;
+    ps->cull = back ? FOGVOL_CULL_FRONT : FOGVOL_CULL_BACK;
+    ctx->be.begin_pass(ctx->be.user_data, ps);
+    fogvol__draw_group(ctx, ramp, 0);
+    fogvol__end_pass(ctx);
+    if (has_neg) {
+        ps->clear = 0;
+        ps->cull = back ? FOGVOL_CULL_BACK : FOGVOL_CULL_FRONT;
+        ctx->be.begin_pass(ctx->be.user_data, ps);
+        fogvol__draw_group(ctx, ramp, 1);
+        fogvol__end_pass(ctx);
+        ++passes;
+    }
+    return passes;
+}
+
+static fogvol_result fogvol__debug_capture(fogvol_context *ctx, int *overflow)
+{
+    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    unsigned char *b, *f;
+    fogvol_result r;
+    double range = (double)ctx->frame.zfar - ctx->frame.znear;
+    if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
+    b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 8u);
+    if (!b) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    f = b + n * 4u;
+    r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, b, n * 4u);
+    if (r == FOGVOL_SUCCESS) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_f, f, n * 4u);
+    if (r == FOGVOL_SUCCESS) {
+        *overflow = 0;
+        for (i = 0; i < n; ++i) {
+            const unsigned char *pb = b + 4 * i, *pf = f + 4 * i;
+            int k, sat = 0;
+            for (k = 0; k < 4; ++k) sat |= pb[k] == 255 || pf[k] == 255;
+            *overflow += sat;
+            ctx->frame.debug_thickness[i] = (float)(fogvol_decode_difference(&ctx->enc, pb, pf) * range);
+        }
+    }
+    fogvol__free(&ctx->alloc, b);
+    return r;
+}
+
+FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
+{
+    fogvol_frame_stats st;
+    fogvol_frame_info info;
+    fogvol_constants k;
+    fogvol_pass ps;
+    fogvol_result r = FOGVOL_SUCCESS, rr;
+    const fogvol_frame_desc *fd;
+    int i, w, h, g, overflow = 0, captured = 0;
+    float zk;
+    memset(&st, 0, sizeof st);
+    if (stats) *stats = st;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    fd = &ctx->frame;
+    w = fd->viewport[2];
+    h = fd->viewport[3];
+    fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
+    memset(&info, 0, sizeof info);
+    if (ctx->be.begin_frame) {
+        r = ctx->be.begin_frame(ctx->be.user_data, &info);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s",
+                        fogvol_result_string(r));
+            fogvol_cancel_frame(ctx);
+            return r;
+        }
+    }
+    r = fogvol__ensure_targets(ctx, w, h);
+    if (r != FOGVOL_SUCCESS) goto done;
+
+    /* pass uniforms common to every pass */
+    memset(&ps, 0, sizeof ps);
+    ps.uniforms[FOGVOL_U_ENC][0] = (float)ctx->enc.levels;
+    ps.uniforms[FOGVOL_U_ENC][1] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    ps.uniforms[FOGVOL_U_ENC][2] = k.depth_offset;
+    ps.uniforms[FOGVOL_U_ENC][3] = k.depth_max;
+    ps.uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
+    ps.uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
+    ps.uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)w;
+    ps.uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)h;
+    memcpy(ps.uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
+    zk = (float)(2.0 * ((double)fd->zfar - fd->znear));
+    ps.uniforms[FOGVOL_U_MISC][0] = zk < 1.0f ? zk : 1.0f;
+    ps.viewport[2] = w;
+    ps.viewport[3] = h;
+
+    /* step b: opaque depth into O */
+    ps.target = ctx->tgt_o;
+    ps.clear = 1;
+    ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    ps.depth_test = ps.depth_write = 1;
+    ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+    ps.textures[0] = ctx->tex_rg;
+    ps.textures[1] = ctx->tex_blue;
+    ps.textures[2] = ctx->tex_dither;
+    ctx->be.begin_pass(ctx->be.user_data, &ps);
+    st.passes++;
+    ctx->in_occluder_pass = 1;
+    for (i = 0; i < ctx->nocc; ++i) {
+        const fogvol__occluder *o = &ctx->occ[i];
+        if (o->fn) {
+            o->fn(ctx, o->user_data);
+        } else {
+            fogvol_draw dr;
+            fogvol__draw_for(ctx, o->model, &dr);
+            ctx->be.draw_mesh(ctx->be.user_data, o->mesh->handle, &dr);
+        }
+        st.occluders++;
+    }
+    ctx->in_occluder_pass = 0;
+    fogvol__end_pass(ctx);
+
+    /* steps c-e per colour-ramp group, in order of first appearance */
+    for (g = 0; g < ctx->nvol; ++g) {
+        const fogvol_ramp *ramp = ctx->vols[g].ramp;
+        int seen = 0, has_pos = 0, has_neg = 0, guard;
+        for (i = 0; i < g && !seen; ++i) seen = ctx->vols[i].ramp == ramp;
+        if (seen) continue;
+        for (i = g; i < ctx->nvol; ++i)
+            if (ctx->vols[i].ramp == ramp) {
+                if (ctx->vols[i].negative) has_neg = 1;
+                else has_pos = 1;
+                st.volumes++;
+            }
+        if (!has_pos) continue; /* negative volumes alone subtract from nothing */
+        st.groups++;
+
+        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = 0.0f;
+        ps.depth_test = ps.depth_write = 0;
+        ps.blend = FOGVOL_PASS_BLEND_ADD;
+        ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
+        ps.textures[3] = ctx->tgt_o;
+        ps.uniforms[FOGVOL_U_MISC][1] = 1.0f;
+        st.passes += fogvol__sum_pass(ctx, &ps, ramp, 1, has_neg);
+        st.passes += fogvol__sum_pass(ctx, &ps, ramp, 0, has_neg);
+
+        if (fd->debug_thickness && !captured && (fd->debug_ramp == NULL || fd->debug_ramp == ramp)) {
+            rr = fogvol__debug_capture(ctx, &overflow);
+            captured = 1;
+            if (rr != FOGVOL_SUCCESS) r = rr;
+        }
+
+        /* composite into the engine framebuffer */
+        guard = fd->composite == FOGVOL_COMPOSITE_GEOMETRY;
+        if (guard && info.stencil_bits <= 0) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                        "fogvol: geometry composite needs a stencil buffer; using the full-screen triangle");
+            guard = 0;
+        }
+        ps.target = 0;
+        ps.clear = 0;
+        memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
+        ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)w;
+        ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)h;
+        ps.blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
+        ps.cull = guard ? FOGVOL_CULL_FRONT : FOGVOL_CULL_NONE;
+        ps.stencil_guard = guard;
+        ps.stencil_bit = fd->stencil_bit ? fd->stencil_bit : 0x80u;
+        ps.program = ctx->prog[guard ? FOGVOL_PROGRAM_COMPOSITE_MESH : FOGVOL_PROGRAM_COMPOSITE];
+        ps.textures[0] = ctx->tgt_b;
+        ps.textures[1] = ctx->tgt_f;
+        ps.textures[2] = ramp->texture;
+        ps.textures[3] = 0;
+        ps.uniforms[FOGVOL_U_RAMP][0] =
+            (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
+        ps.uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
+        ps.uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
+        ctx->be.begin_pass(ctx->be.user_data, &ps);
+        st.passes++;
+        if (guard) fogvol__draw_group(ctx, ramp, 0);
+        else ctx->be.draw_fullscreen(ctx->be.user_data);
+        fogvol__end_pass(ctx);
+        /* back to target-space settings for the next group */
+        ps.stencil_guard = 0;
+        ps.uniforms[FOGVOL_U_SCREEN][2] = ps.uniforms[FOGVOL_U_SCREEN][3] = 0.0f;
+        ps.viewport[0] = ps.viewport[1] = 0;
+        ps.viewport[2] = w;
+        ps.viewport[3] = h;
+        ps.textures[0] = ctx->tex_rg;
+        ps.textures[1] = ctx->tex_blue;
+        ps.textures[2] = ctx->tex_dither;
+    }
+    st.overflow_pixels = overflow;
+    if (overflow > 0 && r == FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)", overflow,
+                    ctx->enc.precision_bits, ctx->enc.max_faces);
+        r = FOGVOL_ERROR_DEPTH_OVERFLOW;
+    }
+done:
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    ctx->in_frame = 0;
+    ctx->nvol = ctx->nocc = 0;
+    if (stats) *stats = st;
+    return r;
+}
+
+/* >>gl backend ============================================================ */
+#ifndef FOGVOL_NO_GL
+
+#ifndef FOGVOL_GLAPIENTRY
+#if defined(_WIN32)
+#define FOGVOL_GLAPIENTRY __stdcall
+#else
+#define FOGVOL_GLAPIENTRY
+#endif
+#endif
+
+typedef unsigned int fogvol__GLenum;
+typedef unsigned int fogvol__GLuint;
+typedef int fogvol__GLint;
+typedef int fogvol__GLsizei;
+typedef float fogvol__GLfloat;
+typedef double fogvol__GLdouble;
+typedef unsigned char fogvol__GLboolean;
+typedef unsigned char fogvol__GLubyte;
+typedef char fogvol__GLchar;
+typedef unsigned int fogvol__GLbitfield;
+typedef ptrdiff_t fogvol__GLsizeiptr;
+
+/* GL enums (values from the Khronos registry) */
+enum {
+    FOGVOL__GL_NO_ERROR = 0, FOGVOL__GL_TRIANGLES = 0x0004, FOGVOL__GL_NEVER = 0x0200, FOGVOL__GL_LESS = 0x0201,
+    FOGVOL__GL_NOTEQUAL = 0x0205, FOGVOL__GL_ZERO = 0, FOGVOL__GL_ONE = 1, FOGVOL__GL_SRC_ALPHA = 0x0302,
+    FOGVOL__GL_ONE_MINUS_SRC_ALPHA = 0x0303, FOGVOL__GL_FRONT = 0x0404, FOGVOL__GL_BACK = 0x0405,
+    FOGVOL__GL_FRONT_AND_BACK = 0x0408, FOGVOL__GL_CW = 0x0900, FOGVOL__GL_CCW = 0x0901,
+    FOGVOL__GL_POLYGON_MODE = 0x0B40, FOGVOL__GL_CULL_FACE = 0x0B44, FOGVOL__GL_CULL_FACE_MODE = 0x0B45,
+    FOGVOL__GL_FRONT_FACE = 0x0B46, FOGVOL__GL_DEPTH_TEST = 0x0B71, FOGVOL__GL_DEPTH_WRITEMASK = 0x0B72,
+    FOGVOL__GL_DEPTH_CLEAR_VALUE = 0x0B73, FOGVOL__GL_DEPTH_FUNC = 0x0B74, FOGVOL__GL_STENCIL_TEST = 0x0B90,
+    FOGVOL__GL_STENCIL_CLEAR_VALUE = 0x0B91, FOGVOL__GL_STENCIL_FUNC = 0x0B92,
+    FOGVOL__GL_STENCIL_VALUE_MASK = 0x0B93, FOGVOL__GL_STENCIL_FAIL = 0x0B94,
+    FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL = 0x0B95, FOGVOL__GL_STENCIL_PASS_DEPTH_PASS = 0x0B96,
+    FOGVOL__GL_STENCIL_REF = 0x0B97, FOGVOL__GL_STENCIL_WRITEMASK = 0x0B98, FOGVOL__GL_VIEWPORT = 0x0BA2,
+    FOGVOL__GL_ALPHA_TEST = 0x0BC0, FOGVOL__GL_DITHER = 0x0BD0, FOGVOL__GL_BLEND = 0x0BE2,
+    FOGVOL__GL_COLOR_LOGIC_OP = 0x0BF2, FOGVOL__GL_SCISSOR_BOX = 0x0C10, FOGVOL__GL_SCISSOR_TEST = 0x0C11,
+    FOGVOL__GL_COLOR_CLEAR_VALUE = 0x0C22, FOGVOL__GL_COLOR_WRITEMASK = 0x0C23,
+    FOGVOL__GL_UNPACK_ROW_LENGTH = 0x0CF2, FOGVOL__GL_UNPACK_SKIP_ROWS = 0x0CF3,
+    FOGVOL__GL_UNPACK_SKIP_PIXELS = 0x0CF4, FOGVOL__GL_UNPACK_ALIGNMENT = 0x0CF5,
+    FOGVOL__GL_PACK_ROW_LENGTH = 0x0D02, FOGVOL__GL_PACK_SKIP_ROWS = 0x0D03, FOGVOL__GL_PACK_SKIP_PIXELS = 0x0D04,
+    FOGVOL__GL_PACK_ALIGNMENT = 0x0D05, FOGVOL__GL_STENCIL_BITS = 0x0D57, FOGVOL__GL_TEXTURE_2D = 0x0DE1,
+    FOGVOL__GL_UNSIGNED_BYTE = 0x1401, FOGVOL__GL_UNSIGNED_SHORT = 0x1403, FOGVOL__GL_UNSIGNED_INT = 0x1405,
+    FOGVOL__GL_FLOAT = 0x1406, FOGVOL__GL_STENCIL = 0x1802, FOGVOL__GL_RGBA = 0x1908, FOGVOL__GL_FILL = 0x1B02,
+    FOGVOL__GL_KEEP = 0x1E00, FOGVOL__GL_REPLACE = 0x1E01, FOGVOL__GL_VERSION = 0x1F02,
+    FOGVOL__GL_EXTENSIONS = 0x1F03, FOGVOL__GL_NEAREST = 0x2600, FOGVOL__GL_LINEAR = 0x2601,
+    FOGVOL__GL_TEXTURE_MAG_FILTER = 0x2800, FOGVOL__GL_TEXTURE_MIN_FILTER = 0x2801,
+    FOGVOL__GL_TEXTURE_WRAP_S = 0x2802, FOGVOL__GL_TEXTURE_WRAP_T = 0x2803, FOGVOL__GL_REPEAT = 0x2901,
+    FOGVOL__GL_POLYGON_OFFSET_FILL = 0x8037, FOGVOL__GL_RGBA8 = 0x8058, FOGVOL__GL_TEXTURE_BINDING_2D = 0x8069,
+    FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
+    FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
+    FOGVOL__GL_BLEND_SRC_ALPHA = 0x80CB, FOGVOL__GL_FUNC_ADD = 0x8006, FOGVOL__GL_BLEND_EQUATION_RGB = 0x8009,
+    FOGVOL__GL_CLAMP_TO_EDGE = 0x812F, FOGVOL__GL_DEPTH_COMPONENT16 = 0x81A5,
+    FOGVOL__GL_DEPTH_COMPONENT24 = 0x81A6, FOGVOL__GL_TEXTURE0 = 0x84C0, FOGVOL__GL_ACTIVE_TEXTURE = 0x84E0,
+    FOGVOL__GL_VERTEX_ARRAY_BINDING = 0x85B5, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED = 0x8622,
+    FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE = 0x8623, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE = 0x8624,
+    FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE = 0x8625, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER = 0x8645,
+    FOGVOL__GL_STENCIL_BACK_FUNC = 0x8800, FOGVOL__GL_STENCIL_BACK_FAIL = 0x8801,
+    FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL = 0x8802, FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS = 0x8803,
+    FOGVOL__GL_BLEND_EQUATION_ALPHA = 0x883D, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED = 0x886A,
+    FOGVOL__GL_ARRAY_BUFFER = 0x8892, FOGVOL__GL_ELEMENT_ARRAY_BUFFER = 0x8893,
+    FOGVOL__GL_ARRAY_BUFFER_BINDING = 0x8894, FOGVOL__GL_ELEMENT_ARRAY_BUFFER_BINDING = 0x8895,
+    FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING = 0x889F, FOGVOL__GL_STATIC_DRAW = 0x88E4,
+    FOGVOL__GL_PIXEL_PACK_BUFFER = 0x88EB, FOGVOL__GL_PIXEL_UNPACK_BUFFER = 0x88EC,
+    FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING = 0x88ED, FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING = 0x88EF,
+    FOGVOL__GL_SAMPLER_BINDING = 0x8919, FOGVOL__GL_FRAGMENT_SHADER = 0x8B30, FOGVOL__GL_VERTEX_SHADER = 0x8B31,
+    FOGVOL__GL_COMPILE_STATUS = 0x8B81, FOGVOL__GL_LINK_STATUS = 0x8B82, FOGVOL__GL_INFO_LOG_LENGTH = 0x8B84,
+    FOGVOL__GL_CURRENT_PROGRAM = 0x8B8D, FOGVOL__GL_SHADING_LANGUAGE_VERSION = 0x8B8C,
+    FOGVOL__GL_RASTERIZER_DISCARD = 0x8C89, FOGVOL__GL_STENCIL_BACK_REF = 0x8CA3,
+    FOGVOL__GL_STENCIL_BACK_VALUE_MASK = 0x8CA4, FOGVOL__GL_STENCIL_BACK_WRITEMASK = 0x8CA5,
+    FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING = 0x8CA6, FOGVOL__GL_RENDERBUFFER_BINDING = 0x8CA7,
+    FOGVOL__GL_READ_FRAMEBUFFER = 0x8CA8, FOGVOL__GL_DRAW_FRAMEBUFFER = 0x8CA9,
+    FOGVOL__GL_READ_FRAMEBUFFER_BINDING = 0x8CAA, FOGVOL__GL_FRAMEBUFFER_COMPLETE = 0x8CD5,
+    FOGVOL__GL_COLOR_ATTACHMENT0 = 0x8CE0, FOGVOL__GL_DEPTH_ATTACHMENT = 0x8D00,
+    FOGVOL__GL_STENCIL_ATTACHMENT = 0x8D20, FOGVOL__GL_FRAMEBUFFER = 0x8D40, FOGVOL__GL_RENDERBUFFER = 0x8D41,
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
+    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
+    FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
+    FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400
+};
+
+/* X(return type, name without "gl", parameter list). Base: GL 2.0 / GLES 2.0. */
+#define FOGVOL__GL_BASE(X) \
+    X(const fogvol__GLubyte *, GetString, (fogvol__GLenum)) \
+    X(void, GetIntegerv, (fogvol__GLenum, fogvol__GLint *)) \
+    X(void, GetFloatv, (fogvol__GLenum, fogvol__GLfloat *)) \
+    X(void, GetBooleanv, (fogvol__GLenum, fogvol__GLboolean *)) \
+    X(fogvol__GLenum, GetError, (void)) \
+    X(void, Enable, (fogvol__GLenum)) \
+    X(void, Disable, (fogvol__GLenum)) \
+    X(fogvol__GLboolean, IsEnabled, (fogvol__GLenum)) \
+    X(void, Viewport, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
+    X(void, Scissor, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
+    X(void, ClearColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
+    X(void, Clear, (fogvol__GLbitfield)) \
+    X(void, ClearStencil, (fogvol__GLint)) \
+    X(void, ColorMask, (fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean)) \
+    X(void, DepthMask, (fogvol__GLboolean)) \
+    X(void, DepthFunc, (fogvol__GLenum)) \
+    X(void, CullFace, (fogvol__GLenum)) \
+    X(void, FrontFace, (fogvol__GLenum)) \
+    X(void, BlendFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
+    X(void, BlendEquationSeparate, (fogvol__GLenum, fogvol__GLenum)) \
+    X(void, StencilFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint, fogvol__GLuint)) \
+    X(void, StencilOpSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
+    X(void, StencilMaskSeparate, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, PixelStorei, (fogvol__GLenum, fogvol__GLint)) \
+    X(void, ReadPixels, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei, fogvol__GLenum, \
+                         fogvol__GLenum, void *)) \
+    X(void, GenTextures, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteTextures, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BindTexture, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, ActiveTexture, (fogvol__GLenum)) \
+    X(void, TexImage2D, (fogvol__GLenum, fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei, \
+                         fogvol__GLint, fogvol__GLenum, fogvol__GLenum, const void *)) \
+    X(void, TexParameteri, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint)) \
+    X(void, GenBuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteBuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BindBuffer, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, BufferData, (fogvol__GLenum, fogvol__GLsizeiptr, const void *, fogvol__GLenum)) \
+    X(void, VertexAttribPointer, (fogvol__GLuint, fogvol__GLint, fogvol__GLenum, fogvol__GLboolean, \
+                                  fogvol__GLsizei, const void *)) \
+    X(void, EnableVertexAttribArray, (fogvol__GLuint)) \
+    X(void, DisableVertexAttribArray, (fogvol__GLuint)) \
+    X(void, GetVertexAttribiv, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint *)) \
+    X(void, GetVertexAttribPointerv, (fogvol__GLuint, fogvol__GLenum, void **)) \
+    X(void, DrawElements, (fogvol__GLenum, fogvol__GLsizei, fogvol__GLenum, const void *)) \
+    X(void, DrawArrays, (fogvol__GLenum, fogvol__GLint, fogvol__GLsizei)) \
+    X(fogvol__GLuint, CreateShader, (fogvol__GLenum)) \
+    X(void, ShaderSource, (fogvol__GLuint, fogvol__GLsizei, const fogvol__GLchar *const *, const fogvol__GLint *)) \
+    X(void, CompileShader, (fogvol__GLuint)) \
+    X(void, GetShaderiv, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint *)) \
+    X(void, GetShaderInfoLog, (fogvol__GLuint, fogvol__GLsizei, fogvol__GLsizei *, fogvol__GLchar *)) \
+    X(void, DeleteShader, (fogvol__GLuint)) \
+    X(fogvol__GLuint, CreateProgram, (void)) \
+    X(void, AttachShader, (fogvol__GLuint, fogvol__GLuint)) \
+    X(void, BindAttribLocation, (fogvol__GLuint, fogvol__GLuint, const fogvol__GLchar *)) \
+    X(void, LinkProgram, (fogvol__GLuint)) \
+    X(void, GetProgramiv, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint *)) \
+    X(void, GetProgramInfoLog, (fogvol__GLuint, fogvol__GLsizei, fogvol__GLsizei *, fogvol__GLchar *)) \
+    X(void, DeleteProgram, (fogvol__GLuint)) \
+    X(void, UseProgram, (fogvol__GLuint)) \
+    X(fogvol__GLint, GetUniformLocation, (fogvol__GLuint, const fogvol__GLchar *)) \
+    X(void, Uniform1i, (fogvol__GLint, fogvol__GLint)) \
+    X(void, Uniform4fv, (fogvol__GLint, fogvol__GLsizei, const fogvol__GLfloat *)) \
+    X(void, UniformMatrix4fv, (fogvol__GLint, fogvol__GLsizei, fogvol__GLboolean, const fogvol__GLfloat *))
+
+/* Framebuffer objects: GL 3.0, ARB_framebuffer_object, GLES 2.0; EXT_framebuffer_object names as fallback. */
+#define FOGVOL__GL_FBO(X) \
+    X(void, GenFramebuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteFramebuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BindFramebuffer, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, FramebufferTexture2D, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint, fogvol__GLint)) \
+    X(fogvol__GLenum, CheckFramebufferStatus, (fogvol__GLenum)) \
+    X(void, GenRenderbuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteRenderbuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BindRenderbuffer, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, RenderbufferStorage, (fogvol__GLenum, fogvol__GLenum, fogvol__GLsizei, fogvol__GLsizei)) \
+    X(void, FramebufferRenderbuffer, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint)) \
+    X(void, GetFramebufferAttachmentParameteriv, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLint *))
+
+/* Vertex array objects: GL 3.0, GLES 3.0 (required in core profiles). */
+#define FOGVOL__GL_VAO(X) \
+    X(void, GenVertexArrays, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BindVertexArray, (fogvol__GLuint))
+
+/* Sampler objects: GL 3.3, GLES 3.0 (only to unbind the engine's from our units). */
+#define FOGVOL__GL_SAMPLER(X) X(void, BindSampler, (fogvol__GLuint, fogvol__GLuint))
+
+/* Desktop only. */
+#define FOGVOL__GL_DESKTOP(X) \
+    X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
+    X(void, ClearDepth, (fogvol__GLdouble))
+
+/* GLES only. */
+#define FOGVOL__GL_ES(X) X(void, ClearDepthf, (fogvol__GLfloat))
+
+#define FOGVOL__GL_ALL(X) \
+    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_DESKTOP(X) \
+        FOGVOL__GL_ES(X)
+
+#define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
+FOGVOL__GL_ALL(FOGVOL__GL_PFN)
+#undef FOGVOL__GL_PFN
+
+typedef struct fogvol__gl_state {
+    fogvol__GLint draw_fbo, read_fbo, renderbuffer, viewport[4], scissor_box[4], program, vao, array_buffer,
+        element_buffer, active_texture, tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS];
+    fogvol__GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
+    fogvol__GLint depth_func, cull_mode, front_face, polygon_mode[2];
+    fogvol__GLboolean depth_mask, color_mask[4];
+    fogvol__GLfloat clear_color[4], clear_depth;
+    fogvol__GLint st_func, st_ref, st_vmask, st_fail, st_zfail, st_zpass, st_wmask;
+    fogvol__GLint stb_func, stb_ref, stb_vmask, stb_fail, stb_zfail, stb_zpass, stb_wmask, st_clear;
+    fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
+    fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
+    void *a0_pointer;
+    fogvol__GLboolean en_blend, en_depth, en_cull, en_scissor, en_stencil, en_dither, en_a2c, en_samplecov,
+        en_polyoffset, en_discard, en_logicop, en_alphatest;
+} fogvol__gl_state;
+
+/* Textures and targets share this header so either can be bound for sampling. */
+typedef struct fogvol__gl_texture {
+    fogvol__GLuint tex;
+} fogvol__gl_texture;
+
+typedef struct fogvol__gl_target {
+    fogvol__gl_texture base; /* the colour texture */
+    fogvol__GLuint fbo, depth;
+    int width, height;
+} fogvol__gl_target;
+
+typedef struct fogvol__gl_program {
+    fogvol__GLuint id;
+    fogvol__GLint u_mvp, u_depth, u_vec[FOGVOL_U_COUNT];
+} fogvol__gl_program;
+
+typedef struct fogvol__gl_mesh {
+    fogvol__GLuint vbo, ibo, vao;
+    fogvol__GLsizei count;
+    fogvol__GLenum index_type;
+} fogvol__gl_mesh;
+
+typedef struct fogvol__gl {
+#define FOGVOL__GL_MEMBER(ret, name, params) fogvol__PFN_##name name;
+    FOGVOL__GL_ALL(FOGVOL__GL_MEMBER)
+#undef FOGVOL__GL_MEMBER
+    fogvol_allocator alloc;
+    fogvol_logger log;
+    int major, minor, gles, core;
+    int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
+    int stencil_override;
+    fogvol_dialect dialect;
+    fogvol__gl_state saved;
+    int in_frame, guard;
+    unsigned guard_bit;
+    int guard_box[4];
+    fogvol__gl_program *program;
+    fogvol__gl_mesh fullscreen;
+} fogvol__gl;
+
+static int fogvol__has_ext(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    const char *p = list;
+    if (!list) return 0;
+    while ((p = strstr(p, name)) != NULL) {
+        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return 1;
+        p += n;
+    }
+    return 0;
+}
+
+static void fogvol__gl_enable(fogvol__gl *gl, fogvol__GLenum cap, int on)
+{
+    if (on) gl->Enable(cap);
+    else gl->Disable(cap);
+}
+
+static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    int i;
+    memset(s, 0, sizeof *s);
+    if (gl->has_split_fbo) {
+        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
+        gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
+    } else {
+        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo); /* == FRAMEBUFFER_BINDING */
+    }
+    gl->GetIntegerv(FOGVOL__GL_RENDERBUFFER_BINDING, &s->renderbuffer);
+    gl->GetIntegerv(FOGVOL__GL_VIEWPORT, s->viewport);
+    gl->GetIntegerv(FOGVOL__GL_SCISSOR_BOX, s->scissor_box);
+    gl->GetIntegerv(FOGVOL__GL_CURRENT_PROGRAM, &s->program);
+    if (gl->has_vao) gl->GetIntegerv(FOGVOL__GL_VERTEX_ARRAY_BINDING, &s->vao);
+    gl->GetIntegerv(FOGVOL__GL_ARRAY_BUFFER_BINDING, &s->array_buffer);
+    gl->GetIntegerv(FOGVOL__GL_ELEMENT_ARRAY_BUFFER_BINDING, &s->element_buffer);
+    if (!gl->has_vao) {
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->a0_enabled);
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE, &s->a0_size);
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE, &s->a0_type);
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED, &s->a0_normalized);
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE, &s->a0_stride);
+        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, &s->a0_buffer);
+        gl->GetVertexAttribPointerv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER, &s->a0_pointer);
+    }
+    gl->GetIntegerv(FOGVOL__GL_ACTIVE_TEXTURE, &s->active_texture);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->GetIntegerv(FOGVOL__GL_TEXTURE_BINDING_2D, &s->tex2d[i]);
+        if (gl->has_sampler) gl->GetIntegerv(FOGVOL__GL_SAMPLER_BINDING, &s->sampler[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_RGB, &s->blend_src_rgb);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_RGB, &s->blend_dst_rgb);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_ALPHA, &s->blend_src_a);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_ALPHA, &s->blend_dst_a);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_RGB, &s->blend_eq_rgb);
+    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_ALPHA, &s->blend_eq_a);
+    gl->GetIntegerv(FOGVOL__GL_DEPTH_FUNC, &s->depth_func);
+    gl->GetIntegerv(FOGVOL__GL_CULL_FACE_MODE, &s->cull_mode);
+    gl->GetIntegerv(FOGVOL__GL_FRONT_FACE, &s->front_face);
+    if (!gl->gles) gl->GetIntegerv(FOGVOL__GL_POLYGON_MODE, s->polygon_mode);
+    gl->GetBooleanv(FOGVOL__GL_DEPTH_WRITEMASK, &s->depth_mask);
+    gl->GetBooleanv(FOGVOL__GL_COLOR_WRITEMASK, s->color_mask);
+    gl->GetFloatv(FOGVOL__GL_COLOR_CLEAR_VALUE, s->clear_color);
+    gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_FUNC, &s->st_func);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_REF, &s->st_ref);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_VALUE_MASK, &s->st_vmask);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_FAIL, &s->st_fail);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL, &s->st_zfail);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_PASS, &s->st_zpass);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_WRITEMASK, &s->st_wmask);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FUNC, &s->stb_func);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_REF, &s->stb_ref);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_VALUE_MASK, &s->stb_vmask);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FAIL, &s->stb_fail);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL, &s->stb_zfail);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS, &s->stb_zpass);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_WRITEMASK, &s->stb_wmask);
+    gl->GetIntegerv(FOGVOL__GL_STENCIL_CLEAR_VALUE, &s->st_clear);
+    gl->GetIntegerv(FOGVOL__GL_UNPACK_ALIGNMENT, &s->unpack[0]);
+    gl->GetIntegerv(FOGVOL__GL_PACK_ALIGNMENT, &s->pack[0]);
+    if (gl->has_row_length) {
+        gl->GetIntegerv(FOGVOL__GL_UNPACK_ROW_LENGTH, &s->unpack[1]);
+        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_ROWS, &s->unpack[2]);
+        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_PIXELS, &s->unpack[3]);
+        gl->GetIntegerv(FOGVOL__GL_PACK_ROW_LENGTH, &s->pack[1]);
+        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_ROWS, &s->pack[2]);
+        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_PIXELS, &s->pack[3]);
+    }
+    if (gl->has_pixel_buffers) {
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
+    }
+    s->en_blend = gl->IsEnabled(FOGVOL__GL_BLEND);
+    s->en_depth = gl->IsEnabled(FOGVOL__GL_DEPTH_TEST);
+    s->en_cull = gl->IsEnabled(FOGVOL__GL_CULL_FACE);
+    s->en_scissor = gl->IsEnabled(FOGVOL__GL_SCISSOR_TEST);
+    s->en_stencil = gl->IsEnabled(FOGVOL__GL_STENCIL_TEST);
+    s->en_dither = gl->IsEnabled(FOGVOL__GL_DITHER);
+    s->en_a2c = gl->IsEnabled(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
+    s->en_samplecov = gl->IsEnabled(FOGVOL__GL_SAMPLE_COVERAGE);
+    s->en_polyoffset = gl->IsEnabled(FOGVOL__GL_POLYGON_OFFSET_FILL);
+    if (gl->has_discard) s->en_discard = gl->IsEnabled(FOGVOL__GL_RASTERIZER_DISCARD);
+    if (!gl->gles) s->en_logicop = gl->IsEnabled(FOGVOL__GL_COLOR_LOGIC_OP);
+    if (!gl->gles && !gl->core) s->en_alphatest = gl->IsEnabled(FOGVOL__GL_ALPHA_TEST);
+}
+
+static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    if (gl->has_split_fbo) {
+        gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+        gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
+    } else {
+        gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+    }
+    gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
+    gl->Viewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
+    gl->Scissor(s->scissor_box[0], s->scissor_box[1], s->scissor_box[2], s->scissor_box[3]);
+    gl->UseProgram((fogvol__GLuint)s->program);
+    if (gl->has_vao) {
+        gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
+    } else {
+        gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->a0_buffer);
+        gl->VertexAttribPointer(0, s->a0_size, (fogvol__GLenum)s->a0_type, (fogvol__GLboolean)s->a0_normalized,
+                                s->a0_stride, s->a0_pointer);
+        if (s->a0_enabled) gl->EnableVertexAttribArray(0);
+        else gl->DisableVertexAttribArray(0);
+        gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)s->element_buffer);
+    }
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, (fogvol__GLuint)s->tex2d[i]);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, (fogvol__GLuint)s->sampler[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
+    gl->BlendFuncSeparate((fogvol__GLenum)s->blend_src_rgb, (fogvol__GLenum)s->blend_dst_rgb,
+                          (fogvol__GLenum)s->blend_src_a, (fogvol__GLenum)s->blend_dst_a);
+    gl->BlendEquationSeparate((fogvol__GLenum)s->blend_eq_rgb, (fogvol__GLenum)s->blend_eq_a);
+    gl->DepthFunc((fogvol__GLenum)s->depth_func);
+    gl->CullFace((fogvol__GLenum)s->cull_mode);
+    gl->FrontFace((fogvol__GLenum)s->front_face);
+    if (!gl->gles) {
+        /* core profiles accept only FRONT_AND_BACK; both entries hold the same mode there */
+        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, (fogvol__GLenum)s->polygon_mode[0]);
+        if (!gl->core && s->polygon_mode[1] != s->polygon_mode[0])
+            gl->PolygonMode(FOGVOL__GL_BACK, (fogvol__GLenum)s->polygon_mode[1]);
+    }
+    gl->DepthMask(s->depth_mask);
+    gl->ColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
+    gl->ClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
+    if (gl->gles) gl->ClearDepthf(s->clear_depth);
+    else gl->ClearDepth(s->clear_depth);
+    gl->StencilFuncSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_func, s->st_ref, (fogvol__GLuint)s->st_vmask);
+    gl->StencilOpSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_fail, (fogvol__GLenum)s->st_zfail,
+                          (fogvol__GLenum)s->st_zpass);
+    gl->StencilMaskSeparate(FOGVOL__GL_FRONT, (fogvol__GLuint)s->st_wmask);
+    gl->StencilFuncSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_func, s->stb_ref, (fogvol__GLuint)s->stb_vmask);
+    gl->StencilOpSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_fail, (fogvol__GLenum)s->stb_zfail,
+                          (fogvol__GLenum)s->stb_zpass);
+    gl->StencilMaskSeparate(FOGVOL__GL_BACK, (fogvol__GLuint)s->stb_wmask);
+    gl->ClearStencil(s->st_clear);
+    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, s->unpack[0]);
+    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, s->pack[0]);
+    if (gl->has_row_length) {
+        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, s->unpack[1]);
+        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, s->unpack[2]);
+        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, s->unpack[3]);
+        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, s->pack[1]);
+        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, s->pack[2]);
+        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, s->pack[3]);
+    }
+    if (gl->has_pixel_buffers) {
+        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, (fogvol__GLuint)s->unpack_buffer);
+        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, (fogvol__GLuint)s->pack_buffer);
+    }
+    fogvol__gl_enable(gl, FOGVOL__GL_BLEND, s->en_blend);
+    fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, s->en_depth);
+    fogvol__gl_enable(gl, FOGVOL__GL_CULL_FACE, s->en_cull);
+    fogvol__gl_enable(gl, FOGVOL__GL_SCISSOR_TEST, s->en_scissor);
+    fogvol__gl_enable(gl, FOGVOL__GL_STENCIL_TEST, s->en_stencil);
+    fogvol__gl_enable(gl, FOGVOL__GL_DITHER, s->en_dither);
+    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, s->en_a2c);
+    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_COVERAGE, s->en_samplecov);
+    fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_OFFSET_FILL, s->en_polyoffset);
+    if (gl->has_discard) fogvol__gl_enable(gl, FOGVOL__GL_RASTERIZER_DISCARD, s->en_discard);
+    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_COLOR_LOGIC_OP, s->en_logicop);
+    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_ALPHA_TEST, s->en_alphatest);
+}
+
+/* Resource entries called outside a frame save and restore the state they touch. */
+static void fogvol__gl_enter(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    if (!gl->in_frame) fogvol__gl_save(gl, s);
+    if (gl->has_pixel_buffers) {
+        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, 0);
+        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, 0);
+    }
+    if (gl->has_row_length) {
+        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, 0);
+        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, 0);
+        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, 0);
+        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, 0);
+        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, 0);
+        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, 0);
+    }
+    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, 4);
+    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, 4);
+}
+
+static void fogvol__gl_leave(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    if (!gl->in_frame) fogvol__gl_restore(gl, s);
+}
+
+static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLint bits = 0;
+    if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    fogvol__gl_save(gl, &gl->saved);
+    gl->in_frame = 1;
+    fogvol__gl_enter(gl, &gl->saved);
+    if (gl->stencil_override > 0) {
+        bits = gl->stencil_override;
+    } else if (gl->core) {
+        fogvol__GLint type = 0;
+        gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_DRAW_FRAMEBUFFER,
+                                                gl->saved.draw_fbo ? FOGVOL__GL_STENCIL_ATTACHMENT : FOGVOL__GL_STENCIL,
+                                                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+        if (type != 0)
+            gl->GetFramebufferAttachmentParameteriv(
+                FOGVOL__GL_DRAW_FRAMEBUFFER, gl->saved.draw_fbo ? FOGVOL__GL_STENCIL_ATTACHMENT : FOGVOL__GL_STENCIL,
+                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE, &bits);
+    } else {
+        gl->GetIntegerv(FOGVOL__GL_STENCIL_BITS, &bits);
+    }
+    info->stencil_bits = bits;
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__gl_end_frame(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    if (!gl->in_frame) return;
+    fogvol__gl_restore(gl, &gl->saved);
+    gl->in_frame = 0;
+    gl->program = NULL;
+}
+
+static fogvol_result fogvol__gl_check(fogvol__gl *gl, const char *what)
+{
+    fogvol__GLenum e = gl->GetError();
+    if (e == FOGVOL__GL_NO_ERROR) return FOGVOL_SUCCESS;
+    while (gl->GetError() != FOGVOL__GL_NO_ERROR) {
+    }
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL error 0x%04x in %s", e, what);
+    return FOGVOL_ERROR_BACKEND;
+}
+
+static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_state s;
+    fogvol__GLuint tex = 0;
+    fogvol__GLint filt = d->filter == FOGVOL_FILTER_LINEAR ? FOGVOL__GL_LINEAR : FOGVOL__GL_NEAREST;
+    fogvol__GLint wrap = d->wrap == FOGVOL_WRAP_REPEAT ? FOGVOL__GL_REPEAT : FOGVOL__GL_CLAMP_TO_EDGE;
+    fogvol__gl_texture *t;
+    fogvol_result r;
+    *out = 0;
+    t = (fogvol__gl_texture *)fogvol__alloc(&gl->alloc, sizeof *t);
+    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    fogvol__gl_enter(gl, &s);
+    gl->GetError();
+    gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
+    gl->GenTextures(1, &tex);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, filt);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, filt);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, wrap);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, wrap);
+    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
+                   d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, d->pixels);
+    r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
+    if (r != FOGVOL_SUCCESS) gl->DeleteTextures(1, &tex);
+    if (gl->in_frame) gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    fogvol__gl_leave(gl, &s);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(&gl->alloc, t);
+        return r;
+    }
+    t->tex = tex;
+    *out = (fogvol_handle)t;
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_texture *t = (fogvol__gl_texture *)h;
+    if (!t) return;
+    gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
+    fogvol__free(&gl->alloc, t);
+}
+
+static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_state s;
+    fogvol__gl_target *t;
+    fogvol__GLenum status;
+    fogvol_result r;
+    *out = 0;
+    t = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t);
+    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(t, 0, sizeof *t);
+    t->width = d->width;
+    t->height = d->height;
+    fogvol__gl_enter(gl, &s);
+    gl->GetError();
+    gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
+    gl->GenTextures(1, &t->base.tex);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, t->base.tex);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
+    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
+                   d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
+    gl->GenFramebuffers(1, &t->fbo);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D, t->base.tex, 0);
+    if (d->depth) {
+        gl->GenRenderbuffers(1, &t->depth);
+        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
+        gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
+                                gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
+                                d->width, d->height);
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    }
+    status = gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER);
+    r = fogvol__gl_check(gl, d->label ? d->label : "create_target");
+    if (r == FOGVOL_SUCCESS && status != FOGVOL__GL_FRAMEBUFFER_COMPLETE) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s: framebuffer incomplete (0x%04x) at %dx%d",
+                    d->label ? d->label : "target", status, d->width, d->height);
+        r = FOGVOL_ERROR_FRAMEBUFFER;
+    }
+    if (r != FOGVOL_SUCCESS) {
+        gl->DeleteFramebuffers(1, &t->fbo);
+        gl->DeleteTextures(1, &t->base.tex);
+        if (t->depth) gl->DeleteRenderbuffers(1, &t->depth);
+        fogvol__free(&gl->alloc, t);
+        t = NULL;
+    }
+    if (gl->in_frame) { /* the next pass rebinds what it needs; keep the saved renderbuffer binding */
+        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)gl->saved.renderbuffer);
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    }
+    fogvol__gl_leave(gl, &s);
+    if (t) *out = (fogvol_handle)t;
+    return r;
+}
+
+static void fogvol__gl_destroy_target(void *u, fogvol_handle h)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_target *t = (fogvol__gl_target *)h;
+    if (!t) return;
+    gl->DeleteFramebuffers(1, &t->fbo);
+    gl->DeleteTextures(1, &t->base.tex);
+    if (t->depth) gl->DeleteRenderbuffers(1, &t->depth);
+    fogvol__free(&gl->alloc, t);
+}
+
+static fogvol__GLuint fogvol__gl_shader(fogvol__gl *gl, fogvol__GLenum type, const char *const *src, int n,
+                                        const char *label, fogvol_result *r)
+{
+    fogvol__GLint ok = 0, len = 0;
+    fogvol__GLuint sh = gl->CreateShader(type);
+    gl->ShaderSource(sh, n, src, NULL);
+    gl->CompileShader(sh);
+    gl->GetShaderiv(sh, FOGVOL__GL_COMPILE_STATUS, &ok);
+    if (ok) return sh;
+    gl->GetShaderiv(sh, FOGVOL__GL_INFO_LOG_LENGTH, &len);
+    {
+        char buf[1024];
+        fogvol__GLsizei got = 0;
+        buf[0] = 0;
+        gl->GetShaderInfoLog(sh, (fogvol__GLsizei)sizeof buf, &got, buf);
+        buf[sizeof buf - 1] = 0;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %s shader (GLSL %s) failed to compile: %s", label,
+                    type == FOGVOL__GL_VERTEX_SHADER ? "vertex" : "fragment", fogvol_dialect_name(gl->dialect), buf);
+    }
+    gl->DeleteShader(sh);
+    *r = FOGVOL_ERROR_SHADER_COMPILE;
+    return 0;
+}
+
+static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_state s;
+    fogvol__gl_program *p;
+    fogvol__GLuint vs, fs;
+    fogvol__GLint ok = 0;
+    fogvol_result r = FOGVOL_SUCCESS;
+    const char *label = d->label ? d->label : "program";
+    int i;
+    *out = 0;
+    p = (fogvol__gl_program *)fogvol__alloc(&gl->alloc, sizeof *p);
+    if (!p) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(p, 0, sizeof *p);
+    fogvol__gl_enter(gl, &s);
+    vs = fogvol__gl_shader(gl, FOGVOL__GL_VERTEX_SHADER, d->vs, d->vs_count, label, &r);
+    fs = r == FOGVOL_SUCCESS ? fogvol__gl_shader(gl, FOGVOL__GL_FRAGMENT_SHADER, d->fs, d->fs_count, label, &r) : 0;
+    if (r == FOGVOL_SUCCESS) {
+        p->id = gl->CreateProgram();
+        gl->AttachShader(p->id, vs);
+        gl->AttachShader(p->id, fs);
+        gl->BindAttribLocation(p->id, 0, "fv_position");
+        gl->LinkProgram(p->id);
+        gl->GetProgramiv(p->id, FOGVOL__GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char buf[1024];
+            fogvol__GLsizei got = 0;
+            buf[0] = 0;
+            gl->GetProgramInfoLog(p->id, (fogvol__GLsizei)sizeof buf, &got, buf);
+            buf[sizeof buf - 1] = 0;
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s failed to link: %s", label, buf);
+            r = FOGVOL_ERROR_SHADER_LINK;
+            gl->DeleteProgram(p->id);
+        }
+    }
+    if (vs) gl->DeleteShader(vs);
+    if (fs) gl->DeleteShader(fs);
+    if (r == FOGVOL_SUCCESS) {
+        gl->UseProgram(p->id);
+        p->u_mvp = gl->GetUniformLocation(p->id, "fv_mvp");
+        p->u_depth = gl->GetUniformLocation(p->id, "fv_depth");
+        for (i = 0; i < FOGVOL_U_COUNT; ++i) p->u_vec[i] = gl->GetUniformLocation(p->id, fogvol_uniform_name((fogvol_uniform)i));
+        for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
+            if (d->samplers[i]) gl->Uniform1i(gl->GetUniformLocation(p->id, d->samplers[i]), i);
+        r = fogvol__gl_check(gl, label);
+        if (r != FOGVOL_SUCCESS) gl->DeleteProgram(p->id);
+        if (gl->in_frame) gl->UseProgram(gl->program ? gl->program->id : 0);
+    }
+    fogvol__gl_leave(gl, &s);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(&gl->alloc, p);
+        return r;
+    }
+    *out = (fogvol_handle)p;
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__gl_destroy_program(void *u, fogvol_handle h)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_program *p = (fogvol__gl_program *)h;
+    if (!p) return;
+    gl->DeleteProgram(p->id); /* deferred by GL while the engine's program is current: no state change */
+    if (gl->program == p) gl->program = NULL;
+    fogvol__free(&gl->alloc, p);
+}
+
+static void fogvol__gl_bind_mesh(fogvol__gl *gl, const fogvol__gl_mesh *m)
+{
+    if (gl->has_vao) {
+        gl->BindVertexArray(m->vao);
+    } else {
+        gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->EnableVertexAttribArray(0);
+        gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
+    }
+}
+
+static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const float *pos, int nv,
+                                       const uint32_t *idx, int ni)
+{
+    fogvol__gl_state s;
+    fogvol_result r;
+    void *tmp = NULL;
+    const void *data = idx;
+    size_t isz = 4;
+    int i;
+    memset(m, 0, sizeof *m);
+    m->count = ni;
+    m->index_type = FOGVOL__GL_UNSIGNED_INT;
+    if (idx && nv <= 65535) { /* 16-bit indices where they fit (GLES2 needs them) */
+        uint16_t *s16 = (uint16_t *)fogvol__alloc(&gl->alloc, sizeof(uint16_t) * (size_t)ni);
+        if (!s16) return FOGVOL_ERROR_OUT_OF_MEMORY;
+        for (i = 0; i < ni; ++i) s16[i] = (uint16_t)idx[i];
+        tmp = s16;
+        data = s16;
+        isz = 2;
+        m->index_type = FOGVOL__GL_UNSIGNED_SHORT;
+    } else if (idx && !gl->has_uint_index) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %d vertices need 32-bit indices, which this GLES2 lacks", nv);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    fogvol__gl_enter(gl, &s);
+    gl->GetError();
+    if (gl->has_vao) {
+        gl->GenVertexArrays(1, &m->vao);
+        gl->BindVertexArray(m->vao);
+    }
+    gl->GenBuffers(1, &m->vbo);
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
+    gl->BufferData(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLsizeiptr)(sizeof(float) * 3u * (size_t)nv), pos,
+                   FOGVOL__GL_STATIC_DRAW);
+    if (idx) {
+        gl->GenBuffers(1, &m->ibo);
+        gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
+        gl->BufferData(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLsizeiptr)(isz * (size_t)ni), data,
+                       FOGVOL__GL_STATIC_DRAW);
+    }
+    if (gl->has_vao) {
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->EnableVertexAttribArray(0);
+    }
+    r = fogvol__gl_check(gl, "create_mesh");
+    if (r != FOGVOL_SUCCESS) {
+        if (m->vao) gl->DeleteVertexArrays(1, &m->vao);
+        if (m->vbo) gl->DeleteBuffers(1, &m->vbo);
+        if (m->ibo) gl->DeleteBuffers(1, &m->ibo);
+    }
+    if (gl->in_frame) { /* restore the bindings the frame save knows about */
+        if (gl->has_vao) gl->BindVertexArray((fogvol__GLuint)gl->saved.vao);
+        else gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)gl->saved.element_buffer);
+        gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)gl->saved.array_buffer);
+    }
+    fogvol__gl_leave(gl, &s);
+    fogvol__free(&gl->alloc, tmp);
+    return r;
+}
+
+static void fogvol__gl_free_mesh(fogvol__gl *gl, fogvol__gl_mesh *m)
+{
+    if (m->vao) gl->DeleteVertexArrays(1, &m->vao);
+    if (m->vbo) gl->DeleteBuffers(1, &m->vbo);
+    if (m->ibo) gl->DeleteBuffers(1, &m->ibo);
+}
+
+static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_mesh *m;
+    fogvol_result r;
+    *out = 0;
+    m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
+    if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    r = fogvol__gl_upload(gl, m, d->positions, d->vertex_count, d->indices, d->index_count);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(&gl->alloc, m);
+        return r;
+    }
+    *out = (fogvol_handle)m;
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_mesh *m = (fogvol__gl_mesh *)h;
+    if (!m) return;
+    fogvol__gl_free_mesh(gl, m);
+    fogvol__free(&gl->alloc, m);
+}
+
+static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    const fogvol__gl_target *t = (const fogvol__gl_target *)p->target;
+    int i;
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
+    gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    gl->Disable(FOGVOL__GL_DITHER);
+    gl->Disable(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
+    gl->Disable(FOGVOL__GL_SAMPLE_COVERAGE);
+    gl->Disable(FOGVOL__GL_POLYGON_OFFSET_FILL);
+    if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
+    if (!gl->gles) {
+        gl->Disable(FOGVOL__GL_COLOR_LOGIC_OP);
+        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
+    }
+    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_ALPHA_TEST);
+    gl->ColorMask(1, 1, 1, 1);
+    if (p->clear) {
+        fogvol__GLbitfield bits = FOGVOL__GL_COLOR_BUFFER_BIT;
+        gl->ClearColor(p->clear_color[0], p->clear_color[1], p->clear_color[2], p->clear_color[3]);
+        if (t && t->depth) {
+            gl->DepthMask(1);
+            if (gl->gles) gl->ClearDepthf(1.0f);
+            else gl->ClearDepth(1.0);
+            bits |= FOGVOL__GL_DEPTH_BUFFER_BIT;
+        }
+        gl->Clear(bits);
+    }
+    switch (p->blend) {
+    case FOGVOL_PASS_BLEND_ADD:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
+        break;
+    case FOGVOL_PASS_BLEND_FOG:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA, FOGVOL__GL_ONE_MINUS_SRC_ALPHA, FOGVOL__GL_ZERO, FOGVOL__GL_ONE);
+        break;
+    case FOGVOL_PASS_BLEND_LIGHT:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA, FOGVOL__GL_ONE, FOGVOL__GL_ZERO, FOGVOL__GL_ONE);
+        break;
+    default: gl->Disable(FOGVOL__GL_BLEND); break;
+    }
+    gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+    if (p->cull == FOGVOL_CULL_NONE) {
+        gl->Disable(FOGVOL__GL_CULL_FACE);
+    } else {
+        gl->Enable(FOGVOL__GL_CULL_FACE);
+        gl->CullFace(p->cull == FOGVOL_CULL_FRONT ? FOGVOL__GL_FRONT : FOGVOL__GL_BACK);
+    }
+    gl->FrontFace(FOGVOL__GL_CCW);
+    fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
+    gl->DepthFunc(FOGVOL__GL_LESS);
+    gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
+    gl->guard = p->stencil_guard;
+    if (p->stencil_guard) {
+        gl->guard_bit = p->stencil_bit;
+        memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
+        gl->Enable(FOGVOL__GL_STENCIL_TEST);
+        gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
+        gl->ClearStencil(0);
+        gl->Enable(FOGVOL__GL_SCISSOR_TEST);
+        gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
+        gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
+        gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+        gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
+                                p->stencil_bit);
+        gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
+    } else {
+        gl->Disable(FOGVOL__GL_STENCIL_TEST);
+    }
+    gl->program = (fogvol__gl_program *)p->program;
+    gl->UseProgram(gl->program ? gl->program->id : 0);
+    if (gl->program)
+        for (i = 0; i < FOGVOL_U_COUNT; ++i)
+            if (gl->program->u_vec[i] >= 0) gl->Uniform4fv(gl->program->u_vec[i], 1, p->uniforms[i]);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        /* texture and target handles both start with the texture name */
+        fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, 0);
+    }
+}
+
+static void fogvol__gl_end_pass(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    if (!gl->guard) return;
+    /* leave the guard bit zero, as it was before the pass */
+    gl->Enable(FOGVOL__GL_SCISSOR_TEST);
+    gl->Scissor(gl->guard_box[0], gl->guard_box[1], gl->guard_box[2], gl->guard_box[3]);
+    gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, gl->guard_bit);
+    gl->ClearStencil(0);
+    gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    gl->Disable(FOGVOL__GL_STENCIL_TEST);
+    gl->guard = 0;
+}
+
+static void fogvol__gl_set_draw(void *u, const fogvol_draw *d)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    if (!gl->program) return;
+    if (gl->program->u_mvp >= 0) gl->UniformMatrix4fv(gl->program->u_mvp, 1, 0, d->mvp);
+    if (gl->program->u_depth >= 0) gl->Uniform4fv(gl->program->u_depth, 1, d->depth);
+    gl->FrontFace(d->front_cw ? FOGVOL__GL_CW : FOGVOL__GL_CCW);
+}
+
+static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    const fogvol__gl_mesh *m = (const fogvol__gl_mesh *)h;
+    if (!m) return;
+    fogvol__gl_set_draw(u, d);
+    fogvol__gl_bind_mesh(gl, m);
+    gl->DrawElements(FOGVOL__GL_TRIANGLES, m->count, m->index_type, NULL);
+}
+
+static void fogvol__gl_draw_fullscreen(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__gl_bind_mesh(gl, &gl->fullscreen);
+    gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
+}
+
+static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned char *rgba, size_t size)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    const fogvol__gl_target *t = (const fogvol__gl_target *)h;
+    fogvol__gl_state s;
+    fogvol_result r;
+    if (!t || !rgba || size < (size_t)t->width * (size_t)t->height * 4u) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    fogvol__gl_enter(gl, &s);
+    gl->GetError();
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
+    gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, rgba);
+    r = fogvol__gl_check(gl, "read_target");
+    fogvol__gl_leave(gl, &s);
+    return r;
+}
+
+static void fogvol__gl_destroy(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol_allocator a;
+    if (!gl) return;
+    fogvol__gl_free_mesh(gl, &gl->fullscreen);
+    a = gl->alloc;
+    fogvol__free(&a, gl);
+}
+
+/* Parse "M.m" at the first digit of s. */
+static void fogvol__parse_version(const char *s, int *major, int *minor)
+{
+    *major = *minor = 0;
+    if (!s) return;
+    while (*s && (*s < '0' || *s > '9')) ++s;
+    while (*s >= '0' && *s <= '9') *major = *major * 10 + (*s++ - '0');
+    if (*s == '.') ++s;
+    while (*s >= '0' && *s <= '9') *minor = *minor * 10 + (*s++ - '0');
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out)
+{
+    static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
+    fogvol__gl *gl;
+    fogvol_logger silent;
+    const char *ver, *ext = NULL;
+    const char *fbo_suffix = "";
+    fogvol_result r;
+    int need_vao;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    memset(&silent, 0, sizeof silent);
+    if (!logger) logger = &silent;
+    if (!desc || !desc->get_proc_address) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
+    if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(gl, 0, sizeof *gl);
+    if (alloc) gl->alloc = *alloc;
+    gl->log = *logger;
+
+#define FOGVOL__GL_LOAD(ret, name, params) \
+    gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
+    FOGVOL__GL_BASE(FOGVOL__GL_LOAD)
+#undef FOGVOL__GL_LOAD
+#define FOGVOL__GL_REQUIRE(ret, name, params) \
+    if (!gl->name) { \
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function gl%s is missing", #name); \
+        fogvol__free(alloc, gl); \
+        return FOGVOL_ERROR_MISSING_FUNCTION; \
+    }
+    FOGVOL__GL_BASE(FOGVOL__GL_REQUIRE)
+
+    ver = (const char *)gl->GetString(FOGVOL__GL_VERSION);
+    if (!ver) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: glGetString(GL_VERSION) returned NULL: no current context?");
+        fogvol__free(alloc, gl);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    gl->gles = strncmp(ver, "OpenGL ES", 9) == 0;
+    fogvol__parse_version(ver, &gl->major, &gl->minor);
+    if (!gl->gles && (gl->major > 3 || (gl->major == 3 && gl->minor >= 2))) {
+        fogvol__GLint mask = 0;
+        gl->GetIntegerv(FOGVOL__GL_CONTEXT_PROFILE_MASK, &mask);
+        gl->core = (mask & 1) != 0;
+    }
+    if (desc->version_major > 0) { /* treat the context as an older one */
+        gl->major = desc->version_major;
+        gl->minor = desc->version_minor;
+        gl->gles = desc->gles != 0;
+        if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
+    }
+    if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
+                    gl->gles ? "OpenGL ES" : "OpenGL", gl->major, gl->minor);
+        fogvol__free(alloc, gl);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    gl->has_split_fbo = gl->major >= 3;
+    gl->has_vao = gl->major >= 3;
+    gl->has_sampler = gl->gles ? gl->major >= 3 : (gl->major > 3 || (gl->major == 3 && gl->minor >= 3));
+    gl->has_pixel_buffers = gl->gles ? gl->major >= 3 : (gl->major > 2 || (gl->major == 2 && gl->minor >= 1));
+    gl->has_row_length = !gl->gles || gl->major >= 3;
+    gl->has_discard = gl->major >= 3;
+    gl->has_uint_index = !gl->gles || gl->major >= 3;
+    if (gl->major < 3) ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
+    if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(ext, "GL_OES_element_index_uint");
+    if (!gl->gles && gl->major < 3 && !fogvol__has_ext(ext, "GL_ARB_framebuffer_object")) {
+        if (!fogvol__has_ext(ext, "GL_EXT_framebuffer_object")) {
+            fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: GL %d.%d without framebuffer objects", gl->major, gl->minor);
+            fogvol__free(alloc, gl);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+        fbo_suffix = "EXT";
+    }
+    {
+        char name[64];
+#define FOGVOL__GL_LOAD_FBO(ret, nm, params) \
+    snprintf(name, sizeof name, "gl%s%s", #nm, fbo_suffix); \
+    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
+    if (!gl->nm) { \
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
+        fogvol__free(alloc, gl); \
+        return FOGVOL_ERROR_MISSING_FUNCTION; \
+    }
+        FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
+#undef FOGVOL__GL_LOAD_FBO
+    }
+#define FOGVOL__GL_LOAD(ret, name, params) \
+    gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
+    need_vao = gl->has_vao;
+    if (need_vao) {
+        FOGVOL__GL_VAO(FOGVOL__GL_LOAD)
+        FOGVOL__GL_VAO(FOGVOL__GL_REQUIRE)
+    }
+    if (gl->has_sampler) {
+        FOGVOL__GL_SAMPLER(FOGVOL__GL_LOAD)
+        FOGVOL__GL_SAMPLER(FOGVOL__GL_REQUIRE)
+    }
+    if (gl->gles) {
+        FOGVOL__GL_ES(FOGVOL__GL_LOAD)
+        FOGVOL__GL_ES(FOGVOL__GL_REQUIRE)
+    } else {
+        FOGVOL__GL_DESKTOP(FOGVOL__GL_LOAD)
+        FOGVOL__GL_DESKTOP(FOGVOL__GL_REQUIRE)
+    }
+#undef FOGVOL__GL_LOAD
+#undef FOGVOL__GL_REQUIRE
+
+    gl->dialect = desc->dialect;
+    if (gl->dialect == FOGVOL_GLSL_AUTO) {
+        if (gl->gles) gl->dialect = gl->major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
+        else if (gl->major > 3 || (gl->major == 3 && gl->minor >= 3)) gl->dialect = FOGVOL_GLSL_330;
+        else if (gl->major == 3 && gl->minor == 2) gl->dialect = FOGVOL_GLSL_150;
+        else if (gl->major == 3) gl->dialect = FOGVOL_GLSL_130;
+        else gl->dialect = gl->minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
+    }
+    gl->stencil_override = desc->stencil_bits;
+    r = fogvol__gl_upload(gl, &gl->fullscreen, tri, 3, NULL, 0);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(alloc, gl);
+        return r;
+    }
+    fogvol__log(logger, FOGVOL_LOG_INFO, "fogvol: GL backend on %s (%s%d.%d%s), GLSL %s", ver,
+                gl->gles ? "ES " : "", gl->major, gl->minor, gl->core ? " core" : "", fogvol_dialect_name(gl->dialect));
+
+    out->user_data = gl;
+    out->dialect = gl->dialect;
+    out->begin_frame = fogvol__gl_begin_frame;
+    out->end_frame = fogvol__gl_end_frame;
+    out->create_texture = fogvol__gl_create_texture;
+    out->destroy_texture = fogvol__gl_destroy_texture;
+    out->create_target = fogvol__gl_create_target;
+    out->destroy_target = fogvol__gl_destroy_target;
+    out->create_program = fogvol__gl_create_program;
+    out->destroy_program = fogvol__gl_destroy_program;
+    out->create_mesh = fogvol__gl_create_mesh;
+    out->destroy_mesh = fogvol__gl_destroy_mesh;
+    out->begin_pass = fogvol__gl_begin_pass;
+    out->set_draw = fogvol__gl_set_draw;
+    out->draw_mesh = fogvol__gl_draw_mesh;
+    out->draw_fullscreen = fogvol__gl_draw_fullscreen;
+    out->end_pass = fogvol__gl_end_pass;
+    out->read_target = fogvol__gl_read_target;
+    out->destroy = fogvol__gl_destroy;
+    return FOGVOL_SUCCESS;
+}
+
+#endif /* FOGVOL_NO_GL */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FOGVOL_IMPLEMENTATION_DONE */
+#endif /* FOGVOL_IMPLEMENTATION */
+
+/*
+   REVISION HISTORY
+     0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
+                       colour-ramp textures, mesh validation, PS20 renderer, GL backend,
+                       recording null backend.
+
+   ------------------------------------------------------------------------------
+   This software is available under 2 licenses -- choose whichever you prefer.
+   ------------------------------------------------------------------------------
+   ALTERNATIVE A - MIT License
+   Copyright (c) 2026 the fogvol.h authors
+   Permission is hereby granted, free of charge, to any person obtaining a copy of
+   this software and associated documentation files (the "Software"), to deal in
+   the Software without restriction, including without limitation the rights to
+   use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+   of the Software, and to permit persons to whom the Software is furnished to do
+   so, subject to the following conditions:
+   The above copyright notice and this permission notice shall be included in all
+   copies or substantial portions of the Software.
+   THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+   IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+   FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+   AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+   LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+   OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+   SOFTWARE.
+   ------------------------------------------------------------------------------
+   ALTERNATIVE B - Public Domain (www.unlicense.org)
+   This is free and unencumbered software released into the public domain.
+   Anyone is free to copy, modify, publish, use, compile, sell, or distribute this
+   software, either in source code form or as a compiled binary, for any purpose,
+   commercial or non-commercial, and by any means.
+   In jurisdictions that recognize copyright laws, the author or authors of this
+   software dedicate any and all copyright interest in the software to the public
+   domain. We make this dedication for the benefit of the public at large and to
+   the detriment of our heirs and successors. We intend this dedication to be an
+   overt act of relinquishment in perpetuity of all present and future rights to
+   this software under copyright law.
+   THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+   IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+   FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+   AUTHORS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER LIABILITY, WHETHER IN AN
+   ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM, OUT OF OR IN CONNECTION
+   WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE SOFTWARE.
+   ------------------------------------------------------------------------------
+*/
