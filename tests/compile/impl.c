@@ -1,0 +1,3 @@
+/* Translation unit holding the implementation (two-TU build). */
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The header compiles clean (-Wall -Wextra -pedantic -Werror) as C99, C11, C++11,
+# C++17 with gcc and clang: implementation in one TU, static mode, FOGVOL_NO_GL,
+# and implementation in one of two TUs (linked and run).
+set -u
+out=${BUILD:-build}/compile
+mkdir -p "$out"
+n=0
+check() { # description, command...
+  n=$((n + 1)); desc=$1; shift
+  if msg=$("$@" 2>&1); then echo "ok $n - $desc"; else echo "not ok $n - $desc"; echo "$msg" | head -20 | sed 's/^/#   /'; fi
+}
+flags="-Wall -Wextra -pedantic -Werror -I."
+for cc in gcc clang g++ clang++; do
+  case $cc in *++) stds="c++11 c++17"; lang="-x c++";; *) stds="c99 c11"; lang="";; esac
+  for std in $stds; do
+    tag="$cc-$std"
+    check "$tag single TU" $cc -std=$std $flags $lang tests/compile/single.c -o "$out/single-$tag" -lm
+    check "$tag static" $cc -std=$std $flags $lang -DFOGVOL_STATIC tests/compile/single.c -o "$out/static-$tag" -lm
+    check "$tag FOGVOL_NO_GL" $cc -std=$std $flags $lang -DFOGVOL_NO_GL tests/compile/single.c -o "$out/nogl-$tag" -lm
+    check "$tag two TUs" bash -c "$cc -std=$std $flags $lang -c tests/compile/impl.c -o $out/impl-$tag.o && \
+      $cc -std=$std $flags $lang -c tests/compile/user.c -o $out/user-$tag.o && \
+      $cc $out/impl-$tag.o $out/user-$tag.o -o $out/two-$tag -lm && $out/two-$tag >/dev/null"
+  done
+done
+echo "1..$n"

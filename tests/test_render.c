@@ -1,0 +1,514 @@
+/* test_render.c - fogvol's PS20 renderer and GL backend under OSMesa, against
+   ground truth ray-cast in the test (tests/raycast.h) from the very triangles
+   that are drawn: per pixel, the w-extent inside the meshes between the near
+   plane and the nearest opaque surface.
+
+   Every scene runs in a 3.3 core context and in a compatibility context
+   treated as GL 2.1 (GLSL 120, no VAO), with dithering off and on.
+   Errors are in LSBs of the encoding ((far - near) / 2^(3L)) over interior
+   pixels (the one-pixel silhouette band excluded by rc_interior).
+   Images go to build/render/<scene>_<profile>.png: composite | thickness | error map. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#include "tests/gl_util.h"
+#include "tests/raycast.h"
+#include "tests/shapes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <sys/stat.h>
+
+#define W 128
+#define H 128
+#define MAX_OBJ 24
+
+typedef struct tobj {
+    shp_mesh mesh;
+    float model[16];
+    int sign; /* +1 volume, -1 negative volume, 0 occluder */
+} tobj;
+
+typedef struct tscene {
+    const char *name;
+    rc_camera cam;
+    tobj obj[MAX_OBJ];
+    int n;
+    int bits;
+    float density; /* extinction ramp density for the composite check */
+    int expect_overflow;
+} tscene;
+
+typedef struct tcase {
+    int scene;
+    int core;
+} tcase;
+
+/* measured per scene/profile for the closing table */
+typedef struct tstats {
+    double max_err, mean_abs, mean_per_pair, block_max;
+    double max_comp;
+    int interior, max_faces;
+} tstats;
+
+static tscene g_scenes[20];
+static int g_nscenes;
+static tstats g_stats[20][2];
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l <= FOGVOL_LOG_WARNING) print_message("  [fogvol %s] %s\n", l == 0 ? "error" : "warning", m);
+}
+
+static void mat_trs(float m[16], float tx, float ty, float tz, float ang, float ax, float ay, float az, float s)
+{
+    float t[16], r[16], sc[16], tmp[16];
+    shp_mat_translate(t, tx, ty, tz);
+    shp_mat_rotate(r, ang, ax, ay, az);
+    shp_mat_scale(sc, s, s, s);
+    shp_mat_mul(tmp, r, sc);
+    shp_mat_mul(m, t, tmp);
+}
+
+static tscene *new_scene(const char *name, double ex, double ey, double ez, double tx, double ty, double tz,
+                         double znear, double zfar)
+{
+    tscene *s = &g_scenes[g_nscenes++];
+    memset(s, 0, sizeof *s);
+    s->name = name;
+    s->cam.eye[0] = ex;
+    s->cam.eye[1] = ey;
+    s->cam.eye[2] = ez;
+    s->cam.target[0] = tx;
+    s->cam.target[1] = ty;
+    s->cam.target[2] = tz;
+    s->cam.up[1] = 1.0;
+    s->cam.fovy_deg = 50.0;
+    s->cam.aspect = (double)W / H;
+    s->cam.znear = znear;
+    s->cam.zfar = zfar;
+    s->cam.width = W;
+    s->cam.height = H;
+    s->bits = 4;
+    s->density = 0.8f;
+    return s;
+}
+
+static void add(tscene *s, shp_mesh m, int sign, const float model[16])
+{
+    tobj *o = &s->obj[s->n++];
+    o->mesh = m;
+    o->sign = sign;
+    memcpy(o->model, model, sizeof o->model);
+}
+
+static void build_scenes(void)
+{
+    float m[16];
+    tscene *s;
+    int i;
+
+    s = new_scene("sphere", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    shp_mat_identity(m);
+    add(s, shp_sphere(1.0f, 64, 32), 1, m);
+
+    s = new_scene("box", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 35, 0.3f, 1, 0.2f, 1);
+    add(s, shp_box(0.9f, 0.6f, 0.8f), 1, m);
+
+    s = new_scene("torus_edge_on", 0, 0.15, 4.5, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 90, 1, 0, 0, 1); /* ring in the xz plane: seen edge-on */
+    add(s, shp_torus(1.1f, 0.35f, 96, 32), 1, m);
+
+    s = new_scene("two_spheres", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    shp_mat_translate(m, -0.45f, 0, 0);
+    add(s, shp_sphere(0.85f, 64, 32), 1, m);
+    shp_mat_translate(m, 0.45f, 0.1f, -0.2f);
+    add(s, shp_sphere(0.85f, 64, 32), 1, m);
+
+    s = new_scene("torus_knot_L5", 0, 0.3, 4.2, 0, 0, 0, 0.5, 10);
+    s->bits = 5;
+    mat_trs(m, 0, 0, 0, 10, 1, 0, 0, 1);
+    add(s, shp_torus_knot(3, 4, 1.0f, 0.45f, 0.22f, 480, 20), 1, m);
+
+    /* one concave mesh (8 spheres along the view axis) whose central rays
+       cross 8 back and 8 front faces: the limit of the 15-bit encoding,
+       placed deep (d up to 0.93) so the channel sums come close to 255 */
+    s = new_scene("stack8_L5", 0, 0, 3.0, 0, 0, -6, 0.5, 14);
+    s->bits = 5;
+    s->density = 0.5f;
+    s->cam.fovy_deg = 12.0; /* the far spheres stay large on screen */
+    {
+        shp_mesh all = shp_sphere(0.3f, 32, 16);
+        for (i = 1; i < 8; ++i) {
+            shp_mesh one = shp_sphere(0.3f, 32, 16);
+            float t[16];
+            shp_mat_translate(t, 0, 0, -1.05f * (float)i);
+            shp_transform(&one, t);
+            shp_append(&all, &one);
+            shp_free(&one);
+        }
+        shp_mat_translate(m, 0, 0, -2.0f);
+        add(s, all, 1, m);
+    }
+
+    s = new_scene("plane_cuts_sphere", 0, 1.6, 3.6, 0, 0, 0, 0.5, 10);
+    shp_mat_identity(m);
+    add(s, shp_sphere(1.0f, 64, 32), 1, m);
+    mat_trs(m, 0, -0.25f, 0, -90, 1, 0, 0, 1); /* xy plane turned into a floor at y = -0.25 */
+    add(s, shp_grid_plane(3, 3, 4), 0, m);
+
+    s = new_scene("cube_inside_volume", 0.5, 0.8, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 20, 0, 1, 0, 1);
+    add(s, shp_box(1.1f, 0.9f, 1.0f), 1, m);
+    mat_trs(m, 0.1f, 0.05f, 0.1f, 40, 1, 1, 0, 1);
+    add(s, shp_box(0.35f, 0.35f, 0.35f), 0, m);
+
+    s = new_scene("negative_sphere_in_box", 0, 0.4, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 15, 0, 1, 0, 1);
+    add(s, shp_box(1.0f, 1.0f, 1.0f), 1, m);
+    shp_mat_translate(m, 0.1f, 0, 0);
+    add(s, shp_sphere(0.6f, 64, 32), -1, m);
+
+    s = new_scene("camera_inside_sphere", 0, 0, 0.6, 0, 0, -1, 0.2, 8);
+    shp_mat_identity(m);
+    add(s, shp_sphere(2.5f, 64, 32), 1, m);
+
+    s = new_scene("camera_half_inside_box", 1.0, 0.05, 0.4, 1.0, 0.05, -1, 0.2, 8);
+    shp_mat_identity(m);
+    add(s, shp_box(1.0f, 1.0f, 1.5f), 1, m);
+
+    /* 20 nested shells far from the camera: 20 back faces > 16 at L = 4, and
+       with depths near the far end the red channel saturates. */
+    s = new_scene("overflow_shells", 0, 0, 9, 0, 0, 0, 0.5, 10);
+    s->expect_overflow = 1;
+    for (i = 0; i < 20; ++i) {
+        shp_mat_identity(m);
+        add(s, shp_sphere(0.3f + 0.03f * (float)i, 32, 16), 1, m);
+    }
+}
+
+static void free_scenes(void)
+{
+    int i, j;
+    for (i = 0; i < g_nscenes; ++i)
+        for (j = 0; j < g_scenes[i].n; ++j) shp_free(&g_scenes[i].obj[j].mesh);
+}
+
+typedef struct frame_out {
+    float *thick;          /* decoded thickness (debug read-back) */
+    unsigned char *pixels; /* engine framebuffer after the composite */
+    fogvol_result result;
+    fogvol_frame_stats stats;
+} frame_out;
+
+static const float g_scene_rgb[3] = {0.2f, 0.5f, 0.8f};
+static const float g_fog_rgb[3] = {0.9f, 0.6f, 0.3f};
+
+/* Render the scene with fogvol into the current OSMesa framebuffer. */
+static void render(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp, int dither,
+                   fogvol_composite comp, int show_overflow, glu_ctx *g, frame_out *out)
+{
+    fogvol_frame_desc fd;
+    int i;
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&s->cam, fd.view, fd.projection);
+    fd.znear = (float)s->cam.znear;
+    fd.zfar = (float)s->cam.zfar;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.composite = comp;
+    fd.show_overflow = show_overflow;
+    fd.debug_thickness = out->thick;
+    glClearColor(g_scene_rgb[0], g_scene_rgb[1], g_scene_rgb[2], 1.0f);
+    glClearStencil(0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    fogvol_set_dither(fv, dither);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    for (i = 0; i < s->n; ++i) {
+        if (s->obj[i].sign == 0) {
+            assert_int_equal(fogvol_add_occluder(fv, meshes[i], s->obj[i].model), FOGVOL_SUCCESS);
+        } else {
+            fogvol_volume_desc vd;
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = meshes[i];
+            vd.ramp = ramp;
+            vd.negative = s->obj[i].sign < 0;
+            memcpy(vd.model, s->obj[i].model, sizeof vd.model);
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        }
+    }
+    out->result = fogvol_end_frame(fv, &out->stats);
+    glFinish();
+    memcpy(out->pixels, g->pixels, (size_t)W * H * 4);
+}
+
+static unsigned char to8(double v) { return (unsigned char)(v < 0 ? 0 : v > 1 ? 255 : v * 255.0 + 0.5); }
+
+static void write_png(const char *name, const char *profile, const frame_out *f, const double *gt,
+                      const unsigned char *interior, double lsb, double tmax)
+{
+    unsigned char *img = (unsigned char *)calloc((size_t)W * 3 * H, 4);
+    char path[256];
+    int x, y;
+    for (y = 0; y < H; ++y)
+        for (x = 0; x < W; ++x) {
+            int i = y * W + x, row = H - 1 - y; /* PNG rows top to bottom */
+            unsigned char *a = img + ((size_t)row * W * 3 + x) * 4, *b = a + W * 4, *c = b + W * 4;
+            double e = (f->thick[i] - gt[i]) / lsb;
+            memcpy(a, f->pixels + i * 4, 4);
+            a[3] = 255;
+            b[0] = b[1] = b[2] = to8(f->thick[i] / tmax);
+            b[3] = 255;
+            if (!interior[i]) {
+                c[0] = c[1] = c[2] = 40;
+            } else {
+                c[0] = to8(e / 2.0);
+                c[1] = to8(1.0 - fabs(e) / 2.0) / 2;
+                c[2] = to8(-e / 2.0);
+            }
+            c[3] = 255;
+        }
+    mkdir("build", 0777);
+    mkdir("build/render", 0777);
+    snprintf(path, sizeof path, "build/render/%s_%s.png", name, profile);
+    stbi_write_png(path, W * 3, H, 4, img, W * 3 * 4);
+    free(img);
+}
+
+static void run_case(void **state)
+{
+    const tcase *tc = (const tcase *)*state;
+    const tscene *s = &g_scenes[tc->scene];
+    const char *profile = tc->core ? "core33" : "gl21";
+    glu_ctx g;
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp = NULL;
+    fogvol_ramp_desc rd;
+    rc_object ro[MAX_OBJ];
+    rc_scene rs;
+    double *gt = (double *)calloc((size_t)W * H, sizeof(double)), lsb, sum_abs = 0, sum_pp = 0, max_err = 0,
+           block_max = 0,
+           max_comp = 0, tmax = 0;
+    int *pairs = (int *)calloc((size_t)W * H, sizeof(int)), i, x, y, ninterior = 0, max_faces = 0, bad = 0;
+    unsigned char *interior = (unsigned char *)calloc((size_t)W * H, 1);
+    unsigned char *covered = (unsigned char *)calloc((size_t)W * H, 1); /* a volume face on the ray */
+    frame_out f0, f1, fg;
+    tstats *st = &g_stats[tc->scene][tc->core];
+
+    f0.thick = (float *)calloc((size_t)W * H, sizeof(float));
+    f1.thick = (float *)calloc((size_t)W * H, sizeof(float));
+    fg.thick = (float *)calloc((size_t)W * H, sizeof(float));
+    f0.pixels = (unsigned char *)malloc((size_t)W * H * 4);
+    f1.pixels = (unsigned char *)malloc((size_t)W * H * 4);
+    fg.pixels = (unsigned char *)malloc((size_t)W * H * 4);
+
+    /* ground truth */
+    for (i = 0; i < s->n; ++i) {
+        ro[i].pos = s->obj[i].mesh.pos;
+        ro[i].vcount = s->obj[i].mesh.vcount;
+        ro[i].idx = s->obj[i].mesh.idx;
+        ro[i].icount = s->obj[i].mesh.icount;
+        memcpy(ro[i].model, s->obj[i].model, sizeof ro[i].model);
+        ro[i].sign = s->obj[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, s->n));
+    for (y = 0; y < H; ++y)
+        for (x = 0; x < W; ++x) {
+            rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);
+            int k = y * W + x;
+            gt[k] = r.thickness;
+            pairs[k] = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            covered[k] = r.faces_front + r.faces_back > 0;
+            if (pairs[k] < 1) pairs[k] = 1;
+            interior[k] = (unsigned char)rc_interior(&rs, &s->cam, x, y);
+            if (r.faces_back > max_faces) max_faces = r.faces_back;
+            if (r.faces_front > max_faces) max_faces = r.faces_front;
+            if (gt[k] > tmax) tmax = gt[k];
+        }
+    rc_scene_free(&rs);
+    lsb = (s->cam.zfar - s->cam.znear) / pow(2.0, 3.0 * s->bits);
+
+    /* fogvol */
+    assert_true(glu_create(&g, W, H, tc->core));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.encoding_bits = s->bits;
+    if (!tc->core) {
+        cd.gl.version_major = 2;
+        cd.gl.version_minor = 1;
+    }
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    for (i = 0; i < s->n; ++i) {
+        fogvol_mesh_desc md;
+        memset(&md, 0, sizeof md);
+        md.positions = s->obj[i].mesh.pos;
+        md.vertex_count = s->obj[i].mesh.vcount;
+        md.indices = (const uint32_t *)s->obj[i].mesh.idx;
+        md.index_count = s->obj[i].mesh.icount;
+        md.allow_open = s->obj[i].sign == 0;
+        assert_int_equal(fogvol_create_mesh(fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
+    }
+    memset(&rd, 0, sizeof rd);
+    memcpy(rd.color, g_fog_rgb, sizeof rd.color);
+    rd.density = s->density;
+    rd.width = 1024;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+
+    render(fv, s, meshes, ramp, 0, FOGVOL_COMPOSITE_FULLSCREEN, 0, &g, &f0);
+    render(fv, s, meshes, ramp, 1, FOGVOL_COMPOSITE_FULLSCREEN, 0, &g, &f1);
+    render(fv, s, meshes, ramp, 1, FOGVOL_COMPOSITE_GEOMETRY, s->expect_overflow, &g, &fg);
+
+    if (s->expect_overflow) {
+        /* the saturated pixels are reported, and painted magenta when asked */
+        int magenta = 0, deep = 0;
+        assert_int_equal(f0.result, FOGVOL_ERROR_DEPTH_OVERFLOW);
+        assert_true(f0.stats.overflow_pixels > 0);
+        for (i = 0; i < W * H; ++i) {
+            const unsigned char *p = fg.pixels + 4 * i;
+            magenta += p[0] == 255 && p[1] == 0 && p[2] == 255;
+        }
+        for (i = 0; i < W * H; ++i) deep += pairs[i] > 16;
+        print_message("  %s/%s: %d pixels cross > 16 faces, %d reported saturated, %d painted magenta\n", s->name,
+                      profile, deep, f0.stats.overflow_pixels, magenta);
+        assert_true(magenta > 0);
+        assert_int_equal(magenta, f0.stats.overflow_pixels);
+        /* not silently wrong: every pixel that is not flagged is within the error bound */
+        for (i = 0; i < W * H; ++i) {
+            const unsigned char *p = fg.pixels + 4 * i;
+            int flagged = p[0] == 255 && p[1] == 0 && p[2] == 255;
+            if (!interior[i] || flagged) continue;
+            if (fabs(f0.thick[i] - gt[i]) / lsb > pairs[i] + 1e-3) ++bad;
+            if (pairs[i] > 16) ++max_faces; /* reused as: deep pixels that stayed exact */
+        }
+        print_message("  %s/%s: %d unflagged pixels beyond 16 faces, all exact; %d unflagged pixels off\n", s->name,
+                      profile, max_faces, bad);
+        assert_int_equal(bad, 0);
+        write_png(s->name, profile, &fg, gt, interior, lsb, tmax > 0 ? tmax : 1);
+        goto cleanup;
+    }
+    assert_int_equal(f0.result, FOGVOL_SUCCESS);
+    assert_int_equal(f1.result, FOGVOL_SUCCESS);
+    assert_int_equal(fg.result, FOGVOL_SUCCESS);
+
+    /* dither off: |err| <= 1 LSB per pair of faces everywhere, mean |err| <= 0.5 LSB
+       over the interior pixels that a volume covers */
+    for (i = 0; i < W * H; ++i) {
+        double e;
+        if (!interior[i]) continue;
+        e = fabs(f0.thick[i] - gt[i]) / lsb;
+        if (covered[i]) {
+            ++ninterior;
+            sum_abs += e;
+            sum_pp += e / pairs[i];
+        }
+        if (e > max_err) max_err = e;
+        if (e > pairs[i] + 1e-3) {
+            if (bad < 5)
+                print_message("  %s/%s pixel (%d,%d): %.4f vs %.4f = %.2f LSB with %d pairs\n", s->name, profile,
+                              i % W, i / W, f0.thick[i], gt[i], e, pairs[i]);
+            ++bad;
+        }
+    }
+    /* dither on: signed error averaged over fully interior 8x8 blocks <= 0.25 LSB */
+    for (y = 0; y + 8 <= H; y += 8)
+        for (x = 0; x + 8 <= W; x += 8) {
+            double acc = 0;
+            int full = 1, xx, yy, nonzero = 0;
+            for (yy = y; yy < y + 8; ++yy)
+                for (xx = x; xx < x + 8; ++xx) {
+                    int k = yy * W + xx;
+                    full &= interior[k];
+                    nonzero |= covered[k];
+                    acc += (f1.thick[k] - gt[k]) / lsb;
+                }
+            if (full && nonzero && fabs(acc / 64) > block_max) block_max = fabs(acc / 64);
+        }
+    /* composite: colour = mix(scene, fog, 1 - exp(-density * t)) within 2/255 (dither on) */
+    for (i = 0; i < W * H; ++i) {
+        double a = 1.0 - exp(-(double)s->density * (gt[i] > 0 ? gt[i] : 0)), worst = 0;
+        int c;
+        if (!interior[i] || gt[i] <= 0) continue;
+        for (c = 0; c < 3; ++c) {
+            double want = g_scene_rgb[c] + (g_fog_rgb[c] - g_scene_rgb[c]) * a;
+            double got = f1.pixels[4 * i + c] / 255.0, d = fabs(got - want);
+            if (d > worst) worst = d;
+        }
+        if (worst > max_comp) max_comp = worst;
+    }
+    /* geometry composite (stencil guard: one blend per pixel) gives the same picture */
+    {
+        int diff = 0;
+        for (i = 0; i < W * H * 4; ++i)
+            if (abs((int)fg.pixels[i] - (int)f1.pixels[i]) > 0) ++diff;
+        print_message("  %s/%s: geometry vs full-screen composite: %d differing bytes\n", s->name, profile, diff);
+        assert_int_equal(diff, 0);
+    }
+
+    st->max_err = max_err;
+    st->mean_abs = ninterior ? sum_abs / ninterior : 0;
+    st->mean_per_pair = ninterior ? sum_pp / ninterior : 0;
+    st->block_max = block_max;
+    st->max_comp = max_comp * 255.0;
+    st->interior = ninterior;
+    st->max_faces = max_faces;
+    print_message("  %-24s %-6s L=%d covered %5d max faces %2d | no dither: max %.3f LSB mean %.3f LSB "
+                  "(%.3f per pair) | dither 8x8 max |mean| %.3f LSB | composite max %.2f/255\n",
+                  s->name, profile, s->bits, ninterior, max_faces, max_err, st->mean_abs, st->mean_per_pair,
+                  block_max, st->max_comp);
+    write_png(s->name, profile, &f1, gt, interior, lsb, tmax > 0 ? tmax : 1);
+    assert_true(ninterior > 200);
+    assert_int_equal(bad, 0);
+    assert_true(st->mean_per_pair <= 0.5); /* the raw mean when every ray crosses one pair */
+    assert_true(block_max <= 0.25);
+    assert_true(max_comp <= 2.0 / 255.0);
+
+cleanup:
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free(gt);
+    free(pairs);
+    free(interior);
+    free(covered);
+    free(f0.thick);
+    free(f1.thick);
+    free(fg.thick);
+    free(f0.pixels);
+    free(f1.pixels);
+    free(fg.pixels);
+}
+
+int main(void)
+{
+    static tcase cases[32];
+    struct CMUnitTest tests[32];
+    char names[32][64];
+    int i, n = 0, rc;
+    build_scenes();
+    for (i = 0; i < g_nscenes; ++i) {
+        int core;
+        for (core = 1; core >= 0; --core) {
+            cases[n].scene = i;
+            cases[n].core = core;
+            snprintf(names[n], sizeof names[n], "%s_%s", g_scenes[i].name, core ? "core33" : "gl21");
+            memset(&tests[n], 0, sizeof tests[n]);
+            tests[n].name = names[n];
+            tests[n].test_func = run_case;
+            tests[n].initial_state = &cases[n];
+            ++n;
+        }
+    }
+    rc = _cmocka_run_group_tests("render", tests, (size_t)n, NULL, NULL);
+    free_scenes();
+    return rc;
+}

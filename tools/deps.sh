@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the tests and examples need, only when missing.
+# Usage: tools/deps.sh test|demo|run
+set -euo pipefail
+what=${1:-test}
+pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev"
+pkgs_demo="gcc make libosmesa6-dev libstb-dev"
+pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth"
+case "$what" in
+  test) pkgs="$pkgs_test" ;;
+  demo) pkgs="$pkgs_demo" ;;
+  run) pkgs="$pkgs_run" ;;
+  *) echo "usage: $0 test|demo|run" >&2; exit 2 ;;
+esac
+missing=()
+for p in $pkgs; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "deps: installing ${missing[*]}"
+sudo=""
+if [ "$(id -u)" != 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then sudo="sudo"; else
+    echo "deps: missing packages ${missing[*]}; run as root or install them with apt-get" >&2; exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
