@@ -193,9 +193,11 @@ typedef struct fogvol_encoding {
 
 /* Fill *out for L = bits (1..8). */
 FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits);
-/* Most precise encoding that sums at least max_faces faces (1..128). */
+/* Most precise encoding that sums at least max_faces faces (1..128).
+   max_faces < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 128: FOGVOL_ERROR_UNSUPPORTED. */
 FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces);
-/* Encoding with the most faces that still gives at least precision_bits (1..24). */
+/* Encoding with the most faces that still gives at least precision_bits (1..24).
+   precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
 FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits);
 /* The table of every L = 1..8 (the seed's Figure 3). Returns the row count (8);
    writes min(count, capacity) rows when rows != NULL. */
@@ -975,7 +977,8 @@ FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, un
 
 static unsigned char fogvol__unorm8(double v)
 {
-    v = v < 0 ? 0 : (v > 1 ? 1 : v);
+    if (!(v > 0)) return 0; /* also NaN */
+    if (v > 1) v = 1;
     return (unsigned char)(v * 255.0 + 0.5);
 }
 
@@ -1047,6 +1050,7 @@ FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, un
     if (r != FOGVOL_SUCCESS) return r;
     w = desc->width ? desc->width : 256;
     tmax = fogvol__ramp_max_thickness(desc);
+    if (!fogvol__finite(tmax) || !(tmax > 0)) return FOGVOL_ERROR_INVALID_ARGUMENT; /* 7/density overflowed */
     if (max_thickness_out) *max_thickness_out = (float)tmax;
     r = fogvol__image_check(w, 1, pixels, capacity, info);
     if (r != FOGVOL_SUCCESS || !pixels) return r;
@@ -2509,7 +2513,8 @@ enum {
 /* Desktop only. */
 #define FOGVOL__GL_DESKTOP(X) \
     X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
-    X(void, ClearDepth, (fogvol__GLdouble))
+    X(void, ClearDepth, (fogvol__GLdouble)) \
+    X(void, GetDoublev, (fogvol__GLenum, fogvol__GLdouble *))
 
 /* GLES only. */
 #define FOGVOL__GL_ES(X) X(void, ClearDepthf, (fogvol__GLfloat))
@@ -2529,6 +2534,7 @@ typedef struct fogvol__gl_state {
     fogvol__GLint depth_func, cull_mode, front_face, polygon_mode[2];
     fogvol__GLboolean depth_mask, color_mask[4];
     fogvol__GLfloat clear_color[4], clear_depth;
+    fogvol__GLdouble clear_depth_d; /* desktop: kept in double so it comes back exactly */
     fogvol__GLint st_func, st_ref, st_vmask, st_fail, st_zfail, st_zpass, st_wmask;
     fogvol__GLint stb_func, stb_ref, stb_vmask, stb_fail, stb_zfail, stb_zpass, stb_wmask, st_clear;
     fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
@@ -2642,7 +2648,8 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
     gl->GetBooleanv(FOGVOL__GL_DEPTH_WRITEMASK, &s->depth_mask);
     gl->GetBooleanv(FOGVOL__GL_COLOR_WRITEMASK, s->color_mask);
     gl->GetFloatv(FOGVOL__GL_COLOR_CLEAR_VALUE, s->clear_color);
-    gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
+    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
+    else gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
     gl->GetIntegerv(FOGVOL__GL_STENCIL_FUNC, &s->st_func);
     gl->GetIntegerv(FOGVOL__GL_STENCIL_REF, &s->st_ref);
     gl->GetIntegerv(FOGVOL__GL_STENCIL_VALUE_MASK, &s->st_vmask);
@@ -2732,7 +2739,7 @@ static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
     gl->ColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
     gl->ClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
     if (gl->gles) gl->ClearDepthf(s->clear_depth);
-    else gl->ClearDepth(s->clear_depth);
+    else gl->ClearDepth(s->clear_depth_d);
     gl->StencilFuncSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_func, s->st_ref, (fogvol__GLuint)s->st_vmask);
     gl->StencilOpSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_fail, (fogvol__GLenum)s->st_zfail,
                           (fogvol__GLenum)s->st_zpass);
@@ -3395,6 +3402,9 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         }
         fbo_suffix = "EXT";
     }
+    if (!gl->gles && gl->major < 3) /* ARB_framebuffer_object / EXT_framebuffer_blit: separate read and draw */
+        gl->has_split_fbo = fogvol__has_ext(ext, "GL_ARB_framebuffer_object") ||
+                            fogvol__has_ext(ext, "GL_EXT_framebuffer_blit");
     {
         char name[64];
 #define FOGVOL__GL_LOAD_FBO(ret, nm, params) \

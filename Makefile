@@ -1,0 +1,83 @@
+# fogvol.h - tests, demo and examples. The library itself is fogvol.h alone.
+#   make test   build and run every test (installs missing Debian packages)
+#   make demo   render the headless demo into build/demo/*.png
+#   make images refresh the README pictures in docs/ from the demo
+CC      ?= cc
+BUILD   ?= build
+WARN     = -Wall -Wextra -pedantic -Werror
+CFLAGS  ?= -O2 -g
+SAN      = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+INC      = -I.
+GL_LIBS  = -lOSMesa -lm
+LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
+           UBSAN_OPTIONS=print_stacktrace=1
+TAP      = CMOCKA_MESSAGE_OUTPUT=TAP
+
+HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
+
+.PHONY: all test demo images deps-test deps-demo clean
+
+all: test
+
+deps-test:
+	@tools/deps.sh test
+deps-demo:
+	@tools/deps.sh demo
+
+$(BUILD):
+	@mkdir -p $(BUILD)
+
+# --- test programs: plain and under ASan+UBSan ---------------------------------
+$(BUILD)/test_cpu: tests/test_cpu.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lm
+$(BUILD)/test_cpu_cpp: tests/test_cpu.c fogvol.h | $(BUILD)
+	$(CXX) -x c++ -std=c++11 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lm
+$(BUILD)/test_cpu_san: tests/test_cpu.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka -lm
+$(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
+$(BUILD)/test_render: tests/test_render.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_render_san: tests/test_render.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_glstate: tests/test_glstate.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_glstate_san: tests/test_glstate.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
+
+TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
+            $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
+            $(BUILD)/dump_shaders
+
+test: deps-test
+	@$(MAKE) --no-print-directory $(TEST_BINS)
+	@LOGDIR=$(BUILD)/logs tests/run.sh \
+	  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
+	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
+	  "cpu=$(TAP) $(BUILD)/test_cpu" \
+	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
+	  "cpu_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_cpu_san" \
+	  "raycast_selftest=$(BUILD)/test_raycast" \
+	  "render=$(TAP) $(BUILD)/test_render" \
+	  "render_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_render_san" \
+	  "glstate=$(TAP) $(BUILD)/test_glstate" \
+	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san"
+
+# --- demo --------------------------------------------------------------------------
+$(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+demo: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
+	@$(BUILD)/demo_headless $(BUILD)/demo
+
+# the README pictures, regenerated from the demo
+images: demo
+	@mkdir -p docs
+	cp $(BUILD)/demo/scene_overview.png docs/demo_overview.png
+	cp $(BUILD)/demo/scene_inside_fog_bank.png docs/demo_inside_fog_bank.png
+
+clean:
+	rm -rf $(BUILD)
