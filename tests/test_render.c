@@ -16,7 +16,9 @@
 
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
 #include "tests/gl_util.h"
+#include <GL/glext.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -55,14 +57,21 @@ typedef struct tstats {
     int interior, max_faces;
 } tstats;
 
-static tscene g_scenes[20];
+static tscene g_scenes[24];
 static int g_nscenes;
-static tstats g_stats[20][2];
+static tstats g_stats[24][2];
 
 static void logger(void *u, fogvol_log_level l, const char *m)
 {
     (void)u;
     if (l <= FOGVOL_LOG_WARNING) print_message("  [fogvol %s] %s\n", l == 0 ? "error" : "warning", m);
+}
+
+static int mirrored(const float m[16])
+{
+    double d = (double)m[0] * (m[5] * m[10] - m[9] * m[6]) - (double)m[4] * (m[1] * m[10] - m[9] * m[2]) +
+               (double)m[8] * (m[1] * m[6] - m[5] * m[2]);
+    return d < 0;
 }
 
 static void mat_trs(float m[16], float tx, float ty, float tz, float ang, float ax, float ay, float az, float s)
@@ -175,6 +184,17 @@ static void build_scenes(void)
     shp_mat_translate(m, 0.1f, 0, 0);
     add(s, shp_sphere(0.6f, 64, 32), -1, m);
 
+    /* a mirroring model matrix (negative determinant) flips the winding: fogvol
+       must flip its face culling, the solid is the same */
+    s = new_scene("mirrored_box", 0, 0.3, 4, 0, 0, 0, 0.5, 10);
+    {
+        float r[16], sc[16];
+        shp_mat_rotate(r, 30, 0.2f, 1, 0);
+        shp_mat_scale(sc, -1.0f, 1.0f, 1.0f);
+        shp_mat_mul(m, r, sc);
+    }
+    add(s, shp_box(0.9f, 0.6f, 0.7f), 1, m);
+
     s = new_scene("camera_inside_sphere", 0, 0, 0.6, 0, 0, -1, 0.2, 8);
     shp_mat_identity(m);
     add(s, shp_sphere(2.5f, 64, 32), 1, m);
@@ -209,6 +229,52 @@ typedef struct frame_out {
 
 static const float g_scene_rgb[3] = {0.2f, 0.5f, 0.8f};
 static const float g_fog_rgb[3] = {0.9f, 0.6f, 0.3f};
+
+/* An OSMesa context, a fogvol context with the scene's encoding, its meshes
+   uploaded, and an extinction ramp blended as fog or light. core = 0: a
+   compatibility context treated as GL 2.1 (GLSL 120, no VAO). */
+static void setup(const tscene *s, int core, fogvol_blend blend, glu_ctx *g, fogvol_context **fv,
+                  fogvol_mesh **meshes, fogvol_ramp **ramp)
+{
+    fogvol_context_desc cd;
+    fogvol_ramp_desc rd;
+    int i;
+    assert_true(glu_create(g, W, H, core));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.encoding_bits = s->bits;
+    if (!core) {
+        cd.gl.version_major = 2;
+        cd.gl.version_minor = 1;
+    }
+    assert_int_equal(fogvol_create_context(&cd, fv), FOGVOL_SUCCESS);
+    for (i = 0; i < s->n; ++i) {
+        fogvol_mesh_desc md;
+        memset(&md, 0, sizeof md);
+        md.positions = s->obj[i].mesh.pos;
+        md.vertex_count = s->obj[i].mesh.vcount;
+        md.indices = (const uint32_t *)s->obj[i].mesh.idx;
+        md.index_count = s->obj[i].mesh.icount;
+        md.allow_open = s->obj[i].sign == 0;
+        assert_int_equal(fogvol_create_mesh(*fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
+    }
+    memset(&rd, 0, sizeof rd);
+    memcpy(rd.color, g_fog_rgb, sizeof rd.color);
+    rd.density = s->density;
+    rd.width = 1024;
+    rd.blend = blend;
+    assert_int_equal(fogvol_create_ramp(*fv, &rd, ramp), FOGVOL_SUCCESS);
+}
+
+static void teardown(const tscene *s, glu_ctx *g, fogvol_context *fv, fogvol_mesh **meshes, fogvol_ramp *ramp)
+{
+    int i;
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(g);
+}
 
 /* Render the scene with fogvol into the current OSMesa framebuffer. */
 static void render(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp, int dither,
@@ -281,19 +347,65 @@ static void write_png(const char *name, const char *profile, const frame_out *f,
     free(img);
 }
 
+/* Ground truth for every pixel centre: thickness, pairs of faces crossed,
+   interior mask (rc_interior), covered mask (a volume face on the ray). */
+static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char *interior, unsigned char *covered,
+                         int *max_faces, double *tmax)
+{
+    rc_object ro[MAX_OBJ];
+    unsigned *reversed[MAX_OBJ] = {0};
+    rc_scene rs;
+    int i, x, y;
+    *max_faces = 0;
+    *tmax = 0;
+    /* ground truth; a mirrored instance is the same solid, so its triangles are
+       reversed for the ray caster, which reads orientation from the winding */
+    for (i = 0; i < s->n; ++i) {
+        ro[i].pos = s->obj[i].mesh.pos;
+        ro[i].vcount = s->obj[i].mesh.vcount;
+        ro[i].idx = s->obj[i].mesh.idx;
+        if (mirrored(s->obj[i].model)) {
+            unsigned *rev = (unsigned *)malloc(sizeof(unsigned) * (size_t)s->obj[i].mesh.icount);
+            int t;
+            for (t = 0; t < s->obj[i].mesh.icount; t += 3) {
+                rev[t] = s->obj[i].mesh.idx[t];
+                rev[t + 1] = s->obj[i].mesh.idx[t + 2];
+                rev[t + 2] = s->obj[i].mesh.idx[t + 1];
+            }
+            ro[i].idx = rev;
+            reversed[i] = rev;
+        }
+        ro[i].icount = s->obj[i].mesh.icount;
+        memcpy(ro[i].model, s->obj[i].model, sizeof ro[i].model);
+        ro[i].sign = s->obj[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, s->n));
+    for (i = 0; i < s->n; ++i) free(reversed[i]);
+    for (y = 0; y < H; ++y)
+        for (x = 0; x < W; ++x) {
+            rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);
+            int k = y * W + x;
+            gt[k] = r.thickness;
+            pairs[k] = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            covered[k] = r.faces_front + r.faces_back > 0;
+            if (pairs[k] < 1) pairs[k] = 1;
+            interior[k] = (unsigned char)rc_interior(&rs, &s->cam, x, y);
+            if (r.faces_back > *max_faces) *max_faces = r.faces_back;
+            if (r.faces_front > *max_faces) *max_faces = r.faces_front;
+            if (gt[k] > *tmax) *tmax = gt[k];
+        }
+    rc_scene_free(&rs);
+}
+
 static void run_case(void **state)
 {
     const tcase *tc = (const tcase *)*state;
     const tscene *s = &g_scenes[tc->scene];
     const char *profile = tc->core ? "core33" : "gl21";
     glu_ctx g;
-    fogvol_context_desc cd;
     fogvol_context *fv = NULL;
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp = NULL;
-    fogvol_ramp_desc rd;
-    rc_object ro[MAX_OBJ];
-    rc_scene rs;
     double *gt = (double *)calloc((size_t)W * H, sizeof(double)), lsb, sum_abs = 0, sum_pp = 0, max_err = 0,
            block_max = 0,
            max_comp = 0, tmax = 0;
@@ -310,58 +422,11 @@ static void run_case(void **state)
     f1.pixels = (unsigned char *)malloc((size_t)W * H * 4);
     fg.pixels = (unsigned char *)malloc((size_t)W * H * 4);
 
-    /* ground truth */
-    for (i = 0; i < s->n; ++i) {
-        ro[i].pos = s->obj[i].mesh.pos;
-        ro[i].vcount = s->obj[i].mesh.vcount;
-        ro[i].idx = s->obj[i].mesh.idx;
-        ro[i].icount = s->obj[i].mesh.icount;
-        memcpy(ro[i].model, s->obj[i].model, sizeof ro[i].model);
-        ro[i].sign = s->obj[i].sign;
-    }
-    assert_true(rc_scene_init(&rs, ro, s->n));
-    for (y = 0; y < H; ++y)
-        for (x = 0; x < W; ++x) {
-            rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);
-            int k = y * W + x;
-            gt[k] = r.thickness;
-            pairs[k] = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
-            covered[k] = r.faces_front + r.faces_back > 0;
-            if (pairs[k] < 1) pairs[k] = 1;
-            interior[k] = (unsigned char)rc_interior(&rs, &s->cam, x, y);
-            if (r.faces_back > max_faces) max_faces = r.faces_back;
-            if (r.faces_front > max_faces) max_faces = r.faces_front;
-            if (gt[k] > tmax) tmax = gt[k];
-        }
-    rc_scene_free(&rs);
+    ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax);
     lsb = (s->cam.zfar - s->cam.znear) / pow(2.0, 3.0 * s->bits);
 
     /* fogvol */
-    assert_true(glu_create(&g, W, H, tc->core));
-    memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = logger;
-    cd.encoding_bits = s->bits;
-    if (!tc->core) {
-        cd.gl.version_major = 2;
-        cd.gl.version_minor = 1;
-    }
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    for (i = 0; i < s->n; ++i) {
-        fogvol_mesh_desc md;
-        memset(&md, 0, sizeof md);
-        md.positions = s->obj[i].mesh.pos;
-        md.vertex_count = s->obj[i].mesh.vcount;
-        md.indices = (const uint32_t *)s->obj[i].mesh.idx;
-        md.index_count = s->obj[i].mesh.icount;
-        md.allow_open = s->obj[i].sign == 0;
-        assert_int_equal(fogvol_create_mesh(fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
-    }
-    memset(&rd, 0, sizeof rd);
-    memcpy(rd.color, g_fog_rgb, sizeof rd.color);
-    rd.density = s->density;
-    rd.width = 1024;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    setup(s, tc->core, FOGVOL_BLEND_FOG, &g, &fv, meshes, &ramp);
 
     render(fv, s, meshes, ramp, 0, FOGVOL_COMPOSITE_FULLSCREEN, 0, &g, &f0);
     render(fv, s, meshes, ramp, 1, FOGVOL_COMPOSITE_FULLSCREEN, 0, &g, &f1);
@@ -472,10 +537,7 @@ static void run_case(void **state)
     assert_true(max_comp <= 2.0 / 255.0);
 
 cleanup:
-    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
-    glu_destroy(&g);
+    teardown(s, &g, fv, meshes, ramp);
     free(gt);
     free(pairs);
     free(interior);
@@ -488,11 +550,141 @@ cleanup:
     free(fg.pixels);
 }
 
+/* The engine draws the occluder itself, from its own VAO and element buffer,
+   inside fogvol's O pass. */
+typedef struct engine_occluder {
+    GLuint vao, vbo, ibo;
+    GLsizei count;
+    const float *model;
+    int calls;
+} engine_occluder;
+
+static void draw_engine_occluder(fogvol_context *fv, void *user)
+{
+    engine_occluder *eo = (engine_occluder *)user;
+    eo->calls++;
+    assert_int_equal(fogvol_occluder_transform(fv, eo->model), FOGVOL_SUCCESS);
+    glBindVertexArray(eo->vao);
+    glDrawElements(GL_TRIANGLES, eo->count, GL_UNSIGNED_INT, NULL);
+}
+
+static int scene_index(const char *name)
+{
+    int i;
+    for (i = 0; i < g_nscenes; ++i)
+        if (strcmp(g_scenes[i].name, name) == 0) return i;
+    fail_msg("no scene %s", name);
+    return 0;
+}
+
+/* Occluders through the engine callback give the same thickness, bit for bit,
+   as the same occluder mesh handed to fogvol; and the light blend adds
+   colour * (1 - exp(-density * t)) to the scene within 2/255. */
+static void test_callback_and_light(void **state)
+{
+    const tscene *s = &g_scenes[scene_index("plane_cuts_sphere")];
+    glu_ctx g;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    frame_out a, b;
+    engine_occluder eo;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    double *gt = (double *)calloc((size_t)W * H, sizeof(double)), tmax, worst = 0;
+    int *pairs = (int *)calloc((size_t)W * H, sizeof(int)), i, max_faces, n = 0, diff = 0, occ = -1, vol = -1;
+    unsigned char *interior = (unsigned char *)calloc((size_t)W * H, 1);
+    unsigned char *covered = (unsigned char *)calloc((size_t)W * H, 1);
+    (void)state;
+    a.thick = (float *)calloc((size_t)W * H, sizeof(float));
+    b.thick = (float *)calloc((size_t)W * H, sizeof(float));
+    a.pixels = (unsigned char *)malloc((size_t)W * H * 4);
+    b.pixels = (unsigned char *)malloc((size_t)W * H * 4);
+    ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax);
+    setup(s, 1, FOGVOL_BLEND_LIGHT, &g, &fv, meshes, &ramp);
+    render(fv, s, meshes, ramp, 1, FOGVOL_COMPOSITE_FULLSCREEN, 0, &g, &a);
+    assert_int_equal(a.result, FOGVOL_SUCCESS);
+
+    for (i = 0; i < s->n; ++i) {
+        if (s->obj[i].sign == 0) occ = i;
+        else vol = i;
+    }
+    memset(&eo, 0, sizeof eo);
+    eo.model = s->obj[occ].model;
+    eo.count = s->obj[occ].mesh.icount;
+    glGenVertexArrays(1, &eo.vao);
+    glBindVertexArray(eo.vao);
+    glGenBuffers(1, &eo.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, eo.vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 3 * (size_t)s->obj[occ].mesh.vcount),
+                 s->obj[occ].mesh.pos, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+    glEnableVertexAttribArray(0);
+    glGenBuffers(1, &eo.ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, eo.ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(unsigned) * (size_t)eo.count), s->obj[occ].mesh.idx,
+                 GL_STATIC_DRAW);
+    glBindVertexArray(0);
+
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&s->cam, fd.view, fd.projection);
+    fd.znear = (float)s->cam.znear;
+    fd.zfar = (float)s->cam.zfar;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.debug_thickness = b.thick;
+    glClearColor(g_scene_rgb[0], g_scene_rgb[1], g_scene_rgb[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_occluder_callback(fv, draw_engine_occluder, &eo), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = meshes[vol];
+    vd.ramp = ramp;
+    memcpy(vd.model, s->obj[vol].model, sizeof vd.model);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    glFinish();
+    memcpy(b.pixels, g.pixels, (size_t)W * H * 4);
+    assert_int_equal(eo.calls, 1);
+    assert_int_equal(fogvol_occluder_transform(fv, eo.model), FOGVOL_ERROR_INVALID_STATE); /* outside the pass */
+
+    for (i = 0; i < W * H; ++i) diff += a.thick[i] != b.thick[i];
+    for (i = 0; i < W * H; ++i) {
+        double al;
+        int c;
+        if (!interior[i] || !covered[i]) continue;
+        al = 1.0 - exp(-(double)s->density * (gt[i] > 0 ? gt[i] : 0));
+        for (c = 0; c < 3; ++c) {
+            double want = g_scene_rgb[c] + g_fog_rgb[c] * al, got = a.pixels[4 * i + c] / 255.0;
+            if (want > 1) want = 1;
+            if (fabs(got - want) > worst) worst = fabs(got - want);
+        }
+        ++n;
+    }
+    print_message("  engine-callback occluder: %d pixels differ from the fogvol-mesh occluder; "
+                  "light blend over %d pixels: max error %.2f/255\n", diff, n, worst * 255);
+    assert_int_equal(diff, 0);
+    assert_true(n > 1000);
+    assert_true(worst <= 2.0 / 255.0);
+    glDeleteBuffers(1, &eo.vbo);
+    glDeleteBuffers(1, &eo.ibo);
+    glDeleteVertexArrays(1, &eo.vao);
+    teardown(s, &g, fv, meshes, ramp);
+    free(gt);
+    free(pairs);
+    free(interior);
+    free(covered);
+    free(a.thick);
+    free(b.thick);
+    free(a.pixels);
+    free(b.pixels);
+}
+
 int main(void)
 {
-    static tcase cases[32];
-    struct CMUnitTest tests[32];
-    char names[32][64];
+    static tcase cases[40];
+    struct CMUnitTest tests[40];
+    char names[40][64];
     int i, n = 0, rc;
     build_scenes();
     for (i = 0; i < g_nscenes; ++i) {
@@ -508,6 +700,10 @@ int main(void)
             ++n;
         }
     }
+    memset(&tests[n], 0, sizeof tests[n]);
+    tests[n].name = "callback_occluder_and_light_blend";
+    tests[n].test_func = test_callback_and_light;
+    ++n;
     rc = _cmocka_run_group_tests("render", tests, (size_t)n, NULL, NULL);
     free_scenes();
     return rc;
