@@ -36,19 +36,28 @@ $(BUILD)/test_cpu_san: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka -lm
 $(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
-$(BUILD)/test_render: tests/test_render.c $(HEADERS) | $(BUILD)
+$(BUILD)/test_render: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_render_san: tests/test_render.c $(HEADERS) | $(BUILD)
+$(BUILD)/test_render_san: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_glstate: tests/test_glstate.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_glstate_san: tests/test_glstate.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_tiers: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_tiers_san: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_backend: tests/test_backend.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_backend_san: tests/test_backend.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
 
 TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
+            $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/dump_shaders
 
 test: deps-test
@@ -63,7 +72,11 @@ test: deps-test
 	  "render=$(TAP) $(BUILD)/test_render" \
 	  "render_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_render_san" \
 	  "glstate=$(TAP) $(BUILD)/test_glstate" \
-	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san"
+	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san" \
+	  "tiers=$(TAP) $(BUILD)/test_tiers" \
+	  "tiers_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_tiers_san" \
+	  "backend=$(TAP) $(BUILD)/test_backend" \
+	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san"
 
 # --- demo --------------------------------------------------------------------------
 $(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)

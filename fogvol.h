@@ -350,18 +350,60 @@ typedef enum fogvol_dialect {
     FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
 } fogvol_dialect;
 
+/* Tiers: the shader-model tiers of the seed, in GLSL terms.
+   passes = screen passes per frame for one colour-ramp group as the seed
+   counts them (the engine's own opaque pass included):
+     PS13   6  RGBA8; engine, O, B, F, resolve B-F to an encoded thickness,
+              composite decoding by dependent lookup; per-channel compare
+              (works with lowp/mediump fragment precision)
+     PS20   5  RGBA8; engine, O, B, F, composite; decoded compare
+     MRT    4  RGBA8; the engine's opaque pass writes O as a second colour
+              target (fogvol_mrt_prepare + fogvol_mrt_snippet), B, F, composite
+     FLOAT  3  R32F with signed additive float blending; engine, O, one pass for
+              all faces (sign from gl_FrontFacing), composite; 2 library passes
+              with FOGVOL_VARIANT_ENGINE_DEPTH (O comes from the engine's depth
+              texture) */
 typedef enum fogvol_tier {
     FOGVOL_TIER_AUTO = 0,
-    FOGVOL_TIER_PS20 = 2, /* RGBA8, O/B/F targets, decoded compare, 5 steps */
+    FOGVOL_TIER_PS13 = 1,
+    FOGVOL_TIER_PS20 = 2,
+    FOGVOL_TIER_MRT = 3,
+    FOGVOL_TIER_FLOAT = 4,
+    FOGVOL_TIER_COUNT = 5,
     FOGVOL_TIER_MAX_ENUM = 0x7fffffff
 } fogvol_tier;
 
+/* Variants (bit flags) that combine with tiers; fogvol_combination_supported()
+   says which combinations exist. */
+enum {
+    /* RGBA8 tiers: one sum target starting from mid-range (128), back faces
+       added, front faces subtracted by reverse-subtract blending; half the
+       face limit (fogvol_encoding.max_faces_single). */
+    FOGVOL_VARIANT_SINGLE_TARGET = 1u << 0,
+    /* PS20/PS13: Baker's inside/outside count in alpha instead of the min
+       compare: faces are depth-tested against the opaque depth, and the
+       opaque depth is added once per missing back face. The camera must be
+       outside the volumes (or combine with NEAR_CLAMP). */
+    FOGVOL_VARIANT_COUNT = 1u << 1,
+    /* PS20/MRT: RGB-encode by arithmetic in the fragment shader instead of
+       ramp textures ("newer hardware can calculate the ramp values"). Same bytes. */
+    FOGVOL_VARIANT_ALU = 1u << 2,
+    /* Snap vertices behind the near plane onto it (Baker) instead of relying
+       on near-plane clipping for a camera partly inside a volume. */
+    FOGVOL_VARIANT_NEAR_CLAMP = 1u << 3,
+    /* FLOAT: the opaque depth comes from the engine's depth texture
+       (fogvol_frame_desc.engine_depth_texture), linearised; no O pass. */
+    FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
+    FOGVOL_VARIANT_ALL = (1u << 5) - 1u
+};
+
 typedef enum fogvol_program {
     FOGVOL_PROGRAM_ENCODE = 0,         /* opaque depth into O */
-    FOGVOL_PROGRAM_FACE = 1,           /* volume faces into B / F, min with O */
+    FOGVOL_PROGRAM_FACE = 1,           /* volume faces into B / F (FLOAT: signed, one target) */
     FOGVOL_PROGRAM_COMPOSITE = 2,      /* full-screen triangle: thickness -> ramp -> blend */
     FOGVOL_PROGRAM_COMPOSITE_MESH = 3, /* the same, driven by the volume geometry */
-    FOGVOL_PROGRAM_COUNT = 4,
+    FOGVOL_PROGRAM_RESOLVE = 4,        /* PS13: B - F with carries -> encoded thickness */
+    FOGVOL_PROGRAM_COUNT = 5,
     FOGVOL_PROGRAM_MAX_ENUM = 0x7fffffff
 } fogvol_program;
 
@@ -371,12 +413,46 @@ typedef enum fogvol_stage {
     FOGVOL_STAGE_MAX_ENUM = 0x7fffffff
 } fogvol_stage;
 
-#define FOGVOL_MAX_SHADER_STRINGS 4
+#define FOGVOL_MAX_SHADER_STRINGS 12
+
+typedef struct fogvol_shader_desc {
+    fogvol_tier tier;      /* not AUTO */
+    unsigned variants;     /* FOGVOL_VARIANT_* */
+    fogvol_program program;
+    fogvol_dialect dialect;/* not AUTO */
+    fogvol_stage stage;
+} fogvol_shader_desc;
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
-   Unknown or unsupported combinations return FOGVOL_ERROR_UNSUPPORTED. */
+   Combinations that do not exist (fogvol_combination_supported) or programs a
+   tier does not use return FOGVOL_ERROR_UNSUPPORTED and *count = 0. */
+FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *desc, const char **strings, int *count);
+/* Shorthand for variants = 0. */
 FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
                                               fogvol_stage stage, const char **strings, int *count);
+/* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
+   else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
+   so on; see the table in the README). */
+FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+/* 1 if the tier runs this program. */
+FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
+
+typedef struct fogvol_tier_info {
+    int seed_passes;    /* as the seed counts them, the engine's opaque pass included */
+    int library_passes; /* passes fogvol issues per frame for one colour-ramp group
+                           (+1 per negative group pass in the RGBA8 tiers) */
+    int targets;        /* render targets fogvol allocates */
+    const char *name;
+} fogvol_tier_info;
+FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
+FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
+
+/* MRT tier: GLSL for the engine's opaque fragment shader. It declares
+   uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
+   vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
+   writes to its second colour output. Insert after the #version line and the
+   engine's precision statements. */
+FOGVOL_API const char *fogvol_mrt_snippet(void);
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 
 /* ---- backend table -------------------------------------------------------
@@ -391,19 +467,23 @@ typedef uintptr_t fogvol_handle;
 
 typedef enum fogvol_uniform {
     FOGVOL_U_ENC = 0,    /* "fv_enc":    (N, N^2, depth_offset, depth_max) */
-    FOGVOL_U_DITHER = 1, /* "fv_dith":   (255 or 0 = dither off, 1/D, 0, 0) */
+    FOGVOL_U_DITHER = 1, /* "fv_dith":   (255 or 0 = dither off, 1/D, D, 0) */
     FOGVOL_U_SCREEN = 2, /* "fv_screen": (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1] */
     FOGVOL_U_DECODE = 3, /* "fv_dec":    decode weights (world units) */
     FOGVOL_U_RAMP = 4,   /* "fv_rampmap": (slope, offset, overflow flag, 0): thickness -> ramp s */
-    FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, 0, 0) */
-    FOGVOL_U_COUNT = 6
+    FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, near-clamp w, 0) */
+    FOGVOL_U_LINEAR = 6, /* "fv_lin":    projection (A, B, C, D) = (m[10], m[14], m[11], m[15]):
+                            view z = (B - D z_ndc) / (C z_ndc - A) (engine depth texture) */
+    FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), 0, 0): view depth -> d */
+    FOGVOL_U_COUNT = 8
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
 /* Sampler units, fixed per program:
    ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3 (FACE only)
-   COMPOSITE*:    fv_back 0, fv_front 1, fv_colors 2
-   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))).
+   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3
+   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
+   "fv_sign" (float, FLOAT tier: -1 for negative volumes).
    Vertex attribute 0: "fv_position" (vec3). */
 #define FOGVOL_MAX_TEXTURE_UNITS 4
 
@@ -418,9 +498,16 @@ typedef struct fogvol_texture_desc {
     const char *label;
 } fogvol_texture_desc;
 
+typedef enum fogvol_format {
+    FOGVOL_FORMAT_RGBA8 = 0,
+    FOGVOL_FORMAT_R32F = 1   /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+} fogvol_format;
+
 typedef struct fogvol_target_desc {
-    int width, height; /* RGBA8 colour texture, NEAREST, CLAMP */
-    int depth;         /* 1: with a depth buffer */
+    int width, height;        /* colour texture, NEAREST, CLAMP */
+    fogvol_format format;
+    int depth;                /* 1: with a depth buffer */
+    fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
     const char *label;
 } fogvol_target_desc;
 
@@ -443,6 +530,7 @@ typedef struct fogvol_mesh_data {
 typedef enum fogvol_pass_blend {
     FOGVOL_PASS_BLEND_NONE = 0,
     FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
+    FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
     FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
     FOGVOL_PASS_BLEND_LIGHT = 3  /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
 } fogvol_pass_blend;
@@ -456,7 +544,7 @@ typedef struct fogvol_pass {
     float clear_color[4];
     fogvol_pass_blend blend;
     fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
-    int depth_test;         /* LESS */
+    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
     int depth_write;
     int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
                                stencil buffer; the bit is zero before and after the pass */
@@ -464,14 +552,25 @@ typedef struct fogvol_pass {
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
+    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+                                                            backend's own API (GL: a texture name) */
     float uniforms[FOGVOL_U_COUNT][4];
 } fogvol_pass;
 
 typedef struct fogvol_draw {
     float mvp[16];
     float depth[4];
+    float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
     int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
 } fogvol_draw;
+
+/* Capabilities a backend reports (fogvol_backend.caps). */
+enum {
+    FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
+    FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
+    FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
+    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3    /* the engine can sample its depth buffer */
+};
 
 typedef struct fogvol_frame_info {
     int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
@@ -480,6 +579,7 @@ typedef struct fogvol_frame_info {
 typedef struct fogvol_backend {
     void *user_data;
     fogvol_dialect dialect; /* shader dialect the backend compiles */
+    unsigned caps;          /* FOGVOL_CAP_* */
     /* optional: save engine state, report the engine framebuffer */
     fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
     void (*end_frame)(void *user_data);                      /* optional: restore engine state */
@@ -496,9 +596,12 @@ typedef struct fogvol_backend {
     void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
     void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
     void (*end_pass)(void *user_data);        /* optional */
-    /* read the whole target as RGBA8, rows bottom to top; size >= w*h*4 */
+    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+       bytes or (R32F targets) floats; size >= w*h*4 */
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
+    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
+    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -516,6 +619,8 @@ typedef struct fogvol_null_backend {
     int create_calls;
     int stencil_bits;       /* reported by begin_frame */
 } fogvol_null_backend;
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE (AUTO picks PS20);
+   change table->caps before creating a context to test other choices. */
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
 
 /* ---- renderer ------------------------------------------------------------ */
@@ -545,7 +650,11 @@ typedef struct fogvol_context_desc {
     fogvol_allocator allocator;
     fogvol_logger logger;
     int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces) */
-    fogvol_tier tier;      /* 0 = best for the backend */
+    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
+                              FLOAT if float blending, else MRT if engine_mrt and MRT,
+                              else PS20 if highp fragment shaders, else PS13 */
+    unsigned variants;     /* FOGVOL_VARIANT_* */
+    int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
     fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
     fogvol_gl_desc gl;     /* for the GL backend */
@@ -585,6 +694,9 @@ typedef struct fogvol_frame_desc {
        first group). Set debug_thickness to a width*height float buffer. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp;
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
+       object, GL: texture name), depth range [0,1], sampled with its .r */
+    uintptr_t engine_depth_texture;
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -608,6 +720,21 @@ typedef struct fogvol_volume_desc {
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
+FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
+
+/* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
+   makes the O texture the size of the frame's viewport (this touches the GPU,
+   state restored) and returns what the engine needs: the texture to attach as
+   its second colour target (backend API object, GL: texture name), the colour
+   to clear that attachment to before drawing ("far"), and the values of the
+   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
+   viewport-sized with origin (0,0). */
+typedef struct fogvol_mrt_info {
+    uintptr_t texture;
+    float clear_color[4];
+    float uniforms[8];
+} fogvol_mrt_info;
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
 
 #ifndef FOGVOL_NO_GL
 /* The default GL backend on its own (fogvol_create_context makes one when the
@@ -1282,8 +1409,11 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
 }
 
 /* >>shaders =============================================================== */
-/* One body per program; one prelude per dialect defines FV_ATTRIB,
-   FV_VARYING_OUT (vertex), FV_VARYING_IN, FV_TEXTURE, FV_FRAGCOLOR (fragment). */
+/* One body per program, written with small compatibility macros; one prelude
+   per dialect defines FV_ATTRIB, FV_VARYING_OUT (vertex), FV_VARYING_IN,
+   FV_TEXTURE, FV_FRAGCOLOR (fragment). Tiers and variants select code with
+   #defines: FV_PS13, FV_FLOAT, FV_SINGLE, FV_COUNT, FV_ALU, FV_NEAR_CLAMP,
+   FV_ENGINE_DEPTH (FV_NORMALIZE follows from PS13 and COUNT). */
 
 static const char *const fogvol__version[FOGVOL_GLSL_COUNT] = {
     "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
@@ -1296,16 +1426,26 @@ static const char fogvol__fs_legacy[] =
     "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
 static const char fogvol__fs_modern[] =
     "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* GLES: highp where the GPU has it (samplers too: their default is lowp, which
+   would fetch depths at low precision); the PS13 tier is written for mediump */
 static const char fogvol__fs_es100[] =
-    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump float;\n#endif\n"
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
+    "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
     "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
 static const char fogvol__fs_es300[] =
-    "precision highp float;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
+    "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
     "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
 
-/* Mesh vertex shader: position, clip position, normalised depth d. With
-   fv_misc.y = 1 clip z is replaced by k*d - w: the near plane still clips
-   exactly (d >= 0) and nothing is clipped at the far plane. */
+static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
+                                                                   "#define FV_FLOAT\n"};
+static const char *const fogvol__variant_define[5] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
+                                                      "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
+                                                      "#define FV_ENGINE_DEPTH\n"};
+
+/* Mesh vertex shader: clip position and normalised depth d = (w - near) /
+   (far - near). With fv_misc.y = 1 clip z is replaced by k*d - w: the near
+   plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
+   NEAR_CLAMP snaps vertices behind the near plane onto it instead (Baker). */
 static const char fogvol__vs_mesh[] =
     "FV_ATTRIB vec3 fv_position;\n"
     "uniform mat4 fv_mvp;\n"
@@ -1315,8 +1455,16 @@ static const char fogvol__vs_mesh[] =
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
     "    vec4 c = fv_mvp * p;\n"
-    "    fv_d = dot(fv_depth, p);\n"
-    "    c.z = mix(c.z, fv_d * fv_misc.x - c.w, fv_misc.y);\n"
+    "    float d = dot(fv_depth, p);\n"
+    "#ifdef FV_NEAR_CLAMP\n"
+    "    if (fv_misc.w > 0.5) {\n"
+    "        d = max(d, 0.0);\n"
+    "        c.w = max(c.w, fv_misc.z);\n"
+    "        c.z = max(c.z, -c.w);\n"
+    "    }\n"
+    "#endif\n"
+    "    fv_d = d;\n"
+    "    c.z = mix(c.z, d * fv_misc.x - c.w, fv_misc.y);\n"
     "    gl_Position = c;\n"
     "}\n";
 
@@ -1326,57 +1474,159 @@ static const char fogvol__vs_fullscreen[] =
     "    gl_Position = vec4(fv_position.xy, 0.0, 1.0);\n"
     "}\n";
 
-/* RGB-encode d with the ramps: red+green from one N x N ramp, blue (dithered,
-   borrow in alpha) from the (N*D) x D ramp, row from the 8x8 index pattern. */
-#define FOGVOL__FS_ENCODE_COMMON \
-    "uniform vec4 fv_enc;\n" \
-    "uniform vec4 fv_dith;\n" \
-    "uniform vec4 fv_screen;\n" \
-    "uniform vec4 fv_dec;\n" \
-    "uniform sampler2D fv_rg;\n" \
-    "uniform sampler2D fv_blue;\n" \
-    "uniform sampler2D fv_dither;\n" \
-    "FV_VARYING_IN float fv_d;\n" \
-    "vec4 fv_encode(float d) {\n" \
-    "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n" \
-    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n" \
-    "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n" \
-    "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n" \
-    "    return rg + b;\n" \
-    "}\n"
-
-static const char fogvol__fs_encode[] = FOGVOL__FS_ENCODE_COMMON
-    "void main() {\n"
-    "    FV_FRAGCOLOR = fv_encode(fv_d);\n"
-    "}\n";
-
-/* PS 6: keep the lesser of the face depth and the opaque depth, compared decoded. */
-static const char fogvol__fs_face[] = FOGVOL__FS_ENCODE_COMMON
-    "uniform sampler2D fv_opaque;\n"
-    "void main() {\n"
-    "    vec4 e = fv_encode(fv_d);\n"
-    "    vec4 o = FV_TEXTURE(fv_opaque, gl_FragCoord.xy * fv_screen.xy + fv_screen.zw);\n"
-    "    FV_FRAGCOLOR = dot(e - o, fv_dec) >= 0.0 ? o : e;\n"
-    "}\n";
-
-/* PS 4: thickness = decode(B - F) -> colour ramp. */
-static const char fogvol__fs_composite[] =
+/* Shared fragment code: uniforms, the RGB encode (ramps or ALU, same bytes),
+   the borrow fold (normalised digits, alpha free), screen coordinates. */
+static const char fogvol__fs_common[] =
+    "uniform vec4 fv_enc;\n"    /* (N, N^2, depth offset, depth max) */
+    "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
+    "vec2 fv_st() { return gl_FragCoord.xy * fv_screen.xy + fv_screen.zw; }\n"
+    "#if !defined(FV_FLOAT)\n"
+    "uniform sampler2D fv_dither;\n"
+    "#ifndef FV_ALU\n"
+    "uniform sampler2D fv_rg;\n"
+    "uniform sampler2D fv_blue;\n"
+    "#endif\n"
+    "vec4 fv_encode(float d) {\n"
+    "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
+    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n"
+    "#ifdef FV_ALU\n"
+    "    float n = fv_enc.x, dd = fv_dith.z;\n"
+    "    float t = u * fv_enc.y * n;\n"            /* blue LSBs; scaling by powers of two is exact */
+    "    float h = floor(t / n);\n"
+    "    float x = mod(floor(t * dd), n * dd);\n"   /* the blue-ramp texel */
+    "    float q = floor((x + mod(row + dd * 0.5, dd)) / dd) - 1.0;\n"
+    "    float a = q < 0.0 ? 1.0 : 0.0;\n"
+    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n"
+    "#else\n"
+    "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n"
+    "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n"
+    "    return rg + b;\n"
+    "#endif\n"
+    "}\n"
+    "#if defined(FV_PS13) || defined(FV_COUNT)\n"
+    "#define FV_NORMALIZE\n"
+    "#endif\n"
+    "vec4 fv_normalize(vec4 e) {\n"                /* fold the borrow: digits R, G, B in [0, N-1], alpha 0 */
+    "    float g = e.g - e.a;\n"
+    "    float c = g < -0.5 / 255.0 ? 1.0 : 0.0;\n"
+    "    vec4 r = vec4(e.r - c / 255.0, g + c * fv_enc.x / 255.0, e.b, 0.0);\n"
+    "    return r.r < -0.5 / 255.0 ? vec4(0.0) : r;\n"
+    "}\n"
+    "#endif\n";
+
+static const char fogvol__fs_encode[] =
+    "FV_VARYING_IN float fv_d;\n"
+    "void main() {\n"
+    "#if defined(FV_FLOAT)\n"
+    "    FV_FRAGCOLOR = vec4(clamp(fv_d, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
+    "#elif defined(FV_NORMALIZE)\n"
+    "    FV_FRAGCOLOR = fv_normalize(fv_encode(fv_d));\n"
+    "#else\n"
+    "    FV_FRAGCOLOR = fv_encode(fv_d);\n"
+    "#endif\n"
+    "}\n";
+
+/* Volume faces. RGBA8: keep the lesser of face and opaque depth (PS 6 decoded
+   compare, or PS 5 per-channel saturated compare on normalised digits), or
+   with COUNT rely on the depth test and count faces in alpha. FLOAT: signed
+   depth of every face in one pass, the sign from gl_FrontFacing. */
+static const char fogvol__fs_face[] =
+    "FV_VARYING_IN float fv_d;\n"
+    "uniform sampler2D fv_opaque;\n"
+    "#ifdef FV_FLOAT\n"
+    "uniform float fv_sign;\n"
+    "uniform vec4 fv_lin;\n"
+    "uniform vec4 fv_nf;\n"
+    "void main() {\n"
+    "#ifdef FV_ENGINE_DEPTH\n"
+    "    float z = FV_TEXTURE(fv_opaque, fv_st()).r * 2.0 - 1.0;\n"
+    "    float o = -(fv_lin.y - fv_lin.w * z) / (fv_lin.z * z - fv_lin.x) * fv_nf.x + fv_nf.y;\n"
+    "#else\n"
+    "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
+    "#endif\n"
+    "    float d = min(max(fv_d, 0.0), o);\n"
+    "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
+    "}\n"
+    "#else\n"
+    "void main() {\n"
+    "    vec4 e = fv_encode(fv_d);\n"
+    "#ifdef FV_NORMALIZE\n"
+    "    e = fv_normalize(e);\n"
+    "#endif\n"
+    "#ifdef FV_COUNT\n"
+    "    FV_FRAGCOLOR = vec4(e.rgb, 1.0 / 255.0);\n"
+    "#else\n"
+    "    vec4 o = FV_TEXTURE(fv_opaque, fv_st());\n"
+    "#ifdef FV_PS13\n"
+    "    vec3 s = clamp((e.rgb - o.rgb) * 255.0, -1.0, 1.0);\n"
+    "    FV_FRAGCOLOR = dot(s, vec3(1.0, 0.66, 0.31)) - 0.01 > 0.0 ? o : e;\n"
+    "#else\n"
+    "    FV_FRAGCOLOR = dot(e - o, fv_dec) >= 0.0 ? o : e;\n"
+    "#endif\n"
+    "#endif\n"
+    "}\n"
+    "#endif\n";
+
+/* PS13 resolve: B - F per channel with carries into normalised digits (exact
+   small-integer arithmetic, fine in mediump), alpha marks covered pixels. */
+static const char fogvol__fs_resolve[] =
+    "uniform sampler2D fv_back;\n"
+    "uniform sampler2D fv_front;\n"
+    "void main() {\n"
+    "    vec4 b = FV_TEXTURE(fv_back, fv_st()), f = FV_TEXTURE(fv_front, fv_st());\n"
+    "    vec3 d = floor((b.rgb - f.rgb) * 255.0 + 0.5);\n"
+    "    float n = fv_enc.x, c = floor(d.b / n);\n"
+    "    d.b -= c * n;\n"
+    "    d.g += c;\n"
+    "    c = floor(d.g / n);\n"
+    "    d.g -= c * n;\n"
+    "    d.r += c;\n"
+    "    float sat = max(max(b.r, b.g), max(b.b, max(f.r, max(f.g, f.b)))) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
+    "    float covered = b + f == vec4(0.0) ? 0.0 : 1.0;\n"
+    "    FV_FRAGCOLOR = d.r < 0.0 ? vec4(0.0, 0.0, 0.0, covered) : vec4(d / 255.0, covered * (1.0 + sat) / 255.0);\n"
+    "}\n";
+
+/* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F) (PS 4);
+   COUNT adds the opaque depth once per missing back face; SINGLE decodes one
+   biased target; PS13 reads the resolved thickness; FLOAT the float sum. */
+static const char fogvol__fs_composite[] =
     "uniform vec4 fv_rampmap;\n"
     "uniform sampler2D fv_back;\n"
     "uniform sampler2D fv_front;\n"
     "uniform sampler2D fv_colors;\n"
+    "uniform sampler2D fv_opaque;\n"
     "void main() {\n"
-    "    vec2 st = gl_FragCoord.xy * fv_screen.xy + fv_screen.zw;\n"
+    "    vec2 st = fv_st();\n"
     "    vec4 b = FV_TEXTURE(fv_back, st);\n"
+    "    float sat = 0.0, t;\n"
+    "#if defined(FV_FLOAT)\n"
+    "    if (b.r == 0.0) discard;\n"
+    "    t = b.r * fv_dec.x;\n"
+    "#elif defined(FV_PS13)\n"
+    "    if (b.a == 0.0) discard;\n"
+    "    t = dot(b.rgb, fv_dec.xyz);\n"
+    "    sat = b.a > 1.5 / 255.0 ? 1.0 : 0.0;\n"
+    "#elif defined(FV_SINGLE)\n"
+    "    vec4 s = b - vec4(128.0 / 255.0);\n"
+    "    if (s == vec4(0.0)) discard;\n"
+    "    t = dot(s, fv_dec);\n"
+    "    sat = max(max(b.r, b.g), max(b.b, b.a)) > 254.5 / 255.0 || min(min(b.r, b.g), min(b.b, b.a)) < 0.5 / 255.0"
+    " ? 1.0 : 0.0;\n"
+    "#else\n"
     "    vec4 f = FV_TEXTURE(fv_front, st);\n"
     "    if (b + f == vec4(0.0)) discard;\n"
-    "    float t = dot(b - f, fv_dec);\n"
-    "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
     "    vec4 m = max(b, f);\n"
-    "    if (fv_rampmap.z > 0.5 && max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0) c = vec4(1.0, 0.0, 1.0, 1.0);\n"
-    "    FV_FRAGCOLOR = c;\n"
+    "    sat = max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
+    "#ifdef FV_COUNT\n"
+    "    t = dot(b.rgb - f.rgb, fv_dec.xyz) + (f.a - b.a) * 255.0 * dot(FV_TEXTURE(fv_opaque, st).rgb, fv_dec.xyz);\n"
+    "#else\n"
+    "    t = dot(b - f, fv_dec);\n"
+    "#endif\n"
+    "#endif\n"
+    "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
     "}\n";
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
@@ -1387,42 +1637,167 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
     return names[dialect];
 }
 
-FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
-                                              fogvol_stage stage, const char **strings, int *count)
+FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 {
-    int legacy, es;
-    if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    *count = 0;
-    if (tier != FOGVOL_TIER_PS20 && tier != FOGVOL_TIER_AUTO) return FOGVOL_ERROR_UNSUPPORTED;
+    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
+    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
+    return names[tier];
+}
+
+FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
+{
+    int modern; /* GLSL 130+ / 300 es: float targets, multiple outputs */
     if ((int)dialect <= 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((int)program < 0 || (int)program >= FOGVOL_PROGRAM_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
-    if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
-    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
-    strings[0] = fogvol__version[dialect];
-    if (stage == FOGVOL_STAGE_VERTEX) {
-        strings[1] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
-        strings[2] = es ? fogvol__vs_es : "";
-        strings[3] = program == FOGVOL_PROGRAM_COMPOSITE ? fogvol__vs_fullscreen : fogvol__vs_mesh;
-    } else {
-        if (dialect == FOGVOL_GLSL_100) strings[1] = fogvol__fs_es100;
-        else if (dialect == FOGVOL_GLSL_300ES) strings[1] = fogvol__fs_es300;
-        else strings[1] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
-        strings[2] = "";
-        switch (program) {
-        case FOGVOL_PROGRAM_ENCODE: strings[3] = fogvol__fs_encode; break;
-        case FOGVOL_PROGRAM_FACE: strings[3] = fogvol__fs_face; break;
-        default: strings[3] = fogvol__fs_composite; break;
-        }
+    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
+    modern = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_100;
+    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+    switch (tier) {
+    case FOGVOL_TIER_PS13: /* texture ramps only: the tier is for GPUs without fp32 fragment maths */
+        return (v & (FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET))
+                   ? FOGVOL_ERROR_UNSUPPORTED
+                   : FOGVOL_SUCCESS;
+    case FOGVOL_TIER_PS20: return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+    case FOGVOL_TIER_MRT:
+        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
+    case FOGVOL_TIER_FLOAT:
+        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
+    default: return FOGVOL_ERROR_UNSUPPORTED;
     }
-    *count = 4;
+}
+
+FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
+{
+    switch (program) {
+    case FOGVOL_PROGRAM_ENCODE:
+        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
+    case FOGVOL_PROGRAM_FACE:
+    case FOGVOL_PROGRAM_COMPOSITE:
+    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
+    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
+    default: return 0;
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
+{
+    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    out->name = fogvol_tier_name(tier);
+    switch (tier) {
+    case FOGVOL_TIER_PS13:
+        out->seed_passes = 6;
+        out->library_passes = 5;
+        out->targets = single ? 3 : 4; /* O, B, F, T */
+        break;
+    case FOGVOL_TIER_PS20:
+        out->seed_passes = 5;
+        out->library_passes = 4;
+        out->targets = single ? 2 : 3;
+        break;
+    case FOGVOL_TIER_MRT:
+        out->seed_passes = 4;
+        out->library_passes = 3;
+        out->targets = single ? 2 : 3; /* O is written by the engine */
+        break;
+    case FOGVOL_TIER_FLOAT:
+        out->seed_passes = 3;
+        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
+        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
+        break;
+    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     return FOGVOL_SUCCESS;
 }
 
+FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
+{
+    int legacy, es, n = 0, i;
+    if (!strings || !count || !d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *count = 0;
+    if (d->tier <= FOGVOL_TIER_AUTO || d->tier >= FOGVOL_TIER_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    if (fogvol_combination_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
+        return FOGVOL_ERROR_UNSUPPORTED;
+    if ((int)d->program < 0 || (int)d->program >= FOGVOL_PROGRAM_COUNT ||
+        !fogvol_tier_uses_program(d->tier, d->variants, d->program))
+        return FOGVOL_ERROR_UNSUPPORTED;
+    if (d->stage != FOGVOL_STAGE_VERTEX && d->stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
+    legacy = d->dialect == FOGVOL_GLSL_110 || d->dialect == FOGVOL_GLSL_120 || d->dialect == FOGVOL_GLSL_100;
+    es = d->dialect == FOGVOL_GLSL_100 || d->dialect == FOGVOL_GLSL_300ES;
+    strings[n++] = fogvol__version[d->dialect];
+    if (d->stage == FOGVOL_STAGE_VERTEX) {
+        strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
+        if (es) strings[n++] = fogvol__vs_es;
+    } else if (d->dialect == FOGVOL_GLSL_100) {
+        strings[n++] = fogvol__fs_es100;
+    } else if (d->dialect == FOGVOL_GLSL_300ES) {
+        strings[n++] = fogvol__fs_es300;
+    } else {
+        strings[n++] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
+    }
+    if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
+    for (i = 0; i < 5; ++i)
+        if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
+    if (d->stage == FOGVOL_STAGE_VERTEX) {
+        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE)
+                           ? fogvol__vs_fullscreen
+                           : fogvol__vs_mesh;
+    } else {
+        strings[n++] = fogvol__fs_common;
+        switch (d->program) {
+        case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
+        case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
+        case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
+        default: strings[n++] = fogvol__fs_composite; break;
+        }
+    }
+    FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
+    *count = n;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
+                                              fogvol_stage stage, const char **strings, int *count)
+{
+    fogvol_shader_desc d;
+    d.tier = tier;
+    d.variants = 0;
+    d.program = program;
+    d.dialect = dialect;
+    d.stage = stage;
+    return fogvol_shader_strings(&d, strings, count);
+}
+
+/* MRT tier: the engine's copy of the ALU encode, dither pattern by arithmetic
+   (the same 8x8 ordered pattern as fogvol_make_dither_index). */
+static const char fogvol__mrt_snippet[] =
+    "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n"
+    "vec4 fogvol_encode_view_depth(float view_depth) {\n"
+    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
+    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
+    "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
+    "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n"
+    "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n"
+    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n"
+    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n"
+    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n"
+    "    float t = u * fogvol_mrt[0].w * n;\n"
+    "    float h = floor(t / n);\n"
+    "    float x = mod(floor(t * dd), n * dd);\n"
+    "    float q = floor((x + k) / dd) - 1.0;\n"
+    "    float a = q < 0.0 ? 1.0 : 0.0;\n"
+    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n"
+    "}\n";
+
+FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
+
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
-    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec", "fv_rampmap",
-                                                      "fv_misc"};
+    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec",
+                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf"};
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -1516,6 +1891,7 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     state->stencil_bits = 8;
     table->user_data = state;
     table->dialect = FOGVOL_GLSL_330;
+    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
     table->begin_frame = fogvol__null_begin_frame;
     table->end_frame = fogvol__null_end_frame;
     table->create_texture = fogvol__null_create_texture;
@@ -1570,12 +1946,14 @@ struct fogvol_context {
     int owns_backend;
     fogvol_encoding enc;
     fogvol_tier tier;
+    unsigned variants;
     int dither;
     fogvol_handle tex_rg, tex_blue, tex_dither;
     fogvol_handle prog[FOGVOL_PROGRAM_COUNT];
-    fogvol_handle tgt_o, tgt_b, tgt_f;
+    fogvol_handle tgt_o, tgt_b, tgt_f, tgt_t; /* SINGLE: B is the one sum target; PS13: T resolved;
+                                                 FLOAT: B is the float sum */
     int target_w, target_h;
-    int in_frame, in_occluder_pass;
+    int in_frame, in_occluder_pass, mrt_ready;
     fogvol_frame_desc frame;
     double viewproj[16];
     fogvol__volume *vols;
@@ -1622,12 +2000,16 @@ static double fogvol__det4(const double *m)
 
 static void fogvol__destroy_targets(fogvol_context *ctx)
 {
-    if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
+    /* targets that share O's depth go first */
     if (ctx->tgt_b) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_b);
     if (ctx->tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_f);
-    ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = 0;
+    if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
+    if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
+    ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
     ctx->target_w = ctx->target_h = 0;
 }
+
+static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->variants & variant) != 0; }
 
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
 {
@@ -1638,17 +2020,32 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
     memset(&td, 0, sizeof td);
     td.width = w;
     td.height = h;
-    td.depth = 1;
-    td.label = "fogvol O (opaque depth)";
-    r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
-    if (r == FOGVOL_SUCCESS) {
+    r = FOGVOL_SUCCESS;
+    if (ctx->tier == FOGVOL_TIER_FLOAT) {
+        td.format = FOGVOL_FORMAT_R32F;
+        if (!fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) {
+            td.depth = 1;
+            td.label = "fogvol O (opaque depth, float)";
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+        }
         td.depth = 0;
-        td.label = "fogvol B (back faces)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
-    }
-    if (r == FOGVOL_SUCCESS) {
+        td.label = "fogvol signed depth sum (float)";
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+    } else {
+        td.depth = ctx->tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
+        td.label = "fogvol O (opaque depth)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+        td.depth = 0;
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT)) td.share_depth = ctx->tgt_o; /* faces depth-tested */
+        td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
         td.label = "fogvol F (front faces)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_f);
+        if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_f);
+        td.share_depth = 0;
+        td.label = "fogvol T (resolved thickness)";
+        if (r == FOGVOL_SUCCESS && ctx->tier == FOGVOL_TIER_PS13)
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_t);
     }
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create %dx%d render targets: %s", w, h,
@@ -1708,19 +2105,26 @@ static fogvol_result fogvol__make_texture(fogvol_context *ctx, int which, fogvol
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
 {
     static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg", "fv_blue", "fv_dither", "fv_opaque"};
-    static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back", "fv_front", "fv_colors", NULL};
+    static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back", "fv_front", "fv_colors",
+                                                                    "fv_opaque"};
     static const char *const labels[FOGVOL_PROGRAM_COUNT] = {"fogvol encode", "fogvol face", "fogvol composite",
-                                                             "fogvol composite (geometry)"};
+                                                             "fogvol composite (geometry)", "fogvol resolve"};
     fogvol_program_desc pd;
+    fogvol_shader_desc sd;
     fogvol_result r;
     int i;
     memset(&pd, 0, sizeof pd);
-    r = fogvol_shader_source(ctx->tier, p, ctx->be.dialect, FOGVOL_STAGE_VERTEX, pd.vs, &pd.vs_count);
-    if (r == FOGVOL_SUCCESS)
-        r = fogvol_shader_source(ctx->tier, p, ctx->be.dialect, FOGVOL_STAGE_FRAGMENT, pd.fs, &pd.fs_count);
+    sd.tier = ctx->tier;
+    sd.variants = ctx->variants;
+    sd.program = p;
+    sd.dialect = ctx->be.dialect;
+    sd.stage = FOGVOL_STAGE_VERTEX;
+    r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
+    sd.stage = FOGVOL_STAGE_FRAGMENT;
+    if (r == FOGVOL_SUCCESS) r = fogvol_shader_strings(&sd, pd.fs, &pd.fs_count);
     if (r != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no shader for dialect %s",
-                    fogvol_dialect_name(ctx->be.dialect));
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s shader for tier %s, variants 0x%x, GLSL %s",
+                    labels[p], fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect));
         return r;
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
@@ -1728,6 +2132,47 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = NULL;
     pd.label = labels[p];
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
+}
+
+/* AUTO: FLOAT with float blending, MRT when the engine writes O and can,
+   PS20 with highp fragment shaders, else PS13; an explicit tier must exist in
+   the backend's dialect and caps. */
+static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_context_desc *desc)
+{
+    unsigned caps = ctx->be.caps;
+    fogvol_tier t = desc->tier;
+    if (t == FOGVOL_TIER_AUTO) {
+        if ((caps & FOGVOL_CAP_FLOAT_BLEND) &&
+            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->variants, ctx->be.dialect) == FOGVOL_SUCCESS)
+            t = FOGVOL_TIER_FLOAT;
+        else if (desc->engine_mrt && (caps & FOGVOL_CAP_MRT) &&
+                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->variants, ctx->be.dialect) == FOGVOL_SUCCESS)
+            t = FOGVOL_TIER_MRT;
+        else if (caps & FOGVOL_CAP_HIGHP_FRAGMENT)
+            t = FOGVOL_TIER_PS20;
+        else
+            t = FOGVOL_TIER_PS13;
+    }
+    if (fogvol_combination_supported(t, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: tier %s with variants 0x%x does not exist in GLSL %s",
+                    fogvol_tier_name(t), ctx->variants, fogvol_dialect_name(ctx->be.dialect));
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
+        (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
+        ((ctx->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
+                    fogvol_tier_name(t), caps);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    ctx->tier = t;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants)
+{
+    if (variants) *variants = ctx ? ctx->variants : 0;
+    return ctx ? ctx->tier : FOGVOL_TIER_AUTO;
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -1749,9 +2194,11 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: encoding_bits %d outside 1..8", desc->encoding_bits);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->tier != FOGVOL_TIER_AUTO && desc->tier != FOGVOL_TIER_PS20) {
-        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: tier %d is not available", (int)desc->tier);
-        return FOGVOL_ERROR_UNSUPPORTED;
+    if ((int)desc->tier < 0 || (int)desc->tier >= FOGVOL_TIER_COUNT ||
+        (desc->variants & ~(unsigned)FOGVOL_VARIANT_ALL)) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown tier %d or variants 0x%x", (int)desc->tier,
+                    desc->variants);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     ctx = (fogvol_context *)fogvol__alloc(a, sizeof *ctx);
     if (!ctx) {
@@ -1762,7 +2209,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->alloc = *a;
     ctx->log = desc->logger;
     ctx->dither = !desc->disable_dither;
-    ctx->tier = FOGVOL_TIER_PS20;
+    ctx->variants = desc->variants;
     fogvol_encoding_init(&ctx->enc, bits);
     if (desc->backend.create_texture) {
         const fogvol_backend *b = &desc->backend;
@@ -1788,20 +2235,28 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return FOGVOL_ERROR_INVALID_ARGUMENT;
 #endif
     }
-    r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
-    if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
-    if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
+    r = fogvol__choose_tier(ctx, desc);
+    if (r == FOGVOL_SUCCESS && ctx->tier != FOGVOL_TIER_FLOAT) {
+        if (!fogvol__has(ctx, FOGVOL_VARIANT_ALU)) {
+            r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
+            if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
+        }
+        if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
+    }
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
+            r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
         fogvol__release(ctx);
         fogvol__free(a, ctx);
         return r;
     }
-    fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: tier PS20, %d-bit encoding (%d faces), GLSL %s, dither %s",
-                ctx->enc.precision_bits, ctx->enc.max_faces, fogvol_dialect_name(ctx->be.dialect),
-                ctx->dither ? "on" : "off");
+    fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                "fogvol: tier %s, variants 0x%x, %d-bit encoding (%d faces), GLSL %s, dither %s",
+                fogvol_tier_name(ctx->tier), ctx->variants, ctx->enc.precision_bits,
+                fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? ctx->enc.max_faces_single : ctx->enc.max_faces,
+                fogvol_dialect_name(ctx->be.dialect), ctx->dither ? "on" : "off");
     *out = ctx;
     return FOGVOL_SUCCESS;
 }
@@ -2087,6 +2542,7 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
 /* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
 static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
 {
+    dr->sign = 1.0f;
     double m[16], v[16], vm[16], mvp[16], p[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
     int j;
     fogvol__tod(m, model);
@@ -2118,35 +2574,39 @@ static void fogvol__end_pass(fogvol_context *ctx)
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
 }
 
-/* Draw the volumes of one ramp group with the given sign into the current pass. */
+/* Draw the volumes of one ramp group into the current pass: negative = 0
+   positives, 1 negatives, -1 both (FLOAT: the sign goes to the shader). */
 static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
     fogvol_draw dr;
     for (i = 0; i < ctx->nvol; ++i) {
         const fogvol__volume *v = &ctx->vols[i];
-        if (v->ramp != ramp || v->negative != negative) continue;
+        if (v->ramp != ramp || (negative >= 0 && v->negative != negative)) continue;
         fogvol__draw_for(ctx, v->model, &dr);
+        if (v->negative) dr.sign = -1.0f;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
         ++n;
     }
     return n;
 }
 
-/* Sum pass into B (back = 1) or F: positive volumes' back (front) faces, then
-   negative volumes' front (back) faces. */
-static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, const fogvol_ramp *ramp, int back, int has_neg)
+/* One sum pass over a group: the faces culled by 'cull' are left out for the
+   positive volumes; the negative volumes swap front and back. */
+static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, fogvol_handle target, int clear, fogvol_cull cull,
+                            fogvol_pass_blend blend, const fogvol_ramp *ramp, int has_neg)
 {
     int passes = 1;
-    ps->target = back ? ctx->tgt_b : ctx->tgt_f;
-    ps->clear = 1;
-    ps->cull = back ? FOGVOL_CULL_FRONT : FOGVOL_CULL_BACK;
+    ps->target = target;
+    ps->clear = clear;
+    ps->cull = cull;
+    ps->blend = blend;
     ctx->be.begin_pass(ctx->be.user_data, ps);
     fogvol__draw_group(ctx, ramp, 0);
     fogvol__end_pass(ctx);
     if (has_neg) {
         ps->clear = 0;
-        ps->cull = back ? FOGVOL_CULL_BACK : FOGVOL_CULL_FRONT;
+        ps->cull = cull == FOGVOL_CULL_FRONT ? FOGVOL_CULL_BACK : FOGVOL_CULL_FRONT;
         ctx->be.begin_pass(ctx->be.user_data, ps);
         fogvol__draw_group(ctx, ramp, 1);
         fogvol__end_pass(ctx);
@@ -2155,30 +2615,135 @@ static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, const fogvol_r
     return passes;
 }
 
-static fogvol_result fogvol__debug_capture(fogvol_context *ctx, int *overflow)
+/* SINGLE_TARGET: the sum goes up (back faces) then down (front faces), so a
+   channel that saturated at 255 can come back below it; the debug read-back
+   also looks at S after the additions. Marks saturated pixels in sat. */
+static fogvol_result fogvol__single_peak(fogvol_context *ctx, unsigned char *sat)
 {
     size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
-    unsigned char *b, *f;
+    unsigned char *px;
+    fogvol_result r;
+    if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
+    px = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 4u);
+    if (!px) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, px, n * 4u);
+    for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i)
+        sat[i] = px[4 * i] == 255 || px[4 * i + 1] == 255 || px[4 * i + 2] == 255 || px[4 * i + 3] == 255;
+    fogvol__free(&ctx->alloc, px);
+    return r;
+}
+
+/* Decoded thickness per pixel (world units) from the sum targets, and the
+   count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
+static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int *overflow)
+{
+    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    unsigned char *b, *f, *o;
+    float *fl;
     fogvol_result r;
     double range = (double)ctx->frame.zfar - ctx->frame.znear;
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
-    b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 8u);
+    b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 12u);
     if (!b) return FOGVOL_ERROR_OUT_OF_MEMORY;
     f = b + n * 4u;
+    o = f + n * 4u;
+    *overflow = 0;
     r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, b, n * 4u);
-    if (r == FOGVOL_SUCCESS) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_f, f, n * 4u);
-    if (r == FOGVOL_SUCCESS) {
-        *overflow = 0;
-        for (i = 0; i < n; ++i) {
-            const unsigned char *pb = b + 4 * i, *pf = f + 4 * i;
-            int k, sat = 0;
+    if (ctx->tier == FOGVOL_TIER_FLOAT) {
+        fl = (float *)(void *)b;
+        for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->frame.debug_thickness[i] = (float)(fl[i] * range);
+        fogvol__free(&ctx->alloc, b);
+        return r;
+    }
+    if (r == FOGVOL_SUCCESS && !single) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_f, f, n * 4u);
+    if (r == FOGVOL_SUCCESS && count) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_o, o, n * 4u);
+    for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) {
+        unsigned char *pb = b + 4 * i, *pf = f + 4 * i;
+        int k, sat = 0;
+        double t;
+        if (single) {
+            for (k = 0; k < 4; ++k) {
+                sat |= pb[k] == 255 || pb[k] == 0;
+                pf[k] = 128; /* S - bias */
+            }
+            if (peak) sat |= peak[i];
+        } else {
             for (k = 0; k < 4; ++k) sat |= pb[k] == 255 || pf[k] == 255;
-            *overflow += sat;
-            ctx->frame.debug_thickness[i] = (float)(fogvol_decode_difference(&ctx->enc, pb, pf) * range);
         }
+        if (count) { /* alpha holds face counts: add the opaque depth per missing back face */
+            int missing = (int)pf[3] - (int)pb[3];
+            pb[3] = pf[3] = 0;
+            t = fogvol_decode_difference(&ctx->enc, pb, pf) + missing * fogvol_decode(&ctx->enc, o + 4 * i);
+        } else {
+            t = fogvol_decode_difference(&ctx->enc, pb, pf);
+        }
+        *overflow += sat;
+        ctx->frame.debug_thickness[i] = (float)(t * range);
     }
     fogvol__free(&ctx->alloc, b);
     return r;
+}
+
+static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
+{
+    return ctx->frame.debug_thickness && !captured && (ctx->frame.debug_ramp == NULL || ctx->frame.debug_ramp == ramp);
+}
+
+static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
+{
+    ps->viewport[0] = ps->viewport[1] = 0;
+    ps->viewport[2] = ctx->target_w;
+    ps->viewport[3] = ctx->target_h;
+    ps->uniforms[FOGVOL_U_SCREEN][2] = ps->uniforms[FOGVOL_U_SCREEN][3] = 0.0f;
+    ps->stencil_guard = 0;
+    memset(ps->textures, 0, sizeof ps->textures);
+    memset(ps->native_textures, 0, sizeof ps->native_textures);
+    ps->textures[0] = ctx->tex_rg;
+    ps->textures[1] = ctx->tex_blue;
+    ps->textures[2] = ctx->tex_dither;
+}
+
+static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_frame_info *info)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    memset(info, 0, sizeof *info);
+    if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    return r;
+}
+
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info)
+{
+    fogvol_frame_info fi;
+    fogvol_constants k;
+    fogvol_result r;
+    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    if (ctx->tier != FOGVOL_TIER_MRT || !ctx->in_frame || !ctx->be.native_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
+                                                 "backend with native_texture");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    r = fogvol__begin_backend_frame(ctx, &fi);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    if (r != FOGVOL_SUCCESS) return r;
+    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, &k);
+    info->texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    info->uniforms[0] = k.near_far[0];
+    info->uniforms[1] = k.near_far[1];
+    info->uniforms[2] = (float)ctx->enc.levels;
+    info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    info->uniforms[4] = k.depth_offset;
+    info->uniforms[5] = k.depth_max;
+    info->uniforms[6] = (float)ctx->enc.dither_steps;
+    info->uniforms[7] = ctx->dither ? 1.0f : 0.0f;
+    ctx->mrt_ready = 1;
+    return FOGVOL_SUCCESS;
 }
 
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
@@ -2190,6 +2755,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     fogvol_result r = FOGVOL_SUCCESS, rr;
     const fogvol_frame_desc *fd;
     int i, w, h, g, overflow = 0, captured = 0;
+    int single, count, rgba8;
+    unsigned char *peak = NULL;
     float zk;
     memset(&st, 0, sizeof st);
     if (stats) *stats = st;
@@ -2198,16 +2765,25 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     fd = &ctx->frame;
     w = fd->viewport[2];
     h = fd->viewport[3];
+    single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
+    rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
+    if (ctx->tier == FOGVOL_TIER_MRT && !ctx->mrt_ready) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: MRT tier: call fogvol_mrt_prepare and let the engine "
+                                                 "write O before fogvol_end_frame");
+        fogvol_cancel_frame(ctx);
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && !fd->engine_depth_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
+        fogvol_cancel_frame(ctx);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
-    memset(&info, 0, sizeof info);
-    if (ctx->be.begin_frame) {
-        r = ctx->be.begin_frame(ctx->be.user_data, &info);
-        if (r != FOGVOL_SUCCESS) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s",
-                        fogvol_result_string(r));
-            fogvol_cancel_frame(ctx);
-            return r;
-        }
+    r = fogvol__begin_backend_frame(ctx, &info);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol_cancel_frame(ctx);
+        return r;
     }
     r = fogvol__ensure_targets(ctx, w, h);
     if (r != FOGVOL_SUCCESS) goto done;
@@ -2220,39 +2796,54 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     ps.uniforms[FOGVOL_U_ENC][3] = k.depth_max;
     ps.uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
     ps.uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
+    ps.uniforms[FOGVOL_U_DITHER][2] = (float)ctx->enc.dither_steps;
     ps.uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)w;
     ps.uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)h;
-    memcpy(ps.uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
+    if (rgba8) {
+        memcpy(ps.uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
+        if (count || ctx->tier == FOGVOL_TIER_PS13) ps.uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts */
+    } else {
+        ps.uniforms[FOGVOL_U_DECODE][0] = fd->zfar - fd->znear;
+    }
     zk = (float)(2.0 * ((double)fd->zfar - fd->znear));
     ps.uniforms[FOGVOL_U_MISC][0] = zk < 1.0f ? zk : 1.0f;
-    ps.viewport[2] = w;
-    ps.viewport[3] = h;
+    /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
+    ps.uniforms[FOGVOL_U_MISC][2] = fd->projection[15] == 0.0f ? fd->znear : -1e30f;
+    ps.uniforms[FOGVOL_U_LINEAR][0] = fd->projection[10];
+    ps.uniforms[FOGVOL_U_LINEAR][1] = fd->projection[14];
+    ps.uniforms[FOGVOL_U_LINEAR][2] = fd->projection[11];
+    ps.uniforms[FOGVOL_U_LINEAR][3] = fd->projection[15];
+    ps.uniforms[FOGVOL_U_NEARFAR][0] = k.near_far[0];
+    ps.uniforms[FOGVOL_U_NEARFAR][1] = k.near_far[1];
+    fogvol__target_space(ctx, &ps);
 
-    /* step b: opaque depth into O */
-    ps.target = ctx->tgt_o;
-    ps.clear = 1;
-    ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
-    ps.depth_test = ps.depth_write = 1;
-    ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
-    ps.textures[0] = ctx->tex_rg;
-    ps.textures[1] = ctx->tex_blue;
-    ps.textures[2] = ctx->tex_dither;
-    ctx->be.begin_pass(ctx->be.user_data, &ps);
-    st.passes++;
-    ctx->in_occluder_pass = 1;
-    for (i = 0; i < ctx->nocc; ++i) {
-        const fogvol__occluder *o = &ctx->occ[i];
-        if (o->fn) {
-            o->fn(ctx, o->user_data);
-        } else {
-            fogvol_draw dr;
-            fogvol__draw_for(ctx, o->model, &dr);
-            ctx->be.draw_mesh(ctx->be.user_data, o->mesh->handle, &dr);
+    /* step b: opaque depth into O (MRT: the engine wrote it; ENGINE_DEPTH: its depth texture) */
+    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE)) {
+        ps.target = ctx->tgt_o;
+        ps.clear = 1;
+        if (rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+        else ps.clear_color[0] = 1.0f;
+        ps.depth_test = ps.depth_write = 1;
+        ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+        ctx->be.begin_pass(ctx->be.user_data, &ps);
+        st.passes++;
+        ctx->in_occluder_pass = 1;
+        for (i = 0; i < ctx->nocc; ++i) {
+            const fogvol__occluder *o = &ctx->occ[i];
+            if (o->fn) {
+                o->fn(ctx, o->user_data);
+            } else {
+                fogvol_draw dr;
+                fogvol__draw_for(ctx, o->model, &dr);
+                ctx->be.draw_mesh(ctx->be.user_data, o->mesh->handle, &dr);
+            }
+            st.occluders++;
         }
-        st.occluders++;
+        ctx->in_occluder_pass = 0;
+        fogvol__end_pass(ctx);
     }
-    ctx->in_occluder_pass = 0;
-    fogvol__end_pass(ctx);
+    ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
+    ps.depth_write = 0;
 
     /* steps c-e per colour-ramp group, in order of first appearance */
     for (g = 0; g < ctx->nvol; ++g) {
@@ -2264,24 +2855,71 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
             if (ctx->vols[i].ramp == ramp) {
                 if (ctx->vols[i].negative) has_neg = 1;
                 else has_pos = 1;
-                st.volumes++;
             }
         if (!has_pos) continue; /* negative volumes alone subtract from nothing */
         st.groups++;
+        for (i = g; i < ctx->nvol; ++i) st.volumes += ctx->vols[i].ramp == ramp;
 
-        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = 0.0f;
-        ps.depth_test = ps.depth_write = 0;
-        ps.blend = FOGVOL_PASS_BLEND_ADD;
         ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
-        ps.textures[3] = ctx->tgt_o;
-        ps.uniforms[FOGVOL_U_MISC][1] = 1.0f;
-        st.passes += fogvol__sum_pass(ctx, &ps, ramp, 1, has_neg);
-        st.passes += fogvol__sum_pass(ctx, &ps, ramp, 0, has_neg);
+        ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
+        ps.uniforms[FOGVOL_U_MISC][1] = count ? 0.0f : 1.0f;
+        ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = fd->engine_depth_texture;
+        else ps.textures[3] = ctx->tgt_o;
+        if (ctx->tier == FOGVOL_TIER_FLOAT) {
+            /* c+d in one pass: every face, signed by gl_FrontFacing */
+            ps.target = ctx->tgt_b;
+            ps.clear = 1;
+            ps.cull = FOGVOL_CULL_NONE;
+            ps.blend = FOGVOL_PASS_BLEND_ADD;
+            ctx->be.begin_pass(ctx->be.user_data, &ps);
+            fogvol__draw_group(ctx, ramp, -1);
+            fogvol__end_pass(ctx);
+            st.passes++;
+        } else if (single) {
+            ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
+            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp,
+                                          has_neg);
+            if (fogvol__want_debug(ctx, ramp, captured)) {
+                peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)w * (size_t)h);
+                rr = peak ? fogvol__single_peak(ctx, peak) : FOGVOL_ERROR_OUT_OF_MEMORY;
+                if (rr != FOGVOL_SUCCESS) r = rr;
+            }
+            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp,
+                                          has_neg);
+            ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
+        } else {
+            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp,
+                                          has_neg);
+            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp,
+                                          has_neg);
+        }
+        ps.depth_test = 0;
+        ps.cull = FOGVOL_CULL_NONE;
 
-        if (fd->debug_thickness && !captured && (fd->debug_ramp == NULL || fd->debug_ramp == ramp)) {
-            rr = fogvol__debug_capture(ctx, &overflow);
+        if (fogvol__want_debug(ctx, ramp, captured)) {
+            rr = fogvol__debug_capture(ctx, peak, &overflow);
             captured = 1;
             if (rr != FOGVOL_SUCCESS) r = rr;
+            fogvol__free(&ctx->alloc, peak);
+            peak = NULL;
+        }
+        memset(ps.textures, 0, sizeof ps.textures);
+        memset(ps.native_textures, 0, sizeof ps.native_textures);
+        ps.textures[0] = ctx->tgt_b;
+        ps.textures[1] = ctx->tgt_f;
+        ps.textures[3] = count ? ctx->tgt_o : 0;
+        if (ctx->tier == FOGVOL_TIER_PS13) { /* resolve B - F into T */
+            ps.target = ctx->tgt_t;
+            ps.clear = 0;
+            ps.blend = FOGVOL_PASS_BLEND_NONE;
+            ps.program = ctx->prog[FOGVOL_PROGRAM_RESOLVE];
+            ctx->be.begin_pass(ctx->be.user_data, &ps);
+            ctx->be.draw_fullscreen(ctx->be.user_data);
+            fogvol__end_pass(ctx);
+            st.passes++;
+            ps.textures[0] = ctx->tgt_t;
+            ps.textures[1] = 0;
         }
 
         /* composite into the engine framebuffer */
@@ -2296,15 +2934,14 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
         ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)w;
         ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)h;
+        ps.uniforms[FOGVOL_U_MISC][3] = 0.0f;
+        ps.uniforms[FOGVOL_U_MISC][1] = 1.0f;
         ps.blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
         ps.cull = guard ? FOGVOL_CULL_FRONT : FOGVOL_CULL_NONE;
         ps.stencil_guard = guard;
         ps.stencil_bit = fd->stencil_bit ? fd->stencil_bit : 0x80u;
         ps.program = ctx->prog[guard ? FOGVOL_PROGRAM_COMPOSITE_MESH : FOGVOL_PROGRAM_COMPOSITE];
-        ps.textures[0] = ctx->tgt_b;
-        ps.textures[1] = ctx->tgt_f;
         ps.textures[2] = ramp->texture;
-        ps.textures[3] = 0;
         ps.uniforms[FOGVOL_U_RAMP][0] =
             (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
         ps.uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
@@ -2314,26 +2951,20 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         if (guard) fogvol__draw_group(ctx, ramp, 0);
         else ctx->be.draw_fullscreen(ctx->be.user_data);
         fogvol__end_pass(ctx);
-        /* back to target-space settings for the next group */
-        ps.stencil_guard = 0;
-        ps.uniforms[FOGVOL_U_SCREEN][2] = ps.uniforms[FOGVOL_U_SCREEN][3] = 0.0f;
-        ps.viewport[0] = ps.viewport[1] = 0;
-        ps.viewport[2] = w;
-        ps.viewport[3] = h;
-        ps.textures[0] = ctx->tex_rg;
-        ps.textures[1] = ctx->tex_blue;
-        ps.textures[2] = ctx->tex_dither;
+        fogvol__target_space(ctx, &ps); /* back to target-space settings for the next group */
     }
     st.overflow_pixels = overflow;
     if (overflow > 0 && r == FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)", overflow,
-                    ctx->enc.precision_bits, ctx->enc.max_faces);
+                    ctx->enc.precision_bits, single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
         r = FOGVOL_ERROR_DEPTH_OVERFLOW;
     }
 done:
+    fogvol__free(&ctx->alloc, peak);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     ctx->in_frame = 0;
+    ctx->mrt_ready = 0;
     ctx->nvol = ctx->nocc = 0;
     if (stats) *stats = st;
     return r;
@@ -2418,7 +3049,8 @@ enum {
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
     FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
-    FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400
+    FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
+    FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2
 };
 
 /* X(return type, name without "gl", parameter list). Base: GL 2.0 / GLES 2.0. */
@@ -2484,6 +3116,7 @@ enum {
     X(void, UseProgram, (fogvol__GLuint)) \
     X(fogvol__GLint, GetUniformLocation, (fogvol__GLuint, const fogvol__GLchar *)) \
     X(void, Uniform1i, (fogvol__GLint, fogvol__GLint)) \
+    X(void, Uniform1f, (fogvol__GLint, fogvol__GLfloat)) \
     X(void, Uniform4fv, (fogvol__GLint, fogvol__GLsizei, const fogvol__GLfloat *)) \
     X(void, UniformMatrix4fv, (fogvol__GLint, fogvol__GLsizei, fogvol__GLboolean, const fogvol__GLfloat *))
 
@@ -2510,6 +3143,9 @@ enum {
 /* Sampler objects: GL 3.3, GLES 3.0 (only to unbind the engine's from our units). */
 #define FOGVOL__GL_SAMPLER(X) X(void, BindSampler, (fogvol__GLuint, fogvol__GLuint))
 
+/* GL 3.0 / GLES 3.0: extension strings one by one. */
+#define FOGVOL__GL_3(X) X(const fogvol__GLubyte *, GetStringi, (fogvol__GLenum, fogvol__GLuint))
+
 /* Desktop only. */
 #define FOGVOL__GL_DESKTOP(X) \
     X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
@@ -2517,11 +3153,13 @@ enum {
     X(void, GetDoublev, (fogvol__GLenum, fogvol__GLdouble *))
 
 /* GLES only. */
-#define FOGVOL__GL_ES(X) X(void, ClearDepthf, (fogvol__GLfloat))
+#define FOGVOL__GL_ES(X) \
+    X(void, ClearDepthf, (fogvol__GLfloat)) \
+    X(void, GetShaderPrecisionFormat, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint *, fogvol__GLint *))
 
 #define FOGVOL__GL_ALL(X) \
-    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_DESKTOP(X) \
-        FOGVOL__GL_ES(X)
+    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
+        FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -2553,11 +3191,13 @@ typedef struct fogvol__gl_target {
     fogvol__gl_texture base; /* the colour texture */
     fogvol__GLuint fbo, depth;
     int width, height;
+    int owns_depth; /* 0 when depth is another target's renderbuffer */
+    fogvol_format format;
 } fogvol__gl_target;
 
 typedef struct fogvol__gl_program {
     fogvol__GLuint id;
-    fogvol__GLint u_mvp, u_depth, u_vec[FOGVOL_U_COUNT];
+    fogvol__GLint u_mvp, u_depth, u_sign, u_vec[FOGVOL_U_COUNT];
 } fogvol__gl_program;
 
 typedef struct fogvol__gl_mesh {
@@ -2575,6 +3215,7 @@ typedef struct fogvol__gl {
     int major, minor, gles, core;
     int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
     int stencil_override;
+    unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
     int in_frame, guard;
@@ -2905,6 +3546,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     memset(t, 0, sizeof *t);
     t->width = d->width;
     t->height = d->height;
+    t->format = d->format;
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
@@ -2914,12 +3556,21 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
     gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
     gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
-    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
-                   d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
+    if (d->format == FOGVOL_FORMAT_R32F)
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_R32F, d->width, d->height, 0, FOGVOL__GL_RED,
+                       FOGVOL__GL_FLOAT, NULL);
+    else
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
+                       d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
     gl->GenFramebuffers(1, &t->fbo);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D, t->base.tex, 0);
-    if (d->depth) {
+    if (d->share_depth) {
+        t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    } else if (d->depth) {
+        t->owns_depth = 1;
         gl->GenRenderbuffers(1, &t->depth);
         gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
         gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
@@ -2938,7 +3589,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     if (r != FOGVOL_SUCCESS) {
         gl->DeleteFramebuffers(1, &t->fbo);
         gl->DeleteTextures(1, &t->base.tex);
-        if (t->depth) gl->DeleteRenderbuffers(1, &t->depth);
+        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
         fogvol__free(&gl->alloc, t);
         t = NULL;
     }
@@ -2958,8 +3609,14 @@ static void fogvol__gl_destroy_target(void *u, fogvol_handle h)
     if (!t) return;
     gl->DeleteFramebuffers(1, &t->fbo);
     gl->DeleteTextures(1, &t->base.tex);
-    if (t->depth) gl->DeleteRenderbuffers(1, &t->depth);
+    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
     fogvol__free(&gl->alloc, t);
+}
+
+static uintptr_t fogvol__gl_native_texture(void *u, fogvol_handle h)
+{
+    (void)u;
+    return h ? (uintptr_t)((const fogvol__gl_texture *)h)->tex : 0;
 }
 
 static fogvol__GLuint fogvol__gl_shader(fogvol__gl *gl, fogvol__GLenum type, const char *const *src, int n,
@@ -3027,6 +3684,7 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
         gl->UseProgram(p->id);
         p->u_mvp = gl->GetUniformLocation(p->id, "fv_mvp");
         p->u_depth = gl->GetUniformLocation(p->id, "fv_depth");
+        p->u_sign = gl->GetUniformLocation(p->id, "fv_sign");
         for (i = 0; i < FOGVOL_U_COUNT; ++i) p->u_vec[i] = gl->GetUniformLocation(p->id, fogvol_uniform_name((fogvol_uniform)i));
         for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
             if (d->samplers[i]) gl->Uniform1i(gl->GetUniformLocation(p->id, d->samplers[i]), i);
@@ -3180,7 +3838,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     if (p->clear) {
         fogvol__GLbitfield bits = FOGVOL__GL_COLOR_BUFFER_BIT;
         gl->ClearColor(p->clear_color[0], p->clear_color[1], p->clear_color[2], p->clear_color[3]);
-        if (t && t->depth) {
+        if (t && t->owns_depth) {
             gl->DepthMask(1);
             if (gl->gles) gl->ClearDepthf(1.0f);
             else gl->ClearDepth(1.0);
@@ -3190,6 +3848,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     }
     switch (p->blend) {
     case FOGVOL_PASS_BLEND_ADD:
+    case FOGVOL_PASS_BLEND_SUBTRACT:
         gl->Enable(FOGVOL__GL_BLEND);
         gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
         break;
@@ -3203,7 +3862,10 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         break;
     default: gl->Disable(FOGVOL__GL_BLEND); break;
     }
-    gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+    if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_REVERSE_SUBTRACT, FOGVOL__GL_FUNC_REVERSE_SUBTRACT);
+    else
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
     if (p->cull == FOGVOL_CULL_NONE) {
         gl->Disable(FOGVOL__GL_CULL_FACE);
     } else {
@@ -3239,6 +3901,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
+        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, 0);
@@ -3266,6 +3929,7 @@ static void fogvol__gl_set_draw(void *u, const fogvol_draw *d)
     if (!gl->program) return;
     if (gl->program->u_mvp >= 0) gl->UniformMatrix4fv(gl->program->u_mvp, 1, 0, d->mvp);
     if (gl->program->u_depth >= 0) gl->Uniform4fv(gl->program->u_depth, 1, d->depth);
+    if (gl->program->u_sign >= 0) gl->Uniform1f(gl->program->u_sign, d->sign);
     gl->FrontFace(d->front_cw ? FOGVOL__GL_CW : FOGVOL__GL_CCW);
 }
 
@@ -3296,7 +3960,10 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
-    gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, rgba);
+    if (t->format == FOGVOL_FORMAT_R32F)
+        gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
+    else
+        gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, rgba);
     r = fogvol__gl_check(gl, "read_target");
     fogvol__gl_leave(gl, &s);
     return r;
@@ -3310,6 +3977,39 @@ static void fogvol__gl_destroy(void *u)
     fogvol__gl_free_mesh(gl, &gl->fullscreen);
     a = gl->alloc;
     fogvol__free(&a, gl);
+}
+
+static int fogvol__gl_has_ext3(fogvol__gl *gl, const char *name)
+{
+    fogvol__GLint n = 0, i;
+    gl->GetIntegerv(FOGVOL__GL_NUM_EXTENSIONS, &n);
+    for (i = 0; i < n; ++i) {
+        const char *e = (const char *)gl->GetStringi(FOGVOL__GL_EXTENSIONS, (fogvol__GLuint)i);
+        if (e && strcmp(e, name) == 0) return 1;
+    }
+    return 0;
+}
+
+/* What the context can do (ext: the GL 2 / GLES 2 extension string or NULL). */
+static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
+{
+    unsigned caps = 0;
+    if (gl->gles) {
+        fogvol__GLint range[2] = {0, 0}, precision = 0;
+        gl->GetShaderPrecisionFormat(FOGVOL__GL_FRAGMENT_SHADER, FOGVOL__GL_HIGH_FLOAT, range, &precision);
+        if (precision > 0) caps |= FOGVOL_CAP_HIGHP_FRAGMENT;
+        if (gl->major >= 3) {
+            caps |= FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
+            if (fogvol__gl_has_ext3(gl, "GL_EXT_color_buffer_float") && fogvol__gl_has_ext3(gl, "GL_EXT_float_blend"))
+                caps |= FOGVOL_CAP_FLOAT_BLEND;
+        } else if (fogvol__has_ext(ext, "GL_OES_depth_texture")) {
+            caps |= FOGVOL_CAP_DEPTH_TEXTURE;
+        }
+    } else {
+        caps |= FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
+        if (gl->major >= 3) caps |= FOGVOL_CAP_FLOAT_BLEND; /* R32F render targets and float blending are core */
+    }
+    return caps;
 }
 
 /* Parse "M.m" at the first digit of s. */
@@ -3429,6 +4129,10 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_SAMPLER(FOGVOL__GL_LOAD)
         FOGVOL__GL_SAMPLER(FOGVOL__GL_REQUIRE)
     }
+    if (gl->major >= 3) {
+        FOGVOL__GL_3(FOGVOL__GL_LOAD)
+        FOGVOL__GL_3(FOGVOL__GL_REQUIRE)
+    }
     if (gl->gles) {
         FOGVOL__GL_ES(FOGVOL__GL_LOAD)
         FOGVOL__GL_ES(FOGVOL__GL_REQUIRE)
@@ -3448,6 +4152,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         else gl->dialect = gl->minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
     }
     gl->stencil_override = desc->stencil_bits;
+    gl->caps = fogvol__gl_caps(gl, ext);
     r = fogvol__gl_upload(gl, &gl->fullscreen, tri, 3, NULL, 0);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(alloc, gl);
@@ -3458,6 +4163,8 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
     out->user_data = gl;
     out->dialect = gl->dialect;
+    out->caps = gl->caps;
+    out->native_texture = fogvol__gl_native_texture;
     out->begin_frame = fogvol__gl_begin_frame;
     out->end_frame = fogvol__gl_end_frame;
     out->create_texture = fogvol__gl_create_texture;

@@ -1,5 +1,7 @@
-/* Writes every shader string combination to DIR/<tier>_<program>_<dialect>.<vert|frag>
-   (or reports that the combination is unsupported) for glslangValidator. */
+/* Writes every existing shader -- tier x variant set x program x dialect x
+   stage -- to DIR/<tier>_v<variants>_<program>_<dialect>.<vert|frag> for
+   glslangValidator, and checks that combinations that do not exist give
+   FOGVOL_ERROR_UNSUPPORTED and no strings. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -8,40 +10,51 @@
 
 int main(int argc, char **argv)
 {
-    static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh"};
+    static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh",
+                                                           "resolve"};
     static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
     const char *dir = argc > 1 ? argv[1] : ".";
-    int p, d, st, n = 0;
-    for (p = 0; p < FOGVOL_PROGRAM_COUNT; ++p)
-        for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
-            for (st = 0; st < 2; ++st) {
-                const char *s[FOGVOL_MAX_SHADER_STRINGS];
-                int count = 0, i;
-                char path[512];
-                FILE *f;
-                if (fogvol_shader_source(FOGVOL_TIER_PS20, (fogvol_program)p, (fogvol_dialect)d,
-                                         (fogvol_stage)st, s, &count) != FOGVOL_SUCCESS) {
-                    fprintf(stderr, "missing: ps20 %s %s\n", prog[p], dia[d]);
-                    return 1;
-                }
-                snprintf(path, sizeof path, "%s/ps20_%s_%s.%s", dir, prog[p], dia[d], st ? "frag" : "vert");
-                f = fopen(path, "w");
-                if (!f) return 1;
-                for (i = 0; i < count; ++i) fputs(s[i], f);
-                fclose(f);
-                ++n;
-            }
-    /* unsupported combinations give a result code, never a string */
-    {
-        const char *s[FOGVOL_MAX_SHADER_STRINGS];
-        int count = 7;
-        if (fogvol_shader_source(FOGVOL_TIER_PS20, FOGVOL_PROGRAM_COUNT, FOGVOL_GLSL_330, FOGVOL_STAGE_VERTEX, s,
-                                 &count) != FOGVOL_ERROR_UNSUPPORTED || count != 0)
-            return 1;
-        if (fogvol_shader_source(FOGVOL_TIER_PS20, FOGVOL_PROGRAM_FACE, FOGVOL_GLSL_AUTO, FOGVOL_STAGE_VERTEX, s,
-                                 &count) != FOGVOL_ERROR_UNSUPPORTED)
-            return 1;
-    }
-    printf("%d shaders written to %s\n", n, dir);
+    int t, p, d, st, n = 0, refused = 0;
+    unsigned v;
+    for (t = 1; t < FOGVOL_TIER_COUNT; ++t)
+        for (v = 0; v <= FOGVOL_VARIANT_ALL; ++v)
+            for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
+                for (p = 0; p < FOGVOL_PROGRAM_COUNT; ++p)
+                    for (st = 0; st < 2; ++st) {
+                        fogvol_shader_desc sd;
+                        const char *s[FOGVOL_MAX_SHADER_STRINGS];
+                        int count = -1, i;
+                        char path[512];
+                        FILE *f;
+                        fogvol_result r;
+                        sd.tier = (fogvol_tier)t;
+                        sd.variants = v;
+                        sd.program = (fogvol_program)p;
+                        sd.dialect = (fogvol_dialect)d;
+                        sd.stage = (fogvol_stage)st;
+                        r = fogvol_shader_strings(&sd, s, &count);
+                        if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
+                            !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p)) {
+                            if (r != FOGVOL_ERROR_UNSUPPORTED || count != 0) {
+                                fprintf(stderr, "a combination that does not exist gave strings\n");
+                                return 1;
+                            }
+                            ++refused;
+                            continue;
+                        }
+                        if (r != FOGVOL_SUCCESS || count < 3 || count > FOGVOL_MAX_SHADER_STRINGS) {
+                            fprintf(stderr, "missing: %s v%u %s %s\n", fogvol_tier_name((fogvol_tier)t), v, prog[p],
+                                    dia[d]);
+                            return 1;
+                        }
+                        snprintf(path, sizeof path, "%s/%s_v%02u_%s_%s.%s", dir, fogvol_tier_name((fogvol_tier)t), v,
+                                 prog[p], dia[d], st ? "frag" : "vert");
+                        f = fopen(path, "w");
+                        if (!f) return 1;
+                        for (i = 0; i < count; ++i) fputs(s[i], f);
+                        fclose(f);
+                        ++n;
+                    }
+    printf("%d shaders written to %s; %d combinations refused with FOGVOL_ERROR_UNSUPPORTED\n", n, dir, refused);
     return 0;
 }

@@ -625,6 +625,7 @@ static void fv_create(fx *x, const snap *check)
     snap now;
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
+    cd.tier = FOGVOL_TIER_PS20; /* pass counts below are those of PS20 */
     cd.logger.func = fv_log;
     cd.logger.user_data = x;
     if (x->compat) {

@@ -1,0 +1,254 @@
+/* scenes.h - the test scenes (camera, meshes, model matrices, signs) and their
+   ground truth, ray-cast per pixel from the very triangles fogvol draws
+   (tests/raycast.h). Shared by test_render.c and test_tiers.c. Needs cmocka,
+   tests/shapes.h and tests/raycast.h included first. */
+#ifndef SCENES_H
+#define SCENES_H
+
+#define W 128
+#define H 128
+#define MAX_OBJ 24
+
+typedef struct tobj {
+    shp_mesh mesh;
+    float model[16];
+    int sign; /* +1 volume, -1 negative volume, 0 occluder */
+} tobj;
+
+typedef struct tscene {
+    const char *name;
+    rc_camera cam;
+    tobj obj[MAX_OBJ];
+    int n;
+    int bits;
+    float density; /* extinction ramp density for the composite check */
+    int expect_overflow;
+} tscene;
+
+static tscene g_scenes[24];
+static int g_nscenes;
+
+static int mirrored(const float m[16])
+{
+    double d = (double)m[0] * (m[5] * m[10] - m[9] * m[6]) - (double)m[4] * (m[1] * m[10] - m[9] * m[2]) +
+               (double)m[8] * (m[1] * m[6] - m[5] * m[2]);
+    return d < 0;
+}
+
+static void mat_trs(float m[16], float tx, float ty, float tz, float ang, float ax, float ay, float az, float s)
+{
+    float t[16], r[16], sc[16], tmp[16];
+    shp_mat_translate(t, tx, ty, tz);
+    shp_mat_rotate(r, ang, ax, ay, az);
+    shp_mat_scale(sc, s, s, s);
+    shp_mat_mul(tmp, r, sc);
+    shp_mat_mul(m, t, tmp);
+}
+
+static tscene *new_scene(const char *name, double ex, double ey, double ez, double tx, double ty, double tz,
+                         double znear, double zfar)
+{
+    tscene *s = &g_scenes[g_nscenes++];
+    memset(s, 0, sizeof *s);
+    s->name = name;
+    s->cam.eye[0] = ex;
+    s->cam.eye[1] = ey;
+    s->cam.eye[2] = ez;
+    s->cam.target[0] = tx;
+    s->cam.target[1] = ty;
+    s->cam.target[2] = tz;
+    s->cam.up[1] = 1.0;
+    s->cam.fovy_deg = 50.0;
+    s->cam.aspect = (double)W / H;
+    s->cam.znear = znear;
+    s->cam.zfar = zfar;
+    s->cam.width = W;
+    s->cam.height = H;
+    s->bits = 4;
+    s->density = 0.8f;
+    return s;
+}
+
+static void add(tscene *s, shp_mesh m, int sign, const float model[16])
+{
+    tobj *o = &s->obj[s->n++];
+    o->mesh = m;
+    o->sign = sign;
+    memcpy(o->model, model, sizeof o->model);
+}
+
+static void build_scenes(void)
+{
+    float m[16];
+    tscene *s;
+    int i;
+
+    s = new_scene("sphere", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    shp_mat_identity(m);
+    add(s, shp_sphere(1.0f, 64, 32), 1, m);
+
+    s = new_scene("box", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 35, 0.3f, 1, 0.2f, 1);
+    add(s, shp_box(0.9f, 0.6f, 0.8f), 1, m);
+
+    s = new_scene("torus_edge_on", 0, 0.15, 4.5, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 90, 1, 0, 0, 1); /* ring in the xz plane: seen edge-on */
+    add(s, shp_torus(1.1f, 0.35f, 96, 32), 1, m);
+
+    s = new_scene("two_spheres", 0, 0, 4, 0, 0, 0, 0.5, 10);
+    shp_mat_translate(m, -0.45f, 0, 0);
+    add(s, shp_sphere(0.85f, 64, 32), 1, m);
+    shp_mat_translate(m, 0.45f, 0.1f, -0.2f);
+    add(s, shp_sphere(0.85f, 64, 32), 1, m);
+
+    s = new_scene("torus_knot_L5", 0, 0.3, 4.2, 0, 0, 0, 0.5, 10);
+    s->bits = 5;
+    mat_trs(m, 0, 0, 0, 10, 1, 0, 0, 1);
+    add(s, shp_torus_knot(3, 4, 1.0f, 0.45f, 0.22f, 480, 20), 1, m);
+
+    /* one concave mesh (8 spheres along the view axis) whose central rays
+       cross 8 back and 8 front faces: the limit of the 15-bit encoding,
+       placed deep (d up to 0.93) so the channel sums come close to 255 */
+    s = new_scene("stack8_L5", 0, 0, 3.0, 0, 0, -6, 0.5, 14);
+    s->bits = 5;
+    s->density = 0.5f;
+    s->cam.fovy_deg = 12.0; /* the far spheres stay large on screen */
+    {
+        shp_mesh all = shp_sphere(0.3f, 32, 16);
+        for (i = 1; i < 8; ++i) {
+            shp_mesh one = shp_sphere(0.3f, 32, 16);
+            float t[16];
+            shp_mat_translate(t, 0, 0, -1.05f * (float)i);
+            shp_transform(&one, t);
+            shp_append(&all, &one);
+            shp_free(&one);
+        }
+        shp_mat_translate(m, 0, 0, -2.0f);
+        add(s, all, 1, m);
+    }
+
+    s = new_scene("plane_cuts_sphere", 0, 1.6, 3.6, 0, 0, 0, 0.5, 10);
+    shp_mat_identity(m);
+    add(s, shp_sphere(1.0f, 64, 32), 1, m);
+    mat_trs(m, 0, -0.25f, 0, -90, 1, 0, 0, 1); /* xy plane turned into a floor at y = -0.25 */
+    add(s, shp_grid_plane(3, 3, 4), 0, m);
+
+    s = new_scene("cube_inside_volume", 0.5, 0.8, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 20, 0, 1, 0, 1);
+    add(s, shp_box(1.1f, 0.9f, 1.0f), 1, m);
+    mat_trs(m, 0.1f, 0.05f, 0.1f, 40, 1, 1, 0, 1);
+    add(s, shp_box(0.35f, 0.35f, 0.35f), 0, m);
+
+    s = new_scene("negative_sphere_in_box", 0, 0.4, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 15, 0, 1, 0, 1);
+    add(s, shp_box(1.0f, 1.0f, 1.0f), 1, m);
+    shp_mat_translate(m, 0.1f, 0, 0);
+    add(s, shp_sphere(0.6f, 64, 32), -1, m);
+
+    /* a mirroring model matrix (negative determinant) flips the winding: fogvol
+       must flip its face culling, the solid is the same */
+    s = new_scene("mirrored_box", 0, 0.3, 4, 0, 0, 0, 0.5, 10);
+    {
+        float r[16], sc[16];
+        shp_mat_rotate(r, 30, 0.2f, 1, 0);
+        shp_mat_scale(sc, -1.0f, 1.0f, 1.0f);
+        shp_mat_mul(m, r, sc);
+    }
+    add(s, shp_box(0.9f, 0.6f, 0.7f), 1, m);
+
+    /* seeds/001: the ray enters layer 1 (A1), leaves it (B1), enters layer 2
+       (A2) and hits an opaque object (C) before layer 2's back face B2:
+       thickness = (B1 - A1) + (C - A2) */
+    s = new_scene("layers_opaque_between", 0.3, 0.5, 4.5, 0, 0, -0.5, 0.5, 10);
+    shp_mat_translate(m, 0, 0, 0.9f);
+    add(s, shp_box(1.2f, 1.0f, 0.35f), 1, m);
+    shp_mat_translate(m, 0, 0, -0.6f);
+    add(s, shp_box(1.2f, 1.0f, 0.6f), 1, m);
+    mat_trs(m, 0.1f, 0, -0.55f, 25, 0, 1, 0.2f, 1);
+    add(s, shp_box(0.45f, 0.45f, 0.45f), 0, m);
+
+    s = new_scene("camera_inside_sphere", 0, 0, 0.6, 0, 0, -1, 0.2, 8);
+    shp_mat_identity(m);
+    add(s, shp_sphere(2.5f, 64, 32), 1, m);
+
+    s = new_scene("camera_half_inside_box", 1.0, 0.05, 0.4, 1.0, 0.05, -1, 0.2, 8);
+    shp_mat_identity(m);
+    add(s, shp_box(1.0f, 1.0f, 1.5f), 1, m);
+
+    /* 20 nested shells far from the camera: 20 back faces > 16 at L = 4, and
+       with depths near the far end the red channel saturates. */
+    s = new_scene("overflow_shells", 0, 0, 9, 0, 0, 0, 0.5, 10);
+    s->expect_overflow = 1;
+    for (i = 0; i < 20; ++i) {
+        shp_mat_identity(m);
+        add(s, shp_sphere(0.3f + 0.03f * (float)i, 32, 16), 1, m);
+    }
+}
+
+static int scene_index(const char *name)
+{
+    int i;
+    for (i = 0; i < g_nscenes; ++i)
+        if (strcmp(g_scenes[i].name, name) == 0) return i;
+    fail_msg("no scene %s", name);
+    return 0;
+}
+
+static void free_scenes(void)
+{
+    int i, j;
+    for (i = 0; i < g_nscenes; ++i)
+        for (j = 0; j < g_scenes[i].n; ++j) shp_free(&g_scenes[i].obj[j].mesh);
+}
+
+/* Ground truth for every pixel centre: thickness, pairs of faces crossed,
+   interior mask (rc_interior), covered mask (a volume face on the ray). */
+static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char *interior, unsigned char *covered,
+                         int *max_faces, double *tmax)
+{
+    rc_object ro[MAX_OBJ];
+    unsigned *reversed[MAX_OBJ] = {0};
+    rc_scene rs;
+    int i, x, y;
+    *max_faces = 0;
+    *tmax = 0;
+    /* ground truth; a mirrored instance is the same solid, so its triangles are
+       reversed for the ray caster, which reads orientation from the winding */
+    for (i = 0; i < s->n; ++i) {
+        ro[i].pos = s->obj[i].mesh.pos;
+        ro[i].vcount = s->obj[i].mesh.vcount;
+        ro[i].idx = s->obj[i].mesh.idx;
+        if (mirrored(s->obj[i].model)) {
+            unsigned *rev = (unsigned *)malloc(sizeof(unsigned) * (size_t)s->obj[i].mesh.icount);
+            int t;
+            for (t = 0; t < s->obj[i].mesh.icount; t += 3) {
+                rev[t] = s->obj[i].mesh.idx[t];
+                rev[t + 1] = s->obj[i].mesh.idx[t + 2];
+                rev[t + 2] = s->obj[i].mesh.idx[t + 1];
+            }
+            ro[i].idx = rev;
+            reversed[i] = rev;
+        }
+        ro[i].icount = s->obj[i].mesh.icount;
+        memcpy(ro[i].model, s->obj[i].model, sizeof ro[i].model);
+        ro[i].sign = s->obj[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, s->n));
+    for (i = 0; i < s->n; ++i) free(reversed[i]);
+    for (y = 0; y < H; ++y)
+        for (x = 0; x < W; ++x) {
+            rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);
+            int k = y * W + x;
+            gt[k] = r.thickness;
+            pairs[k] = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            covered[k] = r.faces_front + r.faces_back > 0;
+            if (pairs[k] < 1) pairs[k] = 1;
+            interior[k] = (unsigned char)rc_interior(&rs, &s->cam, x, y);
+            if (r.faces_back > *max_faces) *max_faces = r.faces_back;
+            if (r.faces_front > *max_faces) *max_faces = r.faces_front;
+            if (gt[k] > *tmax) *tmax = gt[k];
+        }
+    rc_scene_free(&rs);
+}
+
+#endif

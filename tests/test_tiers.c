@@ -1,0 +1,603 @@
+/* test_tiers.c - every tier and variant that this GL context supports, in
+   every GLSL dialect, on the same scenes, against ray-cast ground truth
+   (tests/scenes.h). Prints the table tier x variant x dialect -> max/mean
+   error.
+
+   The test plays the engine: it renders its opaque occluders into its own
+   framebuffer (colour texture + depth texture), for MRT also the encoded
+   depth into fogvol's O texture through fogvol_mrt_snippet(), and hands
+   fogvol its depth texture for FLOAT + ENGINE_DEPTH. The other tiers get
+   the occluders through fogvol_add_occluder.
+
+   Bounds: RGBA8 tiers, dither off: |error| <= 1 LSB per pair of faces on
+   the ray, mean |error| <= 0.5 LSB per pair; FLOAT: |error| <= 1e-4 (far -
+   near). Interior pixels only (silhouette band excluded). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#include "tests/gl_util.h"
+#include <GL/glext.h>
+#include "tests/raycast.h"
+#include "tests/shapes.h"
+#include "tests/scenes.h"
+
+typedef struct combo {
+    fogvol_tier tier;
+    unsigned variants;
+    const char *name;
+} combo;
+
+static const combo g_combos[] = {
+    {FOGVOL_TIER_PS13, 0, "PS13"},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count"},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp"},
+    {FOGVOL_TIER_PS20, 0, "PS20"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp"},
+    {FOGVOL_TIER_MRT, 0, "MRT"},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu"},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single"},
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT"},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth"},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp"},
+};
+#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
+
+static const char *const g_scene_names[] = {"sphere", "two_spheres", "plane_cuts_sphere", "negative_sphere_in_box",
+                                            "layers_opaque_between", "camera_inside_sphere"};
+#define NSCENE ((int)(sizeof g_scene_names / sizeof g_scene_names[0]))
+
+/* dialects and the context that compiles them: desktop 110..130 in the
+   compatibility context, the rest in the core context */
+static const fogvol_dialect g_dialects[] = {FOGVOL_GLSL_110, FOGVOL_GLSL_120,   FOGVOL_GLSL_130, FOGVOL_GLSL_150,
+                                            FOGVOL_GLSL_330, FOGVOL_GLSL_100, FOGVOL_GLSL_300ES};
+#define NDIALECT ((int)(sizeof g_dialects / sizeof g_dialects[0]))
+
+typedef struct gt_cache {
+    double *gt;
+    int *pairs;
+    unsigned char *interior, *covered;
+    int max_faces;
+    double tmax;
+} gt_cache;
+
+static gt_cache g_gt[NSCENE];
+static double g_max[NCOMBO][NDIALECT], g_mean[NCOMBO][NDIALECT];
+static int g_ran[NCOMBO][NDIALECT];
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l == FOGVOL_LOG_ERROR) print_message("  [fogvol error] %s\n", m);
+}
+
+/* ---- the engine ---------------------------------------------------------- */
+typedef struct engine {
+    GLuint fbo, color, depth, prog;
+    GLint u_mvp, u_view, u_mrt;
+} engine;
+
+static GLuint compile(GLenum type, const char *const *src, int n)
+{
+    GLint ok = 0;
+    GLuint sh = glCreateShader(type);
+    glShaderSource(sh, n, src, NULL);
+    glCompileShader(sh);
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[1024];
+        glGetShaderInfoLog(sh, sizeof log, NULL, log);
+        fail_msg("engine shader: %s", log);
+    }
+    return sh;
+}
+
+static void engine_init(engine *e)
+{
+    static const char *vs =
+        "#version 330 core\nlayout(location = 0) in vec3 p;\nuniform mat4 mvp;\nuniform mat4 mv;\n"
+        "out float view_depth;\n"
+        "void main() { view_depth = -(mv * vec4(p, 1.0)).z; gl_Position = mvp * vec4(p, 1.0); }\n";
+    const char *fs[3];
+    GLint ok = 0;
+    fs[0] = "#version 330 core\n";
+    fs[1] = fogvol_mrt_snippet();
+    fs[2] = "in float view_depth;\nlayout(location = 0) out vec4 color;\nlayout(location = 1) out vec4 fogvol_o;\n"
+            "void main() { color = vec4(0.35, 0.3, 0.25, 1.0); fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
+    e->prog = glCreateProgram();
+    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, &vs, 1));
+    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs, 3));
+    glLinkProgram(e->prog);
+    glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
+    assert_true(ok);
+    e->u_mvp = glGetUniformLocation(e->prog, "mvp");
+    e->u_view = glGetUniformLocation(e->prog, "mv");
+    e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
+    glGenTextures(1, &e->color);
+    glBindTexture(GL_TEXTURE_2D, e->color);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glGenTextures(1, &e->depth);
+    glBindTexture(GL_TEXTURE_2D, e->depth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, W, H, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &e->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->color, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->depth, 0);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+}
+
+static void engine_free(engine *e)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &e->fbo);
+    glDeleteTextures(1, &e->color);
+    glDeleteTextures(1, &e->depth);
+    glDeleteProgram(e->prog);
+}
+
+/* The engine's opaque pass: its occluders into colour + depth, and with mrt
+   the encoded depth into fogvol's O texture as colour attachment 1. */
+static void engine_draw(engine *e, const tscene *s, const float view[16], const float proj[16],
+                        const fogvol_mrt_info *mrt)
+{
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    const float bg[4] = {0.2f, 0.5f, 0.8f, 1.0f};
+    GLuint vao, vbo, ibo;
+    int i;
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, mrt ? (GLuint)mrt->texture : 0, 0);
+    glDrawBuffers(mrt ? 2 : 1, bufs);
+    glViewport(0, 0, W, H);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    if (mrt) glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(e->prog);
+    if (mrt) glUniform4fv(e->u_mrt, 2, mrt->uniforms);
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glGenBuffers(1, &ibo);
+    for (i = 0; i < s->n; ++i) {
+        float mv[16], mvp[16];
+        if (s->obj[i].sign != 0) continue;
+        shp_mat_mul(mv, view, s->obj[i].model);
+        shp_mat_mul(mvp, proj, mv);
+        glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, mvp);
+        glUniformMatrix4fv(e->u_view, 1, GL_FALSE, mv);
+        glBindBuffer(GL_ARRAY_BUFFER, vbo);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)s->obj[i].mesh.vcount), s->obj[i].mesh.pos,
+                     GL_STREAM_DRAW);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+        glEnableVertexAttribArray(0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)s->obj[i].mesh.icount), s->obj[i].mesh.idx,
+                     GL_STREAM_DRAW);
+        glDrawElements(GL_TRIANGLES, s->obj[i].mesh.icount, GL_UNSIGNED_INT, NULL);
+    }
+    glBindVertexArray(0);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteBuffers(1, &vbo);
+    glDeleteBuffers(1, &ibo);
+    glDisable(GL_DEPTH_TEST);
+    glDrawBuffers(1, bufs); /* fogvol composites into attachment 0 only */
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+}
+
+/* ---- one tier/variant/dialect on every scene ------------------------------ */
+static void run(int ci, int di)
+{
+    const combo *c = &g_combos[ci];
+    fogvol_dialect dialect = g_dialects[di];
+    int core = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_130;
+    int sc, i, j, bad = 0, n = 0;
+    double max_lsb = 0, sum_pp = 0;
+    glu_ctx g;
+    engine e;
+    assert_true(glu_create(&g, W, H, core));
+    engine_init(&e);
+    for (sc = 0; sc < NSCENE; ++sc) {
+        const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
+        const gt_cache *t = &g_gt[sc];
+        fogvol_context_desc cd;
+        fogvol_context *fv;
+        fogvol_mesh *meshes[MAX_OBJ];
+        fogvol_ramp *ramp;
+        fogvol_ramp_desc rd;
+        fogvol_frame_desc fd;
+        fogvol_frame_stats st;
+        fogvol_mrt_info mrt;
+        fogvol_tier_info ti;
+        fogvol_result r;
+        float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+        double range = s->cam.zfar - s->cam.znear;
+        double lsb = c->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / pow(2.0, 3.0 * s->bits);
+        int has_neg = 0, count = (c->variants & FOGVOL_VARIANT_COUNT) != 0;
+        /* Baker's count needs the camera outside the volumes */
+        if (count && strcmp(s->name, "camera_inside_sphere") == 0) {
+            free(thick);
+            continue;
+        }
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.gl.dialect = dialect;
+        cd.logger.func = logger;
+        cd.tier = c->tier;
+        cd.variants = c->variants;
+        cd.encoding_bits = s->bits;
+        cd.disable_dither = 1;
+        r = fogvol_create_context(&cd, &fv);
+        assert_int_equal(r, FOGVOL_SUCCESS);
+        for (i = 0; i < s->n; ++i) {
+            fogvol_mesh_desc md;
+            memset(&md, 0, sizeof md);
+            md.positions = s->obj[i].mesh.pos;
+            md.vertex_count = s->obj[i].mesh.vcount;
+            md.indices = (const uint32_t *)s->obj[i].mesh.idx;
+            md.index_count = s->obj[i].mesh.icount;
+            md.allow_open = s->obj[i].sign == 0;
+            assert_int_equal(fogvol_create_mesh(fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
+            has_neg |= s->obj[i].sign < 0;
+        }
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+        rd.density = s->density;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+
+        memset(&fd, 0, sizeof fd);
+        rc_camera_matrices(&s->cam, fd.view, fd.projection);
+        fd.znear = (float)s->cam.znear;
+        fd.zfar = (float)s->cam.zfar;
+        fd.viewport[2] = W;
+        fd.viewport[3] = H;
+        fd.debug_thickness = thick;
+        fd.engine_depth_texture = e.depth;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        if (c->tier == FOGVOL_TIER_MRT) {
+            assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+            engine_draw(&e, s, fd.view, fd.projection, &mrt);
+        } else {
+            engine_draw(&e, s, fd.view, fd.projection, NULL);
+        }
+        for (i = 0; i < s->n; ++i) {
+            if (s->obj[i].sign == 0) {
+                if (c->tier != FOGVOL_TIER_MRT) assert_int_equal(fogvol_add_occluder(fv, meshes[i], s->obj[i].model), 0);
+            } else {
+                fogvol_volume_desc vd;
+                memset(&vd, 0, sizeof vd);
+                vd.mesh = meshes[i];
+                vd.ramp = ramp;
+                vd.negative = s->obj[i].sign < 0;
+                memcpy(vd.model, s->obj[i].model, sizeof vd.model);
+                assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            }
+        }
+        r = fogvol_end_frame(fv, &st);
+        glFinish();
+        assert_int_equal(r, FOGVOL_SUCCESS);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        /* passes as the tier info says: +1 per sum pass for the negative volumes */
+        assert_int_equal(fogvol_get_tier_info(c->tier, c->variants, &ti), FOGVOL_SUCCESS);
+        j = ti.library_passes;
+        if (has_neg && c->tier != FOGVOL_TIER_FLOAT) j += 2;
+        if (c->variants & FOGVOL_VARIANT_SINGLE_TARGET) j += 0; /* S+, S- replace B, F */
+        assert_int_equal(st.passes, j);
+
+        for (i = 0; i < W * H; ++i) {
+            double err;
+            if (!t->interior[i]) continue;
+            err = fabs(thick[i] - t->gt[i]) / lsb;
+            if (err > max_lsb) max_lsb = err;
+            if (t->covered[i]) {
+                sum_pp += err / t->pairs[i];
+                ++n;
+            }
+            if (err > (c->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-3)) {
+                if (bad < 3)
+                    print_message("  %s/%s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units)\n", c->name,
+                                  fogvol_dialect_name(dialect), s->name, i % W, i / W, thick[i], t->gt[i], err);
+                ++bad;
+            }
+        }
+        for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+        free(thick);
+    }
+    engine_free(&e);
+    glu_destroy(&g);
+    g_max[ci][di] = max_lsb;
+    g_mean[ci][di] = n ? sum_pp / n : 0;
+    g_ran[ci][di] = 1;
+    assert_int_equal(bad, 0);
+    assert_true(g_mean[ci][di] <= (g_combos[ci].tier == FOGVOL_TIER_FLOAT ? 0.5 : 0.5));
+}
+
+typedef struct tcase {
+    int combo, dialect;
+} tcase;
+
+static void run_case(void **state)
+{
+    const tcase *t = (const tcase *)*state;
+    run(t->combo, t->dialect);
+}
+
+/* AUTO picks from the backend's caps; unsupported combinations give a code. */
+static void test_choice_and_support(void **state)
+{
+    fogvol_null_backend nb;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    glu_ctx g;
+    const char *s[FOGVOL_MAX_SHADER_STRINGS];
+    int n = 5;
+    (void)state;
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&nb, &cd.backend);
+    cd.backend.caps = FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_FLOAT);
+    fogvol_destroy_context(fv);
+    cd.backend.caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_PS20);
+    fogvol_destroy_context(fv);
+    cd.engine_mrt = 1;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_MRT);
+    fogvol_destroy_context(fv);
+    cd.engine_mrt = 0;
+    cd.backend.caps = 0; /* lowp/mediump fragment shaders only */
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_PS13);
+    fogvol_destroy_context(fv);
+    cd.tier = FOGVOL_TIER_FLOAT; /* asked for, but the backend cannot */
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(nb.creates, nb.destroys);
+    cd.backend.dialect = FOGVOL_GLSL_100; /* GLES2 has no float targets: FLOAT does not exist there */
+    cd.backend.caps = FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_HIGHP_FRAGMENT;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_shader_source(FOGVOL_TIER_FLOAT, FOGVOL_PROGRAM_FACE, FOGVOL_GLSL_100,
+                                          FOGVOL_STAGE_FRAGMENT, s, &n),
+                     FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(n, 0);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_MRT, 0, FOGVOL_GLSL_120), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS13, FOGVOL_VARIANT_ALU, FOGVOL_GLSL_330),
+                     FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET |
+                                                  FOGVOL_VARIANT_COUNT, FOGVOL_GLSL_330), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_tier_uses_program(FOGVOL_TIER_PS20, 0, FOGVOL_PROGRAM_RESOLVE), 0);
+    assert_int_equal(fogvol_shader_source(FOGVOL_TIER_PS20, FOGVOL_PROGRAM_RESOLVE, FOGVOL_GLSL_330,
+                                          FOGVOL_STAGE_FRAGMENT, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+
+    /* the GL backend in Mesa's core context: float blending -> FLOAT; as GL 2.1 -> PS20 */
+    assert_true(glu_create(&g, 16, 16, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_FLOAT);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    assert_true(glu_create(&g, 16, 16, 0));
+    cd.gl.version_major = 2;
+    cd.gl.version_minor = 1;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_PS20);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+}
+
+/* The single-target variant sums on top of 128: half the faces fit. k nested
+   shells near the far plane (digits up to 15 at L = 4): 8 per sign still sum
+   exactly, 12 saturate and are reported, while the two-target PS20 holds 12. */
+static void shells(int k, unsigned variants, fogvol_result *result, int *overflow, double *max_err)
+{
+    glu_ctx g;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *mesh;
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_desc fd;
+    fogvol_frame_stats st;
+    fogvol_volume_desc vd;
+    fogvol_mesh_desc md;
+    rc_camera cam;
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    shp_mesh all = shp_sphere(0.25f, 32, 16);
+    int i;
+    double r0;
+    for (i = 1; i < k; ++i) { /* one mesh: k concentric spheres */
+        shp_mesh one = shp_sphere(0.25f + 0.02f * (float)i, 32, 16);
+        shp_append(&all, &one);
+        shp_free(&one);
+    }
+    memset(&cam, 0, sizeof cam);
+    cam.eye[2] = 9.2;
+    cam.up[1] = 1;
+    cam.fovy_deg = 10;
+    cam.aspect = 1;
+    cam.znear = 0.5;
+    cam.zfar = 10;
+    cam.width = W;
+    cam.height = H;
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.variants = variants;
+    cd.disable_dither = 1;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    memset(&md, 0, sizeof md);
+    md.positions = all.pos;
+    md.vertex_count = all.vcount;
+    md.indices = (const uint32_t *)all.idx;
+    md.index_count = all.icount;
+    assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 1;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&cam, fd.view, fd.projection);
+    fd.znear = 0.5f;
+    fd.zfar = 10;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.debug_thickness = thick;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = mesh;
+    vd.ramp = ramp;
+    shp_mat_identity(vd.model);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    *result = fogvol_end_frame(fv, &st);
+    *overflow = st.overflow_pixels;
+    /* the centre ray: every shell adds its diameter; analytic within the tessellation of the poles
+       (the ray runs pole to pole, where the mesh has vertices: exact) */
+    r0 = 0;
+    for (i = 0; i < k; ++i) r0 += 2.0 * (0.25 + 0.02 * i);
+    *max_err = fabs(thick[(H / 2) * W + W / 2] - r0) / (9.5 / 4096.0);
+    fogvol_destroy_mesh(fv, mesh);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    shp_free(&all);
+    free(thick);
+}
+
+static void test_single_target_limit(void **state)
+{
+    fogvol_result r;
+    int ov;
+    double err;
+    fogvol_encoding e;
+    (void)state;
+    fogvol_encoding_init(&e, 4);
+    assert_int_equal(e.max_faces_single, e.max_faces / 2);
+    shells(8, FOGVOL_VARIANT_SINGLE_TARGET, &r, &ov, &err);
+    print_message("  single target, 8 shells: %s, %d saturated pixels, centre error %.2f LSB\n",
+                  fogvol_result_string(r), ov, err);
+    assert_int_equal(r, FOGVOL_SUCCESS);
+    assert_int_equal(ov, 0);
+    assert_true(err <= 8.0);
+    shells(12, FOGVOL_VARIANT_SINGLE_TARGET, &r, &ov, &err);
+    print_message("  single target, 12 shells: %s, %d saturated pixels\n", fogvol_result_string(r), ov);
+    assert_int_equal(r, FOGVOL_ERROR_DEPTH_OVERFLOW);
+    assert_true(ov > 0);
+    shells(12, 0, &r, &ov, &err);
+    print_message("  two targets, 12 shells: %s, %d saturated pixels, centre error %.2f LSB\n",
+                  fogvol_result_string(r), ov, err);
+    assert_int_equal(r, FOGVOL_SUCCESS);
+    assert_true(err <= 12.0);
+}
+
+/* The pass counts of the seed (engine pass included) and fogvol's own. */
+static void test_pass_counts(void **state)
+{
+    fogvol_tier_info ti;
+    (void)state;
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS13, 0, &ti), 0);
+    assert_int_equal(ti.seed_passes, 6);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, 0, &ti), 0);
+    assert_int_equal(ti.seed_passes, 5);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_MRT, 0, &ti), 0);
+    assert_int_equal(ti.seed_passes, 4);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, 0, &ti), 0);
+    assert_int_equal(ti.seed_passes, 3);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
+    assert_int_equal(ti.library_passes, 2);
+    print_message("  passes (seed / fogvol): PS13 6/5, PS20 5/4, MRT 4/3, FLOAT 3/3, FLOAT+engine depth -/2\n");
+}
+
+static int print_table(void **state)
+{
+    int ci, di;
+    (void)state;
+    print_message("\n| tier + variants | ");
+    for (di = 0; di < NDIALECT; ++di) print_message("%s | ", fogvol_dialect_name(g_dialects[di]));
+    print_message("\n|---|");
+    for (di = 0; di < NDIALECT; ++di) print_message("---|");
+    print_message("\n");
+    for (ci = 0; ci < NCOMBO; ++ci) {
+        print_message("| %s (%s) | ", g_combos[ci].name, g_combos[ci].tier == FOGVOL_TIER_FLOAT ? "1e-4 range" : "LSB");
+        for (di = 0; di < NDIALECT; ++di) {
+            if (g_ran[ci][di]) print_message("%.2f / %.3f | ", g_max[ci][di], g_mean[ci][di]);
+            else print_message("n/a | ");
+        }
+        print_message("\n");
+    }
+    print_message("(max error / mean error per pair of faces over interior pixels of %d scenes; "
+                  "n/a: the combination does not exist in that dialect)\n\n", NSCENE);
+    for (ci = 0; ci < NSCENE; ++ci) {
+        free(g_gt[ci].gt);
+        free(g_gt[ci].pairs);
+        free(g_gt[ci].interior);
+        free(g_gt[ci].covered);
+    }
+    free_scenes();
+    return 0;
+}
+
+static int setup_all(void **state)
+{
+    int i;
+    (void)state;
+    build_scenes();
+    for (i = 0; i < NSCENE; ++i) {
+        gt_cache *t = &g_gt[i];
+        t->gt = (double *)calloc((size_t)W * H, sizeof(double));
+        t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
+        t->interior = (unsigned char *)calloc((size_t)W * H, 1);
+        t->covered = (unsigned char *)calloc((size_t)W * H, 1);
+        ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
+                     &t->max_faces, &t->tmax);
+    }
+    return 0;
+}
+
+int main(void)
+{
+    static tcase cases[NCOMBO * NDIALECT];
+    static struct CMUnitTest tests[NCOMBO * NDIALECT + 3];
+    static char names[NCOMBO * NDIALECT][64];
+    int ci, di, n = 0;
+    tests[n].name = "choice_and_support";
+    tests[n].test_func = test_choice_and_support;
+    ++n;
+    tests[n].name = "pass_counts";
+    tests[n].test_func = test_pass_counts;
+    ++n;
+    tests[n].name = "single_target_limit";
+    tests[n].test_func = test_single_target_limit;
+    ++n;
+    for (ci = 0; ci < NCOMBO; ++ci)
+        for (di = 0; di < NDIALECT; ++di) {
+            tcase *t = &cases[n - 3];
+            if (fogvol_combination_supported(g_combos[ci].tier, g_combos[ci].variants, g_dialects[di]) != 0) continue;
+            t->combo = ci;
+            t->dialect = di;
+            snprintf(names[n - 3], sizeof names[n - 3], "%s_glsl_%s", g_combos[ci].name,
+                     fogvol_dialect_name(g_dialects[di]));
+            tests[n].name = names[n - 3];
+            tests[n].test_func = run_case;
+            tests[n].initial_state = t;
+            ++n;
+        }
+    return _cmocka_run_group_tests("tiers", tests, (size_t)n, setup_all, print_table);
+}
