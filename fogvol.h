@@ -394,7 +394,12 @@ enum {
     /* FLOAT: the opaque depth comes from the engine's depth texture
        (fogvol_frame_desc.engine_depth_texture), linearised; no O pass. */
     FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
-    FOGVOL_VARIANT_ALL = (1u << 5) - 1u
+    /* PS20: more precision by spreading the encoding over two RGBA8 targets
+       per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
+       arithmetic; fp32 fragment maths bounds it to about 23 bits (L <= 3 is
+       exact: 18 bits with 32 faces). Needs GLSL 110-330 or 300 es. */
+    FOGVOL_VARIANT_WIDE = 1u << 5,
+    FOGVOL_VARIANT_ALL = (1u << 6) - 1u
 };
 
 typedef enum fogvol_program {
@@ -480,12 +485,14 @@ typedef enum fogvol_uniform {
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
 /* Sampler units, fixed per program:
-   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3 (FACE only)
-   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3
+   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
+   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
+   (the "2" samplers: second attachments of WIDE targets). Fragment outputs:
+   fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
    "fv_sign" (float, FLOAT tier: -1 for negative volumes).
    Vertex attribute 0: "fv_position" (vec3). */
-#define FOGVOL_MAX_TEXTURE_UNITS 4
+#define FOGVOL_MAX_TEXTURE_UNITS 6
 
 typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
 typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
@@ -505,6 +512,7 @@ typedef enum fogvol_format {
 
 typedef struct fogvol_target_desc {
     int width, height;        /* colour texture, NEAREST, CLAMP */
+    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE), drawn together */
     fogvol_format format;
     int depth;                /* 1: with a depth buffer */
     fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
@@ -602,6 +610,9 @@ typedef struct fogvol_backend {
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
     /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
     uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    /* optional (WIDE): the second colour attachment of a two-attachment target,
+       as a target handle of its own (sampled and read back like any target) */
+    fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -1438,9 +1449,19 @@ static const char fogvol__fs_es300[] =
 
 static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
                                                                    "#define FV_FLOAT\n"};
-static const char *const fogvol__variant_define[5] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
+static const char *const fogvol__variant_define[6] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
-                                                      "#define FV_ENGINE_DEPTH\n"};
+                                                      "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n"};
+/* WIDE ENCODE/FACE write two targets: gl_FragData or an output array at location 0 */
+static const char fogvol__fs_two_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_OUT0 gl_FragData[0]\n"
+    "#define FV_OUT1 gl_FragData[1]\n";
+static const char fogvol__fs_two_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_frag[2];\n#define FV_OUT0 fv_frag[0]\n"
+    "#define FV_OUT1 fv_frag[1]\n";
+static const char fogvol__fs_two_layout[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_frag[2];\n"
+    "#define FV_OUT0 fv_frag[0]\n#define FV_OUT1 fv_frag[1]\n";
 
 /* Mesh vertex shader: clip position and normalised depth d = (w - near) /
    (far - near). With fv_misc.y = 1 clip z is replaced by k*d - w: the near
@@ -1508,6 +1529,16 @@ static const char fogvol__fs_common[] =
     "#if defined(FV_PS13) || defined(FV_COUNT)\n"
     "#define FV_NORMALIZE\n"
     "#endif\n"
+    "#ifdef FV_WIDE\n"                            /* six digits: V = floor(u N^6 + threshold), no borrow */
+    "void fv_encode_wide(float d, out vec4 hi, out vec4 lo) {\n"
+    "    float n = fv_enc.x, n3 = fv_enc.x * fv_enc.y, dd = fv_dith.z;\n"
+    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n"
+    "    float v = floor(clamp(d, 0.0, fv_enc.w) * n3 * n3 + mod(row + dd * 0.5, dd) / dd);\n"
+    "    float a = floor(v / n3), b = v - a * n3;\n"
+    "    hi = vec4(floor(a / fv_enc.y), mod(floor(a / n), n), mod(a, n), 0.0) * (1.0 / 255.0);\n"
+    "    lo = vec4(floor(b / fv_enc.y), mod(floor(b / n), n), mod(b, n), 0.0) * (1.0 / 255.0);\n"
+    "}\n"
+    "#endif\n"
     "vec4 fv_normalize(vec4 e) {\n"                /* fold the borrow: digits R, G, B in [0, N-1], alpha 0 */
     "    float g = e.g - e.a;\n"
     "    float c = g < -0.5 / 255.0 ? 1.0 : 0.0;\n"
@@ -1519,7 +1550,12 @@ static const char fogvol__fs_common[] =
 static const char fogvol__fs_encode[] =
     "FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
-    "#if defined(FV_FLOAT)\n"
+    "#if defined(FV_WIDE)\n"
+    "    vec4 hi, lo;\n"
+    "    fv_encode_wide(fv_d, hi, lo);\n"
+    "    FV_OUT0 = hi;\n"
+    "    FV_OUT1 = lo;\n"
+    "#elif defined(FV_FLOAT)\n"
     "    FV_FRAGCOLOR = vec4(clamp(fv_d, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
     "#elif defined(FV_NORMALIZE)\n"
     "    FV_FRAGCOLOR = fv_normalize(fv_encode(fv_d));\n"
@@ -1548,6 +1584,15 @@ static const char fogvol__fs_face[] =
     "#endif\n"
     "    float d = min(max(fv_d, 0.0), o);\n"
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
+    "}\n"
+    "#elif defined(FV_WIDE)\n"
+    "uniform sampler2D fv_opaque2;\n"
+    "void main() {\n"
+    "    vec4 hi, lo, ohi = FV_TEXTURE(fv_opaque, fv_st()), olo = FV_TEXTURE(fv_opaque2, fv_st());\n"
+    "    fv_encode_wide(fv_d, hi, lo);\n"
+    "    bool behind = dot(hi - ohi, fv_dec) + dot(lo - olo, fv_dec) / (fv_enc.x * fv_enc.y) >= 0.0;\n"
+    "    FV_OUT0 = behind ? ohi : hi;\n"
+    "    FV_OUT1 = behind ? olo : lo;\n"
     "}\n"
     "#else\n"
     "void main() {\n"
@@ -1597,6 +1642,10 @@ static const char fogvol__fs_composite[] =
     "uniform sampler2D fv_front;\n"
     "uniform sampler2D fv_colors;\n"
     "uniform sampler2D fv_opaque;\n"
+    "#ifdef FV_WIDE\n"
+    "uniform sampler2D fv_back2;\n"
+    "uniform sampler2D fv_front2;\n"
+    "#endif\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
     "    vec4 b = FV_TEXTURE(fv_back, st);\n"
@@ -1616,11 +1665,19 @@ static const char fogvol__fs_composite[] =
     " ? 1.0 : 0.0;\n"
     "#else\n"
     "    vec4 f = FV_TEXTURE(fv_front, st);\n"
+    "#ifndef FV_WIDE\n"
     "    if (b + f == vec4(0.0)) discard;\n"
+    "#endif\n"
     "    vec4 m = max(b, f);\n"
     "    sat = max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
-    "#ifdef FV_COUNT\n"
+    "#if defined(FV_COUNT)\n"
     "    t = dot(b.rgb - f.rgb, fv_dec.xyz) + (f.a - b.a) * 255.0 * dot(FV_TEXTURE(fv_opaque, st).rgb, fv_dec.xyz);\n"
+    "#elif defined(FV_WIDE)\n"
+    "    vec4 b2 = FV_TEXTURE(fv_back2, st), f2 = FV_TEXTURE(fv_front2, st);\n"
+    "    if (b + f + b2 + f2 == vec4(0.0)) discard;\n"
+    "    m = max(m, max(b2, f2));\n"
+    "    sat = max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
+    "    t = dot(b - f, fv_dec) + dot(b2 - f2, fv_dec) / (fv_enc.x * fv_enc.y);\n"
     "#else\n"
     "    t = dot(b - f, fv_dec);\n"
     "#endif\n"
@@ -1651,9 +1708,13 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
     if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
     modern = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_100;
     if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || dialect == FOGVOL_GLSL_100 ||
+                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
+        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
     switch (tier) {
     case FOGVOL_TIER_PS13: /* texture ramps only: the tier is for GPUs without fp32 fragment maths */
-        return (v & (FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET))
+        return (v & (FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET |
+                     FOGVOL_VARIANT_WIDE))
                    ? FOGVOL_ERROR_UNSUPPORTED
                    : FOGVOL_SUCCESS;
     case FOGVOL_TIER_PS20: return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
@@ -1731,6 +1792,13 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
         if (es) strings[n++] = fogvol__vs_es;
+    } else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
+               (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE)) {
+        if (d->dialect == FOGVOL_GLSL_300ES) strings[n++] = "precision highp float;\nprecision highp sampler2D;\n";
+        strings[n++] = legacy                              ? fogvol__fs_two_legacy
+                       : d->dialect == FOGVOL_GLSL_330 ||
+                               d->dialect == FOGVOL_GLSL_300ES ? fogvol__fs_two_layout
+                                                               : fogvol__fs_two_modern;
     } else if (d->dialect == FOGVOL_GLSL_100) {
         strings[n++] = fogvol__fs_es100;
     } else if (d->dialect == FOGVOL_GLSL_300ES) {
@@ -1739,7 +1807,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         strings[n++] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
     }
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
-    for (i = 0; i < 5; ++i)
+    for (i = 0; i < 6; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE)
@@ -1875,6 +1943,11 @@ static void fogvol__null_draw_fullscreen(void *u)
     if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->fullscreen[s->pass_count - 1]++;
 }
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
+static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
+{
+    (void)u;
+    return t ? t + ((fogvol_handle)index << 20) : 0; /* a distinct handle, never created or destroyed */
+}
 static fogvol_result fogvol__null_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
 {
     (void)u;
@@ -1908,6 +1981,7 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     table->draw_fullscreen = fogvol__null_draw_fullscreen;
     table->end_pass = fogvol__null_end_pass;
     table->read_target = fogvol__null_read_target;
+    table->target_attachment = fogvol__null_attachment;
 }
 
 /* >>renderer ============================================================== */
@@ -1952,6 +2026,7 @@ struct fogvol_context {
     fogvol_handle prog[FOGVOL_PROGRAM_COUNT];
     fogvol_handle tgt_o, tgt_b, tgt_f, tgt_t; /* SINGLE: B is the one sum target; PS13: T resolved;
                                                  FLOAT: B is the float sum */
+    fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     int target_w, target_h;
     int in_frame, in_occluder_pass, mrt_ready;
     fogvol_frame_desc frame;
@@ -2006,6 +2081,7 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
     if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
     ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
+    ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
     ctx->target_w = ctx->target_h = 0;
 }
 
@@ -2033,6 +2109,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
     } else {
         td.depth = ctx->tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
+        td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
         td.label = "fogvol O (opaque depth)";
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
         td.depth = 0;
@@ -2043,9 +2120,16 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
         if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
             r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_f);
         td.share_depth = 0;
+        td.color_count = 1;
         td.label = "fogvol T (resolved thickness)";
         if (r == FOGVOL_SUCCESS && ctx->tier == FOGVOL_TIER_PS13)
             r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_t);
+        if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
+            ctx->tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_o, 1);
+            ctx->tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_b, 1);
+            ctx->tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_f, 1);
+            if (!ctx->tgt_o2 || !ctx->tgt_b2 || !ctx->tgt_f2) r = FOGVOL_ERROR_BACKEND;
+        }
     }
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create %dx%d render targets: %s", w, h,
@@ -2104,9 +2188,10 @@ static fogvol_result fogvol__make_texture(fogvol_context *ctx, int which, fogvol
 
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
 {
-    static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg", "fv_blue", "fv_dither", "fv_opaque"};
-    static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back", "fv_front", "fv_colors",
-                                                                    "fv_opaque"};
+    static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg",     "fv_blue",    "fv_dither",
+                                                                      "fv_opaque", "fv_opaque2", NULL};
+    static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back",   "fv_front", "fv_colors",
+                                                                    "fv_opaque", "fv_back2", "fv_front2"};
     static const char *const labels[FOGVOL_PROGRAM_COUNT] = {"fogvol encode", "fogvol face", "fogvol composite",
                                                              "fogvol composite (geometry)", "fogvol resolve"};
     fogvol_program_desc pd;
@@ -2129,7 +2214,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
         pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
-    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = pd.samplers[4] = NULL;
     pd.label = labels[p];
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
@@ -2160,6 +2245,7 @@ static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_conte
     }
     if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
         (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
+        ((ctx->variants & FOGVOL_VARIANT_WIDE) && (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
         ((ctx->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
                     fogvol_tier_name(t), caps);
@@ -2237,7 +2323,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     }
     r = fogvol__choose_tier(ctx, desc);
     if (r == FOGVOL_SUCCESS && ctx->tier != FOGVOL_TIER_FLOAT) {
-        if (!fogvol__has(ctx, FOGVOL_VARIANT_ALU)) {
+        if (!fogvol__has(ctx, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_WIDE)) {
             r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
             if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
         }
@@ -2633,6 +2719,37 @@ static fogvol_result fogvol__single_peak(fogvol_context *ctx, unsigned char *sat
     return r;
 }
 
+/* WIDE: six digits over two attachments per sum. */
+static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overflow)
+{
+    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    unsigned char *px[4];
+    fogvol_handle t[4];
+    fogvol_result r = FOGVOL_SUCCESS;
+    double range = (double)ctx->frame.zfar - ctx->frame.znear, n3 = (double)ctx->enc.levels * ctx->enc.levels * ctx->enc.levels;
+    int k;
+    t[0] = ctx->tgt_b;
+    t[1] = ctx->tgt_f;
+    t[2] = ctx->tgt_b2;
+    t[3] = ctx->tgt_f2;
+    px[0] = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 16u);
+    if (!px[0]) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    for (k = 1; k < 4; ++k) px[k] = px[0] + n * 4u * (size_t)k;
+    for (k = 0; k < 4 && r == FOGVOL_SUCCESS; ++k) r = ctx->be.read_target(ctx->be.user_data, t[k], px[k], n * 4u);
+    *overflow = 0;
+    for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) {
+        int sat = 0, c;
+        for (k = 0; k < 4; ++k)
+            for (c = 0; c < 4; ++c) sat |= px[k][4 * i + c] == 255;
+        *overflow += sat;
+        ctx->frame.debug_thickness[i] = (float)((fogvol_decode_difference(&ctx->enc, px[0] + 4 * i, px[1] + 4 * i) +
+                                                 fogvol_decode_difference(&ctx->enc, px[2] + 4 * i, px[3] + 4 * i) / n3) *
+                                                range);
+    }
+    fogvol__free(&ctx->alloc, px[0]);
+    return r;
+}
+
 /* Decoded thickness per pixel (world units) from the sum targets, and the
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
 static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int *overflow)
@@ -2644,6 +2761,7 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
     double range = (double)ctx->frame.zfar - ctx->frame.znear;
     int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
+    if (ctx->tgt_b2) return fogvol__debug_capture_wide(ctx, overflow);
     b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 12u);
     if (!b) return FOGVOL_ERROR_OUT_OF_MEMORY;
     f = b + n * 4u;
@@ -2801,7 +2919,14 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     ps.uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)h;
     if (rgba8) {
         memcpy(ps.uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
-        if (count || ctx->tier == FOGVOL_TIER_PS13) ps.uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts */
+        if (count || ctx->tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
+            ps.uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
+        if (fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) { /* u = clamp(d, 0, 1 - N^-6), no offset */
+            double n6 = (double)ctx->enc.levels * ctx->enc.levels * ctx->enc.levels;
+            n6 *= n6;
+            ps.uniforms[FOGVOL_U_ENC][2] = 0.0f;
+            ps.uniforms[FOGVOL_U_ENC][3] = (float)(1.0 - 1.0 / n6);
+        }
     } else {
         ps.uniforms[FOGVOL_U_DECODE][0] = fd->zfar - fd->znear;
     }
@@ -2866,6 +2991,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
         if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = fd->engine_depth_texture;
         else ps.textures[3] = ctx->tgt_o;
+        ps.textures[4] = ctx->tgt_o2;
         if (ctx->tier == FOGVOL_TIER_FLOAT) {
             /* c+d in one pass: every face, signed by gl_FrontFacing */
             ps.target = ctx->tgt_b;
@@ -2909,6 +3035,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.textures[0] = ctx->tgt_b;
         ps.textures[1] = ctx->tgt_f;
         ps.textures[3] = count ? ctx->tgt_o : 0;
+        ps.textures[4] = ctx->tgt_b2;
+        ps.textures[5] = ctx->tgt_f2;
         if (ctx->tier == FOGVOL_TIER_PS13) { /* resolve B - F into T */
             ps.target = ctx->tgt_t;
             ps.clear = 0;
@@ -3146,6 +3274,10 @@ enum {
 /* GL 3.0 / GLES 3.0: extension strings one by one. */
 #define FOGVOL__GL_3(X) X(const fogvol__GLubyte *, GetStringi, (fogvol__GLenum, fogvol__GLuint))
 
+/* Several colour outputs: GL 2.0, GLES 3.0 (WIDE); desktop GL 3.0 binds output names. */
+#define FOGVOL__GL_DRAW_BUFFERS(X) X(void, DrawBuffers, (fogvol__GLsizei, const fogvol__GLenum *))
+#define FOGVOL__GL_3_DESKTOP(X) X(void, BindFragDataLocation, (fogvol__GLuint, fogvol__GLuint, const fogvol__GLchar *))
+
 /* Desktop only. */
 #define FOGVOL__GL_DESKTOP(X) \
     X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
@@ -3159,7 +3291,7 @@ enum {
 
 #define FOGVOL__GL_ALL(X) \
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
-        FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X)
+        FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -3193,6 +3325,7 @@ typedef struct fogvol__gl_target {
     int width, height;
     int owns_depth; /* 0 when depth is another target's renderbuffer */
     fogvol_format format;
+    struct fogvol__gl_target *second; /* WIDE: attachment 1 as a target of its own (own FBO) */
 } fogvol__gl_target;
 
 typedef struct fogvol__gl_program {
@@ -3533,6 +3666,16 @@ static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
     fogvol__free(&gl->alloc, t);
 }
 
+static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
+{
+    if (!t) return;
+    if (t->second) fogvol__gl_free_target(gl, t->second);
+    gl->DeleteFramebuffers(1, &t->fbo);
+    gl->DeleteTextures(1, &t->base.tex);
+    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    fogvol__free(&gl->alloc, t);
+}
+
 static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -3565,6 +3708,33 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     gl->GenFramebuffers(1, &t->fbo);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D, t->base.tex, 0);
+    if (d->color_count == 2 && gl->DrawBuffers) { /* WIDE: a second RGBA8 texture at attachment 1 */
+        static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
+        fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
+        if (t2) {
+            memset(t2, 0, sizeof *t2);
+            *t2 = *t;
+            t2->second = NULL;
+            t2->depth = 0;
+            gl->GenTextures(1, &t2->base.tex);
+            gl->BindTexture(FOGVOL__GL_TEXTURE_2D, t2->base.tex);
+            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
+            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
+            gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
+                           d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
+            gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
+            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
+            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
+                                     t2->base.tex, 0);
+            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
+            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D,
+                                     t2->base.tex, 0);
+            gl->DrawBuffers(2, bufs); /* framebuffer state of our FBO */
+            t->second = t2;
+        }
+    }
     if (d->share_depth) {
         t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
         gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
@@ -3581,16 +3751,14 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     }
     status = gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_target");
+    if (r == FOGVOL_SUCCESS && d->color_count == 2 && !t->second) r = FOGVOL_ERROR_OUT_OF_MEMORY;
     if (r == FOGVOL_SUCCESS && status != FOGVOL__GL_FRAMEBUFFER_COMPLETE) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s: framebuffer incomplete (0x%04x) at %dx%d",
                     d->label ? d->label : "target", status, d->width, d->height);
         r = FOGVOL_ERROR_FRAMEBUFFER;
     }
     if (r != FOGVOL_SUCCESS) {
-        gl->DeleteFramebuffers(1, &t->fbo);
-        gl->DeleteTextures(1, &t->base.tex);
-        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
-        fogvol__free(&gl->alloc, t);
+        fogvol__gl_free_target(gl, t);
         t = NULL;
     }
     if (gl->in_frame) { /* the next pass rebinds what it needs; keep the saved renderbuffer binding */
@@ -3604,13 +3772,15 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
 
 static void fogvol__gl_destroy_target(void *u, fogvol_handle h)
 {
-    fogvol__gl *gl = (fogvol__gl *)u;
-    fogvol__gl_target *t = (fogvol__gl_target *)h;
-    if (!t) return;
-    gl->DeleteFramebuffers(1, &t->fbo);
-    gl->DeleteTextures(1, &t->base.tex);
-    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
-    fogvol__free(&gl->alloc, t);
+    fogvol__gl_free_target((fogvol__gl *)u, (fogvol__gl_target *)h);
+}
+
+static fogvol_handle fogvol__gl_target_attachment(void *u, fogvol_handle h, int index)
+{
+    const fogvol__gl_target *t = (const fogvol__gl_target *)h;
+    (void)u;
+    if (!t) return 0;
+    return index == 0 ? h : index == 1 ? (fogvol_handle)t->second : 0;
 }
 
 static uintptr_t fogvol__gl_native_texture(void *u, fogvol_handle h)
@@ -3665,6 +3835,7 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
         gl->AttachShader(p->id, vs);
         gl->AttachShader(p->id, fs);
         gl->BindAttribLocation(p->id, 0, "fv_position");
+        if (gl->BindFragDataLocation) gl->BindFragDataLocation(p->id, 0, "fv_frag"); /* WIDE outputs, 130/150 */
         gl->LinkProgram(p->id);
         gl->GetProgramiv(p->id, FOGVOL__GL_LINK_STATUS, &ok);
         if (!ok) {
@@ -4132,6 +4303,14 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     if (gl->major >= 3) {
         FOGVOL__GL_3(FOGVOL__GL_LOAD)
         FOGVOL__GL_3(FOGVOL__GL_REQUIRE)
+        if (!gl->gles) {
+            FOGVOL__GL_3_DESKTOP(FOGVOL__GL_LOAD)
+            FOGVOL__GL_3_DESKTOP(FOGVOL__GL_REQUIRE)
+        }
+    }
+    if (!gl->gles || gl->major >= 3) {
+        FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_LOAD)
+        FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_REQUIRE)
     }
     if (gl->gles) {
         FOGVOL__GL_ES(FOGVOL__GL_LOAD)
@@ -4165,6 +4344,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     out->dialect = gl->dialect;
     out->caps = gl->caps;
     out->native_texture = fogvol__gl_native_texture;
+    out->target_attachment = fogvol__gl_target_attachment;
     out->begin_frame = fogvol__gl_begin_frame;
     out->end_frame = fogvol__gl_end_frame;
     out->create_texture = fogvol__gl_create_texture;

@@ -504,7 +504,7 @@ typedef struct xpass {
 } xpass;
 
 static void x_target_pass(xpass *x, fogvol_handle target, int clear, fogvol_cull cull, fogvol_handle program,
-                          const fogvol_handle tex[4])
+                          const fogvol_handle tex[FOGVOL_MAX_TEXTURE_UNITS])
 {
     memset(x, 0, sizeof *x);
     x->target = target;
@@ -730,7 +730,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     fogvol_frame_stats st;
     fogvol_constants k;
     fogvol_handle enc, face, comp, rg, blue, dith, O = 0, B, F, tl, tf;
-    fogvol_handle lookup[4], faces[4];
+    fogvol_handle lookup[FOGVOL_MAX_TEXTURE_UNITS] = {0}, faces[FOGVOL_MAX_TEXTURE_UNITS] = {0};
     fogvol_encoding e;
     xpass x[9];
     int i, n_depth = 0, n_plain = 0;

@@ -10,8 +10,8 @@
    the occluders through fogvol_add_occluder.
 
    Bounds: RGBA8 tiers, dither off: |error| <= 1 LSB per pair of faces on
-   the ray, mean |error| <= 0.5 LSB per pair; FLOAT: |error| <= 1e-4 (far -
-   near). Interior pixels only (silhouette band excluded). */
+   the ray (+ 1e-6 (far - near) for fp32 geometry, 0.26 LSB at WIDE's 18 bits),
+   mean |error| <= 0.5 LSB per pair; FLOAT: |error| <= 1e-4 (far - near). Interior pixels only (silhouette band excluded). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -31,24 +31,26 @@ typedef struct combo {
     fogvol_tier tier;
     unsigned variants;
     const char *name;
+    int bits; /* 0: the scene's */
 } combo;
 
 static const combo g_combos[] = {
-    {FOGVOL_TIER_PS13, 0, "PS13"},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count"},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp"},
-    {FOGVOL_TIER_PS20, 0, "PS20"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp"},
-    {FOGVOL_TIER_MRT, 0, "MRT"},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu"},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single"},
-    {FOGVOL_TIER_FLOAT, 0, "FLOAT"},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth"},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp"},
+    {FOGVOL_TIER_PS13, 0, "PS13", 0},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 0},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp", 0},
+    {FOGVOL_TIER_PS20, 0, "PS20", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, "PS20+wide (L=3, 18 bits)", 3},
+    {FOGVOL_TIER_MRT, 0, "MRT", 0},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu", 0},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single", 0},
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp", 0},
 };
 #define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
 
@@ -226,7 +228,9 @@ static void run(int ci, int di)
         fogvol_result r;
         float *thick = (float *)calloc((size_t)W * H, sizeof(float));
         double range = s->cam.zfar - s->cam.znear;
-        double lsb = c->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / pow(2.0, 3.0 * s->bits);
+        int bits = c->bits ? c->bits : s->bits;
+        double lsb = c->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range
+                     : range / pow(2.0, ((c->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * bits);
         int has_neg = 0, count = (c->variants & FOGVOL_VARIANT_COUNT) != 0;
         /* Baker's count needs the camera outside the volumes */
         if (count && strcmp(s->name, "camera_inside_sphere") == 0) {
@@ -239,7 +243,7 @@ static void run(int ci, int di)
         cd.logger.func = logger;
         cd.tier = c->tier;
         cd.variants = c->variants;
-        cd.encoding_bits = s->bits;
+        cd.encoding_bits = bits;
         cd.disable_dither = 1;
         r = fogvol_create_context(&cd, &fv);
         assert_int_equal(r, FOGVOL_SUCCESS);
@@ -307,7 +311,8 @@ static void run(int ci, int di)
                 sum_pp += err / t->pairs[i];
                 ++n;
             }
-            if (err > (c->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-3)) {
+            /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits) */
+            if (err > (c->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb)) {
                 if (bad < 3)
                     print_message("  %s/%s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units)\n", c->name,
                                   fogvol_dialect_name(dialect), s->name, i % W, i / W, thick[i], t->gt[i], err);
