@@ -89,6 +89,31 @@
        GL 2.0 -> 110   GL 2.1 -> 120   GL 3.0/3.1 -> 130   GL 3.2 -> 150
        GL 3.3+ -> 330 core   GLES 2 / WebGL 1 -> 100   GLES 3 / WebGL 2 -> 300 es
 
+   TIERS (fogvol_context_desc.tier; 0 = automatic, in this order)
+   =====
+       context has                          tier    passes (seed / fogvol)
+       R32F + float blending (GL 3.0,       FLOAT   3 / 3  (2 with the engine's
+         GLES3 + EXT_color_buffer_float                     depth texture)
+         + EXT_float_blend)
+       MRT and desc.engine_mrt = 1          MRT     4 / 3  (the engine writes O)
+       highp fragment shaders               PS20    5 / 4
+       lowp/mediump only (GLES2)            PS13    6 / 5
+   Variants combine with tiers (FOGVOL_VARIANT_*): single target, Baker's
+   inside/outside count, ALU encoding, near-plane vertex clamping, engine depth
+   texture (FLOAT), two-target precision (WIDE); fogvol_combination_supported()
+   says which exist in a dialect. FLOAT and MRT need GLSL 130+ or 300 es.
+
+   MRT TIER (the engine's opaque pass writes the opaque depth as a 2nd output)
+   ========
+       fogvol_begin_frame(fv, &fd);
+       fogvol_mrt_info mi; fogvol_mrt_prepare(fv, &mi);   // O texture, clear colour, uniforms
+       glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, (GLuint)mi.texture, 0);
+       glDrawBuffers(2, bufs); glClearBufferfv(GL_COLOR, 1, mi.clear_color);
+       // opaque shader: fogvol_mrt_snippet() pasted in, uniform fogvol_mrt[2] = mi.uniforms,
+       //                second output = fogvol_encode_view_depth(-view_space_z)
+       glDrawBuffers(1, bufs);                             // before fogvol composites
+       ... fogvol_add_volume ...; fogvol_end_frame(fv, NULL);
+
    SECTIONS (search for the markers)
    ========
        >>declarations  >>cpu  >>shaders  >>null backend  >>renderer  >>gl backend
@@ -1619,9 +1644,13 @@ static const char fogvol__fs_face[] =
 static const char fogvol__fs_resolve[] =
     "uniform sampler2D fv_back;\n"
     "uniform sampler2D fv_front;\n"
+    "uniform sampler2D fv_opaque;\n"
     "void main() {\n"
     "    vec4 b = FV_TEXTURE(fv_back, fv_st()), f = FV_TEXTURE(fv_front, fv_st());\n"
     "    vec3 d = floor((b.rgb - f.rgb) * 255.0 + 0.5);\n"
+    "#ifdef FV_COUNT\n"                           /* + the opaque depth once per missing back face */
+    "    d += floor((f.a - b.a) * 255.0 + 0.5) * floor(FV_TEXTURE(fv_opaque, fv_st()).rgb * 255.0 + 0.5);\n"
+    "#endif\n"
     "    float n = fv_enc.x, c = floor(d.b / n);\n"
     "    d.b -= c * n;\n"
     "    d.g += c;\n"
