@@ -12,10 +12,12 @@ GL_LIBS  = -lOSMesa -lm
 LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
            UBSAN_OPTIONS=print_stacktrace=1
 TAP      = CMOCKA_MESSAGE_OUTPUT=TAP
+VALGRIND = valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite
+FUZZ_TIME ?= 60
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all test demo images deps-test deps-demo clean
+.PHONY: all test demo images fuzz deps-test deps-demo clean
 
 all: test
 
@@ -52,13 +54,19 @@ $(BUILD)/test_backend: tests/test_backend.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_backend_san: tests/test_backend.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
+$(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c -o $@ -lm
+$(BUILD)/fuzz_mesh: tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
+	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
 $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
 
 TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
-            $(BUILD)/dump_shaders
+            $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh
 
 test: deps-test
 	@$(MAKE) --no-print-directory $(TEST_BINS)
@@ -76,7 +84,10 @@ test: deps-test
 	  "tiers=$(TAP) $(BUILD)/test_tiers" \
 	  "tiers_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_tiers_san" \
 	  "backend=$(TAP) $(BUILD)/test_backend" \
-	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san"
+	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san" \
+	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
+	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
+	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh"
 
 # --- demo --------------------------------------------------------------------------
 $(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
@@ -85,6 +96,12 @@ $(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
 demo: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
 	@$(BUILD)/demo_headless $(BUILD)/demo
+
+# libFuzzer on mesh validation, FUZZ_TIME seconds per target; new inputs go to
+# build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)
+fuzz: deps-test $(BUILD)/fuzz_mesh
+	@mkdir -p $(BUILD)/fuzz/mesh
+	$(BUILD)/fuzz_mesh -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh
 
 # the README pictures, regenerated from the demo
 images: demo

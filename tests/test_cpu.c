@@ -1635,5 +1635,7 @@ int main(void)
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
     };
+    /* CPU_TEST_FILTER: a cmocka pattern (* and ?), e.g. for the quick runs under valgrind */
+    if (getenv("CPU_TEST_FILTER")) cmocka_set_test_filter(getenv("CPU_TEST_FILTER"));
     return cmocka_run_group_tests_name("cpu", tests, NULL, NULL);
 }

@@ -3,7 +3,7 @@
 # Usage: tools/deps.sh test|demo|run
 set -euo pipefail
 what=${1:-test}
-pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev"
+pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
 pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth"
 case "$what" in
