@@ -1,7 +1,7 @@
 /* scenes.h - the test scenes (camera, meshes, model matrices, signs) and their
    ground truth, ray-cast per pixel from the very triangles fogvol draws
    (tests/raycast.h). Shared by test_render.c and test_tiers.c. Needs cmocka,
-   tests/shapes.h and tests/raycast.h included first. */
+   fogvol.h, tests/shapes.h and tests/raycast.h included first. */
 #ifndef SCENES_H
 #define SCENES_H
 
@@ -192,6 +192,22 @@ static int scene_index(const char *name)
         if (strcmp(g_scenes[i].name, name) == 0) return i;
     fail_msg("no scene %s", name);
     return 0;
+}
+
+/* Upload every object of the scene (occluders may be open meshes). */
+static void upload_meshes(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes)
+{
+    int i;
+    for (i = 0; i < s->n; ++i) {
+        fogvol_mesh_desc md;
+        memset(&md, 0, sizeof md);
+        md.positions = s->obj[i].mesh.pos;
+        md.vertex_count = s->obj[i].mesh.vcount;
+        md.indices = (const uint32_t *)s->obj[i].mesh.idx;
+        md.index_count = s->obj[i].mesh.icount;
+        md.allow_open = s->obj[i].sign == 0;
+        assert_int_equal(fogvol_create_mesh(fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
+    }
 }
 
 static void free_scenes(void)

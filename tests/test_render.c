@@ -65,7 +65,6 @@ static void setup(const tscene *s, int core, fogvol_blend blend, glu_ctx *g, fog
 {
     fogvol_context_desc cd;
     fogvol_ramp_desc rd;
-    int i;
     assert_true(glu_create(g, W, H, core));
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
@@ -77,16 +76,7 @@ static void setup(const tscene *s, int core, fogvol_blend blend, glu_ctx *g, fog
         cd.gl.version_minor = 1;
     }
     assert_int_equal(fogvol_create_context(&cd, fv), FOGVOL_SUCCESS);
-    for (i = 0; i < s->n; ++i) {
-        fogvol_mesh_desc md;
-        memset(&md, 0, sizeof md);
-        md.positions = s->obj[i].mesh.pos;
-        md.vertex_count = s->obj[i].mesh.vcount;
-        md.indices = (const uint32_t *)s->obj[i].mesh.idx;
-        md.index_count = s->obj[i].mesh.icount;
-        md.allow_open = s->obj[i].sign == 0;
-        assert_int_equal(fogvol_create_mesh(*fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
-    }
+    upload_meshes(*fv, s, meshes);
     memset(&rd, 0, sizeof rd);
     memcpy(rd.color, g_fog_rgb, sizeof rd.color);
     rd.density = s->density;

@@ -259,17 +259,8 @@ static void run(int ci, int di)
         cd.disable_dither = 1;
         r = fogvol_create_context(&cd, &fv);
         assert_int_equal(r, FOGVOL_SUCCESS);
-        for (i = 0; i < s->n; ++i) {
-            fogvol_mesh_desc md;
-            memset(&md, 0, sizeof md);
-            md.positions = s->obj[i].mesh.pos;
-            md.vertex_count = s->obj[i].mesh.vcount;
-            md.indices = (const uint32_t *)s->obj[i].mesh.idx;
-            md.index_count = s->obj[i].mesh.icount;
-            md.allow_open = s->obj[i].sign == 0;
-            assert_int_equal(fogvol_create_mesh(fv, &md, &meshes[i], NULL), FOGVOL_SUCCESS);
-            has_neg |= s->obj[i].sign < 0;
-        }
+        upload_meshes(fv, s, meshes);
+        for (i = 0; i < s->n; ++i) has_neg |= s->obj[i].sign < 0;
         memset(&rd, 0, sizeof rd);
         rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
         rd.density = s->density;
