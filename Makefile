@@ -66,12 +66,14 @@ $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
-            $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh
+            $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
+            $(BUILD)/demo_headless
 
 test: deps-test
 	@$(MAKE) --no-print-directory $(TEST_BINS)
 	@LOGDIR=$(BUILD)/logs tests/run.sh \
 	  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
+	  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
 	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
 	  "cpu=$(TAP) $(BUILD)/test_cpu" \
 	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
@@ -107,7 +109,9 @@ fuzz: deps-test $(BUILD)/fuzz_mesh
 images: demo
 	@mkdir -p docs
 	cp $(BUILD)/demo/scene_overview.png docs/demo_overview.png
+	cp $(BUILD)/demo/scene_low.png docs/demo_low.png
 	cp $(BUILD)/demo/scene_inside_fog_bank.png docs/demo_inside_fog_bank.png
+	cp $(BUILD)/demo/tiers.png $(BUILD)/demo/dither.png $(BUILD)/demo/ramps.png $(BUILD)/demo/thickness.png docs/
 
 clean:
 	rm -rf $(BUILD)

@@ -1,9 +1,19 @@
 #define _POSIX_C_SOURCE 199309L
-/* demo_headless.c - fogvol.h without a window: OSMesa renders a small scene
-   (a floor and pillars cutting through fog volumes: a sphere, a torus, a long
-   fog bank, a negative sphere carving a hole, a light beam) and writes PNGs.
+/* demo_headless.c - fogvol.h without a window. OSMesa renders a floor and
+   pillars (opaque, drawn by this program's own shader) cutting through fog
+   volumes: a sphere, a torus, a wobbling blob, a long fog bank the camera can
+   stand in, a negative sphere carving a hole into the bank, and a beam of
+   light. It writes PNGs:
+     scene_overview.png, scene_low.png, scene_inside_fog_bank.png  three viewpoints
+     tiers.png        the same frame per tier: PS13 | PS20 | FLOAT
+     dither.png       6-bit encoding, dithering off | on (the banding and its cure)
+     ramps.png        colour ramps: extinction | linear | artist gradient
+     thickness.png    the raw thickness of the fog group as false colour
+   and prints where they went, the tier, the pass count and the frame time.
 
-   usage: demo_headless [output-dir]      (default: build/demo) */
+   usage: demo_headless [output-dir] [--check]    (default dir: build/demo)
+   --check: also verifies the pictures (fog where volumes are, none
+   elsewhere, the inside view fogged everywhere) and prints TAP lines. */
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
 #define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
@@ -125,151 +135,382 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
 }
 
-int main(int argc, char **argv)
-{
-    const char *dir = argc > 1 ? argv[1] : "build/demo";
+
+#define NOBJ 12
+
+typedef struct demo {
     glu_ctx g;
     engine e;
+    shp_mesh mesh[NOBJ];
+    float model[NOBJ][16];
+    int kind[NOBJ]; /* 0 occluder, 1 fog, 2 bank, 3 bank hole (negative), 4 light */
+    int n;
+} demo;
+
+typedef struct settings {
+    fogvol_tier tier;
+    int bits, dither, ramp; /* ramp: 0 extinction, 1 linear, 2 gradient */
+    int w, h, view;
+    float fog_scale;         /* density multiplier of the fog group */
+} settings;
+
+typedef struct shot {
+    unsigned char *rgba;
+    float *thick[3]; /* per group: fog, bank, light (debug read-back), may be NULL */
+    fogvol_frame_stats st;
+    fogvol_tier tier;
+    double ms;
+} shot;
+
+static void add_obj(demo *d, shp_mesh m, int kind, const float model[16])
+{
+    if (d->n == NOBJ) {
+        fprintf(stderr, "demo: more than NOBJ objects\n");
+        exit(1);
+    }
+    d->mesh[d->n] = m;
+    d->kind[d->n] = kind;
+    memcpy(d->model[d->n], model, sizeof d->model[0]);
+    d->n++;
+}
+
+/* a sphere whose radius wobbles with direction: still closed and outward */
+static shp_mesh blob(float t)
+{
+    shp_mesh m = shp_sphere(1.0f, 64, 32);
+    int i;
+    for (i = 0; i < m.vcount; ++i) {
+        float *p = m.pos + 3 * i;
+        float th = atan2f(p[1], p[0]), ph = acosf(p[2] < -1 ? -1 : p[2] > 1 ? 1 : p[2]);
+        float r = 0.8f + 0.22f * sinf(3 * th + t) * sinf(2 * ph) + 0.08f * sinf(5 * ph - t);
+        p[0] *= r, p[1] *= r, p[2] *= r;
+    }
+    return m;
+}
+
+static void build(demo *d)
+{
+    static const float pillars[4][2] = {{-2.5f, -1.0f}, {0.3f, -2.2f}, {2.4f, 0.8f}, {-0.6f, 2.4f}};
+    float m[16], r[16], t[16];
+    int i;
+    shp_mat_translate(m, 0, -1.0f, 0);
+    add_obj(d, shp_box(12, 0.1f, 12), 0, m);
+    for (i = 0; i < 4; ++i) {
+        shp_mat_translate(m, pillars[i][0], 1.0f, pillars[i][1]);
+        add_obj(d, shp_box(0.25f, 2.0f, 0.25f), 0, m);
+    }
+    shp_mat_translate(m, -2.2f, 0.4f, -0.8f);
+    add_obj(d, shp_sphere(1.3f, 64, 32), 1, m);
+    shp_mat_rotate(r, 70, 1, 0, 0.3f);
+    shp_mat_translate(t, 2.0f, 0.5f, -1.2f);
+    shp_mat_mul(m, t, r);
+    add_obj(d, shp_torus(1.3f, 0.45f, 96, 32), 1, m);
+    shp_mat_translate(m, 0.3f, 1.6f, 1.2f);
+    add_obj(d, blob(0.7f), 1, m);
+    shp_mat_translate(m, 0, -0.6f, -3.0f);
+    add_obj(d, shp_box(12, 0.7f, 12), 2, m);
+    shp_mat_translate(m, 0.2f, -0.6f, 1.0f);
+    add_obj(d, shp_sphere(1.1f, 48, 24), 3, m);
+    shp_mat_rotate(r, 18, 0, 0, 1);
+    shp_mat_translate(t, 0.2f, 1.2f, -2.5f);
+    shp_mat_mul(m, t, r);
+    add_obj(d, shp_box(0.6f, 3.0f, 0.6f), 4, m);
+}
+
+static void camera(int view, int w, int h, float v[16], float p[16])
+{
+    static const double eye[3][3] = {{0.0, 3.2, 9.5}, {-4.5, 0.9, 6.0}, {1.5, -0.3, 5.5}};
+    static const double at[3][3] = {{0, 0.3, 0}, {0.5, 0.2, -1.0}, {0, 0.6, -3}};
+    static const double up[3] = {0, 1, 0};
+    glu_look_at(v, eye[view], at[view], up);
+    glu_perspective(p, 55.0, (double)w / h, 0.1, 40.0);
+}
+
+/* One frame: the engine's opaque pass, then fogvol with these settings.
+   Returns 0 if the context could not be created (tier not available). */
+static int render(demo *d, const settings *s, int with_fog, shot *out)
+{
     fogvol_context_desc cd;
     fogvol_context *fv;
-    shp_mesh floor_m = shp_box(12, 0.1f, 12), pillar = shp_box(0.25f, 2.0f, 0.25f);
-    shp_mesh sphere = shp_sphere(1.3f, 64, 32), torus = shp_torus(1.3f, 0.45f, 96, 32);
-    shp_mesh bank = shp_box(12, 0.7f, 12), hole = shp_sphere(1.1f, 48, 24), beam = shp_box(0.6f, 3.0f, 0.6f);
-    fogvol_mesh *m_floor, *m_pillar, *m_sphere, *m_torus, *m_bank, *m_hole, *m_beam;
-    fogvol_ramp *r_fog, *r_bank, *r_light;
+    fogvol_mesh *fm[NOBJ];
+    fogvol_ramp *ramp[3];
     fogvol_ramp_desc rd;
-    float pillar_pos[4][2] = {{-2.5f, -1.0f}, {0.3f, -2.2f}, {2.4f, 0.8f}, {-0.6f, 2.4f}};
-    int view;
-    char path[512];
-    mkdir("build", 0777);
-    mkdir(dir, 0777);
-    if (!glu_create(&g, DW, DH, 1)) {
-        fprintf(stderr, "OSMesa context failed\n");
-        return 1;
-    }
-    engine_init(&e);
+    fogvol_color_key keys[4];
+    float v[16], p[16], vp[16];
+    int i, grp, captures;
+    static const float grey[3] = {0.55f, 0.52f, 0.48f}, stone[3] = {0.7f, 0.66f, 0.6f};
+    if (!glu_create(&d->g, s->w, s->h, 1)) return 0;
+    engine_init(&d->e);
+    camera(s->view, s->w, s->h, v, p);
+    shp_mat_mul(vp, p, v);
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = log_cb;
-    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) return 1;
-    m_floor = upload(fv, &floor_m, 0);
-    m_pillar = upload(fv, &pillar, 0);
-    m_sphere = upload(fv, &sphere, 0);
-    m_torus = upload(fv, &torus, 0);
-    m_bank = upload(fv, &bank, 0);
-    m_hole = upload(fv, &hole, 0);
-    m_beam = upload(fv, &beam, 0);
-
+    cd.tier = s->tier;
+    cd.encoding_bits = s->bits;
+    cd.disable_dither = !s->dither;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
+        glu_destroy(&d->g);
+        return 0;
+    }
+    out->tier = fogvol_context_tier(fv, NULL);
+    for (i = 0; i < d->n; ++i) fm[i] = upload(fv, &d->mesh[i], d->kind[i] == 0);
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.85f, rd.color[1] = 0.88f, rd.color[2] = 0.95f, rd.density = 0.55f;
-    fogvol_create_ramp(fv, &rd, &r_fog);
+    rd.color[0] = 0.85f, rd.color[1] = 0.88f, rd.color[2] = 0.95f, rd.density = 0.55f * s->fog_scale;
+    rd.model = s->ramp == 1 ? FOGVOL_RAMP_LINEAR : s->ramp == 2 ? FOGVOL_RAMP_GRADIENT : FOGVOL_RAMP_EXTINCTION;
+    if (s->ramp == 1) rd.density = 0.3f * s->fog_scale;
+    keys[0].thickness = 0.0f, keys[0].rgba[0] = 0.2f, keys[0].rgba[1] = 0.9f, keys[0].rgba[2] = 0.7f, keys[0].rgba[3] = 0.0f;
+    keys[1].thickness = 0.8f, keys[1].rgba[0] = 0.3f, keys[1].rgba[1] = 0.8f, keys[1].rgba[2] = 1.0f, keys[1].rgba[3] = 0.45f;
+    keys[2].thickness = 1.8f, keys[2].rgba[0] = 0.9f, keys[2].rgba[1] = 0.4f, keys[2].rgba[2] = 0.9f, keys[2].rgba[3] = 0.75f;
+    keys[3].thickness = 3.0f, keys[3].rgba[0] = 1.0f, keys[3].rgba[1] = 0.9f, keys[3].rgba[2] = 0.5f, keys[3].rgba[3] = 0.95f;
+    rd.keys = keys;
+    rd.key_count = 4;
+    fogvol_create_ramp(fv, &rd, &ramp[0]);
+    memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.18f;
-    fogvol_create_ramp(fv, &rd, &r_bank);
+    fogvol_create_ramp(fv, &rd, &ramp[1]);
     rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.35f, rd.blend = FOGVOL_BLEND_LIGHT;
-    fogvol_create_ramp(fv, &rd, &r_light);
+    fogvol_create_ramp(fv, &rd, &ramp[2]);
 
-    for (view = 0; view < 2; ++view) {
-        {
-            float v[16], p[16], vp[16], m[16], id[16];
-            double eye[2][3] = {{0.0, 3.2, 9.5}, {1.5, -0.3, 5.5}}, at[2][3] = {{0, 0.3, 0}, {0, 0.6, -3}};
-            double up[3] = {0, 1, 0};
-            const float grey[3] = {0.55f, 0.52f, 0.48f}, stone[3] = {0.7f, 0.66f, 0.6f};
-            fogvol_frame_desc fd;
+    captures = with_fog ? 3 : 1; /* one frame per group whose thickness is read back, the first one timed */
+    for (grp = 0; grp < captures; ++grp) {
+        fogvol_frame_desc fd;
+        double t0;
+        glViewport(0, 0, s->w, s->h);
+        glEnable(GL_DEPTH_TEST);
+        glClearColor(0.32f, 0.45f, 0.62f, 1);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        for (i = 0; i < d->n; ++i)
+            if (d->kind[i] == 0) engine_draw(&d->e, &d->mesh[i], d->model[i], vp, i == 0 ? grey : stone);
+        glDisable(GL_DEPTH_TEST);
+        if (!with_fog) break;
+        memset(&fd, 0, sizeof fd);
+        memcpy(fd.view, v, sizeof v);
+        memcpy(fd.projection, p, sizeof p);
+        fd.znear = 0.1f;
+        fd.zfar = 40.0f;
+        fd.viewport[2] = s->w;
+        fd.viewport[3] = s->h;
+        fd.debug_thickness = out->thick[grp];
+        fd.debug_ramp = ramp[grp];
+        glFinish();
+        t0 = now_ms();
+        fogvol_begin_frame(fv, &fd);
+        for (i = 0; i < d->n; ++i) {
             fogvol_volume_desc vd;
-            fogvol_frame_stats st;
-            double t0, t1;
-            int i;
-            glu_look_at(v, eye[view], at[view], up);
-            glu_perspective(p, 55.0, (double)DW / DH, 0.1, 40.0);
-            shp_mat_mul(vp, p, v);
-            glViewport(0, 0, DW, DH);
-            glEnable(GL_DEPTH_TEST);
-            glClearColor(0.32f, 0.45f, 0.62f, 1);
-            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-            shp_mat_identity(id);
-            shp_mat_translate(m, 0, -1.0f, 0);
-            engine_draw(&e, &floor_m, m, vp, grey);
-            for (i = 0; i < 4; ++i) {
-                float pm[16];
-                shp_mat_translate(pm, pillar_pos[i][0], 1.0f, pillar_pos[i][1]);
-                engine_draw(&e, &pillar, pm, vp, stone);
-            }
-
-            memset(&fd, 0, sizeof fd);
-            memcpy(fd.view, v, sizeof v);
-            memcpy(fd.projection, p, sizeof p);
-            fd.znear = 0.1f;
-            fd.zfar = 40.0f;
-            fd.viewport[2] = DW;
-            fd.viewport[3] = DH;
-            t0 = now_ms();
-            fogvol_begin_frame(fv, &fd);
-            fogvol_add_occluder(fv, m_floor, m);
-            for (i = 0; i < 4; ++i) {
-                float pm[16];
-                shp_mat_translate(pm, pillar_pos[i][0], 1.0f, pillar_pos[i][1]);
-                fogvol_add_occluder(fv, m_pillar, pm);
+            if (d->kind[i] == 0) {
+                fogvol_add_occluder(fv, fm[i], d->model[i]);
+                continue;
             }
             memset(&vd, 0, sizeof vd);
-            vd.ramp = r_fog;
-            vd.mesh = m_sphere;
-            shp_mat_translate(vd.model, -2.2f, 0.4f, -0.8f);
+            vd.mesh = fm[i];
+            vd.ramp = ramp[d->kind[i] == 1 ? 0 : d->kind[i] == 4 ? 2 : 1];
+            vd.negative = d->kind[i] == 3;
+            memcpy(vd.model, d->model[i], sizeof vd.model);
             fogvol_add_volume(fv, &vd);
-            vd.mesh = m_torus;
-            {
-                float r[16], t[16];
-                shp_mat_rotate(r, 70, 1, 0, 0.3f);
-                shp_mat_translate(t, 2.0f, 0.5f, -1.2f);
-                shp_mat_mul(vd.model, t, r);
+        }
+        fogvol_end_frame(fv, grp == 0 ? &out->st : NULL);
+        glFinish();
+        if (grp == 0) out->ms = now_ms() - t0;
+        if (grp == 0) memcpy(out->rgba, d->g.pixels, (size_t)s->w * s->h * 4);
+    }
+    if (!with_fog) {
+        glFinish();
+        memcpy(out->rgba, d->g.pixels, (size_t)s->w * s->h * 4);
+    }
+    for (i = 0; i < d->n; ++i) fogvol_destroy_mesh(fv, fm[i]);
+    for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
+    fogvol_destroy_context(fv);
+    glu_destroy(&d->g);
+    return 1;
+}
+
+static shot new_shot(int w, int h)
+{
+    shot s;
+    int i;
+    memset(&s, 0, sizeof s);
+    s.rgba = (unsigned char *)calloc((size_t)w * h, 4);
+    for (i = 0; i < 3; ++i) s.thick[i] = (float *)calloc((size_t)w * h, sizeof(float));
+    return s;
+}
+
+static void free_shot(shot *s)
+{
+    int i;
+    free(s->rgba);
+    for (i = 0; i < 3; ++i) free(s->thick[i]);
+}
+
+/* write n images of w x h side by side (rows bottom to top in, PNG top to bottom out) */
+static void save_row(const char *dir, const char *name, unsigned char **imgs, int n, int w, int h)
+{
+    unsigned char *row = (unsigned char *)malloc((size_t)w * n * h * 4);
+    char path[512];
+    int k, y;
+    for (k = 0; k < n; ++k)
+        for (y = 0; y < h; ++y) memcpy(row + ((size_t)(h - 1 - y) * w * n + (size_t)k * w) * 4, imgs[k] + (size_t)y * w * 4, (size_t)w * 4);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    stbi_write_png(path, w * n, h, 4, row, w * n * 4);
+    free(row);
+    printf("%s\n", path);
+}
+
+static void report(const char *what, const shot *s)
+{
+    printf("  %-34s tier %-5s %2d passes, %d groups, fog %.1f ms (llvmpipe)\n", what, fogvol_tier_name(s->tier),
+           s->st.passes, s->st.groups, s->ms);
+}
+
+/* false colour: black -> blue -> cyan -> yellow -> white over [0, tmax] */
+static void false_colour(const float *t, unsigned char *out, int n, float tmax)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        float x = t[i] <= 0 ? 0 : t[i] >= tmax ? 1 : t[i] / tmax;
+        float r = x < 0.5f ? 0 : (x - 0.5f) * 2, g = x < 0.25f ? 0 : x < 0.75f ? (x - 0.25f) * 2 : 1,
+              b = x < 0.5f ? x * 2 : (x < 0.75f ? 1 - (x - 0.5f) * 4 : (x - 0.75f) * 4);
+        out[4 * i] = (unsigned char)(r * 255), out[4 * i + 1] = (unsigned char)(g * 255);
+        out[4 * i + 2] = (unsigned char)(b * 255), out[4 * i + 3] = 255;
+    }
+}
+
+static int g_tap;
+static int check(int ok, const char *what)
+{
+    printf("%s %d - %s\n", ok ? "ok" : "not ok", ++g_tap, what);
+    return ok;
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = "build/demo";
+    int do_check = 0, i, k, failures = 0;
+    demo d;
+    settings s;
+    shot sh[3], plain;
+    unsigned char *imgs[3];
+    static const char *const view_names[3] = {"scene_overview.png", "scene_low.png", "scene_inside_fog_bank.png"};
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--check") == 0) do_check = 1;
+        else dir = argv[i];
+    }
+    mkdir("build", 0777);
+    mkdir(dir, 0777);
+    memset(&d, 0, sizeof d);
+    build(&d);
+    stbi_flip_vertically_on_write(0);
+    memset(&s, 0, sizeof s);
+    s.w = DW;
+    s.h = DH;
+    s.dither = 1;
+    s.fog_scale = 1.0f;
+    printf("fogvol %s demo, %dx%d, images in %s:\n", FOGVOL_VERSION_STRING, DW, DH, dir);
+
+    /* three viewpoints (automatic tier), the third inside the fog bank */
+    for (k = 0; k < 3; ++k) {
+        char path[512];
+        sh[k] = new_shot(DW, DH);
+        s.view = k;
+        if (!render(&d, &s, 1, &sh[k])) return 1;
+        imgs[0] = sh[k].rgba;
+        save_row(dir, view_names[k], imgs, 1, DW, DH);
+        report(view_names[k], &sh[k]);
+        (void)path;
+    }
+    if (do_check) {
+        /* fog only where some group has thickness; the inside view fogged everywhere */
+        int n = DW * DH, same_outside = 0, outside = 0, changed_inside = 0, inside = 0, bank_everywhere = 1;
+        plain = new_shot(DW, DH);
+        s.view = 0;
+        render(&d, &s, 0, &plain);
+        for (i = 0; i < n; ++i) {
+            int fogged = sh[0].thick[0][i] != 0 || sh[0].thick[1][i] != 0 || sh[0].thick[2][i] != 0;
+            int diff = memcmp(sh[0].rgba + 4 * i, plain.rgba + 4 * i, 3) != 0;
+            if (!fogged) {
+                ++outside;
+                same_outside += !diff;
+            } else if (sh[0].thick[0][i] > 0.5f || sh[0].thick[1][i] > 2.0f) {
+                ++inside;
+                changed_inside += diff;
             }
-            fogvol_add_volume(fv, &vd);
-            vd.ramp = r_bank;
-            vd.mesh = m_bank;
-            shp_mat_translate(vd.model, 0, -0.6f, -3.0f);
-            fogvol_add_volume(fv, &vd);
-            vd.mesh = m_hole;
-            vd.negative = 1;
-            shp_mat_translate(vd.model, 0.2f, -0.6f, 1.0f);
-            fogvol_add_volume(fv, &vd);
-            vd.negative = 0;
-            vd.ramp = r_light;
-            vd.mesh = m_beam;
-            {
-                float r[16], t[16];
-                shp_mat_rotate(r, 18, 0, 0, 1);
-                shp_mat_translate(t, 0.2f, 1.2f, -2.5f);
-                shp_mat_mul(vd.model, t, r);
+            if (!(sh[2].thick[1][i] > 0)) bank_everywhere = 0;
+        }
+        printf("# overview: %d pixels without fog, %d of them unchanged; %d thickly fogged, %d of them changed\n",
+               outside, same_outside, inside, changed_inside);
+        failures += !check(outside > 1000 && same_outside == outside, "no fog where no volume is");
+        failures += !check(inside > 1000 && changed_inside == inside, "fog where the volumes are");
+        failures += !check(bank_everywhere, "inside the fog bank every pixel is fogged");
+        free_shot(&plain);
+    }
+    /* the raw thickness of the fog group, false colour (0 .. 3 world units) */
+    {
+        unsigned char *fc = (unsigned char *)malloc((size_t)DW * DH * 4);
+        false_colour(sh[0].thick[0], fc, DW * DH, 3.0f);
+        imgs[0] = fc;
+        save_row(dir, "thickness.png", imgs, 1, DW, DH);
+        free(fc);
+    }
+    for (k = 0; k < 3; ++k) free_shot(&sh[k]);
+
+    /* the same frame per tier, half size */
+    {
+        static const fogvol_tier tiers[3] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
+        settings t = s;
+        int got = 0;
+        t.w = DW / 2;
+        t.h = DH / 2;
+        t.view = 1;
+        for (k = 0; k < 3; ++k) {
+            sh[got] = new_shot(t.w, t.h);
+            t.tier = tiers[k];
+            if (render(&d, &t, 1, &sh[got])) {
+                imgs[got] = sh[got].rgba;
+                ++got;
+            } else {
+                free_shot(&sh[got]);
             }
-            fogvol_add_volume(fv, &vd);
-            fogvol_end_frame(fv, &st);
-            glFinish();
-            t1 = now_ms();
-            snprintf(path, sizeof path, "%s/scene_%s.png", dir, view == 0 ? "overview" : "inside_fog_bank");
-            stbi_flip_vertically_on_write(1);
-            stbi_write_png(path, DW, DH, 4, g.pixels, DW * 4);
-            printf("%s  (tier PS20, %d passes, %d groups, fog %.1f ms on llvmpipe)\n", path, st.passes, st.groups,
-                   t1 - t0);
-            (void)id;
+        }
+        save_row(dir, "tiers.png", imgs, got, t.w, t.h);
+        for (k = 0; k < got; ++k) {
+            report(fogvol_tier_name(sh[k].tier), &sh[k]);
+            free_shot(&sh[k]);
         }
     }
-    fogvol_destroy_mesh(fv, m_floor);
-    fogvol_destroy_mesh(fv, m_pillar);
-    fogvol_destroy_mesh(fv, m_sphere);
-    fogvol_destroy_mesh(fv, m_torus);
-    fogvol_destroy_mesh(fv, m_bank);
-    fogvol_destroy_mesh(fv, m_hole);
-    fogvol_destroy_mesh(fv, m_beam);
-    fogvol_destroy_ramp(fv, r_fog);
-    fogvol_destroy_ramp(fv, r_bank);
-    fogvol_destroy_ramp(fv, r_light);
-    fogvol_destroy_context(fv);
-    shp_free(&floor_m);
-    shp_free(&pillar);
-    shp_free(&sphere);
-    shp_free(&torus);
-    shp_free(&bank);
-    shp_free(&hole);
-    shp_free(&beam);
-    glu_destroy(&g);
-    return 0;
+    /* banding at low precision (6 bits, dense fog) and its cure */
+    {
+        settings t = s;
+        t.w = DW / 2;
+        t.h = DH / 2;
+        t.view = 1;
+        t.tier = FOGVOL_TIER_PS20;
+        t.bits = 2;
+        t.fog_scale = 4.0f;
+        for (k = 0; k < 2; ++k) {
+            sh[k] = new_shot(t.w, t.h);
+            t.dither = k;
+            render(&d, &t, 1, &sh[k]);
+            imgs[k] = sh[k].rgba;
+        }
+        save_row(dir, "dither.png", imgs, 2, t.w, t.h);
+        for (k = 0; k < 2; ++k) free_shot(&sh[k]);
+    }
+    /* colour ramps */
+    {
+        settings t = s;
+        t.w = DW / 2;
+        t.h = DH / 2;
+        t.view = 1;
+        for (k = 0; k < 3; ++k) {
+            sh[k] = new_shot(t.w, t.h);
+            t.ramp = k;
+            render(&d, &t, 1, &sh[k]);
+            imgs[k] = sh[k].rgba;
+        }
+        save_row(dir, "ramps.png", imgs, 3, t.w, t.h);
+        for (k = 0; k < 3; ++k) free_shot(&sh[k]);
+    }
+    for (i = 0; i < d.n; ++i) shp_free(&d.mesh[i]);
+    if (do_check) printf("1..%d\n", g_tap);
+    return failures ? 1 : 0;
 }
