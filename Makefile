@@ -2,6 +2,7 @@
 #   make test   build and run every test (installs missing Debian packages)
 #   make demo   render the headless demo into build/demo/*.png
 #   make images refresh the README pictures in docs/ from the demo
+#   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
@@ -17,7 +18,7 @@ FUZZ_TIME ?= 60
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all test demo images fuzz deps-test deps-demo clean
+.PHONY: all test demo images fuzz run examples deps-test deps-demo deps-run clean
 
 all: test
 
@@ -25,6 +26,8 @@ deps-test:
 	@tools/deps.sh test
 deps-demo:
 	@tools/deps.sh demo
+deps-run:
+	@tools/deps.sh run
 
 $(BUILD):
 	@mkdir -p $(BUILD)
@@ -69,11 +72,12 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
             $(BUILD)/demo_headless
 
-test: deps-test
+test: deps-test deps-run
 	@$(MAKE) --no-print-directory $(TEST_BINS)
 	@LOGDIR=$(BUILD)/logs tests/run.sh \
 	  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
 	  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
+	  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
 	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
 	  "cpu=$(TAP) $(BUILD)/test_cpu" \
 	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
@@ -98,6 +102,20 @@ $(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
 demo: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
 	@$(BUILD)/demo_headless $(BUILD)/demo
+
+$(BUILD)/demo_glfw: examples/demo_glfw.c fogvol.h tests/shapes.h | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lglfw -lGL -lm
+
+# the interactive demo; without a display: 120 frames under Xvfb into $(BUILD)/demo_glfw.png
+run: deps-run
+	@$(MAKE) --no-print-directory $(BUILD)/demo_glfw
+	@if [ -n "$$DISPLAY" ]; then $(BUILD)/demo_glfw; \
+	else echo "no DISPLAY: rendering under Xvfb into $(BUILD)/demo_glfw.png"; \
+	  xvfb-run -a $(BUILD)/demo_glfw --frames 120 --screenshot $(BUILD)/demo_glfw.png; fi
+
+# the examples alone: build, run headless / under Xvfb, check, package consumers
+examples: deps-demo deps-run
+	@LOGDIR=$(BUILD)/logs tests/run.sh "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh"
 
 # libFuzzer on mesh validation, FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)

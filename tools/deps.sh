@@ -5,7 +5,7 @@ set -euo pipefail
 what=${1:-test}
 pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
-pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth"
+pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth cmake pkg-config libosmesa6-dev libstb-dev"
 case "$what" in
   test) pkgs="$pkgs_test" ;;
   demo) pkgs="$pkgs_demo" ;;

@@ -1,0 +1,638 @@
+/* demo_glfw.c - fogvol.h in a window (GLFW, OpenGL 3.3 core).
+
+   A floor and pillars drawn by the demo's own flat shader, cut through by fog
+   volumes: a sphere, a torus, an animated twisted blob (deformed on the CPU and
+   re-uploaded every frame), a long fog bank with a negative sphere carving a
+   hole in it, and a light beam blended additively (FOGVOL_BLEND_LIGHT).
+
+   Controls
+     mouse          look around (click into the window to capture the mouse, Tab releases it)
+     W A S D        fly (Space / C: up / down, Shift: faster); the camera may enter the fog
+     T              cycle tier PS13 -> PS20 -> FLOAT (tiers the context refuses are skipped)
+     B              cycle encoding bits per channel 3, 4, 5, 6 (precision vs. faces per pixel)
+     G              dithering on / off            R   colour ramp: extinction, linear, gradient
+     L              fog / light blend of the main group (sphere, torus, blob)
+     O              paint pixels whose face sums overflowed in magenta
+     P              pause the animation           Esc quit
+   The window title shows the frame time and the current settings.
+
+   usage: demo_glfw [--frames N] [--screenshot FILE.png] [--size WxH] [--tier ps13|ps20|float] [--bits L]
+                    [--camera x,y,z,yaw,pitch] [--keys KEYS]
+     --keys KEYS     press these keys, one per frame from the first (e.g. TTB: two tiers on, then bits)
+     --frames N      render N frames (fixed 1/60 s animation steps) and exit
+     --screenshot F  write the last frame to F as PNG
+
+   build: cc -std=c99 -I. examples/demo_glfw.c -o demo_glfw -lglfw -lGL -lm */
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES
+#define GLFW_INCLUDE_GLEXT
+#include <GLFW/glfw3.h>
+#include "tests/shapes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+
+#define ZNEAR 0.1f
+#define ZFAR 60.0f
+#define NPILLARS 5
+
+/* ---- the demo's own opaque renderer: flat-shaded meshes ------------------------ */
+typedef struct flat_mesh {
+    GLuint vao, vbo;
+    int count;
+} flat_mesh;
+
+static GLuint g_flat_prog;
+static GLint g_u_mvp, g_u_model, g_u_color;
+
+static GLuint compile(GLenum type, const char *src)
+{
+    GLuint s = glCreateShader(type);
+    GLint ok = 0;
+    glShaderSource(s, 1, &src, NULL);
+    glCompileShader(s);
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[1024];
+        glGetShaderInfoLog(s, sizeof log, NULL, log);
+        fprintf(stderr, "shader: %s\n", log);
+        exit(1);
+    }
+    return s;
+}
+
+static void flat_init(void)
+{
+    static const char *vs = "#version 330 core\n"
+                            "layout(location = 0) in vec3 p; layout(location = 1) in vec3 n;\n"
+                            "uniform mat4 mvp, model; out vec3 wn, wp;\n"
+                            "void main() {\n"
+                            "  wn = mat3(model) * n; wp = (model * vec4(p, 1.0)).xyz;\n"
+                            "  gl_Position = mvp * vec4(p, 1.0);\n"
+                            "}\n";
+    static const char *fs = "#version 330 core\n"
+                            "in vec3 wn, wp; uniform vec4 color; out vec4 o;\n"
+                            "void main() {\n"
+                            "  vec3 sun = normalize(vec3(0.38, 0.83, 0.41));\n"
+                            "  float l = 0.35 + 0.65 * max(dot(normalize(wn), sun), 0.0);\n"
+                            "  float check = mod(floor(wp.x) + floor(wp.z), 2.0);\n" /* color.a: checker strength */
+                            "  o = vec4(color.rgb * l * (1.0 - color.a * check), 1.0);\n"
+                            "}\n";
+    GLuint v = compile(GL_VERTEX_SHADER, vs), f = compile(GL_FRAGMENT_SHADER, fs);
+    g_flat_prog = glCreateProgram();
+    glAttachShader(g_flat_prog, v);
+    glAttachShader(g_flat_prog, f);
+    glLinkProgram(g_flat_prog);
+    glDeleteShader(v);
+    glDeleteShader(f);
+    g_u_mvp = glGetUniformLocation(g_flat_prog, "mvp");
+    g_u_model = glGetUniformLocation(g_flat_prog, "model");
+    g_u_color = glGetUniformLocation(g_flat_prog, "color");
+}
+
+/* expand the triangles with face normals, once */
+static flat_mesh flat_upload(const shp_mesh *m)
+{
+    flat_mesh f;
+    float *buf = (float *)malloc(sizeof(float) * 6 * (size_t)m->icount);
+    int t, k;
+    for (t = 0; t < m->icount / 3; ++t) {
+        const float *a = m->pos + 3 * m->idx[3 * t], *b = m->pos + 3 * m->idx[3 * t + 1];
+        const float *c = m->pos + 3 * m->idx[3 * t + 2];
+        float e1[3], e2[3], n[3];
+        for (k = 0; k < 3; ++k) e1[k] = b[k] - a[k], e2[k] = c[k] - a[k];
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        for (k = 0; k < 3; ++k) {
+            const float *p = k == 0 ? a : k == 1 ? b : c;
+            memcpy(buf + 18 * t + 6 * k, p, 12);
+            memcpy(buf + 18 * t + 6 * k + 3, n, 12);
+        }
+    }
+    f.count = m->icount;
+    glGenVertexArrays(1, &f.vao);
+    glGenBuffers(1, &f.vbo);
+    glBindVertexArray(f.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, f.vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 6 * (size_t)m->icount), buf, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 24, (void *)12);
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    free(buf);
+    return f;
+}
+
+static void flat_draw(const flat_mesh *f, const float model[16], const float vp[16], float r, float g, float b,
+                      float checker)
+{
+    float mvp[16];
+    shp_mat_mul(mvp, vp, model);
+    glUseProgram(g_flat_prog);
+    glUniformMatrix4fv(g_u_mvp, 1, GL_FALSE, mvp);
+    glUniformMatrix4fv(g_u_model, 1, GL_FALSE, model);
+    glUniform4f(g_u_color, r, g, b, checker);
+    glBindVertexArray(f->vao);
+    glDrawArrays(GL_TRIANGLES, 0, f->count);
+}
+
+/* ---- scene data ------------------------------------------------------------------ */
+static const float k_pillars[NPILLARS][2] = {
+    {-2.5f, -1.0f}, {0.3f, -2.2f}, {2.4f, 0.8f}, {-0.6f, 2.4f}, {4.5f, -4.0f}};
+static const fogvol_tier k_tiers[3] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
+static const int k_bits[4] = {3, 4, 5, 6};
+static const char *const k_ramp_names[3] = {"extinction", "linear", "gradient"};
+
+enum { M_FLOOR, M_PILLAR, M_SPHERE, M_TORUS, M_BANK, M_HOLE, M_BEAM, M_BLOB, M_COUNT }; /* meshes */
+enum { R_MAIN, R_BANK, R_LIGHT, R_COUNT };                                             /* colour ramps */
+
+typedef struct app {
+    GLFWwindow *win;
+    shp_mesh cpu[M_COUNT]; /* CPU meshes */
+    float *blob_base;      /* the blob before deformation */
+    flat_mesh floor_f, pillar_f;
+    /* fogvol objects: they belong to the context and are rebuilt with it */
+    fogvol_context *fv;
+    fogvol_mesh *vol[M_COUNT];
+    fogvol_ramp *ramp[R_COUNT];
+    /* settings */
+    int tier_i, bits_i, dither, ramp_model, main_light, paused, show_overflow;
+    /* camera and time */
+    float cam[3], yaw, pitch;
+    double anim_t, last_x, last_y;
+    int captured, have_mouse;
+} app;
+
+static void log_cb(void *u, fogvol_log_level level, const char *msg)
+{
+    (void)u;
+    if (level <= FOGVOL_LOG_WARNING) fprintf(stderr, "%s\n", msg);
+}
+
+static fogvol_gl_proc get_proc(const char *name, void *user)
+{
+    (void)user;
+    return glfwGetProcAddress(name); /* GLFWglproc and fogvol_gl_proc are both void (*)(void) */
+}
+
+static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m)
+{
+    fogvol_mesh_desc md;
+    fogvol_mesh *out = NULL;
+    memset(&md, 0, sizeof md);
+    md.positions = m->pos;
+    md.vertex_count = m->vcount;
+    md.indices = (const uint32_t *)m->idx;
+    md.index_count = m->icount;
+    if (fogvol_create_mesh(fv, &md, &out, NULL) != FOGVOL_SUCCESS) fprintf(stderr, "fogvol: mesh refused\n");
+    return out;
+}
+
+/* The main group's colour ramp: the model R cycles, the blend L toggles. */
+static void make_main_ramp(app *a)
+{
+    static const fogvol_color_key keys[4] = {{0.0f, {0.2f, 0.9f, 0.8f, 0.0f}},
+                                             {0.8f, {0.3f, 0.8f, 1.0f, 0.45f}},
+                                             {2.0f, {0.9f, 0.3f, 0.8f, 0.75f}},
+                                             {3.5f, {1.0f, 0.7f, 0.2f, 0.95f}}};
+    fogvol_ramp_desc rd;
+    fogvol_destroy_ramp(a->fv, a->ramp[R_MAIN]); /* (NULL is fine) */
+    a->ramp[R_MAIN] = NULL;
+    memset(&rd, 0, sizeof rd);
+    rd.model = (fogvol_ramp_model)a->ramp_model;
+    rd.color[0] = 0.85f, rd.color[1] = 0.88f, rd.color[2] = 0.95f;
+    rd.density = a->ramp_model == FOGVOL_RAMP_LINEAR ? 0.3f : 0.55f;
+    rd.keys = keys;
+    rd.key_count = 4;
+    rd.blend = a->main_light ? FOGVOL_BLEND_LIGHT : FOGVOL_BLEND_FOG;
+    if (fogvol_create_ramp(a->fv, &rd, &a->ramp[R_MAIN]) != FOGVOL_SUCCESS) fprintf(stderr, "fogvol: ramp refused\n");
+}
+
+static void destroy_fog(app *a)
+{
+    int i;
+    if (!a->fv) return;
+    for (i = 0; i < M_COUNT; ++i) fogvol_destroy_mesh(a->fv, a->vol[i]), a->vol[i] = NULL;
+    for (i = 0; i < R_COUNT; ++i) fogvol_destroy_ramp(a->fv, a->ramp[i]), a->ramp[i] = NULL;
+    fogvol_destroy_context(a->fv);
+    a->fv = NULL;
+}
+
+/* (Re-)create the context with this tier and encoding, and everything it owns.
+   Returns 0 (keeping the current context) when fogvol_create_context refuses. */
+static int build_fog(app *a, fogvol_tier tier, int bits)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_ramp_desc rd;
+    int i;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = get_proc;
+    cd.logger.func = log_cb;
+    cd.tier = tier;
+    cd.encoding_bits = bits;
+    cd.disable_dither = !a->dither;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) return 0;
+    destroy_fog(a);
+    a->fv = fv;
+    for (i = 0; i < 3; ++i)
+        if (k_tiers[i] == fogvol_context_tier(fv, NULL)) a->tier_i = i;
+    for (i = 0; i < 4; ++i)
+        if (k_bits[i] == fogvol_context_encoding(fv)->bits) a->bits_i = i;
+    for (i = 0; i < M_COUNT; ++i) a->vol[i] = upload(fv, &a->cpu[i]);
+    make_main_ramp(a);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.72f, rd.color[1] = 0.78f, rd.color[2] = 0.86f, rd.density = 0.8f;
+    fogvol_create_ramp(fv, &rd, &a->ramp[R_BANK]);
+    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.35f, rd.blend = FOGVOL_BLEND_LIGHT;
+    fogvol_create_ramp(fv, &rd, &a->ramp[R_LIGHT]);
+    return 1;
+}
+
+static void cycle_tier(app *a)
+{
+    int k;
+    for (k = 1; k <= 3; ++k) {
+        int i = (a->tier_i + k) % 3;
+        if (build_fog(a, k_tiers[i], k_bits[a->bits_i])) return;
+        fprintf(stderr, "demo: tier %s refused by this context, skipped\n", fogvol_tier_name(k_tiers[i]));
+    }
+}
+
+/* The blob: a sphere twisted about y and wobbled radially (star-shaped, so it
+   stays a closed, consistently oriented hull whatever the time). */
+static void deform_blob(app *a)
+{
+    double t = a->anim_t;
+    int i;
+    for (i = 0; i < a->cpu[M_BLOB].vcount; ++i) {
+        const float *p = a->blob_base + 3 * i;
+        double x = p[0], y = p[2] * 1.5, z = -p[1]; /* rotated: the sphere's pole axis z becomes y, stretched */
+        double w = 1.0 + 0.22 * sin(3.0 * x + 2.1 * t) * sin(2.5 * y + 1.3 * t) + 0.12 * cos(4.0 * z - 1.7 * t);
+        double ang = 0.9 * sin(0.7 * t) * y, c = cos(ang), s = sin(ang);
+        x *= w, y *= w, z *= w;
+        a->cpu[M_BLOB].pos[3 * i + 0] = (float)(c * x + s * z);
+        a->cpu[M_BLOB].pos[3 * i + 1] = (float)y;
+        a->cpu[M_BLOB].pos[3 * i + 2] = (float)(-s * x + c * z);
+    }
+}
+
+/* ---- input --------------------------------------------------------------------- */
+static void press(app *a, int key)
+{
+    GLFWwindow *w = a->win;
+    switch (key) {
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, 1); break;
+    case GLFW_KEY_TAB:
+        a->captured = 0;
+        glfwSetInputMode(w, GLFW_CURSOR, GLFW_CURSOR_NORMAL);
+        break;
+    case GLFW_KEY_T: cycle_tier(a); break;
+    case GLFW_KEY_B:
+        if (!build_fog(a, k_tiers[a->tier_i], k_bits[(a->bits_i + 1) % 4]))
+            fprintf(stderr, "demo: %d-bit encoding refused\n", k_bits[(a->bits_i + 1) % 4]);
+        break;
+    case GLFW_KEY_G:
+        a->dither = !a->dither;
+        fogvol_set_dither(a->fv, a->dither);
+        break;
+    case GLFW_KEY_R:
+        a->ramp_model = (a->ramp_model + 1) % 3;
+        make_main_ramp(a);
+        break;
+    case GLFW_KEY_L:
+        a->main_light = !a->main_light;
+        make_main_ramp(a);
+        break;
+    case GLFW_KEY_O: a->show_overflow = !a->show_overflow; break;
+    case GLFW_KEY_P: a->paused = !a->paused; break;
+    default: break;
+    }
+}
+
+static void key_cb(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode, (void)mods;
+    if (action == GLFW_PRESS) press((app *)glfwGetWindowUserPointer(w), key);
+}
+
+static void button_cb(GLFWwindow *w, int button, int action, int mods)
+{
+    app *a = (app *)glfwGetWindowUserPointer(w);
+    (void)button, (void)mods;
+    if (action == GLFW_PRESS && !a->captured) {
+        a->captured = 1;
+        a->have_mouse = 0;
+        glfwSetInputMode(w, GLFW_CURSOR, GLFW_CURSOR_DISABLED);
+    }
+}
+
+static void cursor_cb(GLFWwindow *w, double x, double y)
+{
+    app *a = (app *)glfwGetWindowUserPointer(w);
+    if (a->captured && a->have_mouse) {
+        a->yaw += (float)(x - a->last_x) * 0.15f;
+        a->pitch -= (float)(y - a->last_y) * 0.15f;
+        if (a->pitch > 89.0f) a->pitch = 89.0f;
+        if (a->pitch < -89.0f) a->pitch = -89.0f;
+    }
+    a->last_x = x, a->last_y = y, a->have_mouse = 1;
+}
+
+/* forward vector from yaw (0 = -z) and pitch, in degrees */
+static void cam_dir(const app *a, float f[3])
+{
+    double y = a->yaw * 3.14159265358979 / 180.0, p = a->pitch * 3.14159265358979 / 180.0;
+    f[0] = (float)(sin(y) * cos(p));
+    f[1] = (float)sin(p);
+    f[2] = (float)(-cos(y) * cos(p));
+}
+
+static int down(const app *a, int key) { return glfwGetKey(a->win, key) == GLFW_PRESS; }
+
+static void fly(app *a, float dt)
+{
+    float f[3], r[3], speed = 3.0f * dt * (down(a, GLFW_KEY_LEFT_SHIFT) ? 4.0f : 1.0f), l;
+    int k;
+    cam_dir(a, f);
+    l = sqrtf(f[0] * f[0] + f[2] * f[2]) + 1e-6f;
+    r[0] = -f[2] / l, r[1] = 0.0f, r[2] = f[0] / l; /* right = forward x up, normalised */
+    for (k = 0; k < 3; ++k)
+        a->cam[k] += speed * (f[k] * (float)(down(a, GLFW_KEY_W) - down(a, GLFW_KEY_S)) +
+                              r[k] * (float)(down(a, GLFW_KEY_D) - down(a, GLFW_KEY_A)));
+    a->cam[1] += speed * (float)(down(a, GLFW_KEY_SPACE) - down(a, GLFW_KEY_C));
+}
+
+/* ---- matrices -------------------------------------------------------------------- */
+static void view_matrix(const app *a, float m[16])
+{
+    float f[3], s[3], u[3], l;
+    cam_dir(a, f);
+    s[0] = -f[2], s[1] = 0.0f, s[2] = f[0]; /* f x (0,1,0) */
+    l = sqrtf(s[0] * s[0] + s[2] * s[2]);
+    s[0] /= l, s[2] /= l;
+    u[0] = s[1] * f[2] - s[2] * f[1], u[1] = s[2] * f[0] - s[0] * f[2], u[2] = s[0] * f[1] - s[1] * f[0];
+    shp_mat_identity(m);
+    m[0] = s[0], m[4] = s[1], m[8] = s[2];
+    m[1] = u[0], m[5] = u[1], m[9] = u[2];
+    m[2] = -f[0], m[6] = -f[1], m[10] = -f[2];
+    m[12] = -(s[0] * a->cam[0] + s[1] * a->cam[1] + s[2] * a->cam[2]);
+    m[13] = -(u[0] * a->cam[0] + u[1] * a->cam[1] + u[2] * a->cam[2]);
+    m[14] = f[0] * a->cam[0] + f[1] * a->cam[1] + f[2] * a->cam[2];
+}
+
+static void perspective(float m[16], float fovy_deg, float aspect, float n, float f)
+{
+    float t = 1.0f / tanf(fovy_deg * 3.14159265f / 360.0f);
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = t / aspect;
+    m[5] = t;
+    m[10] = (f + n) / (n - f);
+    m[11] = -1.0f;
+    m[14] = 2.0f * f * n / (n - f);
+}
+
+static void trs(float out[16], float tx, float ty, float tz, float angle, float ax, float ay, float az)
+{
+    float r[16], t[16];
+    shp_mat_rotate(r, angle, ax, ay, az);
+    shp_mat_translate(t, tx, ty, tz);
+    shp_mat_mul(out, t, r);
+}
+
+/* ---- one frame ------------------------------------------------------------------- */
+static fogvol_frame_stats render(app *a, int w, int h)
+{
+    float view[16], proj[16], vp[16], m[16];
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_frame_stats st;
+    double t = a->anim_t;
+    int i;
+    memset(&st, 0, sizeof st);
+    view_matrix(a, view);
+    perspective(proj, 60.0f, (float)w / (float)h, ZNEAR, ZFAR);
+    shp_mat_mul(vp, proj, view);
+
+    /* the opaque scene */
+    glViewport(0, 0, w, h);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glClearColor(0.32f, 0.45f, 0.62f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    shp_mat_translate(m, 0.0f, -1.0f, 0.0f);
+    flat_draw(&a->floor_f, m, vp, 0.58f, 0.55f, 0.5f, 0.12f);
+    for (i = 0; i < NPILLARS; ++i) {
+        shp_mat_translate(m, k_pillars[i][0], 1.0f, k_pillars[i][1]);
+        flat_draw(&a->pillar_f, m, vp, 0.7f, 0.66f, 0.6f, 0.0f);
+    }
+    if (!a->fv) return st;
+
+    /* the blob's new shape: one fogvol mesh per frame, re-created before the frame opens
+       (fogvol_destroy_mesh inside an open frame would cancel it) */
+    if (!a->paused || !a->vol[M_BLOB]) {
+        deform_blob(a);
+        fogvol_destroy_mesh(a->fv, a->vol[M_BLOB]);
+        a->vol[M_BLOB] = upload(a->fv, &a->cpu[M_BLOB]);
+    }
+
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, view, sizeof view);
+    memcpy(fd.projection, proj, sizeof proj);
+    fd.znear = ZNEAR;
+    fd.zfar = ZFAR;
+    fd.viewport[2] = w;
+    fd.viewport[3] = h;
+    fd.show_overflow = a->show_overflow;
+    fogvol_begin_frame(a->fv, &fd);
+    shp_mat_translate(m, 0.0f, -1.0f, 0.0f);
+    fogvol_add_occluder(a->fv, a->vol[M_FLOOR], m);
+    for (i = 0; i < NPILLARS; ++i) {
+        shp_mat_translate(m, k_pillars[i][0], 1.0f, k_pillars[i][1]);
+        fogvol_add_occluder(a->fv, a->vol[M_PILLAR], m);
+    }
+    memset(&vd, 0, sizeof vd);
+    vd.ramp = a->ramp[R_MAIN]; /* main group: sphere, torus, blob */
+    vd.mesh = a->vol[M_SPHERE];
+    shp_mat_translate(vd.model, -2.2f, 0.4f, -0.8f);
+    fogvol_add_volume(a->fv, &vd);
+    vd.mesh = a->vol[M_TORUS];
+    trs(vd.model, 2.0f, 0.5f, -1.2f, 70.0f + 25.0f * (float)sin(0.5 * t), 1.0f, 0.0f, 0.3f);
+    fogvol_add_volume(a->fv, &vd);
+    if (a->vol[M_BLOB]) {
+        vd.mesh = a->vol[M_BLOB];
+        shp_mat_translate(vd.model, 0.0f, 0.9f + 0.2f * (float)sin(0.8 * t), 1.8f);
+        fogvol_add_volume(a->fv, &vd);
+    }
+    vd.ramp = a->ramp[R_BANK]; /* the long, low fog bank with a hole carved by a negative sphere */
+    vd.mesh = a->vol[M_BANK];
+    shp_mat_translate(vd.model, 0.0f, -0.4f, -3.8f);
+    fogvol_add_volume(a->fv, &vd);
+    vd.mesh = a->vol[M_HOLE];
+    vd.negative = 1;
+    shp_mat_translate(vd.model, 3.0f * (float)sin(0.4 * t), 0.25f, -3.8f);
+    fogvol_add_volume(a->fv, &vd);
+    vd.negative = 0;
+    vd.ramp = a->ramp[R_LIGHT]; /* a light beam, added to the scene */
+    vd.mesh = a->vol[M_BEAM];
+    trs(vd.model, 0.2f, 1.2f, -2.5f, 18.0f, 0.0f, 0.0f, 1.0f);
+    fogvol_add_volume(a->fv, &vd);
+    fogvol_end_frame(a->fv, &st); /* renders, composites, restores the GL state */
+    return st;
+}
+
+static const char *set_title(app *a, double ms)
+{
+    static char title[256];
+    const fogvol_encoding *e = fogvol_context_encoding(a->fv);
+    fogvol_tier tier = fogvol_context_tier(a->fv, NULL);
+    snprintf(title, sizeof title,
+             "fogvol demo | %.1f ms | [T] %s | [B] %d bits/ch (%d-bit, %d faces%s) | [G] dither %s | [R] %s | "
+             "[L] %s%s%s",
+             ms, fogvol_tier_name(tier), e->bits, e->precision_bits, e->max_faces,
+             tier == FOGVOL_TIER_FLOAT ? ", unused by FLOAT" : "", /* R32F sums: no RGB encoding */
+             a->dither ? "on" : "off", k_ramp_names[a->ramp_model], a->main_light ? "light" : "fog",
+             a->paused ? " | [P] paused" : "", a->show_overflow ? " | [O] overflow" : "");
+    glfwSetWindowTitle(a->win, title);
+    return title;
+}
+
+static int write_png(const char *path, int w, int h)
+{
+    unsigned char *px = (unsigned char *)malloc((size_t)w * (size_t)h * 4);
+    int ok;
+    if (!px) return 0;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    stbi_flip_vertically_on_write(1); /* GL rows go bottom to top */
+    ok = stbi_write_png(path, w, h, 4, px, w * 4);
+    free(px);
+    return ok;
+}
+
+int main(int argc, char **argv)
+{
+    app a;
+    int frames = 0, max_frames = 0, width = 960, height = 540, i, bits = 0, rc = 0, w = 0, h = 0;
+    fogvol_tier tier = FOGVOL_TIER_AUTO;
+    const char *shot = NULL, *keys = "";
+    double t_prev, t_title, ms_acc = 0.0;
+    int ms_n = 0, cam_n = 0;
+    float cam[5];
+    fogvol_frame_stats st;
+
+    memset(&a, 0, sizeof a);
+    memset(&st, 0, sizeof st);
+    for (i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--frames") && i + 1 < argc) max_frames = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--screenshot") && i + 1 < argc) shot = argv[++i];
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%dx%d", &width, &height);
+        else if (!strcmp(argv[i], "--bits") && i + 1 < argc) bits = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--keys") && i + 1 < argc) keys = argv[++i];
+        else if (!strcmp(argv[i], "--camera") && i + 1 < argc)
+            cam_n = sscanf(argv[++i], "%f,%f,%f,%f,%f", &cam[0], &cam[1], &cam[2], &cam[3], &cam[4]);
+        else if (!strcmp(argv[i], "--tier") && i + 1 < argc) {
+            ++i;
+            tier = !strcmp(argv[i], "ps13") ? FOGVOL_TIER_PS13 : !strcmp(argv[i], "ps20") ? FOGVOL_TIER_PS20
+                 : !strcmp(argv[i], "float") ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_AUTO;
+        } else {
+            fprintf(stderr, "usage: %s [--frames N] [--screenshot FILE.png] [--size WxH] [--tier ps13|ps20|float] "
+                            "[--bits 3..6] [--camera x,y,z,yaw,pitch] [--keys TBGRLOP]\n", argv[0]);
+            return 2;
+        }
+    }
+    if (!glfwInit()) {
+        fprintf(stderr, "demo: glfwInit failed (no display? try xvfb-run -a)\n");
+        return 1;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    a.win = glfwCreateWindow(width, height, "fogvol demo", NULL, NULL);
+    if (!a.win) {
+        fprintf(stderr, "demo: no OpenGL 3.3 core window\n");
+        glfwTerminate();
+        return 1;
+    }
+    glfwMakeContextCurrent(a.win);
+    glfwSwapInterval(max_frames ? 0 : 1);
+    glfwSetWindowUserPointer(a.win, &a);
+    glfwSetKeyCallback(a.win, key_cb);
+    glfwSetMouseButtonCallback(a.win, button_cb);
+    glfwSetCursorPosCallback(a.win, cursor_cb);
+
+    a.cpu[M_FLOOR] = shp_box(12.0f, 0.1f, 12.0f);
+    a.cpu[M_PILLAR] = shp_box(0.25f, 2.0f, 0.25f);
+    a.cpu[M_SPHERE] = shp_sphere(1.3f, 64, 32);
+    a.cpu[M_TORUS] = shp_torus(1.3f, 0.45f, 96, 32);
+    a.cpu[M_BANK] = shp_box(9.0f, 0.7f, 2.2f);
+    a.cpu[M_HOLE] = shp_sphere(1.1f, 48, 24);
+    a.cpu[M_BEAM] = shp_box(0.6f, 3.0f, 0.6f);
+    a.cpu[M_BLOB] = shp_sphere(0.9f, 48, 24);
+    a.blob_base = (float *)malloc(sizeof(float) * 3 * (size_t)a.cpu[M_BLOB].vcount);
+    memcpy(a.blob_base, a.cpu[M_BLOB].pos, sizeof(float) * 3 * (size_t)a.cpu[M_BLOB].vcount);
+    deform_blob(&a);
+    flat_init();
+    a.floor_f = flat_upload(&a.cpu[M_FLOOR]);
+    a.pillar_f = flat_upload(&a.cpu[M_PILLAR]);
+
+    a.dither = 1;
+    a.cam[0] = 0.0f, a.cam[1] = 3.4f, a.cam[2] = 8.0f, a.pitch = -20.0f;
+    if (cam_n == 5) a.cam[0] = cam[0], a.cam[1] = cam[1], a.cam[2] = cam[2], a.yaw = cam[3], a.pitch = cam[4];
+    if (!build_fog(&a, tier, bits)) {
+        fprintf(stderr, "demo: fogvol_create_context failed\n");
+        return 1;
+    }
+
+    t_prev = t_title = glfwGetTime();
+    while (!glfwWindowShouldClose(a.win)) {
+        double now = glfwGetTime(), dt = now - t_prev;
+        t_prev = now;
+        if (dt > 0.1) dt = 0.1;
+        if (*keys) press(&a, *keys++); /* --keys: one scripted key press per frame (GLFW key codes are ASCII) */
+        fly(&a, (float)dt);
+        if (!a.paused) a.anim_t += max_frames ? 1.0 / 60.0 : dt; /* --frames: reproducible */
+        glfwGetFramebufferSize(a.win, &w, &h);
+        if (w > 0 && h > 0) {
+            st = render(&a, w, h);
+            if (shot && max_frames && frames + 1 >= max_frames) {
+                if (!write_png(shot, w, h)) fprintf(stderr, "demo: cannot write %s\n", shot), rc = 1;
+                else printf("demo: wrote %s (%dx%d)\n", shot, w, h);
+            }
+        }
+        glfwSwapBuffers(a.win);
+        glfwPollEvents();
+        ms_acc += (glfwGetTime() - now) * 1000.0, ++ms_n;
+        if (glfwGetTime() - t_title > 0.25 || (max_frames && frames + 1 >= max_frames)) {
+            const char *title = set_title(&a, ms_acc / ms_n);
+            t_title = glfwGetTime();
+            if (max_frames && frames + 1 >= max_frames)
+                printf("demo: %d frames; %s; last frame: %d passes, %d volumes, %d groups\n", frames + 1, title,
+                       st.passes, st.volumes, st.groups);
+            ms_acc = 0.0, ms_n = 0;
+        }
+        if (max_frames && ++frames >= max_frames) break;
+    }
+    if (shot && !max_frames && w > 0 && h > 0) { /* interactive: the frame on screen when the window closed */
+        render(&a, w, h);
+        if (!write_png(shot, w, h)) fprintf(stderr, "demo: cannot write %s\n", shot), rc = 1;
+    }
+
+    destroy_fog(&a);
+    glDeleteVertexArrays(1, &a.floor_f.vao);
+    glDeleteBuffers(1, &a.floor_f.vbo);
+    glDeleteVertexArrays(1, &a.pillar_f.vao);
+    glDeleteBuffers(1, &a.pillar_f.vbo);
+    glDeleteProgram(g_flat_prog);
+    for (i = 0; i < M_COUNT; ++i) shp_free(&a.cpu[i]);
+    free(a.blob_base);
+    glfwDestroyWindow(a.win);
+    glfwTerminate();
+    return rc;
+}

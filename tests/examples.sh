@@ -1,0 +1,177 @@
+#!/usr/bin/env bash
+# The examples and the packaging, as TAP:
+#  - every example builds as C99 with -Wall -Wextra -pedantic -Werror
+#  - demo_glfw and engine_integration render a few frames under xvfb-run and write
+#    screenshots into $BUILD/examples/; demo_glfw's keys re-create the context
+#  - engine_integration --check: 0 pixels differ outside the fog, 0 GL state values
+#    differ (FLOAT + the engine's depth texture, and the PS20 fallback)
+#  - custom_backend: the recording backend renders the same picture as the default one
+#  - the CMake package: install, then find_package(fogvol) and add_subdirectory
+#    consumers build and run; pkg-config --cflags fogvol
+# Needs gcc, libglfw3-dev, libgl-dev, xvfb, xauth, libosmesa6-dev, libstb-dev, and
+# cmake + pkg-config for the packaging tests (skipped when absent).
+# Usage: BUILD=build CC=cc tests/examples.sh
+set -u
+cd "$(dirname "$0")/.."
+root=$(pwd)
+build=${BUILD:-build}
+case $build in /*) ;; *) build="$root/$build" ;; esac
+out=$build/examples
+cc=${CC:-cc}
+mkdir -p "$out"
+n=0
+fails=0
+log=$out/last.log
+
+ok() { n=$((n + 1)); echo "ok $n - $1"; }
+not_ok() {
+  n=$((n + 1)); fails=$((fails + 1)); echo "not ok $n - $1"
+  [ -s "$log" ] && tail -n 25 "$log" | sed 's/^/#   /'
+}
+skip() { n=$((n + 1)); echo "ok $n - $1 # SKIP $2"; }
+# run DESCRIPTION COMMAND...: ok when the command exits 0 (output in $log)
+run() {
+  local desc=$1; shift
+  if timeout 60 "$@" > "$log" 2>&1; then ok "$desc"; else not_ok "$desc (exit $?)"; fi
+}
+# expect DESCRIPTION REGEX: ok when the last command's output matches (extended regex)
+expect() {
+  if grep -Eq "$2" "$log"; then ok "$1"; else not_ok "$1 (no line matches /$2/)"; fi
+}
+note() { grep -E "$1" "$log" | sed 's/^/# /'; }
+png_ok() { # a PNG file of at least 10 kB
+  [ -f "$1" ] && [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && [ "$(wc -c < "$1")" -gt 10000 ]
+}
+xrun=(xvfb-run -a -s "-screen 0 1280x1024x24")
+
+# ---- build ---------------------------------------------------------------------------
+flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
+# name, libraries: OSMesa for the headless ones (every GL call must reach OSMesa), GLFW + libGL for the windows
+builds="demo_headless:-lOSMesa custom_backend:-lOSMesa demo_glfw:-lglfw_-lGL engine_integration:-lglfw_-lGL"
+for b in $builds; do # in parallel; each writes its own log
+  name=${b%%:*}; libs=$(echo "${b#*:}" | tr _ ' ')
+  (timeout 120 $cc $flags "examples/$name.c" -o "$out/$name" $libs -lm > "$out/build_$name.log" 2>&1
+   echo $? > "$out/build_$name.rc") &
+done
+wait
+for b in $builds; do
+  name=${b%%:*}; libs=$(echo "${b#*:}" | tr _ ' ')
+  cp "$out/build_$name.log" "$log"
+  if [ "$(cat "$out/build_$name.rc")" = 0 ]; then ok "build $name (C99, -Wall -Wextra -pedantic -Werror, $libs)"
+  else not_ok "build $name (C99, -Wall -Wextra -pedantic -Werror, $libs)"; fi
+  rm -f "$out/build_$name.log" "$out/build_$name.rc"
+done
+lines=$(grep -c 'fogvol \*/' examples/engine_integration.c)
+if [ "$lines" -gt 0 ] && [ "$lines" -lt 40 ]; then ok "engine_integration adds fog in $lines marked lines (< 40)"
+else not_ok "engine_integration adds fog in $lines marked lines (want 1..39)"; fi
+
+# ---- windowed examples under Xvfb ------------------------------------------------------------
+if ! command -v xvfb-run > /dev/null; then
+  : > "$log"; not_ok "xvfb-run is missing (apt-get install xvfb xauth)"
+else
+  run "demo_glfw: 8 frames, screenshot" "${xrun[@]}" "$out/demo_glfw" --frames 8 --size 640x360 \
+    --screenshot "$out/demo_glfw.png"
+  note '^demo:'
+  if png_ok "$out/demo_glfw.png"; then ok "demo_glfw.png written"; else not_ok "demo_glfw.png written"; fi
+  run "demo_glfw: camera inside the fog bank, PS20, screenshot" "${xrun[@]}" "$out/demo_glfw" --frames 4 --size 640x360 \
+    --tier ps20 --camera -5,-0.6,-3.6,90,3 --screenshot "$out/demo_glfw_inside.png"
+  expect "demo_glfw --tier ps20 runs PS20" '\[T\] PS20'
+  run "demo_glfw: keys T B G R L re-create the context and ramps" "${xrun[@]}" "$out/demo_glfw" --frames 7 --size 480x270 \
+    --keys TBGRLOP --screenshot "$out/demo_glfw_keys.png"
+  expect "demo_glfw: keys reached PS13, 5 bits, dither off, linear ramp, light blend" \
+    '\[T\] PS13 \| \[B\] 5 bits/ch.*dither off \| \[R\] linear \| \[L\] light'
+  note '^demo:'
+
+  run "engine_integration: 5 frames with fog, screenshot" "${xrun[@]}" "$out/engine_integration" --frames 5 \
+    --screenshot "$out/engine_integration.png"
+  note '^engine:'
+  run "engine_integration: 5 frames --no-fog, screenshot" "${xrun[@]}" "$out/engine_integration" --frames 5 --no-fog \
+    --screenshot "$out/engine_integration_nofog.png"
+  run "engine_integration: 5 frames PS20 fallback, screenshot" "${xrun[@]}" "$out/engine_integration" --frames 5 --ps20 \
+    --screenshot "$out/engine_integration_ps20.png"
+  if png_ok "$out/engine_integration.png" && png_ok "$out/engine_integration_nofog.png" &&
+     ! cmp -s "$out/engine_integration.png" "$out/engine_integration_nofog.png"; then
+    ok "engine_integration: the fog changes the picture"
+  else
+    not_ok "engine_integration: the fog changes the picture"
+  fi
+  for mode in float ps20; do # FLOAT + the engine's depth texture, and the PS20 fallback with occluders
+    flag=; [ $mode = ps20 ] && flag=--ps20
+    run "engine_integration --check ($mode)" "${xrun[@]}" "$out/engine_integration" --check $flag
+    note '^check:'
+    expect "engine_integration --check ($mode): 0 pixels differ outside the fog" 'outside the fog compared, 0 differ'
+    expect "engine_integration --check ($mode): 0 GL state values differ" 'compared after fogvol_end_frame, 0 differ'
+  done
+fi
+
+# ---- custom backend (headless) ---------------------------------------------------------------
+run "custom_backend: recording backend renders, logs, writes a PNG" "$out/custom_backend" "$out/custom_backend.png"
+note '^  (begin_pass|draw_mesh|draw_fullscreen) |^  [0-9]+ |differ|violations'
+expect "custom_backend: same pixels as the default GL backend" ' 0 of [0-9]+ pixels differ'
+run "custom_backend --tier float" "$out/custom_backend" --tier float "$out/custom_backend_float.png"
+
+# ---- CMake package and pkg-config ------------------------------------------------------------
+if ! command -v cmake > /dev/null; then
+  skip "CMake package: install, find_package, add_subdirectory" "cmake not installed"
+else
+  cm=$out/cmake
+  rm -rf "$cm"
+  mkdir -p "$cm/consumer"
+  cat > "$cm/consumer/main.c" << 'EOF'
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#include <stdio.h>
+int main(void)
+{
+    fogvol_encoding e;
+    if (fogvol_encoding_init(&e, FOGVOL_DEFAULT_BITS) != FOGVOL_SUCCESS) return 1;
+    printf("fogvol %s: %d-bit encoding, %d faces\n", FOGVOL_VERSION_STRING, e.precision_bits, e.max_faces);
+    return e.max_faces == 16 ? 0 : 1;
+}
+EOF
+  cat > "$cm/consumer/CMakeLists.txt" << 'EOF'
+cmake_minimum_required(VERSION 3.14)
+project(fogvol_consumer C)
+if(FOGVOL_SOURCE_DIR)
+  add_subdirectory("${FOGVOL_SOURCE_DIR}" fogvol)
+  if(TARGET demo_glfw OR TARGET demo_headless)
+    message(FATAL_ERROR "fogvol's examples must be off in a subproject")
+  endif()
+else()
+  find_package(fogvol ${FOGVOL_WANT} REQUIRED)
+endif()
+add_executable(consumer main.c)
+target_link_libraries(consumer PRIVATE fogvol::fogvol)
+EOF
+  prefix=$cm/prefix
+  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF \
+    -DCMAKE_INSTALL_PREFIX='$prefix' && cmake --build '$cm/fogvol' && cmake --install '$cm/fogvol'"
+  if [ -f "$prefix/include/fogvol.h" ] && [ -f "$prefix/share/cmake/fogvol/fogvolConfig.cmake" ] &&
+     [ -f "$prefix/share/cmake/fogvol/fogvolConfigVersion.cmake" ] && [ -f "$prefix/share/pkgconfig/fogvol.pc" ]; then
+    ok "cmake: installed fogvol.h, fogvolConfig.cmake, fogvolConfigVersion.cmake, fogvol.pc"
+  else
+    not_ok "cmake: installed fogvol.h, fogvolConfig.cmake, fogvolConfigVersion.cmake, fogvol.pc"
+  fi
+  run "cmake: find_package(fogvol 0.1) consumer builds and runs" bash -c "cmake -S '$cm/consumer' -B '$cm/find' \
+    -DCMAKE_PREFIX_PATH='$prefix' -DFOGVOL_WANT=0.1 && cmake --build '$cm/find' && '$cm/find/consumer'"
+  note '^fogvol [0-9]'
+  if cmake -S "$cm/consumer" -B "$cm/find_wrong" -DCMAKE_PREFIX_PATH="$prefix" -DFOGVOL_WANT=1.0 > "$log" 2>&1; then
+    not_ok "cmake: find_package(fogvol 1.0) is refused (0.x is only compatible within its minor version)"
+  else
+    ok "cmake: find_package(fogvol 1.0) is refused (0.x is only compatible within its minor version)"
+  fi
+  run "cmake: add_subdirectory consumer builds and runs (examples off)" bash -c "cmake -S '$cm/consumer' \
+    -B '$cm/subdir' -DFOGVOL_SOURCE_DIR='$root' && cmake --build '$cm/subdir' && '$cm/subdir/consumer'"
+  if command -v pkg-config > /dev/null; then
+    run "pkg-config --cflags --libs fogvol" env PKG_CONFIG_PATH="$prefix/share/pkgconfig" \
+      pkg-config --cflags --libs fogvol
+    expect "pkg-config: -I$prefix/include" "^-I$prefix/include +-lm"
+    run "pkg-config consumer builds and runs" bash -c "$cc -std=c99 '$cm/consumer/main.c' -o '$cm/pc_consumer' \
+      \$(PKG_CONFIG_PATH='$prefix/share/pkgconfig' pkg-config --cflags --libs fogvol) && '$cm/pc_consumer'"
+  else
+    skip "pkg-config --cflags fogvol" "pkg-config not installed"
+  fi
+fi
+rm -f "$out/last.log"
+echo "1..$n"
+[ "$fails" = 0 ]
