@@ -3,6 +3,7 @@
 #   make demo   render the headless demo into build/demo/*.png
 #   make images refresh the README pictures in docs/ from the demo
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
+#   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
 CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
@@ -18,7 +19,7 @@ FUZZ_TIME ?= 60
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all test demo images fuzz run examples deps-test deps-demo deps-run clean
+.PHONY: all test demo images fuzz run examples bench bench-quick deps-test deps-demo deps-run clean
 
 all: test
 
@@ -70,7 +71,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
-            $(BUILD)/demo_headless
+            $(BUILD)/demo_headless $(BUILD)/bench
 
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory $(TEST_BINS)
@@ -78,6 +79,7 @@ test: deps-test deps-run
 	  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
 	  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
 	  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
+	  "bench_quick=$(BUILD)/bench --quick" \
 	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
 	  "cpu=$(TAP) $(BUILD)/test_cpu" \
 	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
@@ -116,6 +118,19 @@ run: deps-run
 # the examples alone: build, run headless / under Xvfb, check, package consumers
 examples: deps-demo deps-run
 	@LOGDIR=$(BUILD)/logs tests/run.sh "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh"
+
+$(BUILD)/bench: bench/bench.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+# full run, 4-5 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run)
+bench: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/bench
+	$(BUILD)/bench
+
+# smoke test (smallest scene, a few frames), also part of make test
+bench-quick: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/bench
+	$(BUILD)/bench --quick
 
 # libFuzzer on mesh validation, FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)

@@ -1,0 +1,1502 @@
+#define _POSIX_C_SOURCE 200809L
+/* bench.c - fogvol.h benchmark: fixed scenes rendered headless (OSMesa) at
+   1280x720 and 640x360, every tier against two references measured in the
+   same run, interleaved frame by frame:
+
+     floor    the volume triangles drawn once (constant colour, additive, no
+              culling) into an R32F target + one full-screen composite pass
+              (texelFetch, discard where empty, blend): the least any
+              technique that rasterises every face once can cost
+     peeling  exact thickness by depth peeling: an opaque pre-pass (linear
+              depth), then one geometry pass per layer until an occlusion query
+              reports no fragment, then one full-screen composite. Each peel
+              keeps the nearest fragment behind the previous layer (depth
+              test LESS on a fresh depth buffer, discard if z <= previous z +
+              eps) and writes (running sum + its signed depth clamped to the
+              opaque depth, layer count) into one of two RG32F targets in
+              turn, reading the running sum from the other: additive blending
+              inside a peel would add every fragment that passes the depth
+              test on its way, not just the nearest one. The target with the
+              higher count holds a pixel's whole sum.
+
+   Fog time per frame = glFinish .. fog work .. glFinish (the engine's opaque
+   pass is drawn before the clock starts; for MRT it is the engine pass that
+   writes O, so the MRT time is the whole frame minus the median plain engine
+   pass of the same scene). Medians of many frames after warm-up.
+
+   usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
+                               prints only; --scene I: scene I alone, prints only)
+   full run: prints the tables, writes bench/RESULTS.md and bench/plot.png */
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#include "tests/gl_util.h"
+#include <GL/glext.h>
+#include "tests/shapes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <stb/stb_easy_font.h>
+#include <stdarg.h>
+#include <time.h>
+#include <sys/utsname.h>
+
+#define NTIER 5
+#define M_FLOOR NTIER
+#define M_PEEL (NTIER + 1)
+#define NMETH (NTIER + 2)
+#define MAXI 32 /* instances per scene */
+#define MAXMESH 24
+#define MAXLAYERS 96
+#define MAXSCENE 12
+
+typedef struct tier_cfg {
+    const char *name;
+    fogvol_tier tier;
+    unsigned variants;
+} tier_cfg;
+static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0},
+                                        {"PS20", FOGVOL_TIER_PS20, 0},
+                                        {"MRT", FOGVOL_TIER_MRT, 0},
+                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0},
+                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH}};
+static const char *const g_meth_names[NMETH] = {"PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "floor",
+                                                "depth peeling"};
+
+/* ---- small utilities -------------------------------------------------------- */
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(const double *v, int n)
+{
+    double tmp[512];
+    if (n <= 0) return 0;
+    if (n > 512) n = 512;
+    memcpy(tmp, v, sizeof(double) * (size_t)n);
+    qsort(tmp, (size_t)n, sizeof(double), cmp_d);
+    return n % 2 ? tmp[n / 2] : 0.5 * (tmp[n / 2 - 1] + tmp[n / 2]);
+}
+
+static void die(const char *what)
+{
+    fprintf(stderr, "bench: %s\n", what);
+    exit(1);
+}
+
+static void fv_log(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l == FOGVOL_LOG_ERROR) fprintf(stderr, "[fogvol] %s\n", m);
+}
+
+/* output goes to stdout and, in the full run, into RESULTS.md */
+static FILE *g_md;
+static void out(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    if (g_md) {
+        va_start(ap, fmt);
+        vfprintf(g_md, fmt, ap);
+        va_end(ap);
+    }
+    fflush(stdout);
+}
+
+/* ---- GL helpers ------------------------------------------------------------- */
+static GLuint program(const char *const *vs, int nvs, const char *const *fs, int nfs)
+{
+    GLuint p = glCreateProgram(), s[2];
+    GLint ok = 0;
+    char log[2048];
+    int i;
+    for (i = 0; i < 2; ++i) {
+        s[i] = glCreateShader(i ? GL_FRAGMENT_SHADER : GL_VERTEX_SHADER);
+        glShaderSource(s[i], i ? nfs : nvs, i ? fs : vs, NULL);
+        glCompileShader(s[i]);
+        glGetShaderiv(s[i], GL_COMPILE_STATUS, &ok);
+        if (!ok) {
+            glGetShaderInfoLog(s[i], sizeof log, NULL, log);
+            fprintf(stderr, "%s\n", log);
+            die("shader compile");
+        }
+        glAttachShader(p, s[i]);
+    }
+    glLinkProgram(p);
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) die("shader link");
+    glDeleteShader(s[0]);
+    glDeleteShader(s[1]);
+    return p;
+}
+
+static GLuint prog1(const char *vs, const char *fs) { return program(&vs, 1, &fs, 1); }
+
+static GLuint tex2d(GLenum ifmt, int w, int h, GLenum fmt, GLenum type)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexImage2D(GL_TEXTURE_2D, 0, (GLint)ifmt, w, h, 0, fmt, type, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return t;
+}
+
+static GLuint fbo2(GLuint color, GLuint depth_tex, GLuint depth_rb)
+{
+    GLuint f;
+    glGenFramebuffers(1, &f);
+    glBindFramebuffer(GL_FRAMEBUFFER, f);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color, 0);
+    if (depth_tex) glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth_tex, 0);
+    if (depth_rb) glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) die("framebuffer incomplete");
+    return f;
+}
+
+/* ---- shaders of the engine, the floor and the peeling ------------------------- */
+static const char *VS_MESH =
+    "#version 330 core\nlayout(location = 0) in vec3 p;\nuniform mat4 mvp, mv;\nuniform vec2 nf;\n"
+    "out float vd; out float d;\n"
+    "void main() { vd = -(mv * vec4(p, 1.0)).z; d = vd * nf.x + nf.y; gl_Position = mvp * vec4(p, 1.0); }\n";
+static const char *VS_FULL = "#version 330 core\nvoid main() {\n"
+                             "  vec2 v = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+                             "  gl_Position = vec4(v, 0.0, 1.0); }\n";
+static const char *FS_ENGINE = "#version 330 core\nin float vd; in float d;\nuniform vec4 col;\n"
+                               "layout(location = 0) out vec4 o;\nvoid main() { o = col; }\n";
+static const char *FS_ENGINE_MRT =
+    "in float vd; in float d;\nuniform vec4 col;\nlayout(location = 0) out vec4 o;\n"
+    "layout(location = 1) out vec4 fogvol_o;\n"
+    "void main() { o = col; fogvol_o = fogvol_encode_view_depth(vd); }\n";
+static const char *FS_CONST = "#version 330 core\nout vec4 o;\nvoid main() { o = vec4(1.0 / 255.0); }\n";
+static const char *FS_FLOOR_COMP = "#version 330 core\nuniform sampler2D s;\nout vec4 o;\n"
+                                   "void main() { float v = texelFetch(s, ivec2(gl_FragCoord.xy), 0).r;\n"
+                                   "  if (v == 0.0) discard;\n  o = vec4(0.8, 0.8, 0.8, v); }\n";
+static const char *FS_LINDEPTH = "#version 330 core\nin float vd; in float d;\nout vec4 o;\n"
+                                 "void main() { o = vec4(clamp(d, 0.0, 1.0), 0.0, 0.0, 0.0); }\n";
+/* one peel: the nearest fragment behind the previous layer writes (running
+   sum + its signed clamped depth, layer count); ping-pong targets */
+static const char *FS_PEEL =
+    "#version 330 core\nin float vd; in float d;\nuniform sampler2D prevc, prevz, opq;\nuniform float first, eps;\n"
+    "out vec4 o;\n"
+    "void main() {\n  ivec2 c = ivec2(gl_FragCoord.xy);\n"
+    "  if (first < 0.5 && gl_FragCoord.z <= texelFetch(prevz, c, 0).r + eps) discard;\n"
+    "  vec2 pr = texelFetch(prevc, c, 0).rg;\n"
+    "  float v = min(max(d, 0.0), texelFetch(opq, c, 0).r);\n"
+    "  o = vec4(pr.x + (gl_FrontFacing ? -v : v), pr.y + 1.0, 0.0, 0.0);\n}\n";
+static const char *FS_PEEL_COMP =
+    "#version 330 core\nuniform sampler2D a, b;\nuniform vec4 fog;\nuniform float range;\nout vec4 o;\n"
+    "void main() {\n  ivec2 c = ivec2(gl_FragCoord.xy);\n"
+    "  vec2 x = texelFetch(a, c, 0).rg, y = texelFetch(b, c, 0).rg, s = x.y > y.y ? x : y;\n"
+    "  if (s.y == 0.0) discard;\n"
+    "  o = vec4(fog.rgb, 1.0 - exp(-fog.w * max(s.x * range, 0.0))); }\n";
+
+typedef struct progs {
+    GLuint engine, engine_mrt, cnst, floor_comp, lindepth, peel, peel_comp, empty_vao;
+} progs;
+static progs P;
+
+static void make_progs(void)
+{
+    const char *fs[3];
+    P.engine = prog1(VS_MESH, FS_ENGINE);
+    fs[0] = "#version 330 core\n";
+    fs[1] = fogvol_mrt_snippet();
+    fs[2] = FS_ENGINE_MRT;
+    P.engine_mrt = program(&VS_MESH, 1, fs, 3);
+    P.cnst = prog1(VS_MESH, FS_CONST);
+    P.floor_comp = prog1(VS_FULL, FS_FLOOR_COMP);
+    P.lindepth = prog1(VS_MESH, FS_LINDEPTH);
+    P.peel = prog1(VS_MESH, FS_PEEL);
+    P.peel_comp = prog1(VS_FULL, FS_PEEL_COMP);
+    glGenVertexArrays(1, &P.empty_vao);
+}
+
+/* ---- scenes ------------------------------------------------------------------ */
+typedef struct gmesh {
+    shp_mesh m;
+    GLuint vao, vbo, ibo;
+    fogvol_mesh *fm[NTIER];
+} gmesh;
+
+typedef struct inst {
+    int mesh;
+    float model[16];
+    int occluder;
+    float col[3];
+} inst;
+
+typedef struct scene {
+    char name[48];
+    double eye[3], at[3];
+    float fovy, znear, zfar;
+    gmesh mesh[MAXMESH];
+    int nmesh;
+    inst in[MAXI];
+    int n;
+    int k;        /* depth complexity of a shell scene (0: other) */
+    int triangles; /* volume triangles drawn per frame */
+} scene;
+
+static int add_mesh(scene *s, shp_mesh m)
+{
+    if (!m.pos) die("mesh generation");
+    s->mesh[s->nmesh].m = m;
+    return s->nmesh++;
+}
+
+static void add_inst(scene *s, int mesh, const float model[16], int occluder)
+{
+    inst *i = &s->in[s->n++];
+    i->mesh = mesh;
+    memcpy(i->model, model, sizeof i->model);
+    i->occluder = occluder;
+    i->col[0] = 0.55f;
+    i->col[1] = 0.5f;
+    i->col[2] = 0.45f;
+    if (!occluder) s->triangles += s->mesh[mesh].m.icount / 3;
+}
+
+static void trs(float m[16], float tx, float ty, float tz, float ang, float ax, float ay, float az, float sx,
+                float sy, float sz)
+{
+    float t[16], r[16], sc[16];
+    shp_mat_translate(t, tx, ty, tz);
+    shp_mat_rotate(r, ang, ax, ay, az);
+    shp_mat_scale(sc, sx, sy, sz);
+    shp_mat_mul(r, r, sc);
+    shp_mat_mul(m, t, r);
+}
+
+static void set_cam(scene *s, double ex, double ey, double ez, double ax, double ay, double az, float zn, float zf)
+{
+    s->eye[0] = ex;
+    s->eye[1] = ey;
+    s->eye[2] = ez;
+    s->at[0] = ax;
+    s->at[1] = ay;
+    s->at[2] = az;
+    s->fovy = 50.0f;
+    s->znear = zn;
+    s->zfar = zf;
+}
+
+/* which: 0 16 spheres, 1 concave tori, 2..5 shells k = 2, 4, 8, 16, 6 floor and
+   pillars cutting volumes, 7 camera inside a volume */
+#define NSCENES 8
+static void build_scene(scene *s, int which)
+{
+    float m[16];
+    int i, j, a;
+    memset(s, 0, sizeof *s);
+    if (which == 0) {
+        strcpy(s->name, "16 spheres");
+        set_cam(s, 0, 0.5, 9.5, 0, 0, 0, 0.5f, 30);
+        a = add_mesh(s, shp_sphere(0.85f, 48, 24));
+        for (i = 0; i < 4; ++i)
+            for (j = 0; j < 4; ++j) {
+                shp_mat_translate(m, -3.3f + 2.2f * (float)j, -2.4f + 1.6f * (float)i, -1.5f + 0.7f * (float)((i + j) % 4));
+                add_inst(s, a, m, 0);
+            }
+    } else if (which == 1) {
+        strcpy(s->name, "concave tori");
+        set_cam(s, 0, 1.2, 7.5, 0, 0, 0, 0.5f, 30);
+        a = add_mesh(s, shp_torus(1.7f, 0.55f, 96, 32));
+        for (i = 0; i < 3; ++i) {
+            trs(m, -1.6f + 1.6f * (float)i, 0, 0, i % 2 ? 90.0f : 20.0f, 1, 0.2f * (float)i, 0, 1, 1, 1);
+            add_inst(s, a, m, 0);
+        }
+        a = add_mesh(s, shp_torus(1.2f, 0.45f, 96, 32));
+        trs(m, 0, 1.6f, -1.0f, 60, 0, 1, 0.3f, 1, 1, 1);
+        add_inst(s, a, m, 0);
+    } else if (which >= 2 && which <= 5) {
+        int k = 2 << (which - 2);
+        shp_mesh all = shp_sphere(0.8f, 48, 24);
+        s->k = k;
+        snprintf(s->name, sizeof s->name, "shells k=%d", k);
+        set_cam(s, 0, 0, 8.0, 0, 0, 0, 0.5f, 30);
+        for (i = 1; i < k; ++i) { /* k nested spheres in one mesh: k back faces on the centre ray */
+            shp_mesh one = shp_sphere(0.8f + 1.7f * (float)i / (float)(k - 1), 48, 24);
+            if (!shp_append(&all, &one)) die("append");
+            shp_free(&one);
+        }
+        a = add_mesh(s, all);
+        shp_mat_identity(m);
+        add_inst(s, a, m, 0);
+    } else if (which == 6) {
+        static const float pp[6][2] = {{-3, -1}, {0.3f, -2.2f}, {2.6f, 0.8f}, {-0.8f, 2.0f}, {3.5f, -3}, {-3.6f, 2.5f}};
+        strcpy(s->name, "cut by floor+pillars");
+        set_cam(s, 0.5, 4.0, 10.0, 0, -0.2, 0, 0.5f, 40);
+        a = add_mesh(s, shp_box(14, 0.1f, 14));
+        shp_mat_translate(m, 0, -1.1f, 0);
+        add_inst(s, a, m, 1);
+        a = add_mesh(s, shp_box(0.3f, 2.5f, 0.3f));
+        for (i = 0; i < 6; ++i) {
+            shp_mat_translate(m, pp[i][0], 1.0f, pp[i][1]);
+            add_inst(s, a, m, 1);
+        }
+        a = add_mesh(s, shp_box(9, 0.8f, 9)); /* ground fog bank, half below the floor */
+        shp_mat_translate(m, 0, -1.0f, 0);
+        add_inst(s, a, m, 0);
+        a = add_mesh(s, shp_sphere(1.4f, 64, 32));
+        shp_mat_translate(m, -1.5f, -0.2f, 0.5f);
+        add_inst(s, a, m, 0);
+        a = add_mesh(s, shp_torus(1.4f, 0.5f, 96, 32));
+        trs(m, 2.0f, 0.2f, -1.0f, 70, 1, 0, 0.2f, 1, 1, 1);
+        add_inst(s, a, m, 0);
+        a = add_mesh(s, shp_box(0.7f, 3.0f, 0.7f)); /* light beam through the floor */
+        trs(m, 0.3f, 1.0f, 2.0f, 15, 0, 0, 1, 1, 1, 1);
+        add_inst(s, a, m, 0);
+    } else {
+        strcpy(s->name, "camera inside a volume");
+        set_cam(s, 0, 0.3, 0, 0.4, 0.1, -5, 0.3f, 40);
+        a = add_mesh(s, shp_sphere(12.0f, 64, 32));
+        shp_mat_identity(m);
+        add_inst(s, a, m, 0);
+        a = add_mesh(s, shp_box(6, 1.2f, 6)); /* a fog bank the camera stands in too */
+        shp_mat_translate(m, 0, 0.0f, -2.0f);
+        add_inst(s, a, m, 0);
+        a = add_mesh(s, shp_sphere(1.2f, 48, 24));
+        for (i = 0; i < 5; ++i) {
+            shp_mat_translate(m, -4.0f + 2.0f * (float)i, 0.5f * (float)(i % 2), -6.0f - 1.5f * (float)(i % 3));
+            add_inst(s, a, m, 0);
+        }
+    }
+}
+
+/* ---- per-resolution GL resources ---------------------------------------------- */
+typedef struct rt {
+    int w, h;
+    GLuint eng_color, eng_depth, eng_fbo;   /* the engine framebuffer (colour + depth texture) */
+    GLuint floor_tex, floor_fbo;            /* the floor's RGBA8 sum */
+    GLuint po_tex, po_rb, po_fbo;           /* peeling: opaque linear depth */
+    GLuint pc[2], pz[2], pfbo[2];           /* peeling: ping-pong (sum, count) + depth */
+    GLuint query;
+} rt;
+
+static void rt_create(rt *r, int w, int h)
+{
+    int i;
+    memset(r, 0, sizeof *r);
+    r->w = w;
+    r->h = h;
+    r->eng_color = tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE);
+    r->eng_depth = tex2d(GL_DEPTH_COMPONENT24, w, h, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT);
+    r->eng_fbo = fbo2(r->eng_color, r->eng_depth, 0);
+    r->floor_tex = tex2d(GL_R32F, w, h, GL_RED, GL_FLOAT);
+    r->floor_fbo = fbo2(r->floor_tex, 0, 0);
+    r->po_tex = tex2d(GL_R32F, w, h, GL_RED, GL_FLOAT);
+    glGenRenderbuffers(1, &r->po_rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, r->po_rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    r->po_fbo = fbo2(r->po_tex, 0, r->po_rb);
+    for (i = 0; i < 2; ++i) {
+        r->pc[i] = tex2d(GL_RG32F, w, h, GL_RG, GL_FLOAT);
+        r->pz[i] = tex2d(GL_DEPTH_COMPONENT32F, w, h, GL_DEPTH_COMPONENT, GL_FLOAT);
+        r->pfbo[i] = fbo2(r->pc[i], r->pz[i], 0);
+    }
+    glGenQueries(1, &r->query);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static void rt_free(rt *r)
+{
+    GLuint t[9] = {r->eng_color, r->eng_depth, r->floor_tex, r->po_tex, r->pc[0], r->pc[1], r->pz[0], r->pz[1], 0};
+    GLuint f[5] = {r->eng_fbo, r->floor_fbo, r->po_fbo, r->pfbo[0], r->pfbo[1]};
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(5, f);
+    glDeleteTextures(8, t);
+    glDeleteRenderbuffers(1, &r->po_rb);
+    glDeleteQueries(1, &r->query);
+}
+
+/* ---- drawing ------------------------------------------------------------------ */
+typedef struct view {
+    float v[16], p[16], vp[16];
+    float nf[2]; /* view depth -> d in [0,1] between near and far */
+} view;
+
+static void make_view(view *vw, const scene *s, int w, int h)
+{
+    static const double up[3] = {0, 1, 0};
+    glu_look_at(vw->v, s->eye, s->at, up);
+    glu_perspective(vw->p, s->fovy, (double)w / h, s->znear, s->zfar);
+    shp_mat_mul(vw->vp, vw->p, vw->v);
+    vw->nf[0] = 1.0f / (s->zfar - s->znear);
+    vw->nf[1] = -s->znear / (s->zfar - s->znear);
+}
+
+/* draw instances (occluders or volumes) with program prog (mvp, mv, nf, col uniforms) */
+static void draw_insts(const scene *s, const view *vw, GLuint prog, int occluders)
+{
+    GLint u_mvp = glGetUniformLocation(prog, "mvp"), u_mv = glGetUniformLocation(prog, "mv");
+    GLint u_col = glGetUniformLocation(prog, "col");
+    int i;
+    glUniform2fv(glGetUniformLocation(prog, "nf"), 1, vw->nf);
+    for (i = 0; i < s->n; ++i) {
+        const inst *in = &s->in[i];
+        const gmesh *g = &s->mesh[in->mesh];
+        float mv[16], mvp[16];
+        if (in->occluder != occluders) continue;
+        shp_mat_mul(mv, vw->v, in->model);
+        shp_mat_mul(mvp, vw->p, mv);
+        glUniformMatrix4fv(u_mvp, 1, GL_FALSE, mvp);
+        glUniformMatrix4fv(u_mv, 1, GL_FALSE, mv);
+        if (u_col >= 0) glUniform4f(u_col, in->col[0], in->col[1], in->col[2], 1.0f);
+        glBindVertexArray(g->vao);
+        glDrawElements(GL_TRIANGLES, g->m.icount, GL_UNSIGNED_INT, NULL);
+    }
+    glBindVertexArray(0);
+}
+
+/* The engine's opaque pass into its framebuffer; with mrt also O as colour attachment 1. */
+static void engine_pass(const scene *s, const view *vw, const rt *r, const fogvol_mrt_info *mrt)
+{
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    static const float bg[4] = {0.2f, 0.35f, 0.55f, 1.0f};
+    GLuint prog = mrt ? P.engine_mrt : P.engine;
+    glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
+    if (mrt) glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, (GLuint)mrt->texture, 0);
+    glDrawBuffers(mrt ? 2 : 1, bufs);
+    glViewport(0, 0, r->w, r->h);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glDepthMask(GL_TRUE);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    if (mrt) glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(prog);
+    if (mrt) glUniform4fv(glGetUniformLocation(prog, "fogvol_mrt"), 2, mrt->uniforms);
+    draw_insts(s, vw, prog, 1);
+    glDisable(GL_DEPTH_TEST);
+    if (mrt) {
+        glDrawBuffers(1, bufs); /* fogvol composites into attachment 0 only */
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+    }
+    glUseProgram(0);
+}
+
+/* Pass timer: the GL backend's table with begin_pass/end_pass wrapped; when
+   on, every fogvol pass is bracketed by glFinish and timed (the breakdown). */
+#define MAXPASS 12
+typedef struct pass_timer {
+    void (*begin_pass)(void *, const fogvol_pass *);
+    void (*end_pass)(void *);
+    int on, pass;
+    double t0, ms[MAXPASS], engine_ms;
+} pass_timer;
+static pass_timer g_pt;
+
+static void pt_begin_pass(void *u, const fogvol_pass *p)
+{
+    if (g_pt.on) {
+        glFinish();
+        g_pt.t0 = now_ms();
+    }
+    g_pt.begin_pass(u, p);
+}
+
+static void pt_end_pass(void *u)
+{
+    if (g_pt.end_pass) g_pt.end_pass(u);
+    if (g_pt.on) {
+        glFinish();
+        if (g_pt.pass < MAXPASS) g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
+    }
+}
+
+typedef struct fogs {
+    fogvol_context *ctx[NTIER];
+    fogvol_ramp *ramp[NTIER];
+    fogvol_backend be[NTIER];
+} fogs;
+
+/* One fogvol frame of tier t; the engine framebuffer holds the opaque scene
+   (MRT: the engine pass runs inside, after fogvol_mrt_prepare). */
+static fogvol_result fog_frame(fogs *F, int t, const scene *s, const view *vw, const rt *r, float *debug,
+                               fogvol_frame_stats *st)
+{
+    fogvol_context *c = F->ctx[t];
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_result res;
+    int i, mrt = g_tiers[t].tier == FOGVOL_TIER_MRT, ed = (g_tiers[t].variants & FOGVOL_VARIANT_ENGINE_DEPTH) != 0;
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, vw->v, sizeof fd.view);
+    memcpy(fd.projection, vw->p, sizeof fd.projection);
+    fd.znear = s->znear;
+    fd.zfar = s->zfar;
+    fd.viewport[2] = r->w;
+    fd.viewport[3] = r->h;
+    fd.debug_thickness = debug;
+    fd.engine_depth_texture = ed ? r->eng_depth : 0;
+    glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
+    if ((res = fogvol_begin_frame(c, &fd)) != FOGVOL_SUCCESS) return res;
+    if (mrt) {
+        fogvol_mrt_info mi;
+        double t0;
+        if ((res = fogvol_mrt_prepare(c, &mi)) != FOGVOL_SUCCESS) return res;
+        if (g_pt.on) glFinish();
+        t0 = now_ms();
+        engine_pass(s, vw, r, &mi);
+        if (g_pt.on) {
+            glFinish();
+            g_pt.engine_ms = now_ms() - t0;
+        }
+    }
+    memset(&vd, 0, sizeof vd);
+    vd.ramp = F->ramp[t];
+    for (i = 0; i < s->n; ++i) {
+        const inst *in = &s->in[i];
+        if (in->occluder) {
+            if (!mrt && !ed) fogvol_add_occluder(c, s->mesh[in->mesh].fm[t], in->model);
+            continue;
+        }
+        vd.mesh = s->mesh[in->mesh].fm[t];
+        memcpy(vd.model, in->model, sizeof vd.model);
+        fogvol_add_volume(c, &vd);
+    }
+    return fogvol_end_frame(c, st);
+}
+
+/* the floor: volume triangles once, constant colour, additive, + one full-screen composite */
+static void floor_frame(const scene *s, const view *vw, const rt *r)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, r->floor_fbo);
+    glViewport(0, 0, r->w, r->h);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUseProgram(P.cnst);
+    draw_insts(s, vw, P.cnst, 0);
+    if (g_pt.on) {
+        glFinish();
+        g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
+        g_pt.t0 = now_ms();
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(P.floor_comp);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r->floor_tex);
+    glUniform1i(glGetUniformLocation(P.floor_comp, "s"), 0);
+    glBindVertexArray(P.empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glUseProgram(0);
+    if (g_pt.on) {
+        glFinish();
+        g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
+    }
+}
+
+static void bind_tex(int unit, GLuint t)
+{
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D, t);
+}
+
+/* Depth peeling; returns the number of layers found (geometry passes = layers + 1). */
+static int peel_frame(const scene *s, const view *vw, const rt *r)
+{
+    static const float zero[4] = {0, 0, 0, 0};
+    GLint u_first = glGetUniformLocation(P.peel, "first");
+    int k;
+    /* opaque pre-pass: linear depth d of the nearest opaque surface (1 = none) */
+    glBindFramebuffer(GL_FRAMEBUFFER, r->po_fbo);
+    glViewport(0, 0, r->w, r->h);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glClearColor(1, 1, 1, 1);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(P.lindepth);
+    draw_insts(s, vw, P.lindepth, 1);
+    /* layers */
+    glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[0]);
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[1]);
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glUseProgram(P.peel);
+    glUniform1i(glGetUniformLocation(P.peel, "prevc"), 0);
+    glUniform1i(glGetUniformLocation(P.peel, "prevz"), 1);
+    glUniform1i(glGetUniformLocation(P.peel, "opq"), 2);
+    glUniform1f(glGetUniformLocation(P.peel, "eps"), 1e-7f);
+    bind_tex(2, r->po_tex);
+    for (k = 0; k < MAXLAYERS; ++k) {
+        GLuint any = 0;
+        glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[k & 1]);
+        glClear(GL_DEPTH_BUFFER_BIT); /* a fresh depth buffer per layer */
+        bind_tex(0, r->pc[(k + 1) & 1]);
+        bind_tex(1, r->pz[(k + 1) & 1]);
+        glUniform1f(u_first, k == 0 ? 1.0f : 0.0f);
+        glBeginQuery(GL_ANY_SAMPLES_PASSED, r->query);
+        draw_insts(s, vw, P.peel, 0);
+        glEndQuery(GL_ANY_SAMPLES_PASSED);
+        glGetQueryObjectuiv(r->query, GL_QUERY_RESULT, &any);
+        if (!any) break;
+    }
+    glDisable(GL_DEPTH_TEST);
+    bind_tex(0, 0);
+    bind_tex(1, 0);
+    bind_tex(2, 0);
+    /* composite: the target with the higher layer count holds the whole sum */
+    glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(P.peel_comp);
+    glUniform1i(glGetUniformLocation(P.peel_comp, "a"), 0);
+    glUniform1i(glGetUniformLocation(P.peel_comp, "b"), 1);
+    glUniform4f(glGetUniformLocation(P.peel_comp, "fog"), 0.8f, 0.8f, 0.8f, 0.5f);
+    glUniform1f(glGetUniformLocation(P.peel_comp, "range"), s->zfar - s->znear);
+    bind_tex(0, r->pc[0]);
+    bind_tex(1, r->pc[1]);
+    glBindVertexArray(P.empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    bind_tex(0, 0);
+    bind_tex(1, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glDisable(GL_BLEND);
+    glUseProgram(0);
+    return k;
+}
+
+/* peeled thickness (world units) and layer count per pixel, rows bottom to top */
+static void peel_read(const scene *s, const rt *r, float *thick, int *count)
+{
+    size_t n = (size_t)r->w * r->h, i;
+    float *a = (float *)malloc(n * 2 * sizeof(float)), *b = (float *)malloc(n * 2 * sizeof(float));
+    if (!a || !b) die("out of memory");
+    glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[0]);
+    glReadPixels(0, 0, r->w, r->h, GL_RG, GL_FLOAT, a);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[1]);
+    glReadPixels(0, 0, r->w, r->h, GL_RG, GL_FLOAT, b);
+    for (i = 0; i < n; ++i) {
+        const float *x = a[2 * i + 1] > b[2 * i + 1] ? a + 2 * i : b + 2 * i;
+        thick[i] = x[0] * (s->zfar - s->znear);
+        count[i] = (int)(x[1] + 0.5f);
+    }
+    free(a);
+    free(b);
+}
+
+/* ---- uploading a scene ----------------------------------------------------------- */
+static void scene_upload(scene *s, fogs *F)
+{
+    int i, t;
+    for (i = 0; i < s->nmesh; ++i) {
+        gmesh *g = &s->mesh[i];
+        int occ = 0, j;
+        fogvol_mesh_desc md;
+        for (j = 0; j < s->n; ++j) occ |= s->in[j].mesh == i && s->in[j].occluder;
+        glGenVertexArrays(1, &g->vao);
+        glBindVertexArray(g->vao);
+        glGenBuffers(1, &g->vbo);
+        glGenBuffers(1, &g->ibo);
+        glBindBuffer(GL_ARRAY_BUFFER, g->vbo);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)g->m.vcount), g->m.pos, GL_STATIC_DRAW);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+        glEnableVertexAttribArray(0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ibo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)g->m.icount), g->m.idx, GL_STATIC_DRAW);
+        glBindVertexArray(0);
+        memset(&md, 0, sizeof md);
+        md.positions = g->m.pos;
+        md.vertex_count = g->m.vcount;
+        md.indices = (const uint32_t *)g->m.idx;
+        md.index_count = g->m.icount;
+        md.allow_open = occ;
+        for (t = 0; t < NTIER; ++t)
+            if (fogvol_create_mesh(F->ctx[t], &md, &g->fm[t], NULL) != FOGVOL_SUCCESS) die("fogvol_create_mesh");
+    }
+}
+
+static void scene_free(scene *s, fogs *F)
+{
+    int i, t;
+    for (i = 0; i < s->nmesh; ++i) {
+        gmesh *g = &s->mesh[i];
+        for (t = 0; t < NTIER; ++t) fogvol_destroy_mesh(F->ctx[t], g->fm[t]);
+        glDeleteVertexArrays(1, &g->vao);
+        glDeleteBuffers(1, &g->vbo);
+        glDeleteBuffers(1, &g->ibo);
+        shp_free(&g->m);
+    }
+}
+
+/* ---- results ------------------------------------------------------------------- */
+typedef struct result {
+    char scene[48];
+    int w, h, k, triangles;
+    double ms[NMETH];      /* median fog ms per frame */
+    double first_ms[NMETH];/* first frame (shader JIT in llvmpipe) */
+    int passes[NMETH];
+    int layers;            /* peeling */
+    long fogged;           /* pixels with nonzero thickness */
+    double dmax[NTIER], dmean[NTIER]; /* vs peeling: LSB (RGBA8) or world units (FLOAT) */
+    long dn[NTIER];
+    int overflow[NTIER];
+    int frames;
+    /* breakdown (glFinish around every pass; medians): per-pass ms, whole frame, plain engine pass */
+    int bd, bd_np[NMETH];
+    double bd_ms[NMETH][MAXPASS], bd_frame[NMETH], engine_ms, bd_engine_mrt;
+    double cpu_us[NTIER]; /* fogvol_begin_frame .. fogvol_end_frame on the null backend */
+} result;
+
+static result g_res[2 * MAXSCENE];
+static int g_nres;
+
+/* compare fogvol's debug thickness with the peeled one over non-silhouette pixels */
+static void compare(const rt *r, const float *fv, const float *pt, const int *pc, double unit, double *dmax,
+                    double *dmean, long *dn)
+{
+    int x, y, dx, dy;
+    double sum = 0, mx = 0;
+    long n = 0;
+    for (y = 1; y < r->h - 1; ++y)
+        for (x = 1; x < r->w - 1; ++x) {
+            int i = y * r->w + x, same = 1;
+            double e;
+            if (fv[i] == 0.0f || pt[i] == 0.0f) continue;
+            for (dy = -1; dy <= 1 && same; ++dy)
+                for (dx = -1; dx <= 1; ++dx) same &= pc[i + dy * r->w + dx] == pc[i];
+            if (!same) continue;
+            e = fabs((double)fv[i] - pt[i]) / unit;
+            sum += e;
+            if (e > mx) mx = e;
+            ++n;
+        }
+    *dmax = mx;
+    *dmean = n ? sum / n : 0;
+    *dn = n;
+}
+
+/* fogvol's own CPU cost per frame: the same frame on the recording null backend */
+static uintptr_t null_native(void *u, fogvol_handle h)
+{
+    (void)u;
+    return (uintptr_t)h;
+}
+
+static double null_frame_us(const scene *s, int t, int w, int h)
+{
+    enum { NR = 41 };
+    fogvol_null_backend nb;
+    fogvol_context_desc cd;
+    fogvol_context *c;
+    fogvol_mesh *fm[MAXMESH];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_mrt_info mi;
+    view vw;
+    double v[NR];
+    int i, rep;
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&nb, &cd.backend);
+    cd.backend.caps |= FOGVOL_CAP_FLOAT_BLEND;
+    cd.backend.native_texture = null_native;
+    cd.tier = g_tiers[t].tier;
+    cd.variants = g_tiers[t].variants;
+    cd.engine_mrt = 1;
+    if (fogvol_create_context(&cd, &c) != FOGVOL_SUCCESS) die("null context");
+    for (i = 0; i < s->nmesh; ++i) {
+        fogvol_mesh_desc md;
+        memset(&md, 0, sizeof md);
+        md.positions = s->mesh[i].m.pos;
+        md.vertex_count = s->mesh[i].m.vcount;
+        md.indices = (const uint32_t *)s->mesh[i].m.idx;
+        md.index_count = s->mesh[i].m.icount;
+        md.allow_open = 1;
+        if (fogvol_create_mesh(c, &md, &fm[i], NULL) != FOGVOL_SUCCESS) die("null mesh");
+    }
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.5f;
+    if (fogvol_create_ramp(c, &rd, &ramp) != FOGVOL_SUCCESS) die("null ramp");
+    make_view(&vw, s, w, h);
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, vw.v, sizeof fd.view);
+    memcpy(fd.projection, vw.p, sizeof fd.projection);
+    fd.znear = s->znear;
+    fd.zfar = s->zfar;
+    fd.viewport[2] = w;
+    fd.viewport[3] = h;
+    fd.engine_depth_texture = 1;
+    memset(&vd, 0, sizeof vd);
+    vd.ramp = ramp;
+    for (rep = 0; rep < NR; ++rep) {
+        double t0 = now_ms();
+        fogvol_begin_frame(c, &fd);
+        if (g_tiers[t].tier == FOGVOL_TIER_MRT) fogvol_mrt_prepare(c, &mi);
+        for (i = 0; i < s->n; ++i) {
+            if (s->in[i].occluder) {
+                fogvol_add_occluder(c, fm[s->in[i].mesh], s->in[i].model);
+                continue;
+            }
+            vd.mesh = fm[s->in[i].mesh];
+            memcpy(vd.model, s->in[i].model, sizeof vd.model);
+            fogvol_add_volume(c, &vd);
+        }
+        if (fogvol_end_frame(c, NULL) != FOGVOL_SUCCESS) die("null frame");
+        v[rep] = (now_ms() - t0) * 1e3;
+    }
+    for (i = 0; i < s->nmesh; ++i) fogvol_destroy_mesh(c, fm[i]);
+    fogvol_destroy_ramp(c, ramp);
+    fogvol_destroy_context(c);
+    return median(v, NR);
+}
+
+/* ---- one scene at one resolution ------------------------------------------------- */
+static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, result *res)
+{
+    rt r;
+    view vw;
+    double t[NMETH][512], te[512];
+    int ne = 0, it, mi, i, nt[NMETH];
+    size_t npx = (size_t)w * h;
+    float *dbg[NTIER], *pt = (float *)malloc(npx * sizeof(float));
+    int *pc = (int *)malloc(npx * sizeof(int));
+    fogvol_frame_stats st;
+    if (frames > 512) frames = 512;
+    i = res->bd;
+    memset(res, 0, sizeof *res);
+    res->bd = i;
+    memset(nt, 0, sizeof nt);
+    snprintf(res->scene, sizeof res->scene, "%s", s->name);
+    res->w = w;
+    res->h = h;
+    res->k = s->k;
+    res->triangles = s->triangles;
+    res->frames = frames;
+    rt_create(&r, w, h);
+    make_view(&vw, s, w, h);
+    for (i = 0; i < NTIER; ++i) res->cpu_us[i] = null_frame_us(s, i, w, h);
+
+    /* first frame of every method (llvmpipe compiles shader variants on first use) */
+    for (i = 0; i < NMETH; ++i) {
+        double t0;
+        if (i >= NTIER || g_tiers[i].tier != FOGVOL_TIER_MRT) engine_pass(s, &vw, &r, NULL);
+        glFinish();
+        t0 = now_ms();
+        if (i < NTIER) fog_frame(F, i, s, &vw, &r, NULL, &st);
+        else if (i == M_FLOOR) floor_frame(s, &vw, &r);
+        else peel_frame(s, &vw, &r);
+        glFinish();
+        res->first_ms[i] = now_ms() - t0;
+    }
+
+    /* debug frames: thickness of every tier and of the peeling, fogged pixels */
+    for (i = 0; i < NTIER; ++i) {
+        fogvol_result fr;
+        dbg[i] = (float *)calloc(npx, sizeof(float));
+        if (!dbg[i]) die("out of memory");
+        if (g_tiers[i].tier != FOGVOL_TIER_MRT) engine_pass(s, &vw, &r, NULL);
+        fr = fog_frame(F, i, s, &vw, &r, dbg[i], &st);
+        if (fr != FOGVOL_SUCCESS && fr != FOGVOL_ERROR_DEPTH_OVERFLOW) die(fogvol_result_string(fr));
+        res->overflow[i] = st.overflow_pixels;
+    }
+    engine_pass(s, &vw, &r, NULL);
+    res->layers = peel_frame(s, &vw, &r);
+    peel_read(s, &r, pt, pc);
+    for (i = 0; i < (int)npx; ++i) res->fogged += dbg[3][i] != 0.0f;
+    for (i = 0; i < NTIER; ++i) {
+        double unit;
+        if (g_tiers[i].tier == FOGVOL_TIER_FLOAT) {
+            unit = 1.0;
+        } else {
+            fogvol_constants k;
+            fogvol_compute_constants(fogvol_context_encoding(F->ctx[i]), s->znear, s->zfar, 0.0f, &k);
+            unit = k.lsb;
+        }
+        compare(&r, dbg[i], pt, pc, unit, &res->dmax[i], &res->dmean[i], &res->dn[i]);
+        free(dbg[i]);
+    }
+
+    /* timed frames, interleaved: every iteration runs every method once, in rotating order */
+    for (it = 0; it < warm + frames; ++it) {
+        for (mi = 0; mi < NMETH; ++mi) {
+            int m = (mi + it) % NMETH, mrt = m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT;
+            double t0, t1, e0 = 0, e1 = 0;
+            int passes = 0;
+            if (!mrt) {
+                glFinish();
+                e0 = now_ms();
+                engine_pass(s, &vw, &r, NULL);
+            }
+            glFinish();
+            t0 = now_ms();
+            e1 = t0;
+            if (m < NTIER) {
+                fogvol_result fr = fog_frame(F, m, s, &vw, &r, NULL, &st);
+                if (fr != FOGVOL_SUCCESS) die(fogvol_result_string(fr));
+                passes = st.passes;
+            } else if (m == M_FLOOR) {
+                floor_frame(s, &vw, &r);
+                passes = 2;
+            } else {
+                passes = 1 + peel_frame(s, &vw, &r) + 1 + 1;
+            }
+            glFinish();
+            t1 = now_ms();
+            res->passes[m] = passes;
+            if (it >= warm) {
+                t[m][nt[m]++] = t1 - t0;
+                if (!mrt) te[ne++] = e1 - e0;
+            }
+        }
+    }
+    {
+        double eng = median(te, ne);
+        int m;
+        for (m = 0; m < NMETH; ++m) {
+            if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) /* the engine pass writes O: count what it adds */
+                for (i = 0; i < nt[m]; ++i) t[m][i] -= eng;
+            res->ms[m] = median(t[m], nt[m]);
+        }
+    }
+    if (res->bd) { /* where the time goes: every pass bracketed by glFinish */
+        enum { NB = 7 };
+        double bt[NMETH][MAXPASS][NB], bf[NMETH][NB], be[NB];
+        int m, b, p;
+        res->engine_ms = median(te, ne);
+        for (b = 0; b < NB; ++b)
+            for (m = 0; m <= M_FLOOR; ++m) {
+                double t0;
+                if (m >= NTIER || g_tiers[m].tier != FOGVOL_TIER_MRT) engine_pass(s, &vw, &r, NULL);
+                memset(g_pt.ms, 0, sizeof g_pt.ms);
+                g_pt.pass = 0;
+                g_pt.on = 1;
+                glFinish();
+                t0 = g_pt.t0 = now_ms();
+                if (m < NTIER) fog_frame(F, m, s, &vw, &r, NULL, &st);
+                else floor_frame(s, &vw, &r);
+                glFinish();
+                bf[m][b] = now_ms() - t0;
+                g_pt.on = 0;
+                res->bd_np[m] = g_pt.pass;
+                for (p = 0; p < MAXPASS; ++p) bt[m][p][b] = g_pt.ms[p];
+                if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) be[b] = g_pt.engine_ms;
+            }
+        for (m = 0; m <= M_FLOOR; ++m) {
+            res->bd_frame[m] = median(bf[m], NB);
+            for (p = 0; p < MAXPASS; ++p) res->bd_ms[m][p] = median(bt[m][p], NB);
+        }
+        res->bd_engine_mrt = median(be, NB);
+    }
+    if (glGetError() != GL_NO_ERROR) die("GL error");
+    rt_free(&r);
+    free(pt);
+    free(pc);
+}
+
+/* ---- CPU figures ------------------------------------------------------------------ */
+typedef struct cpu_figs {
+    double rg_us, blue_us, color_us;
+    int rg_w, rg_h, blue_w, blue_h, color_w;
+    double validate_ms, validate_mtris;
+    int validate_tris;
+    double create_ms[NTIER];
+} cpu_figs;
+
+static double time_ramp(int which, const fogvol_encoding *e, unsigned char *buf, size_t cap, int reps,
+                        fogvol_image *info)
+{
+    double v[15];
+    int r, i;
+    fogvol_ramp_desc rd;
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = 0.5f;
+    for (r = 0; r < 15; ++r) {
+        double t0 = now_ms();
+        for (i = 0; i < reps; ++i) {
+            fogvol_result fr = which == 0   ? fogvol_make_rg_ramp(e, buf, cap, info)
+                               : which == 1 ? fogvol_make_blue_ramp(e, buf, cap, info)
+                                            : fogvol_make_color_ramp(&rd, buf, cap, info, NULL);
+            if (fr != FOGVOL_SUCCESS) die("ramp");
+        }
+        v[r] = (now_ms() - t0) * 1e3 / reps;
+    }
+    return median(v, 15);
+}
+
+static void cpu_measure(cpu_figs *c, int quick)
+{
+    fogvol_encoding e;
+    fogvol_image info;
+    static unsigned char buf[1 << 20];
+    shp_mesh big = quick ? shp_sphere(1.0f, 128, 64) : shp_sphere(1.0f, 512, 256);
+    fogvol_mesh_desc md;
+    fogvol_mesh_report rep;
+    double v[7];
+    int i, reps = quick ? 3 : 7;
+    fogvol_encoding_init(&e, FOGVOL_DEFAULT_BITS);
+    c->rg_us = time_ramp(0, &e, buf, sizeof buf, 200, &info);
+    c->rg_w = info.width;
+    c->rg_h = info.height;
+    c->blue_us = time_ramp(1, &e, buf, sizeof buf, 50, &info);
+    c->blue_w = info.width;
+    c->blue_h = info.height;
+    c->color_us = time_ramp(2, &e, buf, sizeof buf, 200, &info);
+    c->color_w = info.width;
+    memset(&md, 0, sizeof md);
+    md.positions = big.pos;
+    md.vertex_count = big.vcount;
+    md.indices = (const uint32_t *)big.idx;
+    md.index_count = big.icount;
+    for (i = 0; i < reps; ++i) {
+        double t0 = now_ms();
+        if (fogvol_validate_mesh(&md, NULL, &rep) != FOGVOL_SUCCESS) die("validate");
+        v[i] = now_ms() - t0;
+    }
+    c->validate_tris = big.icount / 3;
+    c->validate_ms = median(v, reps);
+    c->validate_mtris = c->validate_tris / c->validate_ms / 1e3;
+    shp_free(&big);
+}
+
+/* the GL backend (wrapped by the pass timer) + fogvol_create_context, timed together */
+static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
+{
+    fogvol_context_desc cd;
+    fogvol_context *c = NULL;
+    double t0;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = fv_log;
+    cd.tier = g_tiers[t].tier;
+    cd.variants = g_tiers[t].variants;
+    cd.engine_mrt = g_tiers[t].tier == FOGVOL_TIER_MRT;
+    glFinish();
+    t0 = now_ms();
+    if (fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, be) != FOGVOL_SUCCESS) die("fogvol_gl_backend_create");
+    g_pt.begin_pass = be->begin_pass;
+    g_pt.end_pass = be->end_pass;
+    be->begin_pass = pt_begin_pass;
+    be->end_pass = pt_end_pass;
+    cd.backend = *be;
+    if (fogvol_create_context(&cd, &c) != FOGVOL_SUCCESS) die("fogvol_create_context");
+    glFinish();
+    *ms = now_ms() - t0;
+    return c;
+}
+
+static void destroy_tier(fogvol_context *c, fogvol_backend *be)
+{
+    fogvol_destroy_context(c);
+    be->destroy(be->user_data); /* a table handed in is not owned by the context */
+}
+
+/* ---- plot: cost against depth complexity, drawn into an RGBA buffer ---------------- */
+typedef struct canvas {
+    unsigned char *px;
+    int w, h;
+} canvas;
+
+static void fill(canvas *c, int x0, int y0, int x1, int y1, const unsigned char *rgb)
+{
+    int x, y;
+    for (y = y0 < 0 ? 0 : y0; y < y1 && y < c->h; ++y)
+        for (x = x0 < 0 ? 0 : x0; x < x1 && x < c->w; ++x) memcpy(c->px + 4 * ((size_t)y * c->w + x), rgb, 3);
+}
+
+static void line(canvas *c, double x0, double y0, double x1, double y1, int th, const unsigned char *rgb, int dash)
+{
+    double len = sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)), s;
+    for (s = 0; s <= len; s += 0.5) {
+        int x = (int)(x0 + (x1 - x0) * s / (len + 1e-9)), y = (int)(y0 + (y1 - y0) * s / (len + 1e-9));
+        if (dash && ((int)s / dash) % 2) continue;
+        fill(c, x - th / 2, y - th / 2, x - th / 2 + th, y - th / 2 + th, rgb);
+    }
+}
+
+static void text(canvas *c, int x, int y, const char *str, int scale, const unsigned char *rgb)
+{
+    static char vb[60000];
+    char s[256];
+    int q, n;
+    snprintf(s, sizeof s, "%s", str);
+    n = stb_easy_font_print(0, 0, s, NULL, vb, sizeof vb);
+    for (q = 0; q < n; ++q) {
+        const float *v0 = (const float *)(void *)(vb + 64 * q), *v2 = (const float *)(void *)(vb + 64 * q + 32);
+        fill(c, x + (int)(v0[0] * scale), y + (int)(v0[1] * scale), x + (int)(v2[0] * scale), y + (int)(v2[1] * scale),
+             rgb);
+    }
+}
+
+static int text_w(const char *str, int scale)
+{
+    char s[256];
+    snprintf(s, sizeof s, "%s", str);
+    return stb_easy_font_width(s) * scale + 0 * stb_easy_font_height(s); /* both used: -Werror=unused-function */
+}
+
+/* 1-2-5 steps: the largest step value <= v (up = 0) or the smallest >= v (up = 1) */
+static double step125(double v, int up)
+{
+    static const double f[4] = {1, 2, 5, 10};
+    double e = pow(10.0, floor(log10(v))), r = up ? 10 * e : e;
+    int j;
+    for (j = 0; j < 4; ++j) {
+        double x = f[j] * e;
+        if (up ? x >= v * (1 - 1e-9) && x < r : x <= v * (1 + 1e-9)) r = x;
+    }
+    return r;
+}
+
+static void plot(const char *path, const result *rs, int n, int w, int h)
+{
+    static const unsigned char col[NMETH][3] = {{214, 39, 40}, {255, 127, 14}, {148, 103, 189}, {31, 119, 180},
+                                                {23, 190, 207}, {60, 60, 60}, {44, 160, 44}};
+    static const unsigned char black[3] = {0, 0, 0}, grid[3] = {225, 225, 225};
+    static const char *xlabel = "depth complexity k (back faces per ray at the centre, log2 scale)";
+    canvas c;
+    const result *pts[8];
+    int np = 0, i, m, L = 80, R = 40, T = 80, B = 130, lx, ly;
+    double lo = 1e30, hi = 0, v, k0, k1;
+    char s[160];
+    c.w = 1000;
+    c.h = 680;
+    c.px = (unsigned char *)malloc((size_t)c.w * c.h * 4);
+    if (!c.px) die("out of memory");
+    memset(c.px, 255, (size_t)c.w * c.h * 4);
+    for (i = 0; i < n && np < 8; ++i)
+        if (rs[i].k > 0 && rs[i].w == w && rs[i].h == h) pts[np++] = &rs[i];
+    for (i = 0; i < np; ++i)
+        for (m = 0; m < NMETH; ++m) {
+            if (pts[i]->ms[m] > 0 && pts[i]->ms[m] < lo) lo = pts[i]->ms[m];
+            if (pts[i]->ms[m] > hi) hi = pts[i]->ms[m];
+        }
+    if (np < 2 || !(lo > 0)) {
+        free(c.px);
+        return;
+    }
+    lo = step125(lo, 0);
+    hi = step125(hi, 1);
+    k0 = log2((double)pts[0]->k);
+    k1 = log2((double)pts[np - 1]->k);
+#define PX(kk) (L + (log2((double)(kk)) - k0) / (k1 - k0) * (c.w - L - R))
+#define PY(v) (c.h - B - log10((v) / lo) / log10(hi / lo) * (c.h - T - B))
+    stb_easy_font_spacing(0.5f);
+    for (v = lo; v <= hi * 1.0001; v = step125(v * 1.01, 1)) { /* grid and y labels, 1-2-5 */
+        line(&c, L, PY(v), c.w - R, PY(v), 1, grid, 0);
+        snprintf(s, sizeof s, v < 1 ? "%.1f" : "%.0f", v);
+        text(&c, L - 10 - text_w(s, 2), (int)PY(v) - 6, s, 2, black);
+    }
+    for (i = 0; i < np; ++i) { /* x ticks at the measured k */
+        line(&c, PX(pts[i]->k), T, PX(pts[i]->k), c.h - B, 1, grid, 0);
+        snprintf(s, sizeof s, "%d", pts[i]->k);
+        text(&c, (int)PX(pts[i]->k) - text_w(s, 2) / 2, c.h - B + 10, s, 2, black);
+    }
+    line(&c, L, T, L, c.h - B, 2, black, 0);
+    line(&c, L, c.h - B, c.w - R, c.h - B, 2, black, 0);
+    snprintf(s, sizeof s, "fogvol.h: fog cost vs depth complexity (nested shells, %dx%d, llvmpipe)", w, h);
+    text(&c, c.w / 2 - text_w(s, 2) / 2, 16, s, 2, black);
+    text(&c, L - 60, T - 30, "ms per frame (median, log scale)", 2, black);
+    text(&c, L + (c.w - L - R) / 2 - text_w(xlabel, 2) / 2, c.h - B + 38, xlabel, 2, black);
+    for (m = 0; m < NMETH; ++m) {
+        int dash = m == M_FLOOR ? 8 : 0;
+        for (i = 0; i < np; ++i) {
+            double x = PX(pts[i]->k), y = PY(pts[i]->ms[m]);
+            if (i) line(&c, PX(pts[i - 1]->k), PY(pts[i - 1]->ms[m]), x, y, 3, col[m], dash);
+            fill(&c, (int)x - 5, (int)y - 5, (int)x + 6, (int)y + 6, col[m]);
+        }
+    }
+    lx = L; /* legend below the axes, flowing */
+    ly = c.h - 58;
+    for (m = 0; m < NMETH; ++m) {
+        int tw;
+        snprintf(s, sizeof s, "%s", m < NTIER ? g_meth_names[m] : m == M_FLOOR ? "floor (1 geometry + 1 full-screen pass)"
+                                                                                 : "depth peeling (exact)");
+        tw = text_w(s, 2);
+        if (lx + 50 + tw > c.w - 10) {
+            lx = L;
+            ly += 26;
+        }
+        line(&c, lx, ly + 6, lx + 40, ly + 6, 3, col[m], m == M_FLOOR ? 8 : 0);
+        fill(&c, lx + 15, ly + 1, lx + 26, ly + 12, col[m]);
+        text(&c, lx + 48, ly, s, 2, black);
+        lx += 48 + tw + 28;
+    }
+    stbi_flip_vertically_on_write(0);
+    if (!stbi_write_png(path, c.w, c.h, 4, c.px, c.w * 4)) fprintf(stderr, "bench: cannot write %s\n", path);
+#undef PX
+#undef PY
+    free(c.px);
+}
+
+/* ---- tables ------------------------------------------------------------------------ */
+/* CPU model and count from /proc/cpuinfo (Linux) */
+static void cpu_info(char *model, size_t cap, int *count)
+{
+    char line[512];
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    *count = 0;
+    snprintf(model, cap, "unknown CPU");
+    if (!f) return;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "model name", 10) == 0) {
+            char *p = strchr(line, ':');
+            if (p && *count == 0) {
+                snprintf(model, cap, "%s", p + 2);
+                model[strcspn(model, "\n")] = 0;
+            }
+            ++*count;
+        }
+    fclose(f);
+}
+
+static void loadavg(char *buf, size_t cap)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    snprintf(buf, cap, "?");
+    if (f) {
+        if (fgets(buf, (int)cap, f)) buf[strcspn(buf, " ")] = 0; /* the 1-minute average */
+        fclose(f);
+    }
+}
+
+static const char *pf(int ok) { return ok ? "PASS" : "MISS"; }
+
+static void print_results(const result *rs, int n)
+{
+    int i, m;
+    out("| scene | size | method | passes | ms/frame | x floor | ours/peel | fog Mpx/s | vs peeling: max / mean | "
+        "targets |\n|---|---|---|---:|---:|---:|---:|---:|---|---|\n");
+    for (i = 0; i < n; ++i) {
+        const result *r = &rs[i];
+        for (m = 0; m < NMETH; ++m) {
+            char tgt[96] = "", diff[64] = "", ratio[32] = "", xf[32] = "";
+            double floor_ms = r->ms[M_FLOOR];
+            if (m < NTIER) {
+                int is_float = g_tiers[m].tier == FOGVOL_TIER_FLOAT;
+                double lim = is_float ? 1.3 : 2.0;
+                snprintf(tgt, sizeof tgt, "<=%.1fx floor %s", lim, pf(r->ms[m] <= lim * floor_ms));
+                if (r->k == 8)
+                    snprintf(tgt + strlen(tgt), sizeof tgt - strlen(tgt), "; >=5x faster than peeling %s",
+                             pf(r->ms[m] * 5.0 <= r->ms[M_PEEL]));
+                snprintf(diff, sizeof diff, is_float ? "%.2g / %.2g units" : "%.2f / %.3f LSB", r->dmax[m], r->dmean[m]);
+                if (r->overflow[m]) snprintf(diff + strlen(diff), sizeof diff - strlen(diff), " (%d ovf)", r->overflow[m]);
+                snprintf(ratio, sizeof ratio, "%.3f", r->ms[m] / r->ms[M_PEEL]);
+                snprintf(xf, sizeof xf, "%.2f", r->ms[m] / floor_ms);
+            } else if (m == M_PEEL) {
+                snprintf(xf, sizeof xf, "%.2f", r->ms[m] / floor_ms);
+                snprintf(diff, sizeof diff, "(%d layers)", r->layers);
+            } else {
+                snprintf(xf, sizeof xf, "1");
+            }
+            out("| %s | %dx%d | %s | %d | %.2f | %s | %s | %.1f | %s | %s |\n", m == 0 ? r->scene : "", r->w, r->h,
+                g_meth_names[m], r->passes[m], r->ms[m], xf, ratio, r->fogged / r->ms[m] / 1e3, diff, tgt);
+        }
+    }
+}
+
+static void print_breakdown(const result *rs, int n)
+{
+    static const char *const pn[NMETH - 1][5] = {{"O", "B", "F", "resolve", "composite"},
+                                                 {"O", "B", "F", "composite", ""},
+                                                 {"B", "F", "composite", "", ""},
+                                                 {"O", "B-F", "composite", "", ""},
+                                                 {"B-F", "composite", "", "", ""},
+                                                 {"geometry", "composite", "", "", ""}};
+    int i, m, p;
+    out("\n### Where the time goes (1280x720; every pass bracketed by glFinish, medians of 7 frames)\n\n"
+        "Passes serialised by glFinish, so the frame is slower than in the main table (no overlap of vertex work "
+        "on the calling thread with the rasteriser threads). outside = frame - passes: fogvol's CPU work, GL state "
+        "save/restore and the calls between passes. CPU (null): the same frame on fogvol's recording null backend "
+        "(the library's own CPU cost).\n\n| scene | method | passes (ms) | sum | frame | outside | CPU (null) |\n"
+        "|---|---|---|---:|---:|---:|---:|\n");
+    for (i = 0; i < n; ++i) {
+        const result *r = &rs[i];
+        if (!r->bd) continue;
+        for (m = 0; m <= M_FLOOR; ++m) {
+            char cells[256] = "";
+            double sum = 0;
+            if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) {
+                snprintf(cells, sizeof cells, "engine pass writing O %.2f (plain engine pass %.2f), ", r->bd_engine_mrt,
+                         r->engine_ms);
+                sum += r->bd_engine_mrt - r->engine_ms;
+            }
+            for (p = 0; p < r->bd_np[m] && p < 5; ++p) {
+                snprintf(cells + strlen(cells), sizeof cells - strlen(cells), "%s%s %.2f", p ? ", " : "", pn[m][p],
+                         r->bd_ms[m][p]);
+                sum += r->bd_ms[m][p];
+            }
+            if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) {
+                out("| %s | %s | %s | %.2f | %.2f | %.2f | %.1f us |\n", m ? "" : r->scene, g_meth_names[m], cells, sum,
+                    r->bd_frame[m] - r->engine_ms, r->bd_frame[m] - r->engine_ms - sum, r->cpu_us[m]);
+            } else {
+                char cpu[32] = "-";
+                if (m < NTIER) snprintf(cpu, sizeof cpu, "%.1f us", r->cpu_us[m]);
+                out("| %s | %s | %s | %.2f | %.2f | %.2f | %s |\n", m ? "" : r->scene, g_meth_names[m], cells, sum,
+                    r->bd_frame[m], r->bd_frame[m] - sum, cpu);
+            }
+        }
+    }
+}
+
+static void print_summary(const result *rs, int n)
+{
+    int i, m, s;
+    static const int sizes[2][2] = {{1280, 720}, {640, 360}};
+    out("\n### Targets (worst scene per tier and size)\n\n| tier | size | worst x floor (scene) | target | "
+        "k=8: ours/peel | target |\n|---|---|---|---|---:|---|\n");
+    for (s = 0; s < 2; ++s)
+        for (m = 0; m < NTIER; ++m) {
+            double worst = 0, k8 = -1, lim = g_tiers[m].tier == FOGVOL_TIER_FLOAT ? 1.3 : 2.0;
+            const char *ws = "";
+            int any = 0;
+            for (i = 0; i < n; ++i) {
+                const result *r = &rs[i];
+                if (r->w != sizes[s][0]) continue;
+                any = 1;
+                if (r->ms[m] / r->ms[M_FLOOR] > worst) {
+                    worst = r->ms[m] / r->ms[M_FLOOR];
+                    ws = r->scene;
+                }
+                if (r->k == 8) k8 = r->ms[m] / r->ms[M_PEEL];
+            }
+            if (!any) continue;
+            if (k8 >= 0)
+                out("| %s | %dx%d | %.2f (%s) | <=%.1f %s | %.3f (%.1fx faster) | <=0.2 %s |\n", g_meth_names[m],
+                    sizes[s][0], sizes[s][1], worst, ws, lim, pf(worst <= lim), k8, 1.0 / k8, pf(k8 <= 0.2));
+            else
+                out("| %s | %dx%d | %.2f (%s) | <=%.1f %s | - | - |\n", g_meth_names[m], sizes[s][0], sizes[s][1],
+                    worst, ws, lim, pf(worst <= lim));
+        }
+}
+
+int main(int argc, char **argv)
+{
+    static const int sizes[2][2] = {{1280, 720}, {640, 360}};
+    int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
+    int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
+    double t_start = now_ms(), v[5];
+    glu_ctx g;
+    fogs F;
+    cpu_figs cpu;
+    struct utsname un;
+    char cpu_model[256], load0[64], load1[64];
+    int ncpu;
+    if (argc > 1 && !quick && (only < 0 || only >= NSCENES)) {
+        fprintf(stderr, "usage: %s [--quick | --scene 0..%d]\n", argv[0], NSCENES - 1);
+        return 2;
+    }
+    /* cold shader compiles for the startup figures (no Mesa disk cache) */
+    setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
+    if (!glu_create(&g, 64, 64, 1)) die("OSMesa context");
+    make_progs();
+    memset(&F, 0, sizeof F);
+    memset(&cpu, 0, sizeof cpu);
+    for (t = 0; t < NTIER; ++t) {
+        int r, reps = quick ? 1 : 5;
+        fogvol_ramp_desc rd;
+        for (r = 0; r < reps; ++r) {
+            fogvol_context *c = create_tier(t, &v[r], &F.be[t]);
+            if (r < reps - 1) destroy_tier(c, &F.be[t]);
+            else F.ctx[t] = c;
+        }
+        cpu.create_ms[t] = median(v, reps);
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+        rd.density = 0.5f;
+        if (fogvol_create_ramp(F.ctx[t], &rd, &F.ramp[t]) != FOGVOL_SUCCESS) die("ramp");
+    }
+    cpu_measure(&cpu, quick);
+    if (!quick && only < 0) {
+        g_md = fopen("bench/RESULTS.md", "w");
+        if (!g_md) die("cannot write bench/RESULTS.md (run from the repository root)");
+    }
+    uname(&un);
+    cpu_info(cpu_model, sizeof cpu_model, &ncpu);
+    loadavg(load0, sizeof load0);
+    out("# fogvol.h benchmark%s\n\nRenderer: %s (%s), %s %s, %d x %s. Fog volumes: extinction ramp, dither on, "
+        "L = 4 (12-bit, 16 faces per target).\n\n",
+        quick ? " (--quick smoke run)" : "", (const char *)glGetString(GL_RENDERER),
+        (const char *)glGetString(GL_VERSION), un.sysname, un.machine, ncpu, cpu_model);
+
+    for (si = quick ? 1 : 0; si < 2; ++si) {
+        int w = sizes[si][0], h = sizes[si][1];
+        for (sc = 0; sc < NSCENES; ++sc) {
+            scene *s = (scene *)calloc(1, sizeof(scene));
+            int frames, warm = quick ? 1 : 3;
+            if ((quick && sc != 2) || (only >= 0 && sc != only)) {
+                free(s);
+                continue;
+            }
+            build_scene(s, sc);
+            scene_upload(s, &F);
+            frames = quick ? 3 : 15;
+            g_res[g_nres].bd = !quick && w > 640;
+            run_scene(&F, s, w, h, warm, frames, &g_res[g_nres]);
+            fprintf(stderr, "  %-24s %4dx%-4d %3d layers  %6.1f s\n", s->name, w, h, g_res[g_nres].layers,
+                    (now_ms() - t_start) / 1e3);
+            g_nres++;
+            scene_free(s, &F);
+            free(s);
+        }
+    }
+    out("## GPU: fog work per frame\n\nMedians over %d interleaved frames per scene after %d warm-up "
+        "frames; glFinish before the clock starts and after fogvol_end_frame. x floor: time / floor time. ours/peel: "
+        "time / depth-peeling time. Mpx/s: pixels with nonzero thickness (FLOAT debug read-back) per second. "
+        "vs peeling: |fogvol debug thickness - peeled thickness| over pixels where both are nonzero and the 3x3 "
+        "neighbourhood has one layer count (no silhouettes); LSB = (far - near) / 4096 for the RGBA8 tiers, world "
+        "units for FLOAT.\n\n",
+        quick ? 3 : 15, quick ? 1 : 3);
+    print_results(g_res, g_nres);
+    print_summary(g_res, g_nres);
+    print_breakdown(g_res, g_nres);
+    out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
+    out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
+    out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
+    out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
+    out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
+        cpu.validate_ms, cpu.validate_mtris);
+    for (t = 0; t < NTIER; ++t)
+        out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
+            g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
+    for (t = 0; t < NMETH; ++t)
+        out("| first frame of %s, %s %dx%d (target allocation + llvmpipe shader JIT) | %.1f ms |\n", g_meth_names[t],
+            g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
+    loadavg(load1, sizeof load1);
+    out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
+        "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
+        (now_ms() - t_start) / 1e3, load0, load1, ncpu);
+    if (g_md) {
+        fclose(g_md);
+        plot("bench/plot.png", g_res, g_nres, 1280, 720);
+    }
+    for (t = 0; t < NTIER; ++t) {
+        fogvol_destroy_ramp(F.ctx[t], F.ramp[t]);
+        destroy_tier(F.ctx[t], &F.be[t]);
+    }
+    glu_destroy(&g);
+    return 0;
+}
