@@ -19,7 +19,7 @@ FUZZ_TIME ?= 60
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all test demo images fuzz run examples bench bench-quick deps-test deps-demo deps-run clean
+.PHONY: all test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean
 
 all: test
 
@@ -64,6 +64,10 @@ $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BU
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c -o $@ -lm
 $(BUILD)/fuzz_mesh: tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
+$(BUILD)/test_analytic: tests/test_analytic.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_analytic_san: tests/test_analytic.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
 
@@ -71,7 +75,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
-            $(BUILD)/demo_headless $(BUILD)/bench
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
 
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory $(TEST_BINS)
@@ -80,6 +84,8 @@ test: deps-test deps-run
 	  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
 	  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
 	  "bench_quick=$(BUILD)/bench --quick" \
+	  "analytic=BUILD=$(BUILD) $(TAP) $(BUILD)/test_analytic" \
+	  "analytic_asan_ubsan=BUILD=$(BUILD) $(TAP) $(LSAN_ENV) $(BUILD)/test_analytic_san" \
 	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
 	  "cpu=$(TAP) $(BUILD)/test_cpu" \
 	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
@@ -131,6 +137,13 @@ bench: deps-demo
 bench-quick: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/bench
 	$(BUILD)/bench --quick
+
+$(BUILD)/bench_analytic: bench/bench_analytic.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ -lm
+
+# analytic fog: vertex x volume evaluations per second, batch against a scalar loop
+bench-analytic: $(BUILD)/bench_analytic
+	$(BUILD)/bench_analytic
 
 # libFuzzer on mesh validation, FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)

@@ -114,9 +114,20 @@
        glDrawBuffers(1, bufs);                             // before fogvol composites
        ... fogvol_add_volume ...; fogvol_end_frame(fv, NULL);
 
+   ANALYTIC FOG VOLUMES (seeds/002, no render passes)
+   ====================
+   Per-vertex or per-pixel fog from distance fog, half-spaces, spheres and
+   affine transforms of the unit sphere, cube and cylinder, each with density
+   and colour; separate volumes front to back or interpenetrating volumes by the
+   seed's sorted event list; linear or exponential law. fogvol_analytic_prepare
+   once, then fogvol_analytic_batch over vertex arrays (no allocation, order
+   carried between frames) or the GLSL of fogvol_analytic_shader_strings with
+   the uniforms of fogvol_analytic_pack_uniforms; fogvol_fold_fog folds fog into
+   diffuse/specular. Details next to the declarations.
+
    SECTIONS (search for the markers)
    ========
-       >>declarations  >>cpu  >>shaders  >>null backend  >>renderer  >>gl backend
+       >>declarations  >>cpu  >>analytic  >>shaders  >>null backend  >>renderer  >>gl backend
 */
 
 #ifndef FOGVOL_H
@@ -484,6 +495,227 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
    engine's precision statements. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
+
+/* ---- analytic fog volumes (seeds/002, JCAB GDC 2001) ---------------------
+   Per-vertex (or per-pixel) fog from simple analytic volumes, without render
+   passes or textures: for every vertex V the ray X = eye + t (V - eye) is cut
+   by each volume into an entry/exit pair t1 <= t2, clamped to [0, 1] (t = 0 at
+   the eye, 1 at the vertex). The distance travelled through a volume is
+   |V - eye| * (t2 - t1) world units. Shapes: classic distance fog, half-space,
+   sphere, and any affine transform of the unit sphere (ellipsoid), of the unit
+   cube [-1,1]^3 (box) and of the unit cylinder (radius 1, |z| <= 1) (the ray is
+   transformed into the unit shape's space; t is the same there).
+
+   Fog factor f: 1 = no fog, 0 = fully fogged; fog colour C: what the fog adds.
+   The fogged colour of a surface is  surface * f + C * (1 - f)  (or fold the
+   two into the vertex colours with fogvol_fold_fog, the seed's trick).
+     FOGVOL_FOG_LINEAR       f = 1 - clamp01(distance * density)  (the seed's law);
+                             several volumes add up: f = 1 - sum, stopped at 0
+     FOGVOL_FOG_EXP          f = exp(-distance * density); transmittances multiply
+     FOGVOL_FOG_LINEAR_SEED  the linear f with the seed's colour formula verbatim
+                             (C = volume colour * f + C * (1 - f), front to back).
+                             It is exact when the ray ends fully fogged but
+                             otherwise over-weights the volumes further back:
+                             two volumes taking a, b of the fog give
+                             C = cb (1 - a) + ca a instead of (ca a + cb b)/(a + b).
+   LINEAR and EXP use the consistent colour: every stretch of fog contributes its
+   colour weighted by how much of the final pixel it covers (1 - f of the stretch
+   times the transmittance in front of it), C = sum(colour * weight) / sum(weight).
+
+   Combination (fogvol_fog_mix):
+     FOGVOL_MIX_SEPARATE         volumes sorted front to back by t1, each taken
+                                 whole (the seed's "several fog volumes"), with
+                                 early exit once fully fogged. Right for volumes
+                                 that do not overlap along the rays.
+     FOGVOL_MIX_INTERPENETRATING the seed's event list: (t1, +colour*density,
+                                 +density), (t2, -colour*density, -density) per
+                                 volume, sorted by t (ties: entry before exit,
+                                 then volume order), and every stretch between
+                                 events fogged with the summed density and the
+                                 density-weighted mean colour of the volumes it
+                                 is in. Exact for overlapping volumes.
+   With one volume on a ray the two modes agree; with the LINEAR law they agree
+   until the ray is fully fogged. The sort is an insertion sort that starts from
+   the order of the previous vertex or the previous frame (fogvol_analytic_order);
+   it is skipped where the order cannot matter (one volume on the ray, LINEAR
+   before full fog, EXP with a single fog colour). EXP stops once the
+   transmittance is below 1e-7; LINEAR and LINEAR_SEED once the fog reaches 0.
+
+   Classic linear distance fog from fog_start to fog_end is a DISTANCE volume with
+   min_distance = fog_start, max_distance = fog_end, density = 1 / (end - start)
+   and the LINEAR law; max_distance <= 0 means no far bound.
+
+   The GLSL programs (fogvol_analytic_shader_strings, every dialect) evaluate the
+   same thing per vertex or per pixel for up to FOGVOL_ANALYTIC_MAX_VOLUMES
+   volumes read from one uniform array, filled by fogvol_analytic_pack_uniforms:
+
+       uniform vec4 fv_analytic[FOGVOL_ANALYTIC_UNIFORM_VEC4S];   (42 vec4)
+       [0]            (eye.x, eye.y, eye.z, volume count)
+       [1]            (law, mix, 0, 0)           (fogvol_fog_law, fogvol_fog_mix)
+       [2 + 5i + 0..2] rows of the world -> unit-shape affine map of volume i
+                      (DISTANCE: (min, max or 0, 0, 0); HALF_SPACE: the plane
+                      with a unit normal)
+       [2 + 5i + 3]   (red, green, blue, density)
+       [2 + 5i + 4]   (shape, 0, 0, 0)                  (fogvol_analytic_shape)
+   Upload all of it with glUniform4fv(location of "fv_analytic", 42, values).
+   Programs: vertex attribute 0 "fv_position" (vec3, object space), uniforms
+   "fv_mvp" (mat4, clip from object) and "fv_model" (mat4, world from object).
+   The fragment shader writes vec4(fog colour, fog factor) to fv_fragcolor /
+   gl_FragColor; the per-vertex programs pass it in the varying "fv_fog", the
+   per-pixel ones pass the world position in "fv_world". Engines that write
+   their own shaders paste the strings of fogvol_analytic_snippet(): the
+   uniform, void fogvol_analytic(vec3 world_pos, out float fog, out vec3 color)
+   and fogvol_fold_fog(inout vec4 diffuse, inout vec4 specular, float fog,
+   vec3 color).
+   Fragment shaders need highp and 42 uniform vectors (GLES2 promises 16 only).
+
+   Degenerate input never gives NaN: invalid volumes are left out of a set (and
+   reported), vertices with a non-finite coordinate get f = 1, C = 0 (counted). */
+
+/* volumes a fogvol_analytic_set holds (the CPU side), at most 128; define it
+   identically in every file that uses the set */
+#ifndef FOGVOL_ANALYTIC_CAPACITY
+#define FOGVOL_ANALYTIC_CAPACITY 32
+#endif
+#if FOGVOL_ANALYTIC_CAPACITY < 1 || FOGVOL_ANALYTIC_CAPACITY > 128
+#error "FOGVOL_ANALYTIC_CAPACITY must be 1..128 (event orders are stored in bytes)"
+#endif
+#define FOGVOL_ANALYTIC_MAX_VOLUMES 8 /* volumes the shaders read */
+#define FOGVOL_ANALYTIC_UNIFORM_VEC4S (2 + 5 * FOGVOL_ANALYTIC_MAX_VOLUMES)
+#define FOGVOL_ANALYTIC_UNIFORM_FLOATS (4 * FOGVOL_ANALYTIC_UNIFORM_VEC4S)
+/* bytes of fogvol_analytic_order.vertex_orders for `vertices` vertices */
+#define FOGVOL_ANALYTIC_ORDER_BYTES(vertices, volumes) ((size_t)(vertices) * 2u * (size_t)(volumes))
+
+typedef enum fogvol_analytic_shape {
+    FOGVOL_SHAPE_DISTANCE = 0,   /* min_distance <= |X - eye| <= max_distance (max <= 0: no bound) */
+    FOGVOL_SHAPE_HALF_SPACE = 1, /* plane[0] x + plane[1] y + plane[2] z + plane[3] >= 0: the normal
+                                    points into the fog (the seed's (X - P).N > 0); negate the
+                                    plane for the other side */
+    FOGVOL_SHAPE_SPHERE = 2,     /* |X - center| <= radius */
+    FOGVOL_SHAPE_ELLIPSOID = 3,  /* transform * unit sphere */
+    FOGVOL_SHAPE_BOX = 4,        /* transform * [-1,1]^3 */
+    FOGVOL_SHAPE_CYLINDER = 5,   /* transform * {x^2 + y^2 <= 1, |z| <= 1} */
+    FOGVOL_SHAPE_COUNT = 6,
+    FOGVOL_SHAPE_MAX_ENUM = 0x7fffffff
+} fogvol_analytic_shape;
+
+/* A zeroed volume is valid: distance fog of density 0 (no fog). Only the
+   fields of the shape are read. */
+typedef struct fogvol_analytic_volume {
+    fogvol_analytic_shape shape;
+    float color[3];
+    float density;       /* per world unit, >= 0 */
+    float min_distance;  /* DISTANCE: >= 0 */
+    float max_distance;  /* DISTANCE: > min_distance, or <= 0 (or >= 1e30) for no far bound */
+    float plane[4];      /* HALF_SPACE: (a, b, c, d), any non-zero normal length */
+    float center[3];     /* SPHERE */
+    float radius;        /* SPHERE: > 0 */
+    float transform[16]; /* ELLIPSOID, BOX, CYLINDER: unit shape -> world, column-major, affine
+                            (last row 0 0 0 1) and invertible; all 16 zero = identity */
+} fogvol_analytic_volume;
+
+typedef enum fogvol_fog_law {
+    FOGVOL_FOG_LINEAR = 0,
+    FOGVOL_FOG_EXP = 1,
+    FOGVOL_FOG_LINEAR_SEED = 2,
+    FOGVOL_FOG_LAW_MAX_ENUM = 0x7fffffff
+} fogvol_fog_law;
+
+typedef enum fogvol_fog_mix {
+    FOGVOL_MIX_SEPARATE = 0,
+    FOGVOL_MIX_INTERPENETRATING = 1,
+    FOGVOL_FOG_MIX_MAX_ENUM = 0x7fffffff
+} fogvol_fog_mix;
+
+/* Prepared volumes (inverse transforms etc.), caller-owned, about 5 KB; a
+   zeroed set holds no volume. Fields are filled by fogvol_analytic_prepare. */
+typedef struct fogvol_analytic_set {
+    int count;            /* usable volumes */
+    int ignored;          /* invalid volumes left out */
+    int truncated;        /* volumes beyond FOGVOL_ANALYTIC_CAPACITY left out */
+    int uniform_color;    /* 1: every volume with density > 0 has the same colour */
+    int source[FOGVOL_ANALYTIC_CAPACITY];  /* index of each volume in the array given to prepare */
+    int shape[FOGVOL_ANALYTIC_CAPACITY];   /* fogvol_analytic_shape */
+    double map[FOGVOL_ANALYTIC_CAPACITY][12]; /* rows of the world -> unit-shape map (see the uniforms) */
+    double density[FOGVOL_ANALYTIC_CAPACITY];
+    double color[FOGVOL_ANALYTIC_CAPACITY][3];
+} fogvol_analytic_set;
+
+/* The insertion sorts' starting orders, carried between vertices and calls
+   (frame-to-frame coherence). Caller-owned, zero-initialise it. With
+   vertex_orders == NULL one order is carried from vertex to vertex and from
+   call to call; with a buffer of FOGVOL_ANALYTIC_ORDER_BYTES(vertices,
+   set count) bytes, vertex i of a batch keeps its own order there (use one
+   struct per vertex array). The contents never change results (ties are
+   broken by volume order), only the time the sorts take; any bytes are safe
+   (orders that are not permutations are replaced). */
+typedef struct fogvol_analytic_order {
+    unsigned char *vertex_orders; /* optional */
+    size_t vertex_orders_size;    /* bytes */
+    unsigned char carried[2 * FOGVOL_ANALYTIC_CAPACITY]; /* library-owned */
+    int carried_count;            /* library-owned */
+    int sorted_vertices;          /* last call: vertices that needed the sort (the others had at
+                                     most one volume on their ray, or an order-free law) */
+    int64_t moves;                /* last call: insertion-sort moves (0: every order was right) */
+} fogvol_analytic_order;
+
+/* Validates and prepares count volumes. Invalid ones (non-finite values,
+   density < 0, radius <= 0, max_distance in (0, min_distance], a zero plane
+   normal, a matrix that is not affine or is singular: |det| < 1e-6 x the
+   product of its column lengths, or a world -> unit map with an entry beyond
+   1e30, which the shaders' floats could not hold) are left out and the call
+   returns FOGVOL_ERROR_INVALID_ARGUMENT; the others are still usable (a set
+   is never left half-written: count, ignored and source say what it holds;
+   volumes of density 0 are kept and add nothing). More than
+   FOGVOL_ANALYTIC_CAPACITY volumes: the first ones are kept and the call
+   returns FOGVOL_ERROR_BUFFER_TOO_SMALL. */
+FOGVOL_API fogvol_result fogvol_analytic_prepare(fogvol_analytic_set *set, const fogvol_analytic_volume *volumes,
+                                                 int count);
+/* Entry/exit of one volume on the ray from eye to p, clamped to [0, 1]. A hit
+   gives *t1 < *t2; a miss *t1 = *t2 = 0. Invalid volume or non-finite input:
+   FOGVOL_ERROR_INVALID_ARGUMENT (and 0, 0). */
+FOGVOL_API fogvol_result fogvol_analytic_segment(const fogvol_analytic_volume *volume, const float eye[3],
+                                                 const float p[3], float *t1, float *t2);
+/* Fog factor and colour at one point. Non-finite eye or p: fog 1, colour 0,
+   FOGVOL_ERROR_INVALID_ARGUMENT. color may be NULL. */
+FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, const float eye[3], const float p[3],
+                                              fogvol_fog_law law, fogvol_fog_mix mix, float *fog, float color[3]);
+/* The same for count vertices: positions every stride bytes (0 = 12), fog_out
+   every fog_stride bytes (0 = 4), color_out (3 floats) every color_stride bytes
+   (0 = 12); either output may be NULL. Outputs may sit in the same vertex
+   structs as the positions. No allocation; blocks of vertices are evaluated
+   in structure-of-arrays loops the compiler vectorises (compile with
+   -fno-math-errno to vectorise the square roots too). order may be NULL.
+   Vertices with a non-finite coordinate get fog 1, colour 0; *invalid (may be
+   NULL) counts them and the call returns FOGVOL_ERROR_INVALID_ARGUMENT when
+   there are any (every output is still written). */
+FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, const float eye[3],
+                                               const float *positions, int count, int stride, fogvol_fog_law law,
+                                               fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
+                                               int color_stride, fogvol_analytic_order *order, int *invalid);
+/* The seed's register trick: new_diffuse = diffuse * fog, new_specular =
+   specular * fog + fog_color * (1 - fog), on rgb (alpha unchanged); then
+   texture * new_diffuse + new_specular = fogged (texture * diffuse + specular).
+   fog is clamped to [0, 1] (NaN: 1). Outputs may alias the inputs; a NULL
+   diffuse/specular pair is skipped. */
+FOGVOL_API void fogvol_fold_fog(const float diffuse[4], const float specular[4], float fog, const float fog_color[3],
+                                float new_diffuse[4], float new_specular[4]);
+/* Fills the FOGVOL_ANALYTIC_UNIFORM_FLOATS values of "fv_analytic" (layout
+   above). More than FOGVOL_ANALYTIC_MAX_VOLUMES volumes: the first ones are
+   packed and the call returns FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_analytic_pack_uniforms(const fogvol_analytic_set *set, const float eye[3],
+                                                       fogvol_fog_law law, fogvol_fog_mix mix,
+                                                       float out[FOGVOL_ANALYTIC_UNIFORM_FLOATS]);
+/* The strings of the analytic fog program's vertex or fragment shader, per
+   vertex (per_pixel = 0) or per pixel (1), ready for glShaderSource. Every
+   dialect; AUTO and unknown values: FOGVOL_ERROR_UNSUPPORTED, *count = 0. */
+FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, fogvol_stage stage, int per_pixel,
+                                                        const char **strings, int *count);
+/* GLSL for the engine's own shaders (any dialect; after #version and the
+   precision statements): the uniform, fogvol_analytic() and fogvol_fold_fog().
+   Returns the number of strings (3, to be passed in order); writes
+   min(3, capacity) of them when strings != NULL. */
+FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
 
 /* ---- backend table -------------------------------------------------------
    Contract. Every entry gets the table's user_data first. Handles are
@@ -1442,6 +1674,944 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
     fogvol__free(alloc, usable);
     fogvol__free(alloc, vbad);
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
+}
+
+/* >>analytic ============================================================== */
+/* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
+   ways of combining volumes, the batch over vertex arrays, and the same maths
+   as GLSL. Everything is computed in double on the CPU: the chord of a grazing
+   ray depends on the square root of a small discriminant, which float would
+   get wrong by up to sqrt(2^-24) = 2.4e-4 of the chord. */
+
+#define FOGVOL__AN_BLOCK 32      /* vertices per structure-of-arrays block */
+#define FOGVOL__AN_CUTOFF 1e-7   /* EXP: a ray whose transmittance fell below this is done */
+/* the per-ray kernels must be inlined into the block loops for those to vectorise */
+#if defined(__GNUC__) || defined(__clang__)
+#define FOGVOL__AN_INLINE static __inline__ __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define FOGVOL__AN_INLINE static __forceinline
+#else
+#define FOGVOL__AN_INLINE static
+#endif
+
+FOGVOL__AN_INLINE double fogvol__an_min(double a, double b) { return a < b ? a : b; }
+FOGVOL__AN_INLINE double fogvol__an_max(double a, double b) { return a > b ? a : b; }
+
+/* Validates one volume; writes its shape and the rows of its world ->
+   unit-shape map (DISTANCE: min, max or 0; HALF_SPACE: the plane with a unit
+   normal). */
+static fogvol_result fogvol__an_prepare_one(const fogvol_analytic_volume *v, int *shape, double map[12])
+{
+    int i;
+    for (i = 0; i < 12; ++i) map[i] = 0.0;
+    if ((int)v->shape < 0 || (int)v->shape >= (int)FOGVOL_SHAPE_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite(v->density) || v->density < 0.0f || !fogvol__finite_n(v->color, 3))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *shape = (int)v->shape;
+    switch (v->shape) {
+    case FOGVOL_SHAPE_DISTANCE:
+        if (!fogvol__finite(v->min_distance) || !fogvol__finite(v->max_distance) || v->min_distance < 0.0f ||
+            (v->max_distance > 0.0f && v->max_distance <= v->min_distance))
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        map[0] = v->min_distance;
+        map[1] = v->max_distance > 0.0f && v->max_distance < 1e30f ? v->max_distance : 0.0; /* huge: no bound */
+        break;
+    case FOGVOL_SHAPE_HALF_SPACE: {
+        double nn;
+        if (!fogvol__finite_n(v->plane, 4)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        nn = FOGVOL_SQRT((double)v->plane[0] * v->plane[0] + (double)v->plane[1] * v->plane[1] +
+                         (double)v->plane[2] * v->plane[2]);
+        if (!(nn > 0.0)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < 4; ++i) map[i] = v->plane[i] / nn;
+        break;
+    }
+    case FOGVOL_SHAPE_SPHERE: {
+        double r;
+        if (!fogvol__finite_n(v->center, 3) || !fogvol__finite(v->radius) || !(v->radius > 0.0f))
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        r = v->radius;
+        map[0] = map[5] = map[10] = 1.0 / r;
+        map[3] = -v->center[0] / r;
+        map[7] = -v->center[1] / r;
+        map[11] = -v->center[2] / r;
+        break;
+    }
+    default: { /* ELLIPSOID, BOX, CYLINDER: invert the affine transform */
+        const float *m = v->transform;
+        double a00, a01, a02, a10, a11, a12, a20, a21, a22, c00, c01, c02, det, h, id;
+        int zero = 1;
+        if (!fogvol__finite_n(m, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < 16; ++i)
+            if (m[i] != 0.0f) zero = 0;
+        if (zero) { /* a zeroed transform means identity */
+            map[0] = map[5] = map[10] = 1.0;
+            return FOGVOL_SUCCESS;
+        }
+        if (m[3] != 0.0f || m[7] != 0.0f || m[11] != 0.0f || m[15] != 1.0f) return FOGVOL_ERROR_INVALID_ARGUMENT;
+        a00 = m[0], a01 = m[4], a02 = m[8];
+        a10 = m[1], a11 = m[5], a12 = m[9];
+        a20 = m[2], a21 = m[6], a22 = m[10];
+        c00 = a11 * a22 - a12 * a21;
+        c01 = a12 * a20 - a10 * a22;
+        c02 = a10 * a21 - a11 * a20;
+        det = a00 * c00 + a01 * c01 + a02 * c02;
+        h = FOGVOL_SQRT(a00 * a00 + a10 * a10 + a20 * a20) * FOGVOL_SQRT(a01 * a01 + a11 * a11 + a21 * a21) *
+            FOGVOL_SQRT(a02 * a02 + a12 * a12 + a22 * a22);
+        if (!(h > 0.0) || !(FOGVOL_FABS(det) >= 1e-6 * h)) return FOGVOL_ERROR_INVALID_ARGUMENT; /* singular */
+        id = 1.0 / det;
+        map[0] = c00 * id, map[1] = (a02 * a21 - a01 * a22) * id, map[2] = (a01 * a12 - a02 * a11) * id;
+        map[4] = c01 * id, map[5] = (a00 * a22 - a02 * a20) * id, map[6] = (a02 * a10 - a00 * a12) * id;
+        map[8] = c02 * id, map[9] = (a01 * a20 - a00 * a21) * id, map[10] = (a00 * a11 - a01 * a10) * id;
+        for (i = 0; i < 3; ++i)
+            map[i * 4 + 3] = -(map[i * 4] * m[12] + map[i * 4 + 1] * m[13] + map[i * 4 + 2] * m[14]);
+        break;
+    }
+    }
+    /* the shaders read the map as float: keep it well inside the float range */
+    for (i = 0; i < 12; ++i)
+        if (!fogvol__finite(map[i]) || FOGVOL_FABS(map[i]) > 1e30) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_analytic_prepare(fogvol_analytic_set *set, const fogvol_analytic_volume *volumes,
+                                                 int count)
+{
+    fogvol_result res = FOGVOL_SUCCESS;
+    int i, n = 0, shape = 0, have = 0;
+    if (!set || count < 0 || (count > 0 && !volumes)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(set, 0, sizeof *set);
+    for (i = 0; i < count; ++i) {
+        if (n == FOGVOL_ANALYTIC_CAPACITY) {
+            set->truncated = count - i;
+            if (res == FOGVOL_SUCCESS) res = FOGVOL_ERROR_BUFFER_TOO_SMALL;
+            break;
+        }
+        if (fogvol__an_prepare_one(&volumes[i], &shape, set->map[n]) != FOGVOL_SUCCESS) {
+            memset(set->map[n], 0, sizeof set->map[n]);
+            ++set->ignored;
+            res = FOGVOL_ERROR_INVALID_ARGUMENT;
+            continue;
+        }
+        set->source[n] = i;
+        set->shape[n] = shape;
+        set->density[n] = volumes[i].density;
+        set->color[n][0] = volumes[i].color[0];
+        set->color[n][1] = volumes[i].color[1];
+        set->color[n][2] = volumes[i].color[2];
+        ++n;
+    }
+    set->count = n;
+    set->uniform_color = 1;
+    for (i = 0; i < n; ++i) {
+        if (!(set->density[i] > 0.0)) continue;
+        if (have && (set->color[i][0] != set->color[have - 1][0] || set->color[i][1] != set->color[have - 1][1] ||
+                     set->color[i][2] != set->color[have - 1][2]))
+            set->uniform_color = 0;
+        if (!have) have = i + 1;
+    }
+    return res;
+}
+
+/* ---- entry/exit per shape ----
+   Each kernel gives [lo, hi] inside [0, 1] for the ray eye + t d (hi <= lo: a
+   miss). o is the eye in the volume's unit space (per call), d the ray in
+   world space. Everything is computed first and then selected (no arithmetic
+   or comparison inside a branch, guarded divisions), so that the loops over a
+   block of vertices if-convert and vectorise under -ftrapping-math. */
+
+FOGVOL__AN_INLINE void fogvol__an_distance(const double *m, double len, double *lo, double *hi)
+{
+    double ls = len + (double)(len == 0.0);
+    double f = fogvol__an_min(m[1] / ls, 1.0);
+    double h = m[1] > 0.0 ? f : 1.0;
+    *lo = m[0] / ls;
+    *hi = len > 0.0 ? h : -1.0;
+}
+
+/* the seed's half-space: fog where s0 + t s1 >= 0 */
+FOGVOL__AN_INLINE void fogvol__an_half(const double *m, double s0, double dx, double dy, double dz, double *lo,
+                                       double *hi)
+{
+    double s1 = m[0] * dx + m[1] * dy + m[2] * dz;
+    double ss = s1 + (double)(s1 == 0.0), tx = -s0 / ss;
+    double txl = fogvol__an_max(tx, 0.0), txh = fogvol__an_min(tx, 1.0);
+    double par = s0 >= 0.0 ? 1.0 : -1.0; /* parallel to the plane: all or nothing */
+    double h = s1 > 0.0 ? 1.0 : par;
+    *lo = s1 > 0.0 ? txl : 0.0;
+    *hi = s1 < 0.0 ? txh : h;
+}
+
+/* |o + t v| <= 1 along one axis, intersected into [lo, hi] */
+FOGVOL__AN_INLINE void fogvol__an_slab(double o, double v, double *lo, double *hi)
+{
+    double vs = v + (double)(v == 0.0);
+    double ta = (-1.0 - o) / vs, tb = (1.0 - o) / vs;
+    double mn = fogvol__an_min(ta, tb), mx = fogvol__an_max(ta, tb);
+    double par = ((o >= -1.0) & (o <= 1.0)) ? 1.0 : -1.0; /* parallel to the slab */
+    double l = v == 0.0 ? 0.0 : mn, h = v == 0.0 ? par : mx;
+    *lo = fogvol__an_max(*lo, l);
+    *hi = fogvol__an_min(*hi, h);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_box(const double *m, const double *o, double dx, double dy, double dz, double *lo,
+                                      double *hi)
+{
+    double l = 0.0, h = 1.0;
+    fogvol__an_slab(o[0], m[0] * dx + m[1] * dy + m[2] * dz, &l, &h);
+    fogvol__an_slab(o[1], m[4] * dx + m[5] * dy + m[6] * dz, &l, &h);
+    fogvol__an_slab(o[2], m[8] * dx + m[9] * dy + m[10] * dz, &l, &h);
+    *lo = l;
+    *hi = h;
+}
+
+/* Unit sphere (kind 0; kind 2: a sphere, whose map is a scale by m[0] = 1/r
+   and a translation) or the side of the unit cylinder (kind 1, z left out),
+   before the square root: a = v.v, b = o.v, disc = b^2 - a (o.o - 1) written
+   as a - |o x v|^2 (Lagrange's identity; no cancellation of two large terms
+   when the eye is far away). */
+FOGVOL__AN_INLINE void fogvol__an_quad1(const double *m, const double *o, int kind, double dx, double dy, double dz,
+                                        double *a, double *b, double *disc, double *vz)
+{
+    int cyl = kind == 1;
+    double v0 = kind == 2 ? m[0] * dx : m[0] * dx + m[1] * dy + m[2] * dz;
+    double v1 = kind == 2 ? m[0] * dy : m[4] * dx + m[5] * dy + m[6] * dz;
+    double v2 = kind == 2 ? m[0] * dz : m[8] * dx + m[9] * dy + m[10] * dz;
+    double w2 = cyl ? 0.0 : v2, o2 = cyl ? 0.0 : o[2];
+    double cx = o[1] * w2 - o2 * v1, cy = o2 * v0 - o[0] * w2, cz = o[0] * v1 - o[1] * v0;
+    *a = v0 * v0 + v1 * v1 + w2 * w2;
+    *b = o[0] * v0 + o[1] * v1 + o2 * w2;
+    *disc = *a - (cx * cx + cy * cy + cz * cz);
+    *vz = v2;
+}
+
+/* The roots from s = sqrt(max(disc, 0)), in the stable form q = -(b + sign(b) s),
+   t = q / a and c0 / q (c0 = o.o - 1); a == 0: a ray along the cylinder's axis
+   (or of zero length), inside for all t when c0 <= 0. */
+FOGVOL__AN_INLINE void fogvol__an_quad2(double a, double b, double disc, double s, double c0, double *lo, double *hi)
+{
+    double ns = -s, sg = b >= 0.0 ? s : ns;
+    double q = -(b + sg);
+    double qs = q + (double)(q == 0.0), as = a + (double)(a == 0.0);
+    double r1 = q / as, r2 = c0 / qs;
+    double l = fogvol__an_max(fogvol__an_min(r1, r2), 0.0), h = fogvol__an_min(fogvol__an_max(r1, r2), 1.0);
+    double par = c0 <= 0.0 ? 1.0 : -1.0; /* along the cylinder's axis: all or nothing */
+    double hd = disc > 0.0 ? h : -1.0;
+    *lo = a > 0.0 ? l : 0.0;
+    *hi = a > 0.0 ? hd : par;
+}
+
+/* The eye in every volume's unit space (once per call). */
+typedef struct fogvol__an_eye {
+    double o[FOGVOL_ANALYTIC_CAPACITY][3]; /* HALF_SPACE: o[0] = plane value at the eye */
+    double c0[FOGVOL_ANALYTIC_CAPACITY];   /* o.o - 1 (cylinder: x and y only) */
+} fogvol__an_eye;
+
+static void fogvol__an_eye_init(const fogvol_analytic_set *s, const double e[3], fogvol__an_eye *pe)
+{
+    int v, r;
+    for (v = 0; v < s->count; ++v) {
+        const double *m = s->map[v];
+        for (r = 0; r < 3; ++r)
+            pe->o[v][r] = m[r * 4] * e[0] + m[r * 4 + 1] * e[1] + m[r * 4 + 2] * e[2] + m[r * 4 + 3];
+        pe->c0[v] = pe->o[v][0] * pe->o[v][0] + pe->o[v][1] * pe->o[v][1] - 1.0;
+        if (s->shape[v] != FOGVOL_SHAPE_CYLINDER) pe->c0[v] += pe->o[v][2] * pe->o[v][2];
+    }
+}
+
+/* One volume, one ray (the scalar path of eval and segment; the batch runs the
+   same kernels in loops). */
+static void fogvol__an_ray(const fogvol_analytic_set *s, const fogvol__an_eye *pe, int v, double dx, double dy,
+                           double dz, double len, double *lo, double *hi)
+{
+    const double *m = s->map[v], *o = pe->o[v];
+    double a, b, disc, vz;
+    switch (s->shape[v]) {
+    case FOGVOL_SHAPE_DISTANCE: fogvol__an_distance(m, len, lo, hi); break;
+    case FOGVOL_SHAPE_HALF_SPACE: fogvol__an_half(m, o[0], dx, dy, dz, lo, hi); break;
+    case FOGVOL_SHAPE_BOX: fogvol__an_box(m, o, dx, dy, dz, lo, hi); break;
+    default:
+        if (s->shape[v] == FOGVOL_SHAPE_SPHERE) fogvol__an_quad1(m, o, 2, dx, dy, dz, &a, &b, &disc, &vz);
+        else fogvol__an_quad1(m, o, s->shape[v] == FOGVOL_SHAPE_CYLINDER, dx, dy, dz, &a, &b, &disc, &vz);
+        fogvol__an_quad2(a, b, disc, FOGVOL_SQRT(disc > 0.0 ? disc : 0.0), pe->c0[v], lo, hi);
+        if (s->shape[v] == FOGVOL_SHAPE_CYLINDER) fogvol__an_slab(o[2], vz, lo, hi);
+        break;
+    }
+    if (!(*hi > *lo)) *lo = *hi = 0.0;
+}
+
+FOGVOL_API fogvol_result fogvol_analytic_segment(const fogvol_analytic_volume *volume, const float eye[3],
+                                                 const float p[3], float *t1, float *t2)
+{
+    fogvol_analytic_set *s;
+    fogvol__an_eye *pe;
+    struct {
+        fogvol_analytic_set set; /* only slot 0 is used */
+        fogvol__an_eye eye;
+    } one;
+    double e[3], dx, dy, dz, lo, hi;
+    if (t1) *t1 = 0.0f;
+    if (t2) *t2 = 0.0f;
+    if (!volume || !eye || !p || !t1 || !t2 || !fogvol__finite_n(eye, 3) || !fogvol__finite_n(p, 3))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    s = &one.set;
+    pe = &one.eye;
+    s->count = 1;
+    if (fogvol__an_prepare_one(volume, &s->shape[0], s->map[0]) != FOGVOL_SUCCESS)
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    e[0] = eye[0], e[1] = eye[1], e[2] = eye[2];
+    fogvol__an_eye_init(s, e, pe);
+    dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
+    fogvol__an_ray(s, pe, 0, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
+    *t1 = (float)lo;
+    *t2 = (float)hi;
+    if (!(*t2 > *t1)) *t1 = *t2 = 0.0f; /* a hit thinner than float */
+    return FOGVOL_SUCCESS;
+}
+
+/* ---- combining volumes ---- */
+
+/* Running state along one ray, front to back: f = fog factor (LINEAR, the seed's
+   "fog") or transmittance (EXP); w = how much of the pixel the fog covers so
+   far; num = colour * cover (LINEAR_SEED: the fog colour itself). */
+typedef struct fogvol__an_state {
+    double f, w, num[3];
+    int done;
+} fogvol__an_state;
+
+/* One stretch of fog of length l (world units) with density sig and
+   premultiplied colour cs = colour * sig (for a mix: the sums over the volumes
+   it is in, so cs / sig is the density-weighted mean colour).
+   LINEAR: the seed's law, fog -= sig * l until 0. The stretch covers sig * l of
+     the pixel (less when it ends the fog), so it adds its colour times that:
+     num += cs * l.
+   EXP: the physically consistent compositing of transmittances. Behind
+     transmittance T the stretch covers T (1 - exp(-sig l)) and T shrinks by
+     exp(-sig l); the colour weight is written cs * l * T * phi with
+     phi = (1 - exp(-x)) / x (x = sig l) so that no division by a density that
+     may be tiny is needed. Then 1 - f = sum of the covers exactly, and the
+     result does not depend on how a volume is cut into stretches (the seed's
+     colour formula applied to EXP would). Done once T < FOGVOL__AN_CUTOFF.
+   LINEAR_SEED: the seed verbatim, C = colour * fog + C * (1 - fog) (the fog
+     before the stretch), fog = fog + volFog - 1. Stretches of zero length are
+     skipped (the seed would blend their colour in, depending on sort ties). */
+FOGVOL__AN_INLINE void fogvol__an_add(fogvol__an_state *st, int law, const double cs[3], double sig, double l)
+{
+    double tau = sig * l, k;
+    int c;
+    if (!(tau > 0.0) || st->done) return;
+    if (law == FOGVOL_FOG_EXP) {
+        double e = FOGVOL_EXP(-tau);
+        double phi = tau < 1e-5 ? 1.0 - 0.5 * tau : (1.0 - e) / tau;
+        k = l * phi * st->f;
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * k;
+        st->w += sig * k;
+        st->f *= e;
+        if (st->f < FOGVOL__AN_CUTOFF) st->done = 1;
+    } else if (law == FOGVOL_FOG_LINEAR) {
+        k = tau >= st->f ? st->f / tau : 1.0; /* the stretch that ends the fog counts in part */
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * (l * k);
+        st->w += tau * k;
+        if (tau >= st->f) {
+            st->f = 0.0;
+            st->done = 1;
+        } else {
+            st->f -= tau;
+        }
+    } else {
+        for (c = 0; c < 3; ++c) st->num[c] = cs[c] / sig * st->f + st->num[c] * (1.0 - st->f);
+        st->f -= tau < 1.0 ? tau : 1.0;
+        if (st->f <= 0.0) {
+            st->f = 0.0;
+            st->done = 1;
+        }
+    }
+}
+
+/* event e of a vertex: 2v = entry into volume v, 2v + 1 = exit; sorted by
+   (t, e): a strict total order, so the result never depends on the order the
+   insertion sort starts from */
+static int fogvol__an_perm_ok(const unsigned char *p, int m)
+{
+    unsigned char seen[2 * FOGVOL_ANALYTIC_CAPACITY];
+    int i;
+    memset(seen, 0, (size_t)m);
+    for (i = 0; i < m; ++i) {
+        if (p[i] >= m || seen[p[i]]) return 0;
+        seen[p[i]] = 1;
+    }
+    return 1;
+}
+
+static void fogvol__an_identity(unsigned char *p, int m)
+{
+    int i;
+    for (i = 0; i < m; ++i) p[i] = (unsigned char)i;
+}
+
+/* The seed's sorted evaluation of one vertex from its entry/exit pairs (those
+   of volume v at t1[v * ts], t2[v * ts]). Misses sort last and end the walk. */
+static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
+                              const float *t2, int ts, unsigned char *perm, int64_t *moves, fogvol__an_state *st)
+{
+    float key[2 * FOGVOL_ANALYTIC_CAPACITY];
+    int n = s->count, m = 2 * s->count, k, j, v, c;
+    int64_t mv = 0;
+    for (v = 0; v < n; ++v) {
+        float a = t1[v * ts], b = t2[v * ts];
+        int hit = b > a && s->density[v] > 0.0;
+        key[2 * v] = hit ? a : 2.0f;
+        key[2 * v + 1] = hit ? b : 2.0f;
+    }
+    /* insertion sort from the carried order: O(m) when it is still right */
+    for (k = 1; k < m; ++k) {
+        unsigned char x = perm[k];
+        float kx = key[x];
+        for (j = k; j > 0 && (key[perm[j - 1]] > kx || (key[perm[j - 1]] == kx && perm[j - 1] > x)); --j) {
+            perm[j] = perm[j - 1];
+            ++mv;
+        }
+        perm[j] = x;
+    }
+    if (moves) *moves += mv;
+    if (mix == FOGVOL_MIX_SEPARATE) {
+        /* the entries in order of t1; each volume whole */
+        for (k = 0; k < m && !st->done; ++k) {
+            int e = perm[k];
+            double cs[3];
+            if (key[e] > 1.5f) break;
+            if (e & 1) continue;
+            v = e >> 1;
+            for (c = 0; c < 3; ++c) cs[c] = s->color[v][c] * s->density[v];
+            fogvol__an_add(st, law, cs, s->density[v], len * ((double)key[e + 1] - (double)key[e]));
+        }
+    } else {
+        /* the event list: sums of (colour * density, density) of the volumes a
+           stretch is in; the sums restart from exact zeros whenever no volume
+           is open, so that rounding never leaves a ghost density behind. A
+           stretch is (t - lastT) * |D| long (the seed's listing divides by
+           |D| there, a slip: its one-volume algorithm multiplies) */
+        double acc[4] = {0.0, 0.0, 0.0, 0.0}, last = 0.0;
+        int open = 0;
+        for (k = 0; k < m && !st->done; ++k) {
+            int e = perm[k];
+            double t = key[e], sgn = (e & 1) ? -1.0 : 1.0;
+            if (t > 1.5) break;
+            v = e >> 1;
+            if (open > 0 && t > last) fogvol__an_add(st, law, acc, acc[3], (t - last) * len);
+            for (c = 0; c < 3; ++c) acc[c] += sgn * s->color[v][c] * s->density[v];
+            acc[3] += sgn * s->density[v];
+            open += (e & 1) ? -1 : 1;
+            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
+            last = t;
+        }
+    }
+}
+
+static void fogvol__an_sorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
+                                     const float *t2, int ts, unsigned char *perm, int64_t *moves, float *fog,
+                                     float col[3])
+{
+    fogvol__an_state st;
+    double inv;
+    int c;
+    memset(&st, 0, sizeof st);
+    st.f = 1.0;
+    fogvol__an_sorted(s, law, mix, len, t1, t2, ts, perm, moves, &st);
+    inv = st.w > 0.0 ? 1.0 / st.w : 0.0;
+    *fog = (float)st.f;
+    for (c = 0; c < 3; ++c) col[c] = (float)(law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv);
+}
+
+/* Whenever the order of the volumes cannot matter, the sums over the volumes
+   of a vertex are the answer (tau = sum of density * distance, rgb = the same
+   weighted by colour): at most one volume on the ray; LINEAR while the ray is
+   not fully fogged (the law is additive, in both mixes); EXP with one fog
+   colour (transmittances multiply in any order). A vertex with more than one
+   volume on its ray needs the sorted path when tau > this limit. */
+static double fogvol__an_sort_limit(const fogvol_analytic_set *s, int law)
+{
+    if (law == FOGVOL_FOG_LINEAR) return 1.0;
+    return law == FOGVOL_FOG_EXP && s->uniform_color ? 1e308 : -1.0;
+}
+
+static int fogvol__an_args_ok(const fogvol_analytic_set *set, fogvol_fog_law law, fogvol_fog_mix mix)
+{
+    return set && set->count >= 0 && set->count <= FOGVOL_ANALYTIC_CAPACITY && (int)law >= 0 &&
+           (int)law <= (int)FOGVOL_FOG_LINEAR_SEED &&
+           (mix == FOGVOL_MIX_SEPARATE || mix == FOGVOL_MIX_INTERPENETRATING);
+}
+
+FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, const float eye[3], const float p[3],
+                                              fogvol_fog_law law, fogvol_fog_mix mix, float *fog, float color[3])
+{
+    fogvol__an_eye pe;
+    float t1[FOGVOL_ANALYTIC_CAPACITY], t2[FOGVOL_ANALYTIC_CAPACITY], f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+    unsigned char perm[2 * FOGVOL_ANALYTIC_CAPACITY];
+    double e[3], dx, dy, dz, len, tau = 0.0, rgb[3] = {0.0, 0.0, 0.0}, hits = 0.0;
+    fogvol_result res = FOGVOL_SUCCESS;
+    int v, c;
+    if (!fogvol__an_args_ok(set, law, mix) || !fog) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!eye || !p || !fogvol__finite_n(eye, 3) || !fogvol__finite_n(p, 3)) {
+        res = FOGVOL_ERROR_INVALID_ARGUMENT;
+    } else {
+        e[0] = eye[0], e[1] = eye[1], e[2] = eye[2];
+        fogvol__an_eye_init(set, e, &pe);
+        dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
+        len = FOGVOL_SQRT(dx * dx + dy * dy + dz * dz);
+        for (v = 0; v < set->count; ++v) {
+            double lo, hi, tv;
+            fogvol__an_ray(set, &pe, v, dx, dy, dz, len, &lo, &hi);
+            t1[v] = (float)lo;
+            t2[v] = (float)hi;
+            tv = set->density[v] * (len * (hi - lo));
+            tau += tv;
+            for (c = 0; c < 3; ++c) rgb[c] += set->color[v][c] * tv;
+            hits += (double)(tv > 0.0);
+        }
+        if (hits > 1.0 && tau > fogvol__an_sort_limit(set, law)) {
+            fogvol__an_identity(perm, 2 * set->count);
+            fogvol__an_sorted_vertex(set, law, mix, len, t1, t2, 1, perm, NULL, &f, col);
+        } else { /* the same expressions as the batch's order-free loop */
+            double inv = 1.0 / (tau + (double)(tau == 0.0));
+            f = (float)(law == FOGVOL_FOG_EXP ? (tau > 0.0 ? FOGVOL_EXP(-tau) : 1.0) : fogvol__an_max(1.0 - tau, 0.0));
+            for (c = 0; c < 3; ++c) col[c] = (float)(rgb[c] * inv);
+        }
+    }
+    *fog = f;
+    if (color) color[0] = col[0], color[1] = col[1], color[2] = col[2];
+    return res;
+}
+
+/* A block of vertices in structure-of-arrays form; the loops over i below
+   have a constant trip count and no calls but the square roots. */
+typedef struct fogvol__an_block {
+    double dx[FOGVOL__AN_BLOCK], dy[FOGVOL__AN_BLOCK], dz[FOGVOL__AN_BLOCK], len[FOGVOL__AN_BLOCK];
+    double a[FOGVOL__AN_BLOCK], b[FOGVOL__AN_BLOCK], disc[FOGVOL__AN_BLOCK], s[FOGVOL__AN_BLOCK];
+    double vz[FOGVOL__AN_BLOCK], lo[FOGVOL__AN_BLOCK], hi[FOGVOL__AN_BLOCK];
+    double tau[FOGVOL__AN_BLOCK], r[FOGVOL__AN_BLOCK], g[FOGVOL__AN_BLOCK], bl[FOGVOL__AN_BLOCK];
+    double hits[FOGVOL__AN_BLOCK], fog[FOGVOL__AN_BLOCK], need[FOGVOL__AN_BLOCK];
+    float t1[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK], t2[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK];
+} fogvol__an_block;
+
+static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__an_eye *pe, double limit,
+                                  fogvol__an_block *k)
+{
+    int v, i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = FOGVOL_SQRT(k->len[i]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0;
+    for (v = 0; v < set->count; ++v) {
+        const double *m = set->map[v], *o = pe->o[v];
+        const double c0 = pe->c0[v], dens = set->density[v];
+        const double cr = set->color[v][0], cg = set->color[v][1], cb = set->color[v][2];
+        switch (set->shape[v]) {
+        case FOGVOL_SHAPE_DISTANCE:
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_distance(m, k->len[i], &k->lo[i], &k->hi[i]);
+            break;
+        case FOGVOL_SHAPE_HALF_SPACE:
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_half(m, o[0], k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+            break;
+        case FOGVOL_SHAPE_BOX:
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_box(m, o, k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+            break;
+        case FOGVOL_SHAPE_CYLINDER:
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_quad1(m, o, 1, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->s[i] = FOGVOL_SQRT(k->disc[i] > 0.0 ? k->disc[i] : 0.0);
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+                fogvol__an_quad2(k->a[i], k->b[i], k->disc[i], k->s[i], c0, &k->lo[i], &k->hi[i]);
+                fogvol__an_slab(o[2], k->vz[i], &k->lo[i], &k->hi[i]);
+            }
+            break;
+        default: /* SPHERE, ELLIPSOID */
+            if (set->shape[v] == FOGVOL_SHAPE_SPHERE)
+                for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                    fogvol__an_quad1(m, o, 2, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+            else
+                for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                    fogvol__an_quad1(m, o, 0, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->s[i] = FOGVOL_SQRT(k->disc[i] > 0.0 ? k->disc[i] : 0.0);
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_quad2(k->a[i], k->b[i], k->disc[i], k->s[i], c0, &k->lo[i], &k->hi[i]);
+            break;
+        }
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+            double l0 = k->lo[i], h0 = k->hi[i];
+            /* a miss: d = 0 (and lo in [-1, 1]; min(l0, 2) would be clearer but stops the
+               vectoriser: gcc folds the add below into the select's arms) */
+            double d = fogvol__an_max(h0 - l0, 0.0), lo = fogvol__an_min(l0, h0);
+            double tv = dens * (k->len[i] * d);
+            k->tau[i] += tv;
+            k->r[i] += cr * tv;
+            k->g[i] += cg * tv;
+            k->bl[i] += cb * tv;
+            k->hits[i] += (double)(tv > 0.0);
+            k->t1[v][i] = (float)lo;
+            k->t2[v][i] = (float)(lo + d);
+        }
+    }
+    /* the order-free answer (fogvol__an_sort_limit); EXP fog comes after */
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        double tau = k->tau[i], inv = 1.0 / (tau + (double)(tau == 0.0));
+        k->fog[i] = fogvol__an_max(1.0 - tau, 0.0);
+        k->r[i] *= inv;
+        k->g[i] *= inv;
+        k->bl[i] *= inv;
+        k->need[i] = (k->hits[i] > 1.0 && tau > limit) ? 1.0 : 0.0;
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, const float eye[3],
+                                               const float *positions, int count, int stride, fogvol_fog_law law,
+                                               fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
+                                               int color_stride, fogvol_analytic_order *order, int *invalid)
+{
+    fogvol__an_block blk;
+    fogvol__an_eye pe;
+    unsigned char local[2 * FOGVOL_ANALYTIC_CAPACITY], *carry;
+    unsigned char valid[FOGVOL__AN_BLOCK];
+    const unsigned char *src = (const unsigned char *)positions;
+    double e[3], limit;
+    int base, i, m, bad = 0, eye_ok, sorted = 0;
+    int64_t moves = 0;
+    if (invalid) *invalid = 0;
+    if (!fogvol__an_args_ok(set, law, mix) || !eye || count < 0 || (count > 0 && !positions) || stride < 0 ||
+        (stride > 0 && stride < 12) || fog_stride < 0 || (fog_stride > 0 && fog_stride < 4) || color_stride < 0 ||
+        (color_stride > 0 && color_stride < 12))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!stride) stride = 12;
+    if (!fog_stride) fog_stride = 4;
+    if (!color_stride) color_stride = 12;
+    m = 2 * set->count;
+    limit = fogvol__an_sort_limit(set, law);
+    eye_ok = fogvol__finite_n(eye, 3);
+    e[0] = eye_ok ? eye[0] : 0.0, e[1] = eye_ok ? eye[1] : 0.0, e[2] = eye_ok ? eye[2] : 0.0;
+    fogvol__an_eye_init(set, e, &pe);
+    if (order) {
+        carry = order->carried;
+        if (order->carried_count != set->count || !fogvol__an_perm_ok(carry, m)) {
+            fogvol__an_identity(carry, m);
+            order->carried_count = set->count;
+        }
+    } else {
+        carry = local;
+        fogvol__an_identity(carry, m);
+    }
+    for (base = 0; base < count; base += FOGVOL__AN_BLOCK) {
+        int nb = count - base < FOGVOL__AN_BLOCK ? count - base : FOGVOL__AN_BLOCK;
+        /* gather (strided, checked: x - x is 0 for finite x only), pad the block
+           with zero-length rays */
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+            float x = 0.0f, y = 0.0f, z = 0.0f;
+            int ok = 0;
+            if (i < nb) {
+                const float *p = (const float *)(const void *)(src + (size_t)(base + i) * (size_t)stride);
+                x = p[0], y = p[1], z = p[2];
+                ok = eye_ok & (x - x == 0.0f) & (y - y == 0.0f) & (z - z == 0.0f);
+                bad += !ok;
+            }
+            valid[i] = (unsigned char)ok;
+            blk.dx[i] = ok ? (double)x - e[0] : 0.0;
+            blk.dy[i] = ok ? (double)y - e[1] : 0.0;
+            blk.dz[i] = ok ? (double)z - e[2] : 0.0;
+        }
+        fogvol__an_block_eval(set, &pe, limit, &blk);
+        if (law == FOGVOL_FOG_EXP)
+            for (i = 0; i < nb; ++i)
+                if (blk.need[i] == 0.0) blk.fog[i] = blk.tau[i] > 0.0 ? FOGVOL_EXP(-blk.tau[i]) : 1.0;
+        for (i = 0; i < nb; ++i) {
+            size_t idx = (size_t)(base + i);
+            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+            if (!valid[i]) {
+                /* fog 1, colour 0 */
+            } else if (blk.need[i] != 0.0) {
+                unsigned char *perm = carry;
+                if (order && order->vertex_orders && (idx + 1) * (size_t)m <= order->vertex_orders_size) {
+                    perm = order->vertex_orders + idx * (size_t)m;
+                    if (!fogvol__an_perm_ok(perm, m)) memcpy(perm, carry, (size_t)m);
+                }
+                fogvol__an_sorted_vertex(set, law, mix, blk.len[i], (const float *)(const void *)blk.t1 + i,
+                                         (const float *)(const void *)blk.t2 + i, FOGVOL__AN_BLOCK, perm, &moves, &f,
+                                         col);
+                ++sorted;
+                if (perm != carry) memcpy(carry, perm, (size_t)m); /* the next vertex starts from it */
+            } else {
+                f = (float)blk.fog[i];
+                col[0] = (float)blk.r[i], col[1] = (float)blk.g[i], col[2] = (float)blk.bl[i];
+            }
+            if (fog_out) *(float *)(void *)((unsigned char *)fog_out + idx * (size_t)fog_stride) = f;
+            if (color_out) {
+                float *o = (float *)(void *)((unsigned char *)color_out + idx * (size_t)color_stride);
+                o[0] = col[0], o[1] = col[1], o[2] = col[2];
+            }
+        }
+    }
+    if (order) {
+        order->sorted_vertices = sorted;
+        order->moves = moves;
+    }
+    if (invalid) *invalid = bad;
+    return bad ? FOGVOL_ERROR_INVALID_ARGUMENT : FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_fold_fog(const float diffuse[4], const float specular[4], float fog, const float fog_color[3],
+                                float new_diffuse[4], float new_specular[4])
+{
+    float f = fogvol__finite(fog) ? (fog < 0.0f ? 0.0f : fog > 1.0f ? 1.0f : fog) : 1.0f;
+    int c;
+    if (diffuse && new_diffuse) {
+        for (c = 0; c < 3; ++c) new_diffuse[c] = diffuse[c] * f;
+        new_diffuse[3] = diffuse[3];
+    }
+    if (specular && new_specular) {
+        for (c = 0; c < 3; ++c) new_specular[c] = specular[c] * f + (fog_color ? fog_color[c] : 0.0f) * (1.0f - f);
+        new_specular[3] = specular[3];
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_analytic_pack_uniforms(const fogvol_analytic_set *set, const float eye[3],
+                                                       fogvol_fog_law law, fogvol_fog_mix mix,
+                                                       float out[FOGVOL_ANALYTIC_UNIFORM_FLOATS])
+{
+    int n, v, j;
+    if (!fogvol__an_args_ok(set, law, mix) || !eye || !out || !fogvol__finite_n(eye, 3))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    n = set->count < FOGVOL_ANALYTIC_MAX_VOLUMES ? set->count : FOGVOL_ANALYTIC_MAX_VOLUMES;
+    memset(out, 0, FOGVOL_ANALYTIC_UNIFORM_FLOATS * sizeof(float));
+    out[0] = eye[0], out[1] = eye[1], out[2] = eye[2], out[3] = (float)n;
+    out[4] = (float)law, out[5] = (float)mix;
+    for (v = 0; v < n; ++v) {
+        float *u = out + 8 + 20 * v;
+        for (j = 0; j < 12; ++j) u[j] = (float)set->map[v][j];
+        u[12] = (float)set->color[v][0], u[13] = (float)set->color[v][1], u[14] = (float)set->color[v][2];
+        u[15] = (float)set->density[v];
+        u[16] = (float)set->shape[v];
+    }
+    return set->count > FOGVOL_ANALYTIC_MAX_VOLUMES ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+}
+
+/* ---- GLSL ----
+   The same maths in float, for every dialect: only constant-index expressions
+   (loop indices) index arrays, loops have constant bounds, so GLSL ES 1.00
+   fragment shaders accept it. The event list is sorted by a stable insertion
+   sort (adjacent swaps) from the order entry(0), exit(0), entry(1), ... which
+   gives the CPU's (t, event) order. Misses get t = 2 and sort to the end. */
+static const char fogvol__an_glsl_segment[] =
+    "#define FV_AN_MAX 8\n"
+    "uniform vec4 fv_analytic[2 + 5 * FV_AN_MAX];\n"
+    "vec2 fv_an_slab(vec2 t, float o, float v) {\n"
+    "    if (v != 0.0) {\n"
+    "        float a = (-1.0 - o) / v, b = (1.0 - o) / v;\n"
+    "        return vec2(max(t.x, min(a, b)), min(t.y, max(a, b)));\n"
+    "    }\n"
+    "    return abs(o) <= 1.0 ? t : vec2(1.0, -1.0);\n"
+    "}\n"
+    "vec2 fv_an_segment(vec4 r0, vec4 r1, vec4 r2, float shape, vec3 e, vec3 d, float len) {\n"
+    "    vec2 t = vec2(0.0, 1.0);\n"
+    "    if (shape < 0.5) {\n"
+    "        if (len <= 0.0) return vec2(1.0, -1.0);\n"
+    "        return vec2(r0.x / len, r0.y > 0.0 ? min(r0.y / len, 1.0) : 1.0);\n"
+    "    }\n"
+    "    vec3 o = vec3(dot(r0.xyz, e) + r0.w, dot(r1.xyz, e) + r1.w, dot(r2.xyz, e) + r2.w);\n"
+    "    vec3 v = vec3(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d));\n"
+    "    if (shape < 1.5) {\n"
+    "        if (v.x > 0.0) t.x = max(-o.x / v.x, 0.0);\n"
+    "        else if (v.x < 0.0) t.y = min(-o.x / v.x, 1.0);\n"
+    "        else if (o.x < 0.0) t.y = -1.0;\n"
+    "        return t;\n"
+    "    }\n"
+    "    if (shape > 3.5 && shape < 4.5) return fv_an_slab(fv_an_slab(fv_an_slab(t, o.x, v.x), o.y, v.y), o.z, v.z);\n"
+    "    vec3 k = shape > 4.5 ? vec3(1.0, 1.0, 0.0) : vec3(1.0);\n"
+    "    vec3 ok = o * k, vk = v * k, x = cross(ok, vk);\n"
+    "    float a = dot(vk, vk), b = dot(ok, vk), c = dot(ok, ok) - 1.0, disc = a - dot(x, x);\n"
+    "    if (a > 0.0) {\n"
+    "        if (disc <= 0.0) return vec2(1.0, -1.0);\n"
+    "        float s = sqrt(disc);\n"
+    "        float q = -(b + (b >= 0.0 ? s : -s));\n"
+    "        float r1 = q / a, r2 = c / q;\n"
+    "        t = vec2(max(min(r1, r2), 0.0), min(max(r1, r2), 1.0));\n"
+    "    } else if (c > 0.0) return vec2(1.0, -1.0);\n"
+    "    return shape > 4.5 ? fv_an_slab(t, o.z, v.z) : t;\n"
+    "}\n";
+static const char fogvol__an_glsl_add[] =
+    /* s = (fog or transmittance, cover, done, 0); cs = colour * density */
+    "void fv_an_add(vec3 cs, float sig, float l, float law, inout vec4 s, inout vec3 num) {\n"
+    "    float tau = sig * l;\n"
+    "    if (tau <= 0.0 || s.z > 0.5) return;\n"
+    "    if (law > 0.5 && law < 1.5) {\n"
+    "        float e = exp(-tau);\n"
+    "        float k = l * s.x * (tau < 1e-3 ? 1.0 - 0.5 * tau : (1.0 - e) / tau);\n"
+    "        num += cs * k;\n"
+    "        s.y += sig * k;\n"
+    "        s.x *= e;\n"
+    "        if (s.x < 1e-7) s.z = 1.0;\n"
+    "    } else if (law < 0.5) {\n"
+    "        float k = tau >= s.x ? s.x / tau : 1.0;\n"
+    "        num += cs * (l * k);\n"
+    "        s.y += tau * k;\n"
+    "        s.x = tau >= s.x ? 0.0 : s.x - tau;\n"
+    "        if (s.x <= 0.0) s.z = 1.0;\n"
+    "    } else {\n"
+    "        num = cs / sig * s.x + num * (1.0 - s.x);\n"
+    "        s.x = max(s.x - min(tau, 1.0), 0.0);\n"
+    "        if (s.x <= 0.0) s.z = 1.0;\n"
+    "    }\n"
+    "}\n"
+    "void fogvol_fold_fog(inout vec4 diffuse, inout vec4 specular, float fog, vec3 color) {\n"
+    "    diffuse.rgb *= fog;\n"
+    "    specular.rgb = specular.rgb * fog + color * (1.0 - fog);\n"
+    "}\n";
+static const char fogvol__an_glsl_main[] =
+    "void fogvol_analytic(vec3 p, out float fog, out vec3 color) {\n"
+    "    vec3 e = fv_analytic[0].xyz;\n"
+    "    float n = fv_analytic[0].w, law = fv_analytic[1].x;\n"
+    "    bool sep = fv_analytic[1].y < 0.5;\n"
+    "    vec3 d = p - e;\n"
+    "    float len = length(d);\n"
+    "    float kt[2 * FV_AN_MAX];\n"
+    "    vec4 kc[2 * FV_AN_MAX];\n"
+    "    float kl[2 * FV_AN_MAX];\n"
+    "    for (int i = 0; i < FV_AN_MAX; ++i) {\n"
+    "        vec4 cd = fv_analytic[5 * i + 5];\n"
+    "        vec2 t = vec2(2.0);\n"
+    "        if (float(i) < n) {\n"
+    "            t = fv_an_segment(fv_analytic[5 * i + 2], fv_analytic[5 * i + 3], fv_analytic[5 * i + 4],\n"
+    "                              fv_analytic[5 * i + 6].x, e, d, len);\n"
+    "            if (!(t.y > t.x) || cd.w <= 0.0) t = vec2(2.0);\n"
+    "        }\n"
+    "        vec4 c = vec4(cd.rgb * cd.w, cd.w);\n"
+    "        if (sep) {\n"
+    "            kt[i] = t.x;\n"
+    "            kc[i] = c;\n"
+    "            kl[i] = (t.y - t.x) * len;\n"
+    "            kt[i + FV_AN_MAX] = 2.0;\n"
+    "            kc[i + FV_AN_MAX] = vec4(0.0);\n"
+    "            kl[i + FV_AN_MAX] = 0.0;\n"
+    "        } else {\n"
+    "            kt[2 * i] = t.x;\n"
+    "            kc[2 * i] = c;\n"
+    "            kl[2 * i] = 1.0;\n"
+    "            kt[2 * i + 1] = t.y;\n"
+    "            kc[2 * i + 1] = -c;\n"
+    "            kl[2 * i + 1] = -1.0;\n"
+    "        }\n"
+    "    }\n"
+    "    for (int i = 1; i < 2 * FV_AN_MAX; ++i) {\n"
+    "        for (int j = 0; j < 2 * FV_AN_MAX; ++j) {\n"
+    "            if (j >= i || kt[i - j - 1] <= kt[i - j]) break;\n"
+    "            float tt = kt[i - j - 1]; kt[i - j - 1] = kt[i - j]; kt[i - j] = tt;\n"
+    "            vec4 tc = kc[i - j - 1]; kc[i - j - 1] = kc[i - j]; kc[i - j] = tc;\n"
+    "            float tl = kl[i - j - 1]; kl[i - j - 1] = kl[i - j]; kl[i - j] = tl;\n"
+    "        }\n"
+    "    }\n"
+    "    vec4 s = vec4(1.0, 0.0, 0.0, 0.0), acc = vec4(0.0);\n"
+    "    vec3 num = vec3(0.0);\n"
+    "    float open = 0.0, last = 0.0;\n"
+    "    for (int i = 0; i < 2 * FV_AN_MAX; ++i) {\n"
+    "        if (kt[i] > 1.5 || s.z > 0.5) break;\n"
+    "        if (sep) {\n"
+    "            fv_an_add(kc[i].rgb, kc[i].a, kl[i], law, s, num);\n"
+    "        } else {\n"
+    "            if (open > 0.5 && kt[i] > last) fv_an_add(acc.rgb, acc.a, (kt[i] - last) * len, law, s, num);\n"
+    "            acc += kc[i];\n"
+    "            open += kl[i];\n"
+    "            if (open < 0.5) acc = vec4(0.0);\n"
+    "            last = kt[i];\n"
+    "        }\n"
+    "    }\n"
+    "    fog = s.x;\n"
+    "    color = law > 1.5 ? num : (s.y > 0.0 ? num / s.y : vec3(0.0));\n"
+    "}\n";
+static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
+
+static const char *const fogvol__an_version[FOGVOL_GLSL_COUNT] = {
+    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
+    "#version 100\n", "#version 300 es\n"};
+
+static const char fogvol__an_vs_body[] =
+    "FV_ATTRIB vec3 fv_position;\n"
+    "uniform mat4 fv_mvp;\n"
+    "uniform mat4 fv_model;\n"
+    "#ifdef FV_PER_PIXEL\n"
+    "FV_VARYING_OUT vec3 fv_world;\n"
+    "#else\n"
+    "FV_VARYING_OUT vec4 fv_fog;\n"
+    "#endif\n"
+    "void main() {\n"
+    "    vec4 p = vec4(fv_position, 1.0);\n"
+    "    vec3 w = (fv_model * p).xyz;\n"
+    "#ifdef FV_PER_PIXEL\n"
+    "    fv_world = w;\n"
+    "#else\n"
+    "    float f;\n"
+    "    vec3 c;\n"
+    "    fogvol_analytic(w, f, c);\n"
+    "    fv_fog = vec4(c, f);\n"
+    "#endif\n"
+    "    gl_Position = fv_mvp * p;\n"
+    "}\n";
+
+static const char fogvol__an_fs_body[] =
+    "#ifdef FV_PER_PIXEL\n"
+    "FV_VARYING_IN vec3 fv_world;\n"
+    "#else\n"
+    "FV_VARYING_IN vec4 fv_fog;\n"
+    "#endif\n"
+    "void main() {\n"
+    "#ifdef FV_PER_PIXEL\n"
+    "    float f;\n"
+    "    vec3 c;\n"
+    "    fogvol_analytic(fv_world, f, c);\n"
+    "    FV_FRAGCOLOR = vec4(c, f);\n"
+    "#else\n"
+    "    FV_FRAGCOLOR = fv_fog;\n"
+    "#endif\n"
+    "}\n";
+
+FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, fogvol_stage stage, int per_pixel,
+                                                        const char **strings, int *count)
+{
+    int legacy, es, n = 0;
+    if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *count = 0;
+    if ((int)dialect <= (int)FOGVOL_GLSL_AUTO || (int)dialect >= (int)FOGVOL_GLSL_COUNT)
+        return FOGVOL_ERROR_UNSUPPORTED;
+    if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
+    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
+    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
+    strings[n++] = fogvol__an_version[dialect];
+    if (stage == FOGVOL_STAGE_VERTEX) {
+        if (es) strings[n++] = "precision highp float;\n";
+        strings[n++] = legacy ? "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n"
+                              : "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
+    } else {
+        if (dialect == FOGVOL_GLSL_100)
+            strings[n++] = "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\n"
+                           "precision mediump float;\n#endif\n";
+        else if (dialect == FOGVOL_GLSL_300ES)
+            strings[n++] = "precision highp float;\n";
+        strings[n++] = legacy ? "#define FV_VARYING_IN varying\n#define FV_FRAGCOLOR gl_FragColor\n"
+                              : "#define FV_VARYING_IN in\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+    }
+    if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
+    if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
+        strings[n++] = fogvol__an_glsl[0];
+        strings[n++] = fogvol__an_glsl[1];
+        strings[n++] = fogvol__an_glsl[2];
+    }
+    strings[n++] = stage == FOGVOL_STAGE_VERTEX ? fogvol__an_vs_body : fogvol__an_fs_body;
+    FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
+    *count = n;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
+{
+    int i;
+    for (i = 0; strings && i < capacity && i < 3; ++i) strings[i] = fogvol__an_glsl[i];
+    return 3;
 }
 
 /* >>shaders =============================================================== */
