@@ -49,7 +49,7 @@
        fogvol_mesh_desc md;  memset(&md, 0, sizeof md);
        md.positions = verts; md.vertex_count = nv;            // xyz floats
        md.indices = idx;     md.index_count = ni;             // CCW seen from outside
-       fogvol_mesh *blob;   fogvol_create_mesh(fv, &md, &blob);
+       fogvol_mesh *blob;   fogvol_create_mesh(fv, &md, &blob, NULL);
 
        fogvol_ramp_desc rd;  memset(&rd, 0, sizeof rd);       // extinction model
        rd.color[0] = rd.color[1] = rd.color[2] = 0.8f; rd.density = 0.5f;
@@ -65,7 +65,7 @@
        fogvol_volume_desc vd;  memset(&vd, 0, sizeof vd);
        vd.mesh = blob; vd.ramp = fog; memcpy(vd.model, model, 64);
        fogvol_add_volume(fv, &vd);
-       fogvol_end_frame(fv);           // renders and composites; GL state restored
+       fogvol_end_frame(fv, NULL);     // renders and composites; GL state restored
 
    Matrices are column-major float[16] (m[col*4+row]), OpenGL conventions: the
    camera looks down -z in view space, clip w = view depth.
@@ -736,7 +736,8 @@ typedef enum fogvol_uniform {
     FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, near-clamp w, 0) */
     FOGVOL_U_LINEAR = 6, /* "fv_lin":    projection (A, B, C, D) = (m[10], m[14], m[11], m[15]):
                             view z = (B - D z_ndc) / (C z_ndc - A) (engine depth texture) */
-    FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), 0, 0): view depth -> d */
+    FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
+                            zw: offset of the engine depth texel (ENGINE_DEPTH) */
     FOGVOL_U_COUNT = 8
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
@@ -2772,7 +2773,7 @@ static const char fogvol__fs_face[] =
     "uniform vec4 fv_nf;\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = FV_TEXTURE(fv_opaque, fv_st()).r * 2.0 - 1.0;\n"
+    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r * 2.0 - 1.0;\n"
     "    float o = -(fv_lin.y - fv_lin.w * z) / (fv_lin.z * z - fv_lin.x) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
@@ -2829,7 +2830,7 @@ static const char fogvol__fs_resolve[] =
     "    d.r += c;\n"
     "    float sat = max(max(b.r, b.g), max(b.b, max(f.r, max(f.g, f.b)))) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
     "    float covered = b + f == vec4(0.0) ? 0.0 : 1.0;\n"
-    "    FV_FRAGCOLOR = d.r < 0.0 ? vec4(0.0, 0.0, 0.0, covered) : vec4(d / 255.0, covered * (1.0 + sat) / 255.0);\n"
+    "    FV_FRAGCOLOR = vec4(d.r < 0.0 ? vec3(0.0) : d / 255.0, covered * (1.0 + sat) / 255.0);\n"
     "}\n";
 
 /* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F) (PS 4);
@@ -3142,6 +3143,11 @@ static void fogvol__null_draw_fullscreen(void *u)
     if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->fullscreen[s->pass_count - 1]++;
 }
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
+static uintptr_t fogvol__null_native(void *u, fogvol_handle h)
+{
+    (void)u;
+    return (uintptr_t)h;
+}
 static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
 {
     (void)u;
@@ -3181,6 +3187,7 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     table->end_pass = fogvol__null_end_pass;
     table->read_target = fogvol__null_read_target;
     table->target_attachment = fogvol__null_attachment;
+    table->native_texture = fogvol__null_native;
 }
 
 /* >>renderer ============================================================== */
@@ -4139,6 +4146,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     ps.uniforms[FOGVOL_U_LINEAR][3] = fd->projection[15];
     ps.uniforms[FOGVOL_U_NEARFAR][0] = k.near_far[0];
     ps.uniforms[FOGVOL_U_NEARFAR][1] = k.near_far[1];
+    ps.uniforms[FOGVOL_U_NEARFAR][2] = (float)fd->viewport[0]; /* ENGINE_DEPTH: target pixel -> engine texel */
+    ps.uniforms[FOGVOL_U_NEARFAR][3] = (float)fd->viewport[1];
     fogvol__target_space(ctx, &ps);
 
     /* step b: opaque depth into O (MRT: the engine wrote it; ENGINE_DEPTH: its depth texture) */
@@ -4377,7 +4386,8 @@ enum {
     FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
-    FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2
+    FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
+    FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0
 };
 
 /* X(return type, name without "gl", parameter list). Base: GL 2.0 / GLES 2.0. */
@@ -4467,8 +4477,12 @@ enum {
     X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindVertexArray, (fogvol__GLuint))
 
-/* Sampler objects: GL 3.3, GLES 3.0 (only to unbind the engine's from our units). */
-#define FOGVOL__GL_SAMPLER(X) X(void, BindSampler, (fogvol__GLuint, fogvol__GLuint))
+/* Sampler objects: GL 3.3, GLES 3.0 (to unbind the engine's from our units, and to sample the engine's
+   depth texture whatever its own filter and compare mode). */
+#define FOGVOL__GL_SAMPLER(X) X(void, BindSampler, (fogvol__GLuint, fogvol__GLuint)) \
+    X(void, GenSamplers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteSamplers, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, SamplerParameteri, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint))
 
 /* GL 3.0 / GLES 3.0: extension strings one by one. */
 #define FOGVOL__GL_3(X) X(const fogvol__GLubyte *, GetStringi, (fogvol__GLenum, fogvol__GLuint))
@@ -4555,6 +4569,7 @@ typedef struct fogvol__gl {
     int guard_box[4];
     fogvol__gl_program *program;
     fogvol__gl_mesh fullscreen;
+    fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
 } fogvol__gl;
 
 static int fogvol__has_ext(const char *list, const char *name)
@@ -5274,7 +5289,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
-        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, 0);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
     }
 }
 
@@ -5345,6 +5360,7 @@ static void fogvol__gl_destroy(void *u)
     fogvol_allocator a;
     if (!gl) return;
     fogvol__gl_free_mesh(gl, &gl->fullscreen);
+    if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -5531,8 +5547,17 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     }
     gl->stencil_override = desc->stencil_bits;
     gl->caps = fogvol__gl_caps(gl, ext);
+    if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
+        gl->GenSamplers(1, &gl->native_sampler);
+        gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+        gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+        gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
+        gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
+        gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
+    }
     r = fogvol__gl_upload(gl, &gl->fullscreen, tri, 3, NULL, 0);
     if (r != FOGVOL_SUCCESS) {
+        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
         fogvol__free(alloc, gl);
         return r;
     }

@@ -25,7 +25,7 @@ typedef struct tscene {
     int expect_overflow;
 } tscene;
 
-static tscene g_scenes[24];
+static tscene g_scenes[28];
 static int g_nscenes;
 
 static int mirrored(const float m[16])
@@ -155,6 +155,14 @@ static void build_scenes(void)
         shp_mat_mul(m, r, sc);
     }
     add(s, shp_box(0.9f, 0.6f, 0.7f), 1, m);
+
+    /* a negative sphere poking out of its box: where it leaves the box the
+       sum goes below zero, which must show as no fog (and no false overflow) */
+    s = new_scene("negative_pokes_out", 0, 0.4, 4, 0, 0, 0, 0.5, 10);
+    mat_trs(m, 0, 0, 0, 15, 0, 1, 0, 1);
+    add(s, shp_box(0.9f, 0.9f, 0.9f), 1, m);
+    shp_mat_translate(m, 0.85f, 0.1f, 0);
+    add(s, shp_sphere(0.6f, 64, 32), -1, m);
 
     /* seeds/001: the ray enters layer 1 (A1), leaves it (B1), enters layer 2
        (A2) and hits an opaque object (C) before layer 2's back face B2:

@@ -39,7 +39,7 @@ typedef struct tstats {
     int interior, max_faces;
 } tstats;
 
-static tstats g_stats[24][2];
+static tstats g_stats[28][2];
 
 static void logger(void *u, fogvol_log_level l, const char *m)
 {
