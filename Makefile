@@ -64,6 +64,10 @@ $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BU
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c -o $@ -lm
 $(BUILD)/fuzz_mesh: tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
+$(BUILD)/replay_analytic: tests/fuzz/replay.c tests/fuzz/fuzz_analytic.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_analytic.c -o $@ -lm
+$(BUILD)/fuzz_analytic: tests/fuzz/fuzz_analytic.c fogvol.h | $(BUILD)
+	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
 $(BUILD)/test_analytic: tests/test_analytic.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_analytic_san: tests/test_analytic.c $(HEADERS) | $(BUILD)
@@ -75,6 +79,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
+            $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
 
 test: deps-test deps-run
@@ -101,7 +106,9 @@ test: deps-test deps-run
 	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
-	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh"
+	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
+	  "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
+	  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
 
 # --- demo --------------------------------------------------------------------------
 $(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
@@ -145,11 +152,13 @@ $(BUILD)/bench_analytic: bench/bench_analytic.c fogvol.h | $(BUILD)
 bench-analytic: $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic
 
-# libFuzzer on mesh validation, FUZZ_TIME seconds per target; new inputs go to
+# libFuzzer on mesh validation and the analytic fog input, FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)
-fuzz: deps-test $(BUILD)/fuzz_mesh
-	@mkdir -p $(BUILD)/fuzz/mesh
+fuzz: deps-test $(BUILD)/fuzz_mesh $(BUILD)/fuzz_analytic
+	@mkdir -p $(BUILD)/fuzz/mesh $(BUILD)/fuzz/analytic
 	$(BUILD)/fuzz_mesh -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh
+	$(BUILD)/fuzz_analytic -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/analytic \
+	  tests/fuzz/corpus_analytic
 
 # the README pictures, regenerated from the demo
 images: demo
