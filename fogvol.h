@@ -4835,6 +4835,25 @@ static fogvol_result fogvol__gl_check(fogvol__gl *gl, const char *what)
     return FOGVOL_ERROR_BACKEND;
 }
 
+/* A new 2D texture bound on the active unit: RGBA8 or R32F, filter, wrap, pixels (may be NULL). */
+static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvol_format format, fogvol__GLint filter,
+                                             fogvol__GLint wrap, const void *pixels)
+{
+    fogvol__GLuint tex = 0;
+    gl->GenTextures(1, &tex);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, filter);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, filter);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, wrap);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, wrap);
+    if (format == FOGVOL_FORMAT_R32F)
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_R32F, w, h, 0, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, pixels);
+    else
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8, w, h,
+                       0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, pixels);
+    return tex;
+}
+
 static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -4850,14 +4869,7 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
-    gl->GenTextures(1, &tex);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, filt);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, filt);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, wrap);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, wrap);
-    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
-                   d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, d->pixels);
+    tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, filt, wrap, d->pixels);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
     if (r != FOGVOL_SUCCESS) gl->DeleteTextures(1, &tex);
     if (gl->in_frame) gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
@@ -4907,18 +4919,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
-    gl->GenTextures(1, &t->base.tex);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, t->base.tex);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
-    if (d->format == FOGVOL_FORMAT_R32F)
-        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_R32F, d->width, d->height, 0, FOGVOL__GL_RED,
-                       FOGVOL__GL_FLOAT, NULL);
-    else
-        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
-                       d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
+    t->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format, FOGVOL__GL_NEAREST,
+                                         FOGVOL__GL_CLAMP_TO_EDGE, NULL);
     gl->GenFramebuffers(1, &t->fbo);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D, t->base.tex, 0);
@@ -4930,14 +4932,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
             *t2 = *t;
             t2->second = NULL;
             t2->depth = 0;
-            gl->GenTextures(1, &t2->base.tex);
-            gl->BindTexture(FOGVOL__GL_TEXTURE_2D, t2->base.tex);
-            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
-            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
-            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_S, FOGVOL__GL_CLAMP_TO_EDGE);
-            gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
-            gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8,
-                           d->width, d->height, 0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, NULL);
+            t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
+                                                  FOGVOL__GL_CLAMP_TO_EDGE, NULL);
             gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
             gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
             gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
