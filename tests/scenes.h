@@ -218,6 +218,28 @@ static void upload_meshes(fogvol_context *fv, const tscene *s, fogvol_mesh **mes
     }
 }
 
+/* Add the scene to the open frame: volumes with their sign, occluders unless
+   the engine draws them itself (MRT). */
+static void add_scene(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, const fogvol_ramp *ramp,
+                      int with_occluders)
+{
+    int i;
+    for (i = 0; i < s->n; ++i) {
+        if (s->obj[i].sign == 0) {
+            if (with_occluders)
+                assert_int_equal(fogvol_add_occluder(fv, meshes[i], s->obj[i].model), FOGVOL_SUCCESS);
+        } else {
+            fogvol_volume_desc vd;
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = meshes[i];
+            vd.ramp = ramp;
+            vd.negative = s->obj[i].sign < 0;
+            memcpy(vd.model, s->obj[i].model, sizeof vd.model);
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        }
+    }
+}
+
 static void free_scenes(void)
 {
     int i, j;

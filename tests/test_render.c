@@ -99,7 +99,6 @@ static void render(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fo
                    fogvol_composite comp, int show_overflow, glu_ctx *g, frame_out *out)
 {
     fogvol_frame_desc fd;
-    int i;
     memset(&fd, 0, sizeof fd);
     rc_camera_matrices(&s->cam, fd.view, fd.projection);
     fd.znear = (float)s->cam.znear;
@@ -114,19 +113,7 @@ static void render(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fo
     glClear(GL_COLOR_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     fogvol_set_dither(fv, dither);
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-    for (i = 0; i < s->n; ++i) {
-        if (s->obj[i].sign == 0) {
-            assert_int_equal(fogvol_add_occluder(fv, meshes[i], s->obj[i].model), FOGVOL_SUCCESS);
-        } else {
-            fogvol_volume_desc vd;
-            memset(&vd, 0, sizeof vd);
-            vd.mesh = meshes[i];
-            vd.ramp = ramp;
-            vd.negative = s->obj[i].sign < 0;
-            memcpy(vd.model, s->obj[i].model, sizeof vd.model);
-            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-        }
-    }
+    add_scene(fv, s, meshes, ramp, 1);
     out->result = fogvol_end_frame(fv, &out->stats);
     glFinish();
     memcpy(out->pixels, g->pixels, (size_t)W * H * 4);

@@ -287,19 +287,7 @@ static void run(int ci, int di)
         } else {
             engine_draw(&e, s, fd.view, fd.projection, NULL);
         }
-        for (i = 0; i < s->n; ++i) {
-            if (s->obj[i].sign == 0) {
-                if (c->tier != FOGVOL_TIER_MRT) assert_int_equal(fogvol_add_occluder(fv, meshes[i], s->obj[i].model), 0);
-            } else {
-                fogvol_volume_desc vd;
-                memset(&vd, 0, sizeof vd);
-                vd.mesh = meshes[i];
-                vd.ramp = ramp;
-                vd.negative = s->obj[i].sign < 0;
-                memcpy(vd.model, s->obj[i].model, sizeof vd.model);
-                assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-            }
-        }
+        add_scene(fv, s, meshes, ramp, c->tier != FOGVOL_TIER_MRT);
         /* the engine's picture before the fog, to check the composite against */
         glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
         glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, base);
