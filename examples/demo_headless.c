@@ -375,6 +375,29 @@ static void false_colour(const float *t, unsigned char *out, int n, float tmax)
     }
 }
 
+/* n renders with these settings side by side; a setting whose context cannot
+   be created (tier not available) is left out; report: print each one's tier */
+static void row(demo *d, const char *dir, const char *name, const settings *v, int n, int report_each)
+{
+    shot sh[3];
+    unsigned char *imgs[3];
+    int k, got = 0;
+    for (k = 0; k < n; ++k) {
+        sh[got] = new_shot(v[k].w, v[k].h);
+        if (render(d, &v[k], 1, &sh[got])) {
+            imgs[got] = sh[got].rgba;
+            ++got;
+        } else {
+            free_shot(&sh[got]);
+        }
+    }
+    save_row(dir, name, imgs, got, v[0].w, v[0].h);
+    for (k = 0; k < got; ++k) {
+        if (report_each) report(fogvol_tier_name(sh[k].tier), &sh[k]);
+        free_shot(&sh[k]);
+    }
+}
+
 static int g_tap;
 static int check(int ok, const char *what)
 {
@@ -409,14 +432,12 @@ int main(int argc, char **argv)
 
     /* three viewpoints (automatic tier), the third inside the fog bank */
     for (k = 0; k < 3; ++k) {
-        char path[512];
         sh[k] = new_shot(DW, DH);
         s.view = k;
         if (!render(&d, &s, 1, &sh[k])) return 1;
         imgs[0] = sh[k].rgba;
         save_row(dir, view_names[k], imgs, 1, DW, DH);
         report(view_names[k], &sh[k]);
-        (void)path;
     }
     if (do_check) {
         /* fog only where some group has thickness; the inside view fogged everywhere */
@@ -453,62 +474,32 @@ int main(int argc, char **argv)
     }
     for (k = 0; k < 3; ++k) free_shot(&sh[k]);
 
-    /* the same frame per tier, half size */
+    /* side by side at half size: the tiers, dithering at 6 bits, the colour ramps */
     {
-        static const fogvol_tier tiers[3] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
-        settings t = s;
-        int got = 0;
-        t.w = DW / 2;
-        t.h = DH / 2;
-        t.view = 1;
+        settings v[3];
         for (k = 0; k < 3; ++k) {
-            sh[got] = new_shot(t.w, t.h);
-            t.tier = tiers[k];
-            if (render(&d, &t, 1, &sh[got])) {
-                imgs[got] = sh[got].rgba;
-                ++got;
-            } else {
-                free_shot(&sh[got]);
-            }
+            v[k] = s;
+            v[k].w = DW / 2;
+            v[k].h = DH / 2;
+            v[k].view = 1;
         }
-        save_row(dir, "tiers.png", imgs, got, t.w, t.h);
-        for (k = 0; k < got; ++k) {
-            report(fogvol_tier_name(sh[k].tier), &sh[k]);
-            free_shot(&sh[k]);
+        v[0].tier = FOGVOL_TIER_PS13;
+        v[1].tier = FOGVOL_TIER_PS20;
+        v[2].tier = FOGVOL_TIER_FLOAT;
+        row(&d, dir, "tiers.png", v, 3, 1);
+        for (k = 0; k < 2; ++k) { /* banding at low precision (dense fog) and its cure */
+            v[k].tier = FOGVOL_TIER_PS20;
+            v[k].bits = 2;
+            v[k].fog_scale = 4.0f;
+            v[k].dither = k;
         }
-    }
-    /* banding at low precision (6 bits, dense fog) and its cure */
-    {
-        settings t = s;
-        t.w = DW / 2;
-        t.h = DH / 2;
-        t.view = 1;
-        t.tier = FOGVOL_TIER_PS20;
-        t.bits = 2;
-        t.fog_scale = 4.0f;
-        for (k = 0; k < 2; ++k) {
-            sh[k] = new_shot(t.w, t.h);
-            t.dither = k;
-            render(&d, &t, 1, &sh[k]);
-            imgs[k] = sh[k].rgba;
-        }
-        save_row(dir, "dither.png", imgs, 2, t.w, t.h);
-        for (k = 0; k < 2; ++k) free_shot(&sh[k]);
-    }
-    /* colour ramps */
-    {
-        settings t = s;
-        t.w = DW / 2;
-        t.h = DH / 2;
-        t.view = 1;
+        row(&d, dir, "dither.png", v, 2, 0);
         for (k = 0; k < 3; ++k) {
-            sh[k] = new_shot(t.w, t.h);
-            t.ramp = k;
-            render(&d, &t, 1, &sh[k]);
-            imgs[k] = sh[k].rgba;
+            v[k] = v[2];
+            v[k].tier = FOGVOL_TIER_AUTO;
+            v[k].ramp = k;
         }
-        save_row(dir, "ramps.png", imgs, 3, t.w, t.h);
-        for (k = 0; k < 3; ++k) free_shot(&sh[k]);
+        row(&d, dir, "ramps.png", v, 3, 0);
     }
     for (i = 0; i < d.n; ++i) shp_free(&d.mesh[i]);
     if (do_check) printf("1..%d\n", g_tap);
