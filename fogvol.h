@@ -4928,10 +4928,10 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
         static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
         fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
         if (t2) {
-            memset(t2, 0, sizeof *t2);
-            *t2 = *t;
-            t2->second = NULL;
-            t2->depth = 0;
+            memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
+            t2->width = d->width;
+            t2->height = d->height;
+            t2->format = FOGVOL_FORMAT_RGBA8;
             t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
                                                   FOGVOL__GL_CLAMP_TO_EDGE, NULL);
             gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
