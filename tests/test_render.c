@@ -273,6 +273,15 @@ static void run_case(void **state)
         assert_int_equal(diff, 0);
     }
 
+    /* dithering is really on in f1: its per-pixel values differ from the rounded ones
+       on a large share of the covered pixels (the block means above stay unbiased) */
+    {
+        int differ = 0;
+        for (i = 0; i < W * H; ++i) differ += covered[i] && interior[i] && f1.thick[i] != f0.thick[i];
+        print_message("  %s/%s: dithered differs from rounded on %d of %d covered pixels\n", s->name, profile, differ,
+                      ninterior);
+        assert_true(differ * 10 > ninterior); /* about 1/4 per face (E|p - 1/2|); 0 with dithering off */
+    }
     st->max_err = max_err;
     st->mean_abs = ninterior ? sum_abs / ninterior : 0;
     st->mean_per_pair = ninterior ? sum_pp / ninterior : 0;

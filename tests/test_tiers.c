@@ -563,6 +563,17 @@ static void test_pass_counts(void **state)
     assert_int_equal(ti.seed_passes, 3);
     assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
     assert_int_equal(ti.library_passes, 2);
+    /* targets: O, B, F (+ T for PS13's resolve); one sum target S when single; FLOAT: O and the float sum */
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS13, 0, &ti), 0);
+    assert_int_equal(ti.targets, 4);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, 0, &ti), 0);
+    assert_int_equal(ti.targets, 3);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, &ti), 0);
+    assert_int_equal(ti.targets, 2);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, 0, &ti), 0);
+    assert_int_equal(ti.targets, 2);
+    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
+    assert_int_equal(ti.targets, 1);
     print_message("  passes (seed / fogvol): PS13 6/5, PS20 5/4, MRT 4/3, FLOAT 3/3, FLOAT+engine depth -/2\n");
 }
 
