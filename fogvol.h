@@ -225,6 +225,7 @@ typedef struct fogvol_encoding {
 } fogvol_encoding;
 
 #define FOGVOL_DEFAULT_BITS 4
+#define FOGVOL_WIDE_EXACT_BITS 3 /* largest L the WIDE variant encodes exactly (6L = 18 bits) */
 #define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
 
 /* Fill *out for L = bits (1..8). */
@@ -432,8 +433,10 @@ enum {
     FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
     /* PS20: more precision by spreading the encoding over two RGBA8 targets
        per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
-       arithmetic; fp32 fragment maths bounds it to about 23 bits (L <= 3 is
-       exact: 18 bits with 32 faces). Needs GLSL 110-330 or 300 es. */
+       arithmetic; fp32 fragment maths bounds it to about 23 bits, so only
+       L <= FOGVOL_WIDE_EXACT_BITS (3: 18 bits with 32 faces) is exact:
+       encoding_bits 0 picks 3 and larger values are refused
+       (FOGVOL_ERROR_UNSUPPORTED). Needs GLSL 110-330 or 300 es. */
     FOGVOL_VARIANT_WIDE = 1u << 5,
     FOGVOL_VARIANT_ALL = (1u << 6) - 1u
 };
@@ -918,7 +921,8 @@ typedef enum fogvol_composite {
 typedef struct fogvol_context_desc {
     fogvol_allocator allocator;
     fogvol_logger logger;
-    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces) */
+    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
+                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
     fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
                               FLOAT if float blending, else MRT if engine_mrt and MRT,
                               else PS20 if highp fragment shaders, else PS13 */
@@ -3467,6 +3471,33 @@ FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *
     return ctx ? ctx->tier : FOGVOL_TIER_AUTO;
 }
 
+/* encoding_bits: 0 = the default (FOGVOL_DEFAULT_BITS; WIDE: FOGVOL_WIDE_EXACT_BITS, the most precise
+   setting its fp32 arithmetic encodes exactly). Combinations that cannot sum correctly are refused. */
+static fogvol_result fogvol__resolve_bits(const fogvol_context_desc *desc, int *bits)
+{
+    int wide = (desc->variants & FOGVOL_VARIANT_WIDE) != 0;
+    int b = desc->encoding_bits ? desc->encoding_bits : (wide ? FOGVOL_WIDE_EXACT_BITS : FOGVOL_DEFAULT_BITS);
+    if (b < 1 || b > 8) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: encoding_bits %d outside 1..8", desc->encoding_bits);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (wide && b > FOGVOL_WIDE_EXACT_BITS) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR,
+                    "fogvol: WIDE with encoding_bits %d needs %d-bit digits, beyond what fp32 fragment arithmetic "
+                    "encodes exactly; use encoding_bits <= %d (0 picks %d)",
+                    b, 6 * b, FOGVOL_WIDE_EXACT_BITS, FOGVOL_WIDE_EXACT_BITS);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if ((desc->variants & FOGVOL_VARIANT_SINGLE_TARGET) && b >= 8) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR,
+                    "fogvol: SINGLE_TARGET with encoding_bits 8 sums no face (the mid-range bias needs a carry bit); "
+                    "use encoding_bits <= 7");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    *bits = b;
+    return FOGVOL_SUCCESS;
+}
+
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
 {
     fogvol_context *ctx;
@@ -3481,17 +3512,14 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: allocator needs both alloc and free");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    bits = desc->encoding_bits ? desc->encoding_bits : FOGVOL_DEFAULT_BITS;
-    if (bits < 1 || bits > 8) {
-        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: encoding_bits %d outside 1..8", desc->encoding_bits);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
     if ((int)desc->tier < 0 || (int)desc->tier >= FOGVOL_TIER_COUNT ||
         (desc->variants & ~(unsigned)FOGVOL_VARIANT_ALL)) {
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown tier %d or variants 0x%x", (int)desc->tier,
                     desc->variants);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    r = fogvol__resolve_bits(desc, &bits);
+    if (r != FOGVOL_SUCCESS) return r;
     ctx = (fogvol_context *)fogvol__alloc(a, sizeof *ctx);
     if (!ctx) {
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: out of memory for the context");
@@ -3639,10 +3667,30 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     return FOGVOL_SUCCESS;
 }
 
+/* An open frame drops the volumes and occluders that use a mesh or ramp being
+   destroyed; the rest of the frame stays. */
+static void fogvol__forget(fogvol_context *ctx, const fogvol_mesh *mesh, const fogvol_ramp *ramp)
+{
+    int i, n = 0, dv, doc;
+    if (!ctx->in_frame) return;
+    for (i = 0; i < ctx->nvol; ++i)
+        if (!((mesh && ctx->vols[i].mesh == mesh) || (ramp && ctx->vols[i].ramp == ramp))) ctx->vols[n++] = ctx->vols[i];
+    dv = ctx->nvol - n;
+    ctx->nvol = n;
+    for (i = n = 0; i < ctx->nocc; ++i)
+        if (!mesh || ctx->occ[i].fn || ctx->occ[i].mesh != mesh) ctx->occ[n++] = ctx->occ[i];
+    doc = ctx->nocc - n;
+    ctx->nocc = n;
+    if (dv || doc)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: %s destroyed inside a frame: %d volumes and %d occluders that use it are dropped from "
+                    "the frame", mesh ? "mesh" : "ramp", dv, doc);
+}
+
 FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
 {
     if (!ctx || !mesh) return;
-    if (ctx->in_frame) fogvol_cancel_frame(ctx); /* the frame may reference it */
+    fogvol__forget(ctx, mesh, NULL);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
     ctx->live_meshes--;
     fogvol__free(&ctx->alloc, mesh);
@@ -3696,7 +3744,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
 FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
 {
     if (!ctx || !ramp) return;
-    if (ctx->in_frame) fogvol_cancel_frame(ctx);
+    fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
     ctx->live_ramps--;
     fogvol__free(&ctx->alloc, ramp);

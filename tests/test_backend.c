@@ -1187,6 +1187,132 @@ static void test_a3_frame_protocol(void **state)
         if (!log_error_has(&lc, NULL)) fail_msg("%s: no error message was logged", #call);             \
     } while (0)
 
+/* A mesh or ramp destroyed inside a frame drops only what uses it: the rest of
+   the frame renders (a streamed-out asset must not kill the fog). */
+static void test_a3_destroy_inside_frame(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context *fv;
+    shp_mesh box = box_mesh();
+    fogvol_mesh *m[3];
+    fogvol_ramp *fog, *light;
+    fogvol_frame_desc fd;
+    fogvol_frame_stats st;
+    fogvol_volume_desc vd;
+    float id[16];
+    int i;
+    (void)state;
+    log_reset(&lc);
+    rec_init(&r);
+    fv = rec_context(&r, &lc, NULL);
+    for (i = 0; i < 3; ++i) assert_int_equal(make_mesh(fv, &box, 0, 0, &m[i]), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &fog), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_LIGHT, &light), FOGVOL_SUCCESS);
+    a_frame_desc(&fd);
+    mat_identity(id);
+    memset(&vd, 0, sizeof vd);
+    mat_identity(vd.model);
+
+    /* a mesh the frame does not use: nothing dropped, nothing logged */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    vd.mesh = m[0];
+    vd.ramp = fog;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    log_reset(&lc);
+    fogvol_destroy_mesh(fv, m[2]);
+    assert_int_equal(lc.count, 0);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.volumes, 1);
+    assert_int_equal(st.groups, 1);
+
+    /* a mesh used by one volume and one occluder: those two go, with a warning; the other volume renders */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_occluder(fv, m[1], id), FOGVOL_SUCCESS);
+    vd.mesh = m[0];
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    vd.mesh = m[1];
+    vd.ramp = light;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    log_reset(&lc);
+    fogvol_destroy_mesh(fv, m[1]);
+    assert_int_equal(lc.warnings, 1);
+    assert_non_null(strstr(lc.msg[0], "1 volumes and 1 occluders"));
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.volumes, 1);
+    assert_int_equal(st.occluders, 0);
+    assert_int_equal(st.groups, 1);
+    assert_int_equal(r.nb.passes[r.nb.pass_count - 1].blend, FOGVOL_PASS_BLEND_FOG); /* the fog group stayed */
+
+    /* a ramp: its group goes, the other group renders */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    vd.mesh = m[0];
+    vd.ramp = light;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    vd.ramp = fog;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    log_reset(&lc);
+    fogvol_destroy_ramp(fv, light);
+    assert_int_equal(lc.warnings, 1);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.groups, 1);
+    assert_int_equal(st.volumes, 1);
+    assert_int_equal(r.nb.passes[r.nb.pass_count - 1].blend, FOGVOL_PASS_BLEND_FOG);
+    fogvol_destroy_mesh(fv, m[0]);
+    fogvol_destroy_ramp(fv, fog);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r.nb.creates, r.nb.destroys);
+}
+
+/* Encoding settings that cannot sum correctly are refused; WIDE's default is its exact setting. */
+static void test_a4_encoding_combinations(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    (void)state;
+    rec_init(&r);
+    r.table.caps |= FOGVOL_CAP_MRT; /* WIDE draws two targets */
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r.table;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.logger = cap_logger(&lc);
+    /* SINGLE_TARGET, L = 8: 2^(7-8) faces, none; L = 7 sums one face */
+    cd.variants = FOGVOL_VARIANT_SINGLE_TARGET;
+    cd.encoding_bits = 8;
+    log_reset(&lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    assert_null(fv);
+    assert_true(log_error_has(&lc, "SINGLE_TARGET"));
+    cd.encoding_bits = 7;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_encoding(fv)->max_faces_single, 1);
+    fogvol_destroy_context(fv);
+    /* WIDE: 0 = L 3 (18 exact bits); L 4 (24 bits, beyond fp32) refused; L 2 kept */
+    cd.variants = FOGVOL_VARIANT_WIDE;
+    cd.encoding_bits = 0;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_encoding(fv)->bits, 3);
+    fogvol_destroy_context(fv);
+    cd.encoding_bits = 4;
+    log_reset(&lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    assert_null(fv);
+    assert_true(log_error_has(&lc, "WIDE"));
+    cd.encoding_bits = 2;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_encoding(fv)->bits, 2);
+    fogvol_destroy_context(fv);
+    /* without WIDE the default stays 4 */
+    cd.variants = 0;
+    cd.encoding_bits = 0;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_context_encoding(fv)->bits, FOGVOL_DEFAULT_BITS);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r.nb.creates, r.nb.destroys);
+}
+
 static void test_a4_bad_input(void **state)
 {
     rec r;
@@ -2514,6 +2640,8 @@ int main(void)
         cmocka_unit_test(test_a1_geometry_without_stencil),
         cmocka_unit_test(test_a2_negative_only_group),
         cmocka_unit_test(test_a3_frame_protocol),
+        cmocka_unit_test(test_a3_destroy_inside_frame),
+        cmocka_unit_test(test_a4_encoding_combinations),
         cmocka_unit_test(test_a4_bad_input),
         cmocka_unit_test(test_a5_backend_create_faults),
         cmocka_unit_test(test_a5_alloc_faults_context),
