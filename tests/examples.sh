@@ -165,7 +165,23 @@ EOF
   if command -v pkg-config > /dev/null; then
     run "pkg-config --cflags --libs fogvol" env PKG_CONFIG_PATH="$prefix/share/pkgconfig" \
       pkg-config --cflags --libs fogvol
-    expect "pkg-config: -I$prefix/include" "^-I$prefix/include +-lm"
+    # the .pc finds its prefix from its own place (${pcfiledir}): the include dir must be $prefix/include
+    inc=$(sed -n 's/^-I\([^ ]*\).*/\1/p' "$log")
+    if [ -n "$inc" ] && [ "$(cd "$inc" 2>/dev/null && pwd -P)" = "$(cd "$prefix/include" && pwd -P)" ] &&
+       grep -Eq -- ' -lm *$' "$log"; then
+      ok "pkg-config: -I resolves to $prefix/include, -lm"
+    else
+      not_ok "pkg-config: -I resolves to $prefix/include, -lm (got: $(cat "$log"))"
+    fi
+    # installed to another prefix than the one configured: the .pc and the CMake package follow
+    moved=$cm/moved
+    run "cmake --install --prefix (not the configured prefix)" cmake --install "$cm/fogvol" --prefix "$moved"
+    run "pkg-config consumer builds against the moved install" bash -c "$cc -std=c99 '$cm/consumer/main.c' \
+      -o '$cm/pc_moved' \$(PKG_CONFIG_PATH='$moved/share/pkgconfig' pkg-config --cflags --libs fogvol) && \
+      test \"\$(PKG_CONFIG_PATH='$moved/share/pkgconfig' pkg-config --variable=includedir fogvol | xargs realpath)\" \
+        = \"\$(realpath '$moved/include')\" && '$cm/pc_moved'"
+    run "cmake: find_package from the moved install" bash -c "cmake -S '$cm/consumer' -B '$cm/find_moved' \
+      -DCMAKE_PREFIX_PATH='$moved' -DFOGVOL_WANT=0.1 && cmake --build '$cm/find_moved' && '$cm/find_moved/consumer'"
     run "pkg-config consumer builds and runs" bash -c "$cc -std=c99 '$cm/consumer/main.c' -o '$cm/pc_consumer' \
       \$(PKG_CONFIG_PATH='$prefix/share/pkgconfig' pkg-config --cflags --libs fogvol) && '$cm/pc_consumer'"
   else

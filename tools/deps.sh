@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the tests and examples need, only when missing.
 # Usage: tools/deps.sh test|demo|run
+# FOGVOL_NO_INSTALL=1 turns installing off (provide the packages yourself, e.g. on a non-Debian system).
 set -euo pipefail
 what=${1:-test}
 pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind"
@@ -12,6 +13,20 @@ case "$what" in
   run) pkgs="$pkgs_run" ;;
   *) echo "usage: $0 test|demo|run" >&2; exit 2 ;;
 esac
+# FOGVOL_NO_INSTALL=1: never install anything (the dependencies are yours to provide)
+if [ "${FOGVOL_NO_INSTALL:-0}" = 1 ]; then
+  exit 0
+fi
+if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
+  cat >&2 <<EOF2
+deps: this is not a Debian-like system (no dpkg-query/apt-get), so nothing is installed.
+deps: '$what' needs these Debian packages or their equivalents: $pkgs
+deps:   (OSMesa: mesa's libOSMesa + headers; cmocka; stb_image_write.h under <stb/>; glslangValidator;
+deps:    GLFW 3 and Xvfb for the windowed demo; cmake and pkg-config for the packaging tests)
+deps: install them, then run again with FOGVOL_NO_INSTALL=1.
+EOF2
+  exit 1
+fi
 missing=()
 for p in $pkgs; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
