@@ -943,9 +943,12 @@ typedef enum fogvol_composite {
    sample targets, one fog value per pixel for all its samples (edges of
    occluders inside fog come out wrong by up to the full fog contrast); logged
    as a warning once and reported in fogvol_frame_stats.msaa_fallback.
-   Cost: the per-sample passes shade every sample (4x MSAA: about 4x the
-   fragment work of fogvol's passes, and 4x the target memory; measured in
-   tests/test_engine_msaa.c). */
+   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
+   fragment work and 4x the target memory of fogvol's passes (measured in
+   tests/test_engine_msaa.c, FLOAT at 640x480 on llvmpipe: 4x per sample took
+   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
+   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
 typedef enum fogvol_msaa {
     FOGVOL_MSAA_AUTO = 0,
     FOGVOL_MSAA_SINGLE_SAMPLE = 1,
