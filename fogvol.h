@@ -465,6 +465,9 @@ typedef struct fogvol_shader_desc {
     fogvol_program program;
     fogvol_dialect dialect;/* not AUTO */
     fogvol_stage stage;
+    int samples;           /* 0 or 1: single-sample targets; > 1: the fragment shader reads fogvol's
+                              targets as multisample textures at gl_SampleID (FV_MSAA; see
+                              fogvol_msaa_supported). Vertex shaders are the same either way. */
 } fogvol_shader_desc;
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -478,6 +481,12 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
    else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
    so on; see the table in the README). */
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+/* FOGVOL_SUCCESS if the tier with these variants can render into a
+   multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
+   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
+   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
+   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* 1 if the tier runs this program. */
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
 
@@ -775,6 +784,8 @@ typedef struct fogvol_target_desc {
     int width, height;        /* colour texture, NEAREST, CLAMP */
     int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE), drawn together */
     fogvol_format format;
+    int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
+                                 2D multisample, fixed sample locations) and depth renderbuffer */
     int depth;                /* 1: with a depth buffer */
     fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
     const char *label;
@@ -818,6 +829,8 @@ typedef struct fogvol_pass {
     int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
                                stencil buffer; the bit is zero before and after the pass */
     unsigned stencil_bit;
+    int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
+                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
@@ -838,11 +851,15 @@ enum {
     FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
     FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
     FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
-    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3    /* the engine can sample its depth buffer */
+    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
+    FOGVOL_CAP_MULTISAMPLE = 1u << 4      /* multisampled targets and per-sample shading
+                                             (GL 4.0, or GL 3.2 + ARB_sample_shading) */
 };
 
 typedef struct fogvol_frame_info {
     int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
+    int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
+                         GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
 } fogvol_frame_info;
 
 typedef struct fogvol_backend {
@@ -890,6 +907,7 @@ typedef struct fogvol_null_backend {
     int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
     int create_calls;
     int stencil_bits;       /* reported by begin_frame */
+    int samples;            /* reported by begin_frame (engine framebuffer samples) */
 } fogvol_null_backend;
 /* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE (AUTO picks PS20);
    change table->caps before creating a context to test other choices. */
@@ -918,6 +936,28 @@ typedef enum fogvol_composite {
     FOGVOL_COMPOSITE_GEOMETRY = 1    /* the volume geometry, guarded by one stencil bit */
 } fogvol_composite;
 
+/* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
+   fogvol_end_frame). AUTO: fogvol's targets get the engine's sample count and
+   every pass is shaded per sample, so each sample of the engine framebuffer
+   gets the fog of its own ray and the engine's resolve averages them; where
+   the tier, variants or GLSL dialect cannot (fogvol_msaa_supported) or the
+   backend lacks FOGVOL_CAP_MULTISAMPLE, end_frame logs why and returns
+   FOGVOL_ERROR_UNSUPPORTED without drawing. SINGLE_SAMPLE (opt-in): single-
+   sample targets, one fog value per pixel for all its samples (edges of
+   occluders inside fog come out wrong by up to the full fog contrast); logged
+   as a warning once and reported in fogvol_frame_stats.msaa_fallback.
+   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
+   fragment work and 4x the target memory of fogvol's passes (measured in
+   tests/test_engine_msaa.c, FLOAT at 640x480 on llvmpipe: 4x per sample took
+   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
+   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
+typedef enum fogvol_msaa {
+    FOGVOL_MSAA_AUTO = 0,
+    FOGVOL_MSAA_SINGLE_SAMPLE = 1,
+    FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
+} fogvol_msaa;
+
 typedef struct fogvol_context_desc {
     fogvol_allocator allocator;
     fogvol_logger logger;
@@ -929,6 +969,7 @@ typedef struct fogvol_context_desc {
     unsigned variants;     /* FOGVOL_VARIANT_* */
     int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
+    fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
     fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
     fogvol_gl_desc gl;     /* for the GL backend */
 } fogvol_context_desc;
@@ -952,6 +993,9 @@ typedef struct fogvol_frame_stats {
     int volumes, occluders; /* drawn */
     int groups;             /* colour-ramp groups composited */
     int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
+    int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
+    int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
+                               drew one fog value per pixel */
 } fogvol_frame_stats;
 
 typedef struct fogvol_frame_desc {
@@ -966,7 +1010,8 @@ typedef struct fogvol_frame_desc {
        viewport, rows bottom to top, for the group of debug_ramp (NULL = the
        first group). Set debug_thickness to a width*height float buffer. */
     float *debug_thickness;
-    const fogvol_ramp *debug_ramp;
+    const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
+                                      sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
     /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
        object, GL: texture name), depth range [0,1], sampled with its .r */
     uintptr_t engine_depth_texture;
@@ -2630,6 +2675,24 @@ static const char *const fogvol__version[FOGVOL_GLSL_COUNT] = {
     "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
     "#version 100\n", "#version 300 es\n"};
 
+/* Multisampled targets (fogvol_shader_desc.samples > 1): gl_SampleID needs
+   GLSL 400 or ARB_sample_shading, declared before any other token. */
+static const char *const fogvol__version_msaa[FOGVOL_GLSL_COUNT] = {
+    "", "", "", "", "#version 150\n#extension GL_ARB_sample_shading : require\n",
+    "#version 330 core\n#extension GL_ARB_sample_shading : require\n", "", ""};
+/* FV_MSAA: fogvol's targets are sampler2DMS (FV_TARGET_SAMPLER); FV_TEXTURE
+   overloads on the sampler type, so a target read fetches this fragment's
+   own sample and the ramps keep their filtered lookups. */
+static const char fogvol__fs_msaa[] =
+    "#define FV_MSAA\n"
+    "#define FV_TARGET_SAMPLER sampler2DMS\n"
+    "vec4 fv_tex(sampler2D s, vec2 st) { return texture(s, st); }\n"
+    "vec4 fv_tex(sampler2DMS s, vec2 st) {\n"
+    "    return texelFetch(s, ivec2(floor(st * vec2(textureSize(s)))), gl_SampleID);\n"
+    "}\n"
+    "#undef FV_TEXTURE\n"
+    "#define FV_TEXTURE fv_tex\n";
+
 static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
 static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
 static const char fogvol__vs_es[] = "precision highp float;\n";
@@ -2698,6 +2761,7 @@ static const char fogvol__vs_fullscreen[] =
 /* Shared fragment code: uniforms, the RGB encode (ramps or ALU, same bytes),
    the borrow fold (normalised digits, alpha free), screen coordinates. */
 static const char fogvol__fs_common[] =
+    "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
     "uniform vec4 fv_enc;\n"    /* (N, N^2, depth offset, depth max) */
     "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
@@ -2770,7 +2834,7 @@ static const char fogvol__fs_encode[] =
    depth of every face in one pass, the sign from gl_FrontFacing. */
 static const char fogvol__fs_face[] =
     "FV_VARYING_IN float fv_d;\n"
-    "uniform sampler2D fv_opaque;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_FLOAT\n"
     "uniform float fv_sign;\n"
     "uniform vec4 fv_lin;\n"
@@ -2817,9 +2881,9 @@ static const char fogvol__fs_face[] =
 /* PS13 resolve: B - F per channel with carries into normalised digits (exact
    small-integer arithmetic, fine in mediump), alpha marks covered pixels. */
 static const char fogvol__fs_resolve[] =
-    "uniform sampler2D fv_back;\n"
-    "uniform sampler2D fv_front;\n"
-    "uniform sampler2D fv_opaque;\n"
+    "uniform FV_TARGET_SAMPLER fv_back;\n"
+    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "void main() {\n"
     "    vec4 b = FV_TEXTURE(fv_back, fv_st()), f = FV_TEXTURE(fv_front, fv_st());\n"
     "    vec3 d = floor((b.rgb - f.rgb) * 255.0 + 0.5);\n"
@@ -2842,10 +2906,10 @@ static const char fogvol__fs_resolve[] =
    biased target; PS13 reads the resolved thickness; FLOAT the float sum. */
 static const char fogvol__fs_composite[] =
     "uniform vec4 fv_rampmap;\n"
-    "uniform sampler2D fv_back;\n"
-    "uniform sampler2D fv_front;\n"
+    "uniform FV_TARGET_SAMPLER fv_back;\n"
+    "uniform FV_TARGET_SAMPLER fv_front;\n"
     "uniform sampler2D fv_colors;\n"
-    "uniform sampler2D fv_opaque;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_WIDE\n"
     "uniform sampler2D fv_back2;\n"
     "uniform sampler2D fv_front2;\n"
@@ -2933,6 +2997,16 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
     }
 }
 
+FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
+{
+    if (dialect != FOGVOL_GLSL_150 && dialect != FOGVOL_GLSL_330) return FOGVOL_ERROR_UNSUPPORTED;
+    if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
+    if (v & FOGVOL_VARIANT_WIDE) return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
+    if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
+        return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+    return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
+}
+
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
 {
     switch (program) {
@@ -2990,9 +3064,12 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         !fogvol_tier_uses_program(d->tier, d->variants, d->program))
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->stage != FOGVOL_STAGE_VERTEX && d->stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
+    if (d->samples > 1 && fogvol_msaa_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
+        return FOGVOL_ERROR_UNSUPPORTED;
     legacy = d->dialect == FOGVOL_GLSL_110 || d->dialect == FOGVOL_GLSL_120 || d->dialect == FOGVOL_GLSL_100;
     es = d->dialect == FOGVOL_GLSL_100 || d->dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = fogvol__version[d->dialect];
+    strings[n++] = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT ? fogvol__version_msaa[d->dialect]
+                                                                         : fogvol__version[d->dialect];
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
         if (es) strings[n++] = fogvol__vs_es;
@@ -3013,6 +3090,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
     for (i = 0; i < 6; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
+    if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE)
                            ? fogvol__vs_fullscreen
@@ -3040,6 +3118,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     d.program = program;
     d.dialect = dialect;
     d.stage = stage;
+    d.samples = 0;
     return fogvol_shader_strings(&d, strings, count);
 }
 
@@ -3095,6 +3174,7 @@ static fogvol_result fogvol__null_begin_frame(void *u, fogvol_frame_info *info)
     s->frames_begun++;
     s->pass_count = 0;
     info->stencil_bits = s->stencil_bits;
+    info->samples = s->samples;
     return FOGVOL_SUCCESS;
 }
 static void fogvol__null_end_frame(void *u) { ((fogvol_null_backend *)u)->frames_ended++; }
@@ -3238,6 +3318,11 @@ struct fogvol_context {
                                                  FLOAT: B is the float sum */
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     int target_w, target_h;
+    fogvol_msaa msaa;
+    int samples, target_samples;     /* this frame's / the targets' samples per pixel (0: single-sample) */
+    int prog_ms, compile_samples;    /* prog holds the per-sample set; samples for fogvol__make_program */
+    int msaa_warned;
+    fogvol_handle prog_alt[FOGVOL_PROGRAM_COUNT]; /* the other set (single-sample or per-sample), 0 = not built */
     int in_frame, in_occluder_pass, mrt_ready;
     fogvol_frame_desc frame;
     double viewproj[16];
@@ -3301,11 +3386,13 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
 {
     fogvol_target_desc td;
     fogvol_result r;
-    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h) return FOGVOL_SUCCESS;
+    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples)
+        return FOGVOL_SUCCESS;
     fogvol__destroy_targets(ctx);
     memset(&td, 0, sizeof td);
     td.width = w;
     td.height = h;
+    td.samples = ctx->samples;
     r = FOGVOL_SUCCESS;
     if (ctx->tier == FOGVOL_TIER_FLOAT) {
         td.format = FOGVOL_FORMAT_R32F;
@@ -3349,6 +3436,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
     }
     ctx->target_w = w;
     ctx->target_h = h;
+    ctx->target_samples = ctx->samples;
     return FOGVOL_SUCCESS;
 }
 
@@ -3358,6 +3446,8 @@ static void fogvol__release(fogvol_context *ctx)
     fogvol__destroy_targets(ctx);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
         if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
+        if (ctx->prog_alt[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog_alt[i]);
     if (ctx->tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_rg);
     if (ctx->tex_blue) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_blue);
     if (ctx->tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_dither);
@@ -3413,6 +3503,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     sd.variants = ctx->variants;
     sd.program = p;
     sd.dialect = ctx->be.dialect;
+    sd.samples = ctx->compile_samples;
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
@@ -3513,9 +3604,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((int)desc->tier < 0 || (int)desc->tier >= FOGVOL_TIER_COUNT ||
-        (desc->variants & ~(unsigned)FOGVOL_VARIANT_ALL)) {
-        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown tier %d or variants 0x%x", (int)desc->tier,
-                    desc->variants);
+        (desc->variants & ~(unsigned)FOGVOL_VARIANT_ALL) ||
+        (desc->msaa != FOGVOL_MSAA_AUTO && desc->msaa != FOGVOL_MSAA_SINGLE_SAMPLE)) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown tier %d, variants 0x%x or msaa %d",
+                    (int)desc->tier, desc->variants, (int)desc->msaa);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     r = fogvol__resolve_bits(desc, &bits);
@@ -3530,6 +3622,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->log = desc->logger;
     ctx->dither = !desc->disable_dither;
     ctx->variants = desc->variants;
+    ctx->msaa = desc->msaa;
     fogvol_encoding_init(&ctx->enc, bits);
     if (desc->backend.create_texture) {
         const fogvol_backend *b = &desc->backend;
@@ -4076,6 +4169,63 @@ static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
     ps->textures[2] = ctx->tex_dither;
 }
 
+/* Make ctx->prog the per-sample set (ms = 1) or the single-sample set, building
+   the per-sample programs on first use. */
+static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
+{
+    fogvol_handle t[FOGVOL_PROGRAM_COUNT];
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
+    if (ms == ctx->prog_ms) return FOGVOL_SUCCESS;
+    memcpy(t, ctx->prog, sizeof t);
+    memcpy(ctx->prog, ctx->prog_alt, sizeof t);
+    memcpy(ctx->prog_alt, t, sizeof t);
+    ctx->prog_ms = ms;
+    ctx->compile_samples = ms ? 2 : 0;
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
+        if (!ctx->prog[i] && fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
+            r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+    ctx->compile_samples = 0;
+    return r;
+}
+
+/* The engine framebuffer's samples decide this frame's targets and programs
+   (see fogvol_msaa): per sample, the opt-in single-sample fallback, or refused. */
+static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_frame_info *info,
+                                           fogvol_frame_stats *st)
+{
+    int n = info->samples > 1 ? info->samples : 0;
+    const char *why = NULL;
+    if (n && ctx->msaa == FOGVOL_MSAA_SINGLE_SAMPLE) {
+        if (!ctx->msaa_warned)
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                        "fogvol: %d-sample engine framebuffer drawn with single-sample targets "
+                        "(FOGVOL_MSAA_SINGLE_SAMPLE): one fog value per pixel",
+                        n);
+        ctx->msaa_warned = 1;
+        st->msaa_fallback = 1;
+        n = 0;
+    } else if (n) {
+        if (!(ctx->be.caps & FOGVOL_CAP_MULTISAMPLE))
+            why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
+        else if (fogvol_msaa_supported(ctx->tier, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS)
+            why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
+                  "or ENGINE_DEPTH)";
+        else if (ctx->frame.debug_thickness)
+            why = "debug_thickness cannot read multisampled targets";
+        if (why) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                        "fogvol: %d-sample engine framebuffer, tier %s, variants 0x%x, GLSL %s: %s; "
+                        "FOGVOL_MSAA_SINGLE_SAMPLE draws one fog value per pixel instead",
+                        n, fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect), why);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+    }
+    ctx->samples = n;
+    st->samples = n ? n : 1;
+    return fogvol__msaa_programs(ctx, n > 1);
+}
+
 static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_frame_info *info)
 {
     fogvol_result r = FOGVOL_SUCCESS;
@@ -4157,11 +4307,14 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol_cancel_frame(ctx);
         return r;
     }
+    r = fogvol__frame_samples(ctx, &info, &st);
+    if (r != FOGVOL_SUCCESS) goto done;
     r = fogvol__ensure_targets(ctx, w, h);
     if (r != FOGVOL_SUCCESS) goto done;
 
     /* pass uniforms common to every pass */
     memset(&ps, 0, sizeof ps);
+    ps.per_sample = ctx->samples > 1;
     ps.uniforms[FOGVOL_U_ENC][0] = (float)ctx->enc.levels;
     ps.uniforms[FOGVOL_U_ENC][1] = (float)ctx->enc.levels * (float)ctx->enc.levels;
     ps.uniforms[FOGVOL_U_ENC][2] = k.depth_offset;
@@ -4437,6 +4590,12 @@ enum {
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
     FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0
 };
+/* Multisampled targets and per-sample shading. */
+enum {
+    FOGVOL__GL_MULTISAMPLE = 0x809D, FOGVOL__GL_SAMPLE_BUFFERS = 0x80A8, FOGVOL__GL_SAMPLES = 0x80A9,
+    FOGVOL__GL_SAMPLE_SHADING = 0x8C36, FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE = 0x8C37,
+    FOGVOL__GL_TEXTURE_2D_MULTISAMPLE = 0x9100, FOGVOL__GL_TEXTURE_BINDING_2D_MULTISAMPLE = 0x9104
+};
 
 /* X(return type, name without "gl", parameter list). Base: GL 2.0 / GLES 2.0. */
 #define FOGVOL__GL_BASE(X) \
@@ -4558,6 +4717,17 @@ enum {
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
 #undef FOGVOL__GL_PFN
 
+/* Multisampled targets: GL 3.2 (texture multisample), per-sample shading GL 4.0 / ARB_sample_shading. */
+#define FOGVOL__GL_MSAA(X) \
+    X(void, TexImage2DMultisample, (fogvol__GLenum, fogvol__GLsizei, fogvol__GLenum, fogvol__GLsizei, \
+                                    fogvol__GLsizei, fogvol__GLboolean)) \
+    X(void, RenderbufferStorageMultisample, (fogvol__GLenum, fogvol__GLsizei, fogvol__GLenum, fogvol__GLsizei, \
+                                             fogvol__GLsizei)) \
+    X(void, MinSampleShading, (fogvol__GLfloat))
+#define FOGVOL__GL_PFN_MSAA(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
+FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
+#undef FOGVOL__GL_PFN_MSAA
+
 typedef struct fogvol__gl_state {
     fogvol__GLint draw_fbo, read_fbo, renderbuffer, viewport[4], scissor_box[4], program, vao, array_buffer,
         element_buffer, active_texture, tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS];
@@ -4571,6 +4741,9 @@ typedef struct fogvol__gl_state {
     fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
     fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
     void *a0_pointer;
+    fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
+    fogvol__GLboolean en_multisample, en_sample_shading;
+    fogvol__GLfloat min_sample_shading;
     fogvol__GLboolean en_blend, en_depth, en_cull, en_scissor, en_stencil, en_dither, en_a2c, en_samplecov,
         en_polyoffset, en_discard, en_logicop, en_alphatest;
 } fogvol__gl_state;
@@ -4578,6 +4751,7 @@ typedef struct fogvol__gl_state {
 /* Textures and targets share this header so either can be bound for sampling. */
 typedef struct fogvol__gl_texture {
     fogvol__GLuint tex;
+    int samples; /* > 1: a multisample texture (GL_TEXTURE_2D_MULTISAMPLE) */
 } fogvol__gl_texture;
 
 typedef struct fogvol__gl_target {
@@ -4609,6 +4783,10 @@ typedef struct fogvol__gl {
     int major, minor, gles, core;
     int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
     int stencil_override;
+    int has_msaa; /* multisample textures and per-sample shading */
+#define FOGVOL__GL_MEMBER_MSAA(ret, name, params) fogvol__PFN_##name name;
+    FOGVOL__GL_MSAA(FOGVOL__GL_MEMBER_MSAA)
+#undef FOGVOL__GL_MEMBER_MSAA
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -4638,10 +4816,62 @@ static void fogvol__gl_enable(fogvol__gl *gl, fogvol__GLenum cap, int on)
     else gl->Disable(cap);
 }
 
+/* Multisample texture bindings of fogvol's units, multisampling and sample shading. */
+static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    fogvol__GLint active = 0;
+    int i;
+    if (!gl->has_msaa) return;
+    gl->GetIntegerv(FOGVOL__GL_ACTIVE_TEXTURE, &active);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->GetIntegerv(FOGVOL__GL_TEXTURE_BINDING_2D_MULTISAMPLE, &s->tex2dms[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)active);
+    s->en_multisample = gl->IsEnabled(FOGVOL__GL_MULTISAMPLE);
+    s->en_sample_shading = gl->IsEnabled(FOGVOL__GL_SAMPLE_SHADING);
+    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading);
+}
+
+static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    if (!gl->has_msaa) return;
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, (fogvol__GLuint)s->tex2dms[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
+    fogvol__gl_enable(gl, FOGVOL__GL_MULTISAMPLE, s->en_multisample);
+    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, s->en_sample_shading);
+    gl->MinSampleShading(s->min_sample_shading);
+}
+
+/* A pass on multisampled targets: their textures on the multisample binding
+   points, multisampling on and every sample shaded (per_sample); other passes
+   shade once per pixel. */
+static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
+{
+    int i;
+    if (!gl->has_msaa) return;
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        const fogvol__gl_texture *t = (const fogvol__gl_texture *)p->textures[i];
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE,
+                        t && !p->native_textures[i] && t->samples > 1 ? t->tex : 0);
+    }
+    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, p->per_sample);
+    if (p->per_sample) {
+        gl->Enable(FOGVOL__GL_MULTISAMPLE);
+        gl->MinSampleShading(1.0f);
+    }
+}
+
 static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
 {
     int i;
     memset(s, 0, sizeof *s);
+    fogvol__gl_save_msaa(gl, s);
     if (gl->has_split_fbo) {
         gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
         gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
@@ -4732,6 +4962,7 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
 static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
 {
     int i;
+    fogvol__gl_restore_msaa(gl, s);
     if (gl->has_split_fbo) {
         gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
         gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
@@ -4861,6 +5092,12 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
         gl->GetIntegerv(FOGVOL__GL_STENCIL_BITS, &bits);
     }
     info->stencil_bits = bits;
+    if (gl->has_msaa) { /* of the engine's draw framebuffer, still bound */
+        fogvol__GLint buffers = 0, samples = 0;
+        gl->GetIntegerv(FOGVOL__GL_SAMPLE_BUFFERS, &buffers);
+        gl->GetIntegerv(FOGVOL__GL_SAMPLES, &samples);
+        info->samples = buffers ? samples : 0;
+    }
     return FOGVOL_SUCCESS;
 }
 
@@ -4902,6 +5139,18 @@ static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvo
     return tex;
 }
 
+/* A new multisample colour texture (RGBA8 or R32F, fixed sample locations) bound on the active unit. */
+static fogvol__GLuint fogvol__gl_new_texture_ms(fogvol__gl *gl, const fogvol_target_desc *d)
+{
+    fogvol__GLuint tex = 0;
+    gl->GenTextures(1, &tex);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
+    gl->TexImage2DMultisample(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, d->samples,
+                              d->format == FOGVOL_FORMAT_R32F ? (fogvol__GLenum)FOGVOL__GL_R32F : (fogvol__GLenum)FOGVOL__GL_RGBA8, d->width,
+                              d->height, 1);
+    return tex;
+}
+
 static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -4927,6 +5176,7 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
         return r;
     }
     t->tex = tex;
+    t->samples = 0;
     *out = (fogvol_handle)t;
     return FOGVOL_SUCCESS;
 }
@@ -4958,6 +5208,11 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     fogvol__GLenum status;
     fogvol_result r;
     *out = 0;
+    if (d->samples > 1 && (!gl->has_msaa || d->color_count == 2)) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s: no %d-sample target%s on this context",
+                    d->label ? d->label : "target", d->samples, d->color_count == 2 ? " with two attachments" : "");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
     t = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(t, 0, sizeof *t);
@@ -4967,11 +5222,18 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
-    t->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format, FOGVOL__GL_NEAREST,
-                                         FOGVOL__GL_CLAMP_TO_EDGE, NULL);
+    if (d->samples > 1)
+        t->base.tex = fogvol__gl_new_texture_ms(gl, d);
+    else
+        t->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format, FOGVOL__GL_NEAREST,
+                                             FOGVOL__GL_CLAMP_TO_EDGE, NULL);
+    t->base.samples = d->samples > 1 ? d->samples : 0;
     gl->GenFramebuffers(1, &t->fbo);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
-    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D, t->base.tex, 0);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0,
+                             t->base.samples ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
+                                             : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D,
+                             t->base.tex, 0);
     if (d->color_count == 2 && gl->DrawBuffers) { /* WIDE: a second RGBA8 texture at attachment 1 */
         static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
         fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
@@ -5001,9 +5263,13 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
         t->owns_depth = 1;
         gl->GenRenderbuffers(1, &t->depth);
         gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
-        gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
-                                gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
-                                d->width, d->height);
+        if (t->base.samples)
+            gl->RenderbufferStorageMultisample(FOGVOL__GL_RENDERBUFFER, d->samples, FOGVOL__GL_DEPTH_COMPONENT24,
+                                               d->width, d->height);
+        else
+            gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
+                                    gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
+                                    d->width, d->height);
         gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
                                     t->depth);
     }
@@ -5022,6 +5288,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     if (gl->in_frame) { /* the next pass rebinds what it needs; keep the saved renderbuffer binding */
         gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)gl->saved.renderbuffer);
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+        if (gl->has_msaa) gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, 0);
     }
     fogvol__gl_leave(gl, &s);
     if (t) *out = (fogvol_handle)t;
@@ -5330,11 +5597,13 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
+        if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
         if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
     }
+    fogvol__gl_sample_pass(gl, p);
 }
 
 static void fogvol__gl_end_pass(void *u)
@@ -5386,6 +5655,7 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
     fogvol__gl_state s;
     fogvol_result r;
     if (!t || !rgba || size < (size_t)t->width * (size_t)t->height * 4u) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
@@ -5440,6 +5710,23 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         if (gl->major >= 3) caps |= FOGVOL_CAP_FLOAT_BLEND; /* R32F render targets and float blending are core */
     }
     return caps;
+}
+
+/* Multisample targets and per-sample shading: GL 4.0, or GL 3.2 with
+   ARB_sample_shading (desktop; GLES 3.1/3.2 would need a 310 es dialect). */
+static int fogvol__gl_load_msaa(fogvol__gl *gl, const fogvol_gl_desc *desc)
+{
+    int v4 = gl->major >= 4;
+    if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) return 0;
+    if (!v4 && !fogvol__gl_has_ext3(gl, "GL_ARB_sample_shading")) return 0;
+    gl->TexImage2DMultisample =
+        (fogvol__PFN_TexImage2DMultisample)desc->get_proc_address("glTexImage2DMultisample", desc->user_data);
+    gl->RenderbufferStorageMultisample = (fogvol__PFN_RenderbufferStorageMultisample)desc->get_proc_address(
+        "glRenderbufferStorageMultisample", desc->user_data);
+    gl->MinSampleShading = (fogvol__PFN_MinSampleShading)desc->get_proc_address(
+        v4 ? "glMinSampleShading" : "glMinSampleShadingARB", desc->user_data);
+    gl->has_msaa = gl->TexImage2DMultisample && gl->RenderbufferStorageMultisample && gl->MinSampleShading;
+    return gl->has_msaa;
 }
 
 /* Parse "M.m" at the first digit of s. */
@@ -5591,6 +5878,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     }
     gl->stencil_override = desc->stencil_bits;
     gl->caps = fogvol__gl_caps(gl, ext);
+    if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
         gl->GenSamplers(1, &gl->native_sampler);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);

@@ -1,7 +1,9 @@
 /* Writes every existing shader -- tier x variant set x program x dialect x
    stage -- to DIR/<tier>_v<variants>_<program>_<dialect>.<vert|frag> for
    glslangValidator, and checks that combinations that do not exist give
-   FOGVOL_ERROR_UNSUPPORTED and no strings. */
+   FOGVOL_ERROR_UNSUPPORTED and no strings. The per-sample fragment shaders
+   (fogvol_shader_desc.samples = 4, where fogvol_msaa_supported) go to
+   <tier>_v<variants>_<program>_<dialect>_ms.frag. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -14,8 +16,9 @@ int main(int argc, char **argv)
                                                            "resolve"};
     static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
     const char *dir = argc > 1 ? argv[1] : ".";
-    int t, p, d, st, n = 0, refused = 0;
+    int t, p, d, st, n = 0, refused = 0, ms;
     unsigned v;
+    for (ms = 0; ms < 2; ++ms)
     for (t = 1; t < FOGVOL_TIER_COUNT; ++t)
         for (v = 0; v <= FOGVOL_VARIANT_ALL; ++v)
             for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
@@ -32,9 +35,12 @@ int main(int argc, char **argv)
                         sd.program = (fogvol_program)p;
                         sd.dialect = (fogvol_dialect)d;
                         sd.stage = (fogvol_stage)st;
+                        sd.samples = ms ? 4 : 0;
+                        if (ms && st == FOGVOL_STAGE_VERTEX) continue; /* the same as single-sample */
                         r = fogvol_shader_strings(&sd, s, &count);
                         if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
-                            !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p)) {
+                            !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p) ||
+                            (ms && fogvol_msaa_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS)) {
                             if (r != FOGVOL_ERROR_UNSUPPORTED || count != 0) {
                                 fprintf(stderr, "a combination that does not exist gave strings\n");
                                 return 1;
@@ -47,8 +53,8 @@ int main(int argc, char **argv)
                                     dia[d]);
                             return 1;
                         }
-                        snprintf(path, sizeof path, "%s/%s_v%02u_%s_%s.%s", dir, fogvol_tier_name((fogvol_tier)t), v,
-                                 prog[p], dia[d], st ? "frag" : "vert");
+                        snprintf(path, sizeof path, "%s/%s_v%02u_%s_%s%s.%s", dir, fogvol_tier_name((fogvol_tier)t), v,
+                                 prog[p], dia[d], ms ? "_ms" : "", st ? "frag" : "vert");
                         f = fopen(path, "w");
                         if (!f) return 1;
                         for (i = 0; i < count; ++i) fputs(s[i], f);
