@@ -97,6 +97,7 @@ test: deps-test deps-run
 	  "analytic=BUILD=$(BUILD) $(TAP) $(BUILD)/test_analytic" \
 	  "analytic_asan_ubsan=BUILD=$(BUILD) $(TAP) $(LSAN_ENV) $(BUILD)/test_analytic_san" \
 	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
+	  "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
 	  "cpu=$(TAP) $(BUILD)/test_cpu" \
 	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
 	  "cpu_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_cpu_san" \

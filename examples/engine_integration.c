@@ -328,7 +328,7 @@ static void draw_objects(const engine *e)
 /* ================================ fogvol ========================================= */
 static fogvol_gl_proc fv_proc(const char *name, void *u) { (void)u; return glfwGetProcAddress(name); } /* fogvol */
 static fogvol_mesh *fv_mesh(fogvol_context *fv, const shp_mesh *m) { /* fogvol */
-    fogvol_mesh_desc md = {0}; fogvol_mesh *out = NULL; /* fogvol */
+    fogvol_mesh_desc md; fogvol_mesh *out = NULL; memset(&md, 0, sizeof md); /* fogvol */
     md.positions = m->pos; md.vertex_count = m->vcount; /* fogvol */
     md.indices = (const uint32_t *)m->idx; md.index_count = m->icount; /* fogvol */
     fogvol_create_mesh(fv, &md, &out, NULL); return out; } /* fogvol */
@@ -341,7 +341,7 @@ static void fv_occluders(fogvol_context *fv, void *user) { /* fogvol */
 
 static int fog_init(engine *e, int force_ps20)
 {
-    fogvol_context_desc cd = {0}; fogvol_ramp_desc rd = {0}; /* fogvol */
+    fogvol_context_desc cd; fogvol_ramp_desc rd; memset(&cd, 0, sizeof cd); memset(&rd, 0, sizeof rd); /* fogvol */
     cd.gl.get_proc_address = fv_proc; cd.tier = FOGVOL_TIER_FLOAT; cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH; /* fogvol */
     e->engine_depth = !force_ps20 && fogvol_create_context(&cd, &e->fv) == FOGVOL_SUCCESS; /* fogvol */
     cd.tier = FOGVOL_TIER_PS20; cd.variants = 0; /* fogvol */
@@ -356,7 +356,7 @@ static int fog_init(engine *e, int force_ps20)
 /* after the opaque pass, with the engine's framebuffer bound */
 static void fog_render(engine *e)
 {
-    fogvol_frame_desc fd = {0}; fogvol_volume_desc vd = {0}; int i; /* fogvol */
+    fogvol_frame_desc fd; fogvol_volume_desc vd; int i; memset(&fd, 0, sizeof fd); memset(&vd, 0, sizeof vd); /* fogvol */
     memcpy(fd.view, e->view, 64); memcpy(fd.projection, e->proj, 64); /* fogvol */
     fd.znear = ZNEAR; fd.zfar = ZFAR; fd.viewport[2] = e->w; fd.viewport[3] = e->h; /* fogvol */
     fd.engine_depth_texture = e->depth_tex; /* (PS20 ignores it) */ /* fogvol */

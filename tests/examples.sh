@@ -61,6 +61,12 @@ for b in $builds; do
   else not_ok "build $name (C99, -Wall -Wextra -pedantic -Werror, $libs)"; fi
   rm -f "$out/build_$name.log" "$out/build_$name.rc"
 done
+# every example also compiles as C++11 with the same warnings (the header says "one C or C++ file")
+for b in $builds; do
+  name=${b%%:*}
+  run "$name compiles as C++11 (-Wall -Wextra -pedantic -Werror)" \
+    ${CXX:-c++} -x c++ -std=c++11 -Wall -Wextra -pedantic -Werror -fsyntax-only -I. "examples/$name.c"
+done
 lines=$(grep -c 'fogvol \*/' examples/engine_integration.c)
 if [ "$lines" -gt 0 ] && [ "$lines" -lt 40 ]; then ok "engine_integration adds fog in $lines marked lines (< 40)"
 else not_ok "engine_integration adds fog in $lines marked lines (want 1..39)"; fi
