@@ -68,7 +68,16 @@
        fogvol_end_frame(fv, NULL);     // renders and composites; GL state restored
 
    Matrices are column-major float[16] (m[col*4+row]), OpenGL conventions: the
-   camera looks down -z in view space, clip w = view depth.
+   camera looks down -z in view space, clip w = view depth (perspective) or a
+   constant (orthographic). The projection's depth convention does not matter:
+   reversed-Z, [0,1] or [-1,1] depth, infinite far plane, TAA jitter, oblique
+   near plane and mirrored x/y all work, since fogvol computes its own clip depth
+   from znear/zfar and takes the winding from how the projection orients the
+   screen. The GL backend reads the engine's glClipControl and glDepthRange, draws
+   with NEGATIVE_ONE_TO_ONE and depth range (0,1) (same origin) and restores them.
+   A camera known only as a view-projection matrix goes in with
+   fogvol_frame_desc.camera = FOGVOL_CAMERA_VIEW_PROJECTION plus eye and forward;
+   fogvol_projection_planes() recovers znear/zfar from a projection.
 
    RESULT CODES AND LOGGING
    ========================
