@@ -764,6 +764,27 @@ static void test_camera_refused(void **state)
     g_logged = 0;
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
     assert_int_equal(g_logged, 1);
+    /* an engine that only has P V and passes it as the projection with view = I: the w row
+       is the view depth of the real camera, not of the identity view; refused, not guessed */
+    fd.camera = FOGVOL_CAMERA_VIEW_AND_PROJECTION;
+    {
+        const double at[3] = {0.0, 0.0, -6.0}, up[3] = {0.0, 1.0, 0.0};
+        double a[16], b[16], m[16];
+        float v[16];
+        int i;
+        glu_look_at(v, g_eye, at, up);
+        make_projection(P_GL, &s, fd.projection);
+        for (i = 0; i < 16; ++i) {
+            a[i] = fd.projection[i];
+            b[i] = v[i];
+        }
+        mul4d(m, a, b);
+        for (i = 0; i < 16; ++i) fd.projection[i] = (float)m[i];
+        g_logged = 0;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+        assert_int_equal(g_logged, 1);
+        make_projection(P_GL, &s, fd.projection);
+    }
     fd.camera = (fogvol_camera)7;
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
     fd.camera = FOGVOL_CAMERA_VIEW_AND_PROJECTION;
