@@ -8,7 +8,10 @@
    reversed-Z matrices without clip control, orthographic projections (a
    volume reaching far beyond the far plane), infinite far planes,
    TAA-jittered and oblique-near-plane projections, mirrored x or y, and a
-   camera given only as view-projection + eye + forward.
+   camera given only as view-projection + eye + forward, a camera inside the
+   volume, and depth conventions told in the frame desc after the engine reset
+   its state. Tiers: PS13, PS20 (+count, +single, +nearclamp), MRT (the engine
+   writes fogvol's O through fogvol_mrt_snippet), FLOAT, FLOAT+enginedepth.
 
    Ground truth is computed here, independently: each pixel's ray comes from
    the inverse of the engine's own view-projection (in double), the volume is
@@ -96,6 +99,7 @@ static const combo g_combos[] = {
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count"},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single"},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp"},
+    {FOGVOL_TIER_MRT, 0, "MRT"},
 };
 #define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
 
@@ -307,15 +311,15 @@ static gt_px trace(const scene *s, double far_end, const double *ivp, const doub
 typedef struct engine {
     GLuint fbo, color, depth, prog, vao, vbo[3], ibo[3];
     GLsizei count[3];
-    GLint u_mvp, u_color;
+    GLint u_mvp, u_mv, u_color, u_mrt;
     PFNGLCLIPCONTROLPROC clip_control;
 } engine;
 
-static GLuint compile(GLenum type, const char *src)
+static GLuint compile(GLenum type, const char *const *src, int n)
 {
     GLuint s = glCreateShader(type);
     GLint ok = 0;
-    glShaderSource(s, 1, &src, NULL);
+    glShaderSource(s, n, src, NULL);
     glCompileShader(s);
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
     assert_true(ok);
@@ -335,19 +339,28 @@ static void engine_mesh(engine *e, int i, const shp_mesh *m)
 
 static void engine_init(engine *e)
 {
-    const char *vs = "#version 330 core\nlayout(location = 0) in vec3 pos;\nuniform mat4 mvp;\n"
-                     "void main() { gl_Position = mvp * vec4(pos, 1.0); }\n";
-    const char *fs = "#version 330 core\nuniform vec4 color;\nout vec4 frag;\nvoid main() { frag = color; }\n";
+    /* colour, and for the MRT tier fogvol's encoded view depth as a second output */
+    const char *vs = "#version 330 core\nlayout(location = 0) in vec3 pos;\nuniform mat4 mvp;\nuniform mat4 mv;\n"
+                     "out float view_depth;\n"
+                     "void main() { gl_Position = mvp * vec4(pos, 1.0); view_depth = -(mv * vec4(pos, 1.0)).z; }\n";
+    const char *fs[3];
     GLint ok = 0;
+    fs[0] = "#version 330 core\n";
+    fs[1] = fogvol_mrt_snippet();
+    fs[2] = "uniform vec4 color;\nin float view_depth;\nlayout(location = 0) out vec4 frag;\n"
+            "layout(location = 1) out vec4 fogvol_o;\n"
+            "void main() { frag = color; fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
     memset(e, 0, sizeof *e);
     e->prog = glCreateProgram();
-    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, vs));
-    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs));
+    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, &vs, 1));
+    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs, 3));
     glLinkProgram(e->prog);
     glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
     assert_true(ok);
     e->u_mvp = glGetUniformLocation(e->prog, "mvp");
     e->u_color = glGetUniformLocation(e->prog, "color");
+    e->u_mv = glGetUniformLocation(e->prog, "mv");
+    e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
     glGenVertexArrays(1, &e->vao);
     glGenTextures(1, &e->color);
     glBindTexture(GL_TEXTURE_2D, e->color);
@@ -380,10 +393,14 @@ static void engine_free(engine *e)
     glDeleteProgram(e->prog);
 }
 
-/* The engine's opaque pass under its convention; the state stays set for fogvol. */
-static void engine_draw(engine *e, const conv *c, const float *vp, const float model[3][16])
+/* The engine's opaque pass under its convention; the state stays set for fogvol. With
+   mrt, fogvol's O texture is its second colour attachment. */
+static void engine_draw(engine *e, const conv *c, const float *vp, const float *view, const float model[3][16],
+                        const fogvol_mrt_info *mrt)
 {
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     const float bg[4] = {0.2f, 0.5f, 0.8f, 1.0f}, grey[4] = {0.45f, 0.4f, 0.35f, 1.0f};
+    const GLfloat zclear = c->greater ? 0.0f : 1.0f;
     int i;
     e->clip_control(c->upper_left ? GL_UPPER_LEFT : GL_LOWER_LEFT, c->zero_to_one ? GL_ZERO_TO_ONE
                                                                                   : GL_NEGATIVE_ONE_TO_ONE);
@@ -391,14 +408,18 @@ static void engine_draw(engine *e, const conv *c, const float *vp, const float m
     glDepthFunc(c->greater ? GL_GREATER : GL_LESS);
     glClearDepth(c->greater ? 0.0 : 1.0);
     glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, mrt ? (GLuint)mrt->texture : 0, 0);
+    glDrawBuffers(mrt ? 2 : 1, bufs);
     glViewport(0, 0, W, H);
-    glClearColor(bg[0], bg[1], bg[2], bg[3]);
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    if (mrt) glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
+    glClearBufferfv(GL_DEPTH, 0, &zclear);
     glUseProgram(e->prog);
     glBindVertexArray(e->vao);
     glUniform4fv(e->u_color, 1, grey);
+    if (mrt) glUniform4fv(e->u_mrt, 2, mrt->uniforms);
     for (i = 0; i < 2; ++i) {
         double a[16], b[16], m[16];
         float f[16];
@@ -410,6 +431,10 @@ static void engine_draw(engine *e, const conv *c, const float *vp, const float m
         mul4d(m, a, b);
         for (j = 0; j < 16; ++j) f[j] = (float)m[j];
         glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, f);
+        for (j = 0; j < 16; ++j) a[j] = view[j];
+        mul4d(m, a, b);
+        for (j = 0; j < 16; ++j) f[j] = (float)m[j];
+        glUniformMatrix4fv(e->u_mv, 1, GL_FALSE, f);
         glBindBuffer(GL_ARRAY_BUFFER, e->vbo[1 + i]);
         glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, NULL);
         glEnableVertexAttribArray(0);
@@ -419,6 +444,8 @@ static void engine_draw(engine *e, const conv *c, const float *vp, const float m
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);
+    glDrawBuffers(1, bufs); /* fogvol composites into attachment 0 */
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
 }
 
 static void logger(void *u, fogvol_log_level l, const char *m)
@@ -461,6 +488,7 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     float vp[16];
     fogvol_frame_desc fd;
     fogvol_volume_desc vd;
+    fogvol_mrt_info mrt;
     depth_state before, after;
     const fogvol_encoding *enc = fogvol_context_encoding(fv);
     result res;
@@ -495,15 +523,6 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     model[0][5] = (float)((s.bmax[1] - s.bmin[1]) / 2);
     model[0][10] = (float)((s.bmax[2] - s.bmin[2]) / 2);
 
-    engine_draw(e, c, vp, (const float(*)[16])model);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
-    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, base);
-    if (c->told) {
-        e->clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
-        glDepthRange(0.0, 1.0);
-    }
-    get_depth_state(&before);
-
     memset(&fd, 0, sizeof fd);
     if (c->vp_camera) {
         fd.camera = FOGVOL_CAMERA_VIEW_PROJECTION;
@@ -529,7 +548,16 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     }
     res.r = fogvol_begin_frame(fv, &fd);
     if (res.r != FOGVOL_SUCCESS) return res;
-    if (!(cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH))
+    if (cb->tier == FOGVOL_TIER_MRT) assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+    engine_draw(e, c, vp, view, (const float(*)[16])model, cb->tier == FOGVOL_TIER_MRT ? &mrt : NULL);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, base);
+    if (c->told) {
+        e->clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+        glDepthRange(0.0, 1.0);
+    }
+    get_depth_state(&before);
+    if (!(cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && cb->tier != FOGVOL_TIER_MRT)
         for (i = 0; i < 2; ++i) assert_int_equal(fogvol_add_occluder(fv, meshes[1 + i], model[1 + i]), FOGVOL_SUCCESS);
     memset(&vd, 0, sizeof vd);
     vd.mesh = meshes[0];
