@@ -62,6 +62,10 @@ $(BUILD)/test_engine_msaa: tests/test_engine_msaa.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_engine_msaa_san: tests/test_engine_msaa.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_depth: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_depth_san: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
 $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
@@ -86,6 +90,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
 TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
+TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
 
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory $(TEST_BINS)
@@ -112,6 +117,8 @@ test: deps-test deps-run
 	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san" \
 	  "engine_msaa=$(TAP) $(BUILD)/test_engine_msaa" \
 	  "engine_msaa_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_msaa_san" \
+	  "engine_depth=$(TAP) $(BUILD)/test_engine_depth" \
+	  "engine_depth_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_depth_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \

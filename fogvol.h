@@ -68,7 +68,16 @@
        fogvol_end_frame(fv, NULL);     // renders and composites; GL state restored
 
    Matrices are column-major float[16] (m[col*4+row]), OpenGL conventions: the
-   camera looks down -z in view space, clip w = view depth.
+   camera looks down -z in view space, clip w = view depth (perspective) or a
+   constant (orthographic). The projection's depth convention does not matter:
+   reversed-Z, [0,1] or [-1,1] depth, infinite far plane, TAA jitter, oblique
+   near plane and mirrored x/y all work, since fogvol computes its own clip depth
+   from znear/zfar and takes the winding from how the projection orients the
+   screen. The GL backend reads the engine's glClipControl and glDepthRange, draws
+   with NEGATIVE_ONE_TO_ONE and depth range (0,1) (same origin) and restores them.
+   A camera known only as a view-projection matrix goes in with
+   fogvol_frame_desc.camera = FOGVOL_CAMERA_VIEW_PROJECTION plus eye and forward;
+   fogvol_projection_planes() recovers znear/zfar from a projection.
 
    RESULT CODES AND LOGGING
    ========================
@@ -746,11 +755,13 @@ typedef enum fogvol_uniform {
     FOGVOL_U_DECODE = 3, /* "fv_dec":    decode weights (world units) */
     FOGVOL_U_RAMP = 4,   /* "fv_rampmap": (slope, offset, overflow flag, 0): thickness -> ramp s */
     FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, near-clamp w, 0) */
-    FOGVOL_U_LINEAR = 6, /* "fv_lin":    projection (A, B, C, D) = (m[10], m[14], m[11], m[15]):
-                            view z = (B - D z_ndc) / (C z_ndc - A) (engine depth texture) */
+    FOGVOL_U_LINEAR = 6, /* "fv_lin":    engine depth texture -> view depth, numerator row:
+                            view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
+                            (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders) */
     FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
                             zw: offset of the engine depth texel (ENGINE_DEPTH) */
-    FOGVOL_U_COUNT = 8
+    FOGVOL_U_LINEAR_W = 8, /* "fv_lin2": the denominator row of fv_lin */
+    FOGVOL_U_COUNT = 9
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
@@ -860,6 +871,14 @@ typedef struct fogvol_frame_info {
     int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
     int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
                          GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
+    /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
+       GL defaults): depth_zero_to_one 1 = clip control ZERO_TO_ONE (NDC z in [0,1]);
+       clip_upper_left 1 = clip control origin UPPER_LEFT (NDC y points down the window);
+       depth_range = glDepthRange (both 0 = (0, 1)). The GL backend reads them from the
+       context and draws its own passes with NEGATIVE_ONE_TO_ONE and depth range (0, 1). */
+    int depth_zero_to_one;
+    int clip_upper_left;
+    float depth_range[2];
 } fogvol_frame_info;
 
 typedef struct fogvol_backend {
@@ -998,10 +1017,40 @@ typedef struct fogvol_frame_stats {
                                drew one fog value per pixel */
 } fogvol_frame_stats;
 
+/* What the frame's camera is given as (fogvol_frame_desc.camera). */
+typedef enum fogvol_camera {
+    FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
+    FOGVOL_CAMERA_VIEW_PROJECTION = 1      /* view_projection (clip from world), eye and forward */
+} fogvol_camera;
+
+/* Derives the planes of a projection (perspective, reversed, infinite or orthographic).
+   zero_to_one: 1 if the projection maps the depth range to NDC z in [0,1] (D3D style, for
+   glClipControl ZERO_TO_ONE), 0 for [-1,1]; reversed projections (z_ndc high at near) are
+   recognised. Perspective projections need w = -s * z_view (s > 0), orthographic ones w
+   constant > 0; anything else, or planes that are not 0 < near < far (near > 0 for
+   perspective), is FOGVOL_ERROR_INVALID_ARGUMENT. An infinite far plane gives infinite = 1
+   and zfar = 0: choose the far limit of the thickness range yourself. */
+typedef struct fogvol_projection_info {
+    float znear, zfar;
+    int orthographic; /* 1: w constant */
+    int reversed;     /* 1: NDC z decreases with distance */
+    int infinite;     /* 1: no far plane */
+} fogvol_projection_info;
+FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
+                                                  fogvol_projection_info *out);
+
+/* Camera: any projection whose clip w is the view depth times a positive constant
+   (perspective: standard, reversed-Z, [0,1] or [-1,1] depth, infinite far, jittered,
+   oblique near plane) or a positive constant (orthographic); others are refused with
+   FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
+   so the projection's depth convention does not matter to it (only to the engine depth
+   texture, see fogvol_frame_info), and decides the winding from how the projection
+   orients the screen (mirrored x or y flip it). */
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
-    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar */
+    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
+                               depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
     int viewport[4];        /* x, y, width, height in the engine framebuffer */
     fogvol_composite composite;
     unsigned stencil_bit;   /* geometry composite: 0 = 0x80 */
@@ -1013,8 +1062,19 @@ typedef struct fogvol_frame_desc {
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
     /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
-       object, GL: texture name), depth range [0,1], sampled with its .r */
+       object, GL: texture name), sampled with its .r; its window depth is mapped back
+       to view depth through the inverse of projection * view (any projection above) and
+       the depth conventions the backend reports (fogvol_frame_info) unless overridden by
+       the two fields below */
     uintptr_t engine_depth_texture;
+    int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
+    float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
+    /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
+       (world-space direction the camera looks, any length) instead of view and projection;
+       view depth is then measured along forward from eye */
+    fogvol_camera camera;
+    float view_projection[16];
+    float eye[3], forward[3];
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -2767,6 +2827,15 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
     "vec2 fv_st() { return gl_FragCoord.xy * fv_screen.xy + fv_screen.zw; }\n"
+    /* view depth (distance along the view axis) of an engine depth-buffer sample: st in [0,1]
+       across the engine viewport, z its window depth; fv_lin / fv_lin2 hold the inverse
+       view-projection rows with the window -> NDC mapping (depth range, clip control) folded in */
+    "uniform vec4 fv_lin;\n"
+    "uniform vec4 fv_lin2;\n"
+    "float fv_engine_view_depth(vec2 st, float z) {\n"
+    "    vec4 q = vec4(st, z, 1.0);\n"
+    "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
+    "}\n"
     "#if !defined(FV_FLOAT)\n"
     "uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
@@ -2837,12 +2906,11 @@ static const char fogvol__fs_face[] =
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_FLOAT\n"
     "uniform float fv_sign;\n"
-    "uniform vec4 fv_lin;\n"
     "uniform vec4 fv_nf;\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r * 2.0 - 1.0;\n"
-    "    float o = -(fv_lin.y - fv_lin.w * z) / (fv_lin.z * z - fv_lin.x) * fv_nf.x + fv_nf.y;\n"
+    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
     "#endif\n"
@@ -3148,7 +3216,7 @@ FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
     static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec",
-                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf"};
+                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf", "fv_lin2"};
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -3280,6 +3348,7 @@ struct fogvol_mesh {
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
+    float bmin[3], bmax[3]; /* object-space bounds of the vertices */
 };
 
 struct fogvol_ramp {
@@ -3326,6 +3395,11 @@ struct fogvol_context {
     int in_frame, in_occluder_pass, mrt_ready;
     fogvol_frame_desc frame;
     double viewproj[16];
+    double eyerow[4];  /* view depth e = dot(eyerow, (world position, 1)) */
+    double invvp[16];  /* inverse of viewproj (engine depth texture) */
+    double wscale;     /* perspective: clip w = wscale * e; 0 for orthographic */
+    double wconst;     /* orthographic: clip w (constant > 0) */
+    int mirrored;      /* the projection mirrors the screen: front faces come out clockwise */
     fogvol__volume *vols;
     int nvol, capvol;
     fogvol__occluder *occ;
@@ -3359,13 +3433,48 @@ static double fogvol__det3(const double *m)
            m[8] * (m[1] * m[6] - m[5] * m[2]);
 }
 
-static double fogvol__det4(const double *m)
+/* inverse of a 4x4 (cofactors; the layout does not matter: inv(A^T) = inv(A)^T);
+   0 if singular or not finite. a[r][c] below is m[r * 4 + c]. */
+static int fogvol__inv4(const double *m, double *out)
 {
-    double s0 = m[0] * m[5] - m[4] * m[1], s1 = m[0] * m[9] - m[8] * m[1], s2 = m[0] * m[13] - m[12] * m[1];
-    double s3 = m[4] * m[9] - m[8] * m[5], s4 = m[4] * m[13] - m[12] * m[5], s5 = m[8] * m[13] - m[12] * m[9];
-    double c5 = m[10] * m[15] - m[14] * m[11], c4 = m[6] * m[15] - m[14] * m[7], c3 = m[6] * m[11] - m[10] * m[7];
-    double c2 = m[2] * m[15] - m[14] * m[3], c1 = m[2] * m[11] - m[10] * m[3], c0 = m[2] * m[7] - m[6] * m[3];
-    return s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0;
+#define FOGVOL__A(r, c) m[(r) * 4 + (c)]
+    double s0 = FOGVOL__A(0, 0) * FOGVOL__A(1, 1) - FOGVOL__A(1, 0) * FOGVOL__A(0, 1);
+    double s1 = FOGVOL__A(0, 0) * FOGVOL__A(1, 2) - FOGVOL__A(1, 0) * FOGVOL__A(0, 2);
+    double s2 = FOGVOL__A(0, 0) * FOGVOL__A(1, 3) - FOGVOL__A(1, 0) * FOGVOL__A(0, 3);
+    double s3 = FOGVOL__A(0, 1) * FOGVOL__A(1, 2) - FOGVOL__A(1, 1) * FOGVOL__A(0, 2);
+    double s4 = FOGVOL__A(0, 1) * FOGVOL__A(1, 3) - FOGVOL__A(1, 1) * FOGVOL__A(0, 3);
+    double s5 = FOGVOL__A(0, 2) * FOGVOL__A(1, 3) - FOGVOL__A(1, 2) * FOGVOL__A(0, 3);
+    double c5 = FOGVOL__A(2, 2) * FOGVOL__A(3, 3) - FOGVOL__A(3, 2) * FOGVOL__A(2, 3);
+    double c4 = FOGVOL__A(2, 1) * FOGVOL__A(3, 3) - FOGVOL__A(3, 1) * FOGVOL__A(2, 3);
+    double c3 = FOGVOL__A(2, 1) * FOGVOL__A(3, 2) - FOGVOL__A(3, 1) * FOGVOL__A(2, 2);
+    double c2 = FOGVOL__A(2, 0) * FOGVOL__A(3, 3) - FOGVOL__A(3, 0) * FOGVOL__A(2, 3);
+    double c1 = FOGVOL__A(2, 0) * FOGVOL__A(3, 2) - FOGVOL__A(3, 0) * FOGVOL__A(2, 2);
+    double c0 = FOGVOL__A(2, 0) * FOGVOL__A(3, 1) - FOGVOL__A(3, 0) * FOGVOL__A(2, 1);
+    double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0, b[16];
+    int i;
+    if (!(det != 0.0) || det - det != 0.0) return 0;
+    b[0] = FOGVOL__A(1, 1) * c5 - FOGVOL__A(1, 2) * c4 + FOGVOL__A(1, 3) * c3;
+    b[1] = -FOGVOL__A(0, 1) * c5 + FOGVOL__A(0, 2) * c4 - FOGVOL__A(0, 3) * c3;
+    b[2] = FOGVOL__A(3, 1) * s5 - FOGVOL__A(3, 2) * s4 + FOGVOL__A(3, 3) * s3;
+    b[3] = -FOGVOL__A(2, 1) * s5 + FOGVOL__A(2, 2) * s4 - FOGVOL__A(2, 3) * s3;
+    b[4] = -FOGVOL__A(1, 0) * c5 + FOGVOL__A(1, 2) * c2 - FOGVOL__A(1, 3) * c1;
+    b[5] = FOGVOL__A(0, 0) * c5 - FOGVOL__A(0, 2) * c2 + FOGVOL__A(0, 3) * c1;
+    b[6] = -FOGVOL__A(3, 0) * s5 + FOGVOL__A(3, 2) * s2 - FOGVOL__A(3, 3) * s1;
+    b[7] = FOGVOL__A(2, 0) * s5 - FOGVOL__A(2, 2) * s2 + FOGVOL__A(2, 3) * s1;
+    b[8] = FOGVOL__A(1, 0) * c4 - FOGVOL__A(1, 1) * c2 + FOGVOL__A(1, 3) * c0;
+    b[9] = -FOGVOL__A(0, 0) * c4 + FOGVOL__A(0, 1) * c2 - FOGVOL__A(0, 3) * c0;
+    b[10] = FOGVOL__A(3, 0) * s4 - FOGVOL__A(3, 1) * s2 + FOGVOL__A(3, 3) * s0;
+    b[11] = -FOGVOL__A(2, 0) * s4 + FOGVOL__A(2, 1) * s2 - FOGVOL__A(2, 3) * s0;
+    b[12] = -FOGVOL__A(1, 0) * c3 + FOGVOL__A(1, 1) * c1 - FOGVOL__A(1, 2) * c0;
+    b[13] = FOGVOL__A(0, 0) * c3 - FOGVOL__A(0, 1) * c1 + FOGVOL__A(0, 2) * c0;
+    b[14] = -FOGVOL__A(3, 0) * s3 + FOGVOL__A(3, 1) * s1 - FOGVOL__A(3, 2) * s0;
+    b[15] = FOGVOL__A(2, 0) * s3 - FOGVOL__A(2, 1) * s1 + FOGVOL__A(2, 2) * s0;
+#undef FOGVOL__A
+    for (i = 0; i < 16; ++i) {
+        out[i] = b[i] / det;
+        if (out[i] - out[i] != 0.0) return 0;
+    }
+    return 1;
 }
 
 static void fogvol__destroy_targets(fogvol_context *ctx)
@@ -3755,6 +3864,17 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     m->vertex_count = desc->vertex_count;
     m->index_count = desc->index_count;
     m->volume = rep.valid;
+    for (i = 0; i < 3; ++i) m->bmin[i] = m->bmax[i] = desc->vertex_count > 0 ? desc->positions[i] : 0.0f;
+    for (i = 0; i < desc->vertex_count; ++i) { /* bounds (orthographic clip depth scale) */
+        float q[3];
+        int j;
+        memcpy(q, (const unsigned char *)desc->positions + (size_t)i * (desc->stride ? (size_t)desc->stride : 12u),
+               sizeof q);
+        for (j = 0; j < 3; ++j) {
+            if (q[j] < m->bmin[j]) m->bmin[j] = q[j];
+            if (q[j] > m->bmax[j]) m->bmax[j] = q[j];
+        }
+    }
     ctx->live_meshes++;
     *out = m;
     return FOGVOL_SUCCESS;
@@ -3851,9 +3971,141 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
     return FOGVOL_SUCCESS;
 }
 
+/* Camera axes in world space from the frame's input: eye, right X, up Y, forward F (view
+   depth grows along F, X x Y = -F), the view depth row and clip from world. */
+static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_desc *d, double ax[4][3])
+{
+    double v[16], p[16], iv[16], l;
+    int i;
+    if (d->camera == FOGVOL_CAMERA_VIEW_PROJECTION) {
+        if (!fogvol__finite_n(d->view_projection, 16) || !fogvol__finite_n(d->eye, 3) ||
+            !fogvol__finite_n(d->forward, 3))
+            return "non-finite view_projection, eye or forward";
+        fogvol__tod(ctx->viewproj, d->view_projection);
+        l = FOGVOL_SQRT((double)d->forward[0] * d->forward[0] + (double)d->forward[1] * d->forward[1] +
+                        (double)d->forward[2] * d->forward[2]);
+        if (!(l > 0.0)) return "forward is zero";
+        for (i = 0; i < 3; ++i) {
+            ax[0][i] = d->eye[i];
+            ax[3][i] = d->forward[i] / l;
+        }
+        /* X: perpendicular to F (F crossed with the axis it is least aligned with), Y = X x F */
+        i = FOGVOL_FABS(ax[3][0]) < 0.5 ? 0 : 1;
+        ax[1][0] = i ? -ax[3][2] : 0.0;
+        ax[1][1] = i ? 0.0 : ax[3][2];
+        ax[1][2] = i ? ax[3][0] : -ax[3][1];
+        ax[2][0] = ax[1][1] * ax[3][2] - ax[1][2] * ax[3][1];
+        ax[2][1] = ax[1][2] * ax[3][0] - ax[1][0] * ax[3][2];
+        ax[2][2] = ax[1][0] * ax[3][1] - ax[1][1] * ax[3][0];
+        for (i = 0; i < 3; ++i) ctx->eyerow[i] = ax[3][i];
+        ctx->eyerow[3] = -(ax[3][0] * ax[0][0] + ax[3][1] * ax[0][1] + ax[3][2] * ax[0][2]);
+        return NULL;
+    }
+    if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
+    if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16))
+        return "non-finite view or projection matrix";
+    fogvol__tod(v, d->view);
+    fogvol__tod(p, d->projection);
+    fogvol__mul4(ctx->viewproj, p, v);
+    if (!fogvol__inv4(v, iv) || !(iv[15] != 0.0)) return "the view matrix is singular";
+    for (i = 0; i < 3; ++i) {
+        ax[0][i] = iv[12 + i] / iv[15];
+        ax[1][i] = iv[i];
+        ax[2][i] = iv[4 + i];
+        ax[3][i] = -iv[8 + i];
+        ctx->eyerow[i] = -v[i * 4 + 2];
+    }
+    ctx->eyerow[3] = -v[14];
+    return NULL;
+}
+
+/* The frame's camera: how clip w relates to view depth (perspective: w = s e, s > 0;
+   orthographic: w constant > 0), whether the projection mirrors the screen (orientation
+   of a camera-facing triangle, counter-clockwise as seen from the eye, after projection),
+   and the inverse view-projection. Logs and refuses what it cannot interpret. */
+static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
+    const char *why = fogvol__camera_axes(ctx, d, ax);
+    int i, k;
+    for (i = 0; i < 4 && !why; ++i) wr[i] = ctx->viewproj[i * 4 + 3];
+    if (!why) {
+        sc = (wr[0] * ctx->eyerow[0] + wr[1] * ctx->eyerow[1] + wr[2] * ctx->eyerow[2]) /
+             (ctx->eyerow[0] * ctx->eyerow[0] + ctx->eyerow[1] * ctx->eyerow[1] + ctx->eyerow[2] * ctx->eyerow[2]);
+        for (i = 0; i < 4; ++i) {
+            rr += (wr[i] - sc * ctx->eyerow[i]) * (wr[i] - sc * ctx->eyerow[i]);
+            wn += wr[i] * wr[i];
+        }
+        ctx->wscale = ctx->wconst = 0.0;
+        if (sc > 0.0 && rr <= 1e-10 * wn) ctx->wscale = sc;
+        else if (wr[3] > 0.0 && wn - wr[3] * wr[3] <= 1e-12 * wr[3] * wr[3]) ctx->wconst = wr[3];
+        else why = "the projection's clip w is neither the view depth times a positive constant (perspective) "
+                   "nor a positive constant (orthographic)";
+    }
+    if (!why && !fogvol__inv4(ctx->viewproj, ctx->invvp)) why = "the view-projection is singular";
+    if (!why) { /* clip (x, y, w) of eye + F e, + X e, + Y e: the sign of their determinant is the
+                   orientation on screen (every w > 0) */
+        for (k = 0; k < 3; ++k) {
+            double pt[3];
+            for (i = 0; i < 3; ++i) pt[i] = ax[0][i] + ax[3][i] * e + (k ? ax[k][i] * e : 0.0);
+            for (i = 0; i < 3; ++i) {
+                int row = i == 2 ? 3 : i;
+                q[k][i] = ctx->viewproj[row] * pt[0] + ctx->viewproj[4 + row] * pt[1] +
+                          ctx->viewproj[8 + row] * pt[2] + ctx->viewproj[12 + row];
+            }
+        }
+        det = q[0][0] * (q[1][1] * q[2][2] - q[2][1] * q[1][2]) - q[0][1] * (q[1][0] * q[2][2] - q[2][0] * q[1][2]) +
+              q[0][2] * (q[1][0] * q[2][1] - q[2][0] * q[1][1]);
+        if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
+        else ctx->mirrored = det < 0.0;
+    }
+    if (why) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
+                                                  fogvol_projection_info *out)
+{
+    /* on the view axis: z_clip = -A e + B and w = s e + c at view depth e; the planes are
+       where z_clip / w reaches the ends of the NDC depth range (lo and 1) */
+    double a, b, s, c, den, e[2] = {0.0, 0.0};
+    int inf[2] = {0, 0}, t, nearest;
+    if (out) memset(out, 0, sizeof *out);
+    if (!projection || !out || !fogvol__finite_n(projection, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    a = projection[10];
+    b = projection[14];
+    s = -projection[11];
+    c = projection[15];
+    if (projection[3] != 0.0f || projection[7] != 0.0f || !((s > 0.0 && c == 0.0) || (s == 0.0 && c > 0.0)))
+        return FOGVOL_ERROR_INVALID_ARGUMENT; /* w neither view depth * s nor constant */
+    for (t = 0; t < 2; ++t) {
+        double ndc = t ? 1.0 : (zero_to_one ? 0.0 : -1.0);
+        den = s > 0.0 ? a + ndc * s : a;
+        if (den == 0.0) inf[t] = 1;
+        else e[t] = s > 0.0 ? b / den : (b - ndc * c) / a;
+    }
+    if ((inf[0] && inf[1]) || (s == 0.0 && (inf[0] || inf[1])) || (!inf[0] && !inf[1] && e[0] == e[1]))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    nearest = inf[0] ? 1 : inf[1] ? 0 : (e[1] < e[0]);
+    out->znear = (float)e[nearest];
+    out->zfar = inf[!nearest] ? 0.0f : (float)e[!nearest];
+    out->infinite = inf[!nearest];
+    out->reversed = nearest == 1;
+    out->orthographic = s == 0.0;
+    if (!fogvol__finite(out->znear) || !fogvol__finite(out->zfar) || (s > 0.0 && !(out->znear > 0.0f)) ||
+        (!out->infinite && !(out->zfar > out->znear))) {
+        memset(out, 0, sizeof *out);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    return FOGVOL_SUCCESS;
+}
+
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
-    double v[16], p[16];
+    fogvol_result r;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (ctx->in_frame) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
@@ -3861,10 +4113,6 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
         fogvol_cancel_frame(ctx);
     }
     if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite view or projection matrix");
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
     if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: need 0 < znear < zfar (got %g, %g)", (double)d->znear,
                     (double)d->zfar);
@@ -3877,10 +4125,15 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (d->engine_depth_zero_to_one < -1 || d->engine_depth_zero_to_one > 1 ||
+        !fogvol__finite_n(d->engine_depth_range, 2)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_zero_to_one not -1, 0 or 1, or "
+                                                 "non-finite engine_depth_range");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__camera(ctx, d);
+    if (r != FOGVOL_SUCCESS) return r;
     ctx->frame = *d;
-    fogvol__tod(v, d->view);
-    fogvol__tod(p, d->projection);
-    fogvol__mul4(ctx->viewproj, p, v);
     ctx->nvol = ctx->nocc = 0;
     ctx->in_frame = 1;
     return FOGVOL_SUCCESS;
@@ -3975,20 +4228,20 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
 /* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
 static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
 {
-    dr->sign = 1.0f;
-    double m[16], v[16], vm[16], mvp[16], p[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
+    double m[16], mvp[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
     int j;
+    dr->sign = 1.0f;
     fogvol__tod(m, model);
-    fogvol__tod(v, ctx->frame.view);
-    fogvol__tod(p, ctx->frame.projection);
-    fogvol__mul4(vm, v, m);
     fogvol__mul4(mvp, ctx->viewproj, m);
     for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
-    /* view depth e = -(VM row 2) . p;  d = (e - near) / (far - near) */
-    for (j = 0; j < 4; ++j) dr->depth[j] = (float)(-vm[j * 4 + 2] / range);
-    dr->depth[3] = (float)((-vm[14] - ctx->frame.znear) / range);
-    /* standard projections have det < 0 (z flips); mirroring flips the winding */
-    dr->front_cw = (fogvol__det3(vm) < 0) != (fogvol__det4(p) > 0);
+    /* view depth e = eyerow . (M p);  d = (e - near) / (far - near) */
+    for (j = 0; j < 4; ++j)
+        dr->depth[j] = (float)((ctx->eyerow[0] * m[j * 4] + ctx->eyerow[1] * m[j * 4 + 1] +
+                                ctx->eyerow[2] * m[j * 4 + 2] + ctx->eyerow[3] * m[j * 4 + 3] -
+                                (j == 3 ? ctx->frame.znear : 0.0)) /
+                               range);
+    /* a mirroring model matrix or projection flips the winding */
+    dr->front_cw = (fogvol__det3(m) < 0) != (ctx->mirrored != 0);
 }
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
@@ -4268,6 +4521,63 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     return FOGVOL_SUCCESS;
 }
 
+/* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
+   is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
+   window depth -> view depth through the inverse view-projection). */
+static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0, n[4], dn[4], a, b, sy, r0, r1;
+    int i, j, c, z01;
+    if (ctx->wscale > 0.0) {
+        k = 2.0 * ctx->wscale * range; /* k d <= 2 s (e - near) <= 2 w */
+    } else {                           /* orthographic: w is constant, bound d over the volumes */
+        for (i = 0; i < ctx->nvol; ++i)
+            for (c = 0; c < 8; ++c) {
+                const fogvol__volume *v = &ctx->vols[i];
+                double e = ctx->eyerow[3], p[3];
+                p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
+                p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
+                p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
+                for (j = 0; j < 3; ++j)
+                    e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
+                                           v->model[12 + j]);
+                if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
+            }
+        if (dmax > 0.0) k = 1.98 * ctx->wconst / dmax;
+    }
+    ps->uniforms[FOGVOL_U_MISC][0] = (float)(k < 1.0 ? k : 1.0);
+    /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
+    ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
+    /* q = (s, t, window depth, 1) -> NDC (2s - 1, +-(2t - 1), a z + b, 1), folded into the
+       rows eyerow * invVP (numerator) and invVP row 3 (denominator) */
+    z01 = fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
+    r0 = info->depth_range[0];
+    r1 = info->depth_range[1];
+    if (fd->engine_depth_range[0] != 0.0f || fd->engine_depth_range[1] != 0.0f) {
+        r0 = fd->engine_depth_range[0];
+        r1 = fd->engine_depth_range[1];
+    } else if (r0 == 0.0 && r1 == 0.0) {
+        r1 = 1.0;
+    }
+    a = (z01 ? 1.0 : 2.0) / (r1 != r0 ? r1 - r0 : 1.0);
+    b = -r0 * a - (z01 ? 0.0 : 1.0);
+    sy = info->clip_upper_left ? -1.0 : 1.0;
+    for (i = 0; i < 4; ++i) {
+        n[i] = ctx->eyerow[0] * ctx->invvp[i * 4] + ctx->eyerow[1] * ctx->invvp[i * 4 + 1] +
+               ctx->eyerow[2] * ctx->invvp[i * 4 + 2] + ctx->eyerow[3] * ctx->invvp[i * 4 + 3];
+        dn[i] = ctx->invvp[i * 4 + 3];
+    }
+    ps->uniforms[FOGVOL_U_LINEAR][0] = (float)(2.0 * n[0]);
+    ps->uniforms[FOGVOL_U_LINEAR][1] = (float)(2.0 * sy * n[1]);
+    ps->uniforms[FOGVOL_U_LINEAR][2] = (float)(a * n[2]);
+    ps->uniforms[FOGVOL_U_LINEAR][3] = (float)(n[3] - n[0] - sy * n[1] + b * n[2]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][0] = (float)(2.0 * dn[0]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][1] = (float)(2.0 * sy * dn[1]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][2] = (float)(a * dn[2]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
+}
+
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
 {
     fogvol_frame_stats st;
@@ -4279,7 +4589,6 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     int i, w, h, g, overflow = 0, captured = 0;
     int single, count, rgba8;
     unsigned char *peak = NULL;
-    float zk;
     memset(&st, 0, sizeof st);
     if (stats) *stats = st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4337,14 +4646,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     } else {
         ps.uniforms[FOGVOL_U_DECODE][0] = fd->zfar - fd->znear;
     }
-    zk = (float)(2.0 * ((double)fd->zfar - fd->znear));
-    ps.uniforms[FOGVOL_U_MISC][0] = zk < 1.0f ? zk : 1.0f;
-    /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
-    ps.uniforms[FOGVOL_U_MISC][2] = fd->projection[15] == 0.0f ? fd->znear : -1e30f;
-    ps.uniforms[FOGVOL_U_LINEAR][0] = fd->projection[10];
-    ps.uniforms[FOGVOL_U_LINEAR][1] = fd->projection[14];
-    ps.uniforms[FOGVOL_U_LINEAR][2] = fd->projection[11];
-    ps.uniforms[FOGVOL_U_LINEAR][3] = fd->projection[15];
+    fogvol__clip_uniforms(ctx, &info, &ps);
+    ps.uniforms[FOGVOL_U_MISC][1] = 1.0f; /* fogvol's own clip z in every pass */
     ps.uniforms[FOGVOL_U_NEARFAR][0] = k.near_far[0];
     ps.uniforms[FOGVOL_U_NEARFAR][1] = k.near_far[1];
     ps.uniforms[FOGVOL_U_NEARFAR][2] = (float)fd->viewport[0]; /* ENGINE_DEPTH: target pixel -> engine texel */
@@ -4396,7 +4699,6 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
 
         ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
         ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
-        ps.uniforms[FOGVOL_U_MISC][1] = count ? 0.0f : 1.0f;
         ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
         if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = fd->engine_depth_texture;
         else ps.textures[3] = ctx->tgt_o;
@@ -4588,7 +4890,10 @@ enum {
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
-    FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0
+    FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0,
+    FOGVOL__GL_DEPTH_RANGE = 0x0B70, FOGVOL__GL_CLIP_ORIGIN = 0x935C, FOGVOL__GL_CLIP_DEPTH_MODE = 0x935D,
+    FOGVOL__GL_LOWER_LEFT = 0x8CA1, FOGVOL__GL_UPPER_LEFT = 0x8CA2, FOGVOL__GL_NEGATIVE_ONE_TO_ONE = 0x935E,
+    FOGVOL__GL_ZERO_TO_ONE = 0x935F
 };
 /* Multisampled targets and per-sample shading. */
 enum {
@@ -4702,16 +5007,22 @@ enum {
 #define FOGVOL__GL_DESKTOP(X) \
     X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
     X(void, ClearDepth, (fogvol__GLdouble)) \
-    X(void, GetDoublev, (fogvol__GLenum, fogvol__GLdouble *))
+    X(void, GetDoublev, (fogvol__GLenum, fogvol__GLdouble *)) \
+    X(void, DepthRange, (fogvol__GLdouble, fogvol__GLdouble))
 
 /* GLES only. */
 #define FOGVOL__GL_ES(X) \
     X(void, ClearDepthf, (fogvol__GLfloat)) \
+    X(void, DepthRangef, (fogvol__GLfloat, fogvol__GLfloat)) \
     X(void, GetShaderPrecisionFormat, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint *, fogvol__GLint *))
+
+/* Optional: clip control (GL 4.5, ARB_clip_control; GLES: EXT_clip_control as glClipControlEXT). */
+#define FOGVOL__GL_CLIP_CONTROL(X) X(void, ClipControl, (fogvol__GLenum, fogvol__GLenum))
 
 #define FOGVOL__GL_ALL(X) \
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
-        FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X)
+        FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
+            FOGVOL__GL_CLIP_CONTROL(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -4736,6 +5047,9 @@ typedef struct fogvol__gl_state {
     fogvol__GLboolean depth_mask, color_mask[4];
     fogvol__GLfloat clear_color[4], clear_depth;
     fogvol__GLdouble clear_depth_d; /* desktop: kept in double so it comes back exactly */
+    fogvol__GLdouble depth_range_d[2]; /* desktop (double, exact); GLES: depth_range */
+    fogvol__GLfloat depth_range[2];
+    fogvol__GLint clip_origin, clip_depth; /* with clip control */
     fogvol__GLint st_func, st_ref, st_vmask, st_fail, st_zfail, st_zpass, st_wmask;
     fogvol__GLint stb_func, stb_ref, stb_vmask, stb_fail, stb_zfail, stb_zpass, stb_wmask, st_clear;
     fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
@@ -4916,6 +5230,18 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
     gl->GetFloatv(FOGVOL__GL_COLOR_CLEAR_VALUE, s->clear_color);
     if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
     else gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
+    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_RANGE, s->depth_range);
+    else gl->GetDoublev(FOGVOL__GL_DEPTH_RANGE, s->depth_range_d);
+    if (!gl->gles) {
+        s->depth_range[0] = (fogvol__GLfloat)s->depth_range_d[0];
+        s->depth_range[1] = (fogvol__GLfloat)s->depth_range_d[1];
+    }
+    s->clip_origin = FOGVOL__GL_LOWER_LEFT;
+    s->clip_depth = FOGVOL__GL_NEGATIVE_ONE_TO_ONE;
+    if (gl->ClipControl) {
+        gl->GetIntegerv(FOGVOL__GL_CLIP_ORIGIN, &s->clip_origin);
+        gl->GetIntegerv(FOGVOL__GL_CLIP_DEPTH_MODE, &s->clip_depth);
+    }
     gl->GetIntegerv(FOGVOL__GL_STENCIL_FUNC, &s->st_func);
     gl->GetIntegerv(FOGVOL__GL_STENCIL_REF, &s->st_ref);
     gl->GetIntegerv(FOGVOL__GL_STENCIL_VALUE_MASK, &s->st_vmask);
@@ -5007,6 +5333,9 @@ static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
     gl->ClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
     if (gl->gles) gl->ClearDepthf(s->clear_depth);
     else gl->ClearDepth(s->clear_depth_d);
+    if (gl->gles) gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
+    else gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
+    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
     gl->StencilFuncSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_func, s->st_ref, (fogvol__GLuint)s->st_vmask);
     gl->StencilOpSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_fail, (fogvol__GLenum)s->st_zfail,
                           (fogvol__GLenum)s->st_zpass);
@@ -5098,6 +5427,16 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
         gl->GetIntegerv(FOGVOL__GL_SAMPLES, &samples);
         info->samples = buffers ? samples : 0;
     }
+    /* the engine's depth conventions (for its depth texture); fogvol's passes use NDC z in
+       [-1,1] and depth range (0,1) with the engine's clip origin, so its images line up
+       with the engine's and the face orientation stays that of the NDC triangle */
+    info->depth_zero_to_one = gl->saved.clip_depth == FOGVOL__GL_ZERO_TO_ONE;
+    info->clip_upper_left = gl->saved.clip_origin == FOGVOL__GL_UPPER_LEFT;
+    info->depth_range[0] = gl->saved.depth_range[0];
+    info->depth_range[1] = gl->saved.depth_range[1];
+    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)gl->saved.clip_origin, FOGVOL__GL_NEGATIVE_ONE_TO_ONE);
+    if (gl->gles) gl->DepthRangef(0.0f, 1.0f);
+    else gl->DepthRange(0.0, 1.0);
     return FOGVOL_SUCCESS;
 }
 
@@ -5879,6 +6218,13 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     gl->stencil_override = desc->stencil_bits;
     gl->caps = fogvol__gl_caps(gl, ext);
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+    if (!gl->gles && (gl->major > 4 || (gl->major == 4 && gl->minor >= 5) ||
+                      (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_ARB_clip_control")
+                                      : fogvol__has_ext(ext, "GL_ARB_clip_control"))))
+        gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControl", desc->user_data);
+    else if (gl->gles && (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_clip_control")
+                                         : fogvol__has_ext(ext, "GL_EXT_clip_control")))
+        gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControlEXT", desc->user_data);
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
         gl->GenSamplers(1, &gl->native_sampler);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);

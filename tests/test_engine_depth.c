@@ -1,0 +1,832 @@
+/* test_engine_depth.c - depth and camera conventions of real engines.
+
+   The test plays an engine that renders its opaque occluders into its own
+   framebuffer (colour texture + 32-bit float depth texture) under one
+   convention at a time, leaves that GL state set, and calls fogvol:
+   reversed-Z through glClipControl(ZERO_TO_ONE) (with LOWER_LEFT and
+   UPPER_LEFT origin), [0,1] forward projections, glDepthRange(1, 0),
+   reversed-Z matrices without clip control, orthographic projections (a
+   volume reaching far beyond the far plane), infinite far planes,
+   TAA-jittered and oblique-near-plane projections, mirrored x or y, and a
+   camera given only as view-projection + eye + forward, a camera inside the
+   volume, and depth conventions told in the frame desc after the engine reset
+   its state. Tiers: PS13, PS20 (+count, +single, +nearclamp), MRT (the engine
+   writes fogvol's O through fogvol_mrt_snippet), FLOAT, FLOAT+enginedepth.
+
+   Ground truth is computed here, independently: each pixel's ray comes from
+   the inverse of the engine's own view-projection (in double), the volume is
+   an axis-aligned box and the occluders axis-aligned rectangles, so the
+   thickness (view-depth extent of the box inside [znear, min(zfar, nearest
+   occluder)]) is exact. Interior pixels only: the same faces and occluder at
+   the pixel centre and at +-0.75 pixel. Bounds: RGBA8 tiers (dither off)
+   |error| <= 1 LSB (one pair of faces) + 1e-6 of the range; FLOAT (also with
+   the engine's depth texture) |error| <= 3e-5 of the range. The composite
+   (fog colour over the engine's picture) is checked within 2/255 and the
+   engine's depth state (clip control, depth range, depth func, clear depth)
+   must come back unchanged. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#include "tests/gl_util.h"
+#include <GL/glext.h>
+#include "tests/shapes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <sys/stat.h>
+
+#define W 96
+#define H 96
+#define DENSITY 0.5
+
+enum { P_GL, P_GL_REV, P_D3D, P_D3D_REV, P_INF, P_INF_REV01, P_JITTER, P_OBLIQUE, P_MIRROR_X, P_MIRROR_Y,
+       P_ORTHO, P_ORTHO_REV01 };
+
+typedef struct conv {
+    const char *name;
+    int proj;
+    int zero_to_one; /* engine's glClipControl depth mode ZERO_TO_ONE */
+    int upper_left;  /* engine's glClipControl origin UPPER_LEFT */
+    int range_rev;   /* engine's glDepthRange(1, 0) */
+    int greater;     /* engine's depth test GREATER with clear 0 (reversed-Z) */
+    int vp_camera;   /* fogvol gets view-projection + eye + forward only */
+    int told;        /* the engine resets clip control and depth range to the defaults after its
+                        pass and tells fogvol how its depth texture was drawn */
+    int inside;      /* the camera is inside the volume (its near plane cuts it) */
+} conv;
+
+static const conv g_convs[] = {
+    {"standard GL", P_GL, 0, 0, 0, 0, 0, 0, 0},
+    {"clip control ZERO_TO_ONE reversed-Z", P_D3D_REV, 1, 0, 0, 1, 0, 0, 0},
+    {"clip control ZERO_TO_ONE forward", P_D3D, 1, 0, 0, 0, 0, 0, 0},
+    {"clip control UPPER_LEFT", P_GL, 0, 1, 0, 0, 0, 0, 0},
+    {"clip control UPPER_LEFT ZERO_TO_ONE reversed-Z", P_D3D_REV, 1, 1, 0, 1, 0, 0, 0},
+    {"depth range (1,0)", P_GL, 0, 0, 1, 1, 0, 0, 0},
+    {"reversed-Z matrix, no clip control", P_GL_REV, 0, 0, 0, 1, 0, 0, 0},
+    {"orthographic, volume beyond near+2(far-near)", P_ORTHO, 0, 0, 0, 0, 0, 0, 0},
+    {"orthographic reversed ZERO_TO_ONE", P_ORTHO_REV01, 1, 0, 0, 1, 0, 0, 0},
+    {"infinite far", P_INF, 0, 0, 0, 0, 0, 0, 0},
+    {"infinite far reversed ZERO_TO_ONE", P_INF_REV01, 1, 0, 0, 1, 0, 0, 0},
+    {"TAA jitter", P_JITTER, 0, 0, 0, 0, 0, 0, 0},
+    {"oblique near plane", P_OBLIQUE, 0, 0, 0, 0, 0, 0, 0},
+    {"mirrored x", P_MIRROR_X, 0, 0, 0, 0, 0, 0, 0},
+    {"mirrored y", P_MIRROR_Y, 0, 0, 0, 0, 0, 0, 0},
+    {"view-projection + eye + forward", P_GL, 0, 0, 0, 0, 1, 0, 0},
+    {"ZERO_TO_ONE + range (1,0) drawn, told in frame desc", P_D3D, 1, 0, 1, 1, 0, 1, 0},
+    {"camera inside, standard GL", P_GL, 0, 0, 0, 0, 0, 0, 1},
+    {"camera inside, ZERO_TO_ONE reversed-Z", P_D3D_REV, 1, 0, 0, 1, 0, 0, 1},
+    {"camera inside, orthographic", P_ORTHO, 0, 0, 0, 0, 0, 0, 1},
+    {"camera inside, reversed-Z matrix", P_GL_REV, 0, 0, 0, 1, 0, 0, 1},
+};
+#define NCONV ((int)(sizeof g_convs / sizeof g_convs[0]))
+
+typedef struct combo {
+    fogvol_tier tier;
+    unsigned variants;
+    const char *name;
+} combo;
+
+static const combo g_combos[] = {
+    {FOGVOL_TIER_PS20, 0, "PS20"},
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT"},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth"},
+    {FOGVOL_TIER_PS13, 0, "PS13"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single"},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp"},
+    {FOGVOL_TIER_MRT, 0, "MRT"},
+};
+#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
+
+/* the scene, world space: one box volume, two rectangles (z = const) as occluders */
+typedef struct rect {
+    double z, x0, x1, y0, y1;
+} rect;
+
+typedef struct scene {
+    double bmin[3], bmax[3];
+    rect occ[2];
+    double znear, zfar;
+} scene;
+
+static const double g_eye[3] = {1.2, 0.8, 1.0};
+
+static void make_scene(scene *s, int ortho, int inside)
+{
+    static const rect cut = {-6.3, -0.4, 2.5, -3.0, 3.0};
+    rect back = {-9.0, -20.0, 20.0, -20.0, 20.0};
+    s->bmin[0] = -1.5;
+    s->bmax[0] = 1.5;
+    s->bmin[1] = -1.2;
+    s->bmax[1] = 1.2;
+    s->bmin[2] = ortho ? -11.5 : -7.0;
+    s->bmax[2] = ortho ? -5.5 : -5.0;
+    if (ortho) back.z = -14.0;
+    if (inside) { /* around the eye */
+        s->bmin[0] = s->bmin[1] = -3.0;
+        s->bmax[0] = s->bmax[1] = 3.0;
+        s->bmax[2] = 3.0;
+    }
+    s->occ[0] = cut;
+    s->occ[1] = back;
+    s->znear = ortho ? 4.0 : 1.0;
+    s->zfar = ortho ? 8.0 : 50.0;
+}
+
+static void mul4d(double *o, const double *a, const double *b)
+{
+    double t[16];
+    int c, r, k;
+    for (c = 0; c < 4; ++c)
+        for (r = 0; r < 4; ++r) {
+            t[c * 4 + r] = 0.0;
+            for (k = 0; k < 4; ++k) t[c * 4 + r] += a[k * 4 + r] * b[c * 4 + k];
+        }
+    memcpy(o, t, sizeof t);
+}
+
+/* Gauss-Jordan inverse (independent of the library's cofactor inverse) */
+static int inv4d(const double *m, double *o)
+{
+    double a[4][8];
+    int r, c, k;
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 8; ++c) a[r][c] = c < 4 ? m[c * 4 + r] : (c - 4 == r);
+    for (c = 0; c < 4; ++c) {
+        int p = c;
+        for (r = c + 1; r < 4; ++r)
+            if (fabs(a[r][c]) > fabs(a[p][c])) p = r;
+        if (fabs(a[p][c]) < 1e-300) return 0;
+        for (k = 0; k < 8; ++k) {
+            double t = a[c][k];
+            a[c][k] = a[p][k];
+            a[p][k] = t;
+        }
+        for (k = 7; k >= c; --k) a[c][k] /= a[c][c];
+        for (r = 0; r < 4; ++r)
+            if (r != c)
+                for (k = 7; k >= c; --k) a[r][k] -= a[r][c] * a[c][k];
+    }
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 4; ++c) o[c * 4 + r] = a[r][c + 4];
+    return 1;
+}
+
+/* The engine's projection for a convention (column-major, view looks down -z). */
+static void make_projection(int kind, const scene *s, float p[16])
+{
+    double n = s->znear, f = s->zfar, t = 1.0 / tan(25.0 * 3.14159265358979323846 / 180.0);
+    memset(p, 0, 16 * sizeof(float));
+    p[0] = p[5] = (float)t;
+    p[11] = -1.0f;
+    switch (kind) {
+    case P_D3D: /* [0,1]: near -> 0, far -> 1 */
+        p[10] = (float)(-f / (f - n));
+        p[14] = (float)(-f * n / (f - n));
+        break;
+    case P_D3D_REV: /* [0,1]: near -> 1, far -> 0 */
+        p[10] = (float)(n / (f - n));
+        p[14] = (float)(f * n / (f - n));
+        break;
+    case P_INF:
+        p[10] = -1.0f;
+        p[14] = (float)(-2.0 * n);
+        break;
+    case P_INF_REV01:
+        p[10] = 0.0f;
+        p[14] = (float)n;
+        break;
+    case P_ORTHO:
+    case P_ORTHO_REV01:
+        p[0] = p[5] = 1.0f / 3.0f;
+        p[11] = 0.0f;
+        p[15] = 1.0f;
+        p[10] = (float)(kind == P_ORTHO ? -2.0 / (f - n) : 1.0 / (f - n));
+        p[14] = (float)(kind == P_ORTHO ? -(f + n) / (f - n) : f / (f - n));
+        break;
+    default: /* GL [-1,1] */
+        p[10] = (float)((f + n) / (n - f));
+        p[14] = (float)(2.0 * f * n / (n - f));
+        break;
+    }
+    if (kind == P_GL_REV) { /* z_ndc = +1 at near, -1 at far */
+        p[10] = -p[10];
+        p[14] = -p[14];
+    }
+    if (kind == P_JITTER) { /* sub-pixel offsets as TAA applies them */
+        p[8] = (float)(2.0 * 0.37 / W);
+        p[9] = (float)(2.0 * -0.23 / H);
+    }
+    if (kind == P_MIRROR_X) p[0] = -p[0];
+    if (kind == P_MIRROR_Y) p[5] = -p[5];
+    if (kind == P_OBLIQUE) { /* Lengyel's oblique near plane: view-space plane C, camera on its negative side */
+        const double cp[4] = {0.2, 0.1, -1.0, -2.5};
+        double q[4], d, k;
+        q[0] = ((cp[0] > 0 ? 1.0 : -1.0) + p[8]) / p[0];
+        q[1] = ((cp[1] > 0 ? 1.0 : -1.0) + p[9]) / p[5];
+        q[2] = -1.0;
+        q[3] = (1.0 + p[10]) / p[14];
+        d = cp[0] * q[0] + cp[1] * q[1] + cp[2] * q[2] + cp[3] * q[3];
+        k = 2.0 / d;
+        p[2] = (float)(cp[0] * k);
+        p[6] = (float)(cp[1] * k);
+        p[10] = (float)(cp[2] * k + 1.0);
+        p[14] = (float)(cp[3] * k);
+    }
+}
+
+/* ---- ground truth ---- */
+typedef struct gt_px {
+    double t;     /* thickness */
+    unsigned sig; /* faces crossed and nearest occluder */
+} gt_px;
+
+/* the ray of window position (sx, sy): world point p1 at view depth e1 and the world
+   direction per unit of view depth */
+static gt_px trace(const scene *s, double far_end, const double *ivp, const double *view, int upper_left, double sx,
+                   double sy)
+{
+    double x = sx / W * 2.0 - 1.0, y = (sy / H * 2.0 - 1.0) * (upper_left ? -1.0 : 1.0), pt[2][3], e[2], dir[3];
+    double lo = -1e300, hi = 1e300, opq = 1e300, a, b;
+    int i, k, ain = -1, aout = -1, occ = -1;
+    gt_px g;
+    for (k = 0; k < 2; ++k) {
+        double c[4] = {x, y, k ? 0.75 : 0.25, 1.0}, w[4];
+        for (i = 0; i < 4; ++i) w[i] = ivp[i] * c[0] + ivp[4 + i] * c[1] + ivp[8 + i] * c[2] + ivp[12 + i] * c[3];
+        for (i = 0; i < 3; ++i) pt[k][i] = w[i] / w[3];
+        e[k] = -(view[2] * pt[k][0] + view[6] * pt[k][1] + view[10] * pt[k][2] + view[14]);
+    }
+    for (i = 0; i < 3; ++i) dir[i] = (pt[1][i] - pt[0][i]) / (e[1] - e[0]);
+    /* p(e) = pt[0] + dir (e - e[0]) */
+    for (i = 0; i < 3; ++i) {
+        if (fabs(dir[i]) < 1e-15) {
+            if (pt[0][i] < s->bmin[i] || pt[0][i] > s->bmax[i]) lo = 1e300;
+            continue;
+        }
+        a = e[0] + (s->bmin[i] - pt[0][i]) / dir[i];
+        b = e[0] + (s->bmax[i] - pt[0][i]) / dir[i];
+        if (a > b) {
+            double t = a;
+            a = b;
+            b = t;
+        }
+        if (a > lo) {
+            lo = a;
+            ain = i * 2 + (dir[i] < 0);
+        }
+        if (b < hi) {
+            hi = b;
+            aout = i * 2 + (dir[i] > 0);
+        }
+    }
+    for (k = 0; k < 2; ++k) {
+        const rect *r = &s->occ[k];
+        double eh, px, py;
+        if (fabs(dir[2]) < 1e-15) continue;
+        eh = e[0] + (r->z - pt[0][2]) / dir[2];
+        px = pt[0][0] + dir[0] * (eh - e[0]);
+        py = pt[0][1] + dir[1] * (eh - e[0]);
+        if (eh >= s->znear && eh < opq && px >= r->x0 && px <= r->x1 && py >= r->y0 && py <= r->y1) {
+            opq = eh;
+            occ = k;
+        }
+    }
+    g.t = 0.0;
+    g.sig = 0;
+    if (lo < hi) {
+        double end = opq < far_end ? opq : far_end, from = lo > s->znear ? lo : s->znear, to = hi < end ? hi : end;
+        g.t = to > from ? to - from : 0.0;
+        g.sig = 1u + (unsigned)(ain + 1) * 4u + (unsigned)(aout + 1) * 64u;
+    }
+    g.sig += (unsigned)(occ + 1) * 1024u;
+    return g;
+}
+
+/* ---- the engine ---- */
+typedef struct engine {
+    GLuint fbo, color, depth, prog, vao, vbo[3], ibo[3];
+    GLsizei count[3];
+    GLint u_mvp, u_mv, u_color, u_mrt;
+    PFNGLCLIPCONTROLPROC clip_control;
+} engine;
+
+static GLuint compile(GLenum type, const char *const *src, int n)
+{
+    GLuint s = glCreateShader(type);
+    GLint ok = 0;
+    glShaderSource(s, n, src, NULL);
+    glCompileShader(s);
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    assert_true(ok);
+    return s;
+}
+
+static void engine_mesh(engine *e, int i, const shp_mesh *m)
+{
+    glGenBuffers(1, &e->vbo[i]);
+    glBindBuffer(GL_ARRAY_BUFFER, e->vbo[i]);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(m->vcount * 3 * sizeof(float)), m->pos, GL_STATIC_DRAW);
+    glGenBuffers(1, &e->ibo[i]);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo[i]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(m->icount * sizeof(unsigned)), m->idx, GL_STATIC_DRAW);
+    e->count[i] = m->icount;
+}
+
+static void engine_init(engine *e)
+{
+    /* colour, and for the MRT tier fogvol's encoded view depth as a second output */
+    const char *vs = "#version 330 core\nlayout(location = 0) in vec3 pos;\nuniform mat4 mvp;\nuniform mat4 mv;\n"
+                     "out float view_depth;\n"
+                     "void main() { gl_Position = mvp * vec4(pos, 1.0); view_depth = -(mv * vec4(pos, 1.0)).z; }\n";
+    const char *fs[3];
+    GLint ok = 0;
+    fs[0] = "#version 330 core\n";
+    fs[1] = fogvol_mrt_snippet();
+    fs[2] = "uniform vec4 color;\nin float view_depth;\nlayout(location = 0) out vec4 frag;\n"
+            "layout(location = 1) out vec4 fogvol_o;\n"
+            "void main() { frag = color; fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
+    memset(e, 0, sizeof *e);
+    e->prog = glCreateProgram();
+    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, &vs, 1));
+    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs, 3));
+    glLinkProgram(e->prog);
+    glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
+    assert_true(ok);
+    e->u_mvp = glGetUniformLocation(e->prog, "mvp");
+    e->u_color = glGetUniformLocation(e->prog, "color");
+    e->u_mv = glGetUniformLocation(e->prog, "mv");
+    e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
+    glGenVertexArrays(1, &e->vao);
+    glGenTextures(1, &e->color);
+    glBindTexture(GL_TEXTURE_2D, e->color);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glGenTextures(1, &e->depth);
+    glBindTexture(GL_TEXTURE_2D, e->depth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, W, H, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &e->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->color, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->depth, 0);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    e->clip_control = (PFNGLCLIPCONTROLPROC)OSMesaGetProcAddress("glClipControl");
+    assert_non_null(e->clip_control);
+}
+
+static void engine_free(engine *e)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &e->fbo);
+    glDeleteTextures(1, &e->color);
+    glDeleteTextures(1, &e->depth);
+    glDeleteBuffers(3, e->vbo);
+    glDeleteBuffers(3, e->ibo);
+    glDeleteVertexArrays(1, &e->vao);
+    glDeleteProgram(e->prog);
+}
+
+/* The engine's opaque pass under its convention; the state stays set for fogvol. With
+   mrt, fogvol's O texture is its second colour attachment. */
+static void engine_draw(engine *e, const conv *c, const float *vp, const float *view, const float model[3][16],
+                        const fogvol_mrt_info *mrt)
+{
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    const float bg[4] = {0.2f, 0.5f, 0.8f, 1.0f}, grey[4] = {0.45f, 0.4f, 0.35f, 1.0f};
+    const GLfloat zclear = c->greater ? 0.0f : 1.0f;
+    int i;
+    e->clip_control(c->upper_left ? GL_UPPER_LEFT : GL_LOWER_LEFT, c->zero_to_one ? GL_ZERO_TO_ONE
+                                                                                  : GL_NEGATIVE_ONE_TO_ONE);
+    glDepthRange(c->range_rev ? 1.0 : 0.0, c->range_rev ? 0.0 : 1.0);
+    glDepthFunc(c->greater ? GL_GREATER : GL_LESS);
+    glClearDepth(c->greater ? 0.0 : 1.0);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, mrt ? (GLuint)mrt->texture : 0, 0);
+    glDrawBuffers(mrt ? 2 : 1, bufs);
+    glViewport(0, 0, W, H);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    if (mrt) glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
+    glClearBufferfv(GL_DEPTH, 0, &zclear);
+    glUseProgram(e->prog);
+    glBindVertexArray(e->vao);
+    glUniform4fv(e->u_color, 1, grey);
+    if (mrt) glUniform4fv(e->u_mrt, 2, mrt->uniforms);
+    for (i = 0; i < 2; ++i) {
+        double a[16], b[16], m[16];
+        float f[16];
+        int j;
+        for (j = 0; j < 16; ++j) {
+            a[j] = vp[j];
+            b[j] = model[1 + i][j];
+        }
+        mul4d(m, a, b);
+        for (j = 0; j < 16; ++j) f[j] = (float)m[j];
+        glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, f);
+        for (j = 0; j < 16; ++j) a[j] = view[j];
+        mul4d(m, a, b);
+        for (j = 0; j < 16; ++j) f[j] = (float)m[j];
+        glUniformMatrix4fv(e->u_mv, 1, GL_FALSE, f);
+        glBindBuffer(GL_ARRAY_BUFFER, e->vbo[1 + i]);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+        glEnableVertexAttribArray(0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo[1 + i]);
+        glDrawElements(GL_TRIANGLES, e->count[1 + i], GL_UNSIGNED_INT, NULL);
+    }
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_DEPTH_TEST);
+    glDrawBuffers(1, bufs); /* fogvol composites into attachment 0 */
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+}
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l <= FOGVOL_LOG_WARNING) fprintf(stderr, "  [fogvol] %s\n", m);
+}
+
+typedef struct depth_state {
+    GLint origin, mode, func;
+    GLdouble range[2], clear;
+} depth_state;
+
+static void get_depth_state(depth_state *d)
+{
+    glGetIntegerv(GL_CLIP_ORIGIN, &d->origin);
+    glGetIntegerv(GL_CLIP_DEPTH_MODE, &d->mode);
+    glGetIntegerv(GL_DEPTH_FUNC, &d->func);
+    glGetDoublev(GL_DEPTH_RANGE, d->range);
+    glGetDoublev(GL_DEPTH_CLEAR_VALUE, &d->clear);
+}
+
+typedef struct result {
+    double max_err, bound;
+    double comp_max;
+    int fogged, interior;
+    int state_ok;
+    fogvol_result r;
+} result;
+
+/* Render one convention with one tier and compare. */
+static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_mesh *meshes[3],
+                       fogvol_context *fv, const fogvol_ramp *ramp, const char *png)
+{
+    static float thick[W * H];
+    static unsigned char base[W * H * 4], fogged[W * H * 4];
+    scene s;
+    float view[16], proj[16], model[3][16];
+    double v[16], p[16], vpd[16], ivp[16], range, far_end;
+    float vp[16];
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_mrt_info mrt;
+    depth_state before, after;
+    const fogvol_encoding *enc = fogvol_context_encoding(fv);
+    result res;
+    int i, j, ortho = c->proj == P_ORTHO || c->proj == P_ORTHO_REV01;
+    const double at[3] = {0.0, 0.0, ortho ? -8.5 : -6.0}, up[3] = {0.0, 1.0, 0.0};
+
+    memset(&res, 0, sizeof res);
+    make_scene(&s, ortho, c->inside);
+    range = s.zfar - s.znear;
+    glu_look_at(view, g_eye, at, up);
+    make_projection(c->proj, &s, proj);
+    for (i = 0; i < 16; ++i) {
+        v[i] = view[i];
+        p[i] = proj[i];
+    }
+    mul4d(vpd, p, v);
+    for (i = 0; i < 16; ++i) vp[i] = (float)vpd[i];
+    assert_true(inv4d(vpd, ivp));
+    glu_translate_scale(model[0], (float)((s.bmin[0] + s.bmax[0]) / 2), (float)((s.bmin[1] + s.bmax[1]) / 2),
+                        (float)((s.bmin[2] + s.bmax[2]) / 2), 1.0f);
+    for (i = 0; i < 2; ++i) {
+        const rect *r = &s.occ[i];
+        glu_identity(model[1 + i]);
+        model[1 + i][0] = (float)((r->x1 - r->x0) / 2);
+        model[1 + i][5] = (float)((r->y1 - r->y0) / 2);
+        model[1 + i][12] = (float)((r->x0 + r->x1) / 2);
+        model[1 + i][13] = (float)((r->y0 + r->y1) / 2);
+        model[1 + i][14] = (float)r->z;
+    }
+    /* the box mesh is 1 x 1 x 1 half extents scaled here */
+    model[0][0] = (float)((s.bmax[0] - s.bmin[0]) / 2);
+    model[0][5] = (float)((s.bmax[1] - s.bmin[1]) / 2);
+    model[0][10] = (float)((s.bmax[2] - s.bmin[2]) / 2);
+
+    memset(&fd, 0, sizeof fd);
+    if (c->vp_camera) {
+        fd.camera = FOGVOL_CAMERA_VIEW_PROJECTION;
+        memcpy(fd.view_projection, vp, sizeof vp);
+        for (i = 0; i < 3; ++i) {
+            fd.eye[i] = (float)g_eye[i];
+            fd.forward[i] = (float)(at[i] - g_eye[i]);
+        }
+    } else {
+        memcpy(fd.view, view, sizeof view);
+        memcpy(fd.projection, proj, sizeof proj);
+    }
+    fd.znear = (float)s.znear;
+    fd.zfar = (float)s.zfar;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.debug_thickness = thick;
+    fd.engine_depth_texture = e->depth;
+    if (c->told) {
+        fd.engine_depth_zero_to_one = c->zero_to_one ? 1 : -1;
+        fd.engine_depth_range[0] = c->range_rev ? 1.0f : 0.0f;
+        fd.engine_depth_range[1] = c->range_rev ? 0.0f : 1.0f;
+    }
+    res.r = fogvol_begin_frame(fv, &fd);
+    if (res.r != FOGVOL_SUCCESS) return res;
+    if (cb->tier == FOGVOL_TIER_MRT) assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+    engine_draw(e, c, vp, view, (const float(*)[16])model, cb->tier == FOGVOL_TIER_MRT ? &mrt : NULL);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, base);
+    if (c->told) {
+        e->clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+        glDepthRange(0.0, 1.0);
+    }
+    get_depth_state(&before);
+    if (!(cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && cb->tier != FOGVOL_TIER_MRT)
+        for (i = 0; i < 2; ++i) assert_int_equal(fogvol_add_occluder(fv, meshes[1 + i], model[1 + i]), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = meshes[0];
+    memcpy(vd.model, model[0], sizeof vd.model);
+    vd.ramp = ramp;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    for (i = 0; i < W * H; ++i) thick[i] = -1e30f;
+    res.r = fogvol_end_frame(fv, NULL);
+    glFinish();
+    get_depth_state(&after);
+    res.state_ok = before.origin == after.origin && before.mode == after.mode && before.func == after.func &&
+                   before.range[0] == after.range[0] && before.range[1] == after.range[1] &&
+                   before.clear == after.clear;
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, fogged);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+
+    /* RGBA8 encodings clamp d to 1 - 1.5 LSB (fogvol_constants.depth_max): their far end */
+    far_end = cb->tier == FOGVOL_TIER_FLOAT ? s.zfar
+                                            : s.znear + range * (1.0 - 1.5 / ((double)enc->levels * enc->levels * enc->levels));
+    res.bound = cb->tier == FOGVOL_TIER_FLOAT ? 3e-5 * range
+                                              : range / (double)(1 << enc->precision_bits) + 1e-6 * range;
+    for (j = 0; j < H; ++j)
+        for (i = 0; i < W; ++i) {
+            gt_px g = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5, j + 0.5);
+            double err, a;
+            int k, ok = 1, ch;
+            for (k = 0; k < 4 && ok; ++k)
+                ok = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5 + ((k & 1) ? 0.75 : -0.75),
+                           j + 0.5 + ((k & 2) ? 0.75 : -0.75)).sig == g.sig;
+            if (!ok) continue;
+            res.interior++;
+            if (g.t > 0.05) res.fogged++;
+            err = fabs((double)thick[j * W + i] - g.t);
+            if (err > res.max_err) res.max_err = err;
+            a = 1.0 - exp(-DENSITY * g.t);
+            for (ch = 0; ch < 3; ++ch) {
+                double want = base[4 * (j * W + i) + ch] / 255.0 + (0.8 - base[4 * (j * W + i) + ch] / 255.0) * a;
+                double got = fogged[4 * (j * W + i) + ch] / 255.0;
+                if (fabs(got - want) > res.comp_max) res.comp_max = fabs(got - want);
+            }
+        }
+    if (png) {
+        stbi_flip_vertically_on_write(1);
+        stbi_write_png(png, W, H, 4, fogged, W * 4);
+    }
+    return res;
+}
+
+static void test_conventions(void **state)
+{
+    glu_ctx g;
+    engine e;
+    int ci, ti, failures = 0;
+    shp_mesh box = shp_box(1.0f, 1.0f, 1.0f), quad = shp_grid_plane(1.0f, 1.0f, 1);
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    engine_init(&e);
+    engine_mesh(&e, 0, &box);
+    engine_mesh(&e, 1, &quad);
+    engine_mesh(&e, 2, &quad);
+    mkdir("build", 0777);
+    mkdir("build/engine_depth", 0777);
+    for (ti = 0; ti < NCOMBO; ++ti) {
+        const combo *cb = &g_combos[ti];
+        fogvol_context_desc cd;
+        fogvol_context *fv = NULL;
+        fogvol_mesh_desc md;
+        fogvol_mesh *m[3];
+        fogvol_ramp_desc rd;
+        fogvol_ramp *ramp;
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.logger.func = logger;
+        cd.tier = cb->tier;
+        cd.variants = cb->variants;
+        cd.disable_dither = 1;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        memset(&md, 0, sizeof md);
+        md.positions = box.pos;
+        md.vertex_count = box.vcount;
+        md.indices = box.idx;
+        md.index_count = box.icount;
+        assert_int_equal(fogvol_create_mesh(fv, &md, &m[0], NULL), FOGVOL_SUCCESS);
+        md.positions = quad.pos;
+        md.vertex_count = quad.vcount;
+        md.indices = quad.idx;
+        md.index_count = quad.icount;
+        md.allow_open = 1;
+        assert_int_equal(fogvol_create_mesh(fv, &md, &m[1], NULL), FOGVOL_SUCCESS);
+        m[2] = m[1];
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+        rd.density = (float)DENSITY;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        for (ci = 0; ci < NCONV; ++ci) {
+            const conv *c = &g_convs[ci];
+            char png[128];
+            result r;
+            int ok;
+            /* COUNT needs the camera outside the volumes (documented); NEAR_CLAMP snaps
+               vertices behind the eye onto the near plane, which distorts a box reaching
+               behind the camera under every convention (standard GL included) */
+            if (c->inside && (cb->variants & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_NEAR_CLAMP))) continue;
+            snprintf(png, sizeof png, "build/engine_depth/%s_%02d.png", cb->name, ci);
+            r = run_case(&e, c, cb, (const fogvol_mesh **)m, fv, ramp, ti < 3 ? png : NULL);
+            ok = r.r == FOGVOL_SUCCESS && r.max_err <= r.bound && r.comp_max <= 2.0 / 255.0 && r.state_ok &&
+                 r.fogged > 200 && r.interior > W * H / 2;
+            printf("# %-18s %-48s max |err| %.3g (%.3f of bound %.3g), composite %.1f/255, %d fogged of %d "
+                   "interior, state %s, %s%s\n",
+                   cb->name, c->name, r.max_err, r.max_err / r.bound, r.bound, r.comp_max * 255.0, r.fogged,
+                   r.interior, r.state_ok ? "restored" : "CHANGED", fogvol_result_string(r.r), ok ? "" : "  FAIL");
+            failures += !ok;
+        }
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_mesh(fv, m[0]);
+        fogvol_destroy_mesh(fv, m[1]);
+        fogvol_destroy_context(fv);
+    }
+    engine_free(&e);
+    glu_destroy(&g);
+    shp_free(&box);
+    shp_free(&quad);
+    assert_int_equal(failures, 0);
+}
+
+/* ---- the projection helper and refusals (no GPU) ---- */
+static void check_planes(int kind, int zero_to_one, double n, double f, int ortho, int rev, int inf)
+{
+    scene s;
+    float p[16];
+    fogvol_projection_info pi;
+    memset(&s, 0, sizeof s);
+    s.znear = n;
+    s.zfar = f;
+    make_projection(kind, &s, p);
+    assert_int_equal(fogvol_projection_planes(p, zero_to_one, &pi), FOGVOL_SUCCESS);
+    assert_true(fabs(pi.znear - n) <= 1e-5 * n);
+    /* the far plane of a float matrix is known to about 2^-24 f/n relative */
+    if (inf) assert_true(pi.zfar == 0.0f);
+    else assert_true(fabs(pi.zfar - f) <= (1e-6 + 4.0 * f / n / 16777216.0) * f);
+    assert_int_equal(pi.orthographic, ortho);
+    assert_int_equal(pi.reversed, rev);
+    assert_int_equal(pi.infinite, inf);
+}
+
+static void test_projection_planes(void **state)
+{
+    float p[16];
+    fogvol_projection_info pi;
+    scene s;
+    (void)state;
+    check_planes(P_GL, 0, 0.5, 200.0, 0, 0, 0);
+    check_planes(P_GL_REV, 0, 0.5, 200.0, 0, 1, 0);
+    check_planes(P_D3D, 1, 0.1, 1000.0, 0, 0, 0);
+    check_planes(P_D3D_REV, 1, 0.1, 1000.0, 0, 1, 0);
+    check_planes(P_INF, 0, 0.25, 0.0, 0, 0, 1);
+    check_planes(P_INF_REV01, 1, 0.25, 0.0, 0, 1, 1);
+    check_planes(P_JITTER, 0, 1.0, 50.0, 0, 0, 0);
+    check_planes(P_ORTHO, 0, 4.0, 8.0, 1, 0, 0);
+    check_planes(P_ORTHO_REV01, 1, 4.0, 8.0, 1, 1, 0);
+    /* a D3D-style [0,1] projection read as [-1,1]: near comes out where z_ndc = -1 (not n) */
+    memset(&s, 0, sizeof s);
+    s.znear = 1.0;
+    s.zfar = 10.0;
+    make_projection(P_D3D, &s, p);
+    assert_int_equal(fogvol_projection_planes(p, 0, &pi), FOGVOL_SUCCESS);
+    assert_true(fabs(pi.znear - 10.0 / 19.0) < 1e-5); /* by hand: z_ndc = -1 at e = fn / (2f - n) = 10/19 */
+    /* refused: w depends on x; w = 0; NULL */
+    make_projection(P_GL, &s, p);
+    p[3] = 0.5f;
+    assert_int_equal(fogvol_projection_planes(p, 0, &pi), FOGVOL_ERROR_INVALID_ARGUMENT);
+    make_projection(P_GL, &s, p);
+    p[11] = 0.0f;
+    assert_int_equal(fogvol_projection_planes(p, 0, &pi), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_projection_planes(NULL, 0, &pi), FOGVOL_ERROR_INVALID_ARGUMENT);
+}
+
+static int g_logged;
+static void count_log(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    (void)m;
+    if (l == FOGVOL_LOG_ERROR) g_logged++;
+}
+
+static void test_camera_refused(void **state)
+{
+    fogvol_null_backend nb;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd;
+    scene s;
+    (void)state;
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&nb, &cd.backend);
+    cd.logger.func = count_log;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    memset(&s, 0, sizeof s);
+    s.znear = 1.0;
+    s.zfar = 10.0;
+    memset(&fd, 0, sizeof fd);
+    glu_identity(fd.view);
+    make_projection(P_GL, &s, fd.projection);
+    fd.znear = 1.0f;
+    fd.zfar = 10.0f;
+    fd.viewport[2] = fd.viewport[3] = 8;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    g_logged = 0;
+    fd.projection[3] = 0.3f; /* w depends on x: neither perspective nor orthographic */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(g_logged, 1);
+    fd.projection[3] = 0.0f;
+    fd.projection[11] = 1.0f; /* w = -view depth: everything in front is behind */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    fd.projection[11] = -1.0f;
+    fd.projection[0] = 0.0f; /* x collapses */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    make_projection(P_GL, &s, fd.projection);
+    fd.view[10] = 0.0f; /* singular view */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    glu_identity(fd.view);
+    /* view-projection input: zero forward; eye and forward that do not match the w row */
+    fd.camera = FOGVOL_CAMERA_VIEW_PROJECTION;
+    memcpy(fd.view_projection, fd.projection, sizeof fd.view_projection);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT); /* forward 0 */
+    fd.forward[2] = -1.0f;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    fd.forward[0] = 1.0f; /* looks sideways: w is not the depth along forward */
+    g_logged = 0;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(g_logged, 1);
+    /* an engine that only has P V and passes it as the projection with view = I: the w row
+       is the view depth of the real camera, not of the identity view; refused, not guessed */
+    fd.camera = FOGVOL_CAMERA_VIEW_AND_PROJECTION;
+    {
+        const double at[3] = {0.0, 0.0, -6.0}, up[3] = {0.0, 1.0, 0.0};
+        double a[16], b[16], m[16];
+        float v[16];
+        int i;
+        glu_look_at(v, g_eye, at, up);
+        make_projection(P_GL, &s, fd.projection);
+        for (i = 0; i < 16; ++i) {
+            a[i] = fd.projection[i];
+            b[i] = v[i];
+        }
+        mul4d(m, a, b);
+        for (i = 0; i < 16; ++i) fd.projection[i] = (float)m[i];
+        g_logged = 0;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+        assert_int_equal(g_logged, 1);
+        make_projection(P_GL, &s, fd.projection);
+    }
+    fd.camera = (fogvol_camera)7;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    fd.camera = FOGVOL_CAMERA_VIEW_AND_PROJECTION;
+    fd.engine_depth_zero_to_one = 2;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    fogvol_destroy_context(fv);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_projection_planes),
+        cmocka_unit_test(test_camera_refused),
+        cmocka_unit_test(test_conventions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
