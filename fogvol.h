@@ -3796,7 +3796,8 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
         return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (d->draw_buffer < 0 || d->draw_buffer > 15 || (d->alpha != FOGVOL_ALPHA_KEEP && d->alpha != FOGVOL_ALPHA_COVERAGE)) {
+    if (d->draw_buffer < 0 || d->draw_buffer > 15 ||
+        (d->alpha != FOGVOL_ALPHA_KEEP && d->alpha != FOGVOL_ALPHA_COVERAGE)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: draw_buffer %d outside 0..15 or unknown alpha mode %d",
                     d->draw_buffer, (int)d->alpha);
         return FOGVOL_ERROR_INVALID_ARGUMENT;

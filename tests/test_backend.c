@@ -528,8 +528,8 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->vp[2] = A_W;
     x->vp[3] = A_H;
     x->blend = blend;
-    x->cull = geometry ? FOGVOL_CULL_FRONT : FOGVOL_CULL_NONE;
-    x->guard = geometry;
+    (void)geometry; /* both composites: the full-screen program, no stencil guard (geometry adds a scissor) */
+    x->cull = FOGVOL_CULL_NONE;
     x->program = program;
     x->tex[0] = b;
     x->tex[1] = f;
@@ -538,7 +538,7 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->screen[1] = 1.0f / A_H;
     x->screen[2] = -(float)A_X0 / A_W;
     x->screen[3] = -(float)A_Y0 / A_H;
-    x->fullscreen = geometry ? 0 : 1;
+    x->fullscreen = 1;
 }
 
 static void x_add_draw(xpass *x, fogvol_handle m) { x->draws[x->ndraw++] = m; }
@@ -764,7 +764,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     /* resources identified by what they are, not by creation order */
     enc = rec_program(r, FOGVOL_PROGRAM_ENCODE);
     face = rec_program(r, FOGVOL_PROGRAM_FACE);
-    comp = rec_program(r, geometry ? FOGVOL_PROGRAM_COMPOSITE_MESH : FOGVOL_PROGRAM_COMPOSITE);
+    comp = rec_program(r, FOGVOL_PROGRAM_COMPOSITE);
     rg = rec_texture_sized(r, 16, 16);          /* N x N */
     blue = rec_texture_sized(r, 16 * 32, 32);   /* (N*D) x D */
     dith = rec_texture_sized(r, 8, 8);          /* 8 x 8 */
@@ -838,10 +838,6 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     x_target_pass(&x[4], F, 0, FOGVOL_CULL_FRONT, face, faces);
     x_add_draw(&x[4], mh(s->vol[2]));
     x_composite(&x[5], FOGVOL_PASS_BLEND_LIGHT, geometry, comp, B, F, tl);
-    if (geometry) {
-        x_add_draw(&x[5], mh(s->vol[0]));
-        x_add_draw(&x[5], mh(s->vol[3]));
-    }
     /* fog group: V1, V4 */
     x_target_pass(&x[6], B, 1, FOGVOL_CULL_FRONT, face, faces);
     x_add_draw(&x[6], mh(s->vol[1]));
@@ -850,10 +846,6 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     x_add_draw(&x[7], mh(s->vol[1]));
     x_add_draw(&x[7], mh(s->vol[4]));
     x_composite(&x[8], FOGVOL_PASS_BLEND_FOG, geometry, comp, B, F, tf);
-    if (geometry) {
-        x_add_draw(&x[8], mh(s->vol[1]));
-        x_add_draw(&x[8], mh(s->vol[4]));
-    }
     for (i = 0; i < 9; ++i) check_pass(r, i, &x[i], geometry ? "geometry" : "fullscreen");
     for (i = 1; i < 9; ++i) { /* B/F clear to zero */
         if (r->nb.passes[i].clear) {
@@ -861,9 +853,15 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
             for (c = 0; c < 4; ++c) assert_close(r->nb.passes[i].clear_color[c], 0.0, 1e-7, "B/F clear colour");
         }
     }
-    if (geometry) {
-        assert_int_equal(r->nb.passes[5].stencil_bit, want_bit);
-        assert_int_equal(r->nb.passes[8].stencil_bit, want_bit);
+    (void)want_bit; /* the stencil bit is unused: no pass has a stencil guard (check_pass) */
+    for (i = 5; i < 9; i += 3) { /* geometry: a scissor inside the viewport; full-screen: none */
+        const int *sc = r->nb.passes[i].scissor;
+        if (geometry) {
+            assert_true(sc[2] > 0 && sc[3] > 0);
+            assert_true(sc[0] >= A_X0 && sc[1] >= A_Y0 && sc[0] + sc[2] <= A_X0 + A_W && sc[1] + sc[3] <= A_Y0 + A_H);
+        } else {
+            assert_int_equal(sc[2], 0);
+        }
     }
 
     /* uniforms */
@@ -936,13 +934,13 @@ static void test_a1_geometry_stencil_bit(void **state)
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
     (void)state;
     a1_build(s);
-    a1_check(s, 1, 0x04); /* the frame's stencil_bit reaches the composite passes */
+    a1_check(s, 1, 0x04); /* the frame's stencil_bit is ignored: no stencil guard */
     a1_free(s);
     free(s);
 }
 
-/* A geometry composite without an engine stencil buffer falls back to the full-screen
-   triangle (the guard needs a stencil bit), with a warning. */
+/* A geometry composite without an engine stencil buffer works as with one (it uses no stencil):
+   no warning, the full-screen triangle under a scissor. */
 static void test_a1_geometry_without_stencil(void **state)
 {
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
@@ -953,7 +951,8 @@ static void test_a1_geometry_without_stencil(void **state)
     log_reset(&s->lc);
     a1_submit(s, FOGVOL_COMPOSITE_GEOMETRY, 0, &st);
     assert_int_equal(st.passes, 9);
-    assert_true(s->lc.warnings >= 1);
+    assert_int_equal(s->lc.warnings, 0);
+    assert_true(s->r.nb.passes[5].scissor[2] > 0);
     assert_int_equal(s->r.nb.passes[5].stencil_guard, 0);
     assert_int_equal(s->r.nb.fullscreen[5], 1);
     assert_int_equal(s->r.nb.draws[5], 0);

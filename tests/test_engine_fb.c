@@ -442,7 +442,7 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     fogvol_frame_desc fd;
     unsigned char *pre[4], *post[4], *refpx = (unsigned char *)malloc(NPIX * 4);
     int i, changed;
-    char what[96];
+    char what[96], png[64];
     eng_open(&e, prof, FOGVOL_TIER_PS20);
     add_obj(&e, shp_sphere(2.0f, 48, 24), 0, 0, 0, 1, 1, 0);
     add_obj(&e, shp_sphere(1.0f, 32, 16), 1.5f, 1.0f, 1.0f, 1, 1, 1);
@@ -466,7 +466,9 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     check_snap(&before, &after, what);
     assert_int_equal(glGetError(), GL_NO_ERROR);
     for (i = 0; i < 4; ++i) tex_read(f.tex[i], post[i]);
-    write_png4((const unsigned char *const *)post, named ? "four_attachments_named2" : "four_attachments");
+    snprintf(png, sizeof png, "four_attachments_%s_buffer%d",
+             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : "gl21", named);
+    write_png4((const unsigned char *const *)post, png);
     /* reference: a one-attachment FBO with the same contents, default blend state */
     efbo_make(&ref, 1, GL_RGBA8);
     glBindTexture(GL_TEXTURE_2D, ref.tex[0]);
