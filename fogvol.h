@@ -3594,8 +3594,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         }
         if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
     }
-    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i) /* COMPOSITE_MESH: for engines only, the
+                                                                         geometry composite is scissored */
+        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
+            i != FOGVOL_PROGRAM_COMPOSITE_MESH)
             r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
