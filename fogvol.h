@@ -1009,7 +1009,15 @@ typedef struct fogvol_frame_desc {
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
    the GPU before end_frame. A begin_frame while a frame is open discards the
-   open frame (logged as a warning). */
+   open frame (logged as a warning).
+   GL backend, the engine's state (restored, or set for fogvol's passes and
+   restored: the list is in fogvol__gl_save_raster): GL errors the engine left
+   pending are still pending after every fogvol call (out-of-memory and
+   context-loss codes cannot be raised again: logged as a warning); an active
+   transform feedback is paused during the call (GL 4.0 / GLES 3.0; on GL 3.x,
+   where it cannot be queried, do not call fogvol inside one); fogvol must not
+   be called between glBeginConditionalRender and glEndConditionalRender (not
+   queryable: its passes could be skipped). */
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
 /* The callback runs inside the O pass with the depth-encode program bound:
