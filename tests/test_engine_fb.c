@@ -79,16 +79,31 @@ typedef struct eng {
     obj o[MAXOBJ];
     int n;
     fogvol_ramp *ramp[2];
-    int core, v21;
+    int core, v21, es30;
 } eng;
 
-enum { PROF_CORE = 0, PROF_COMPAT = 1, PROF_21 = 2 };
+/* PROF_ES30: the core context treated as OpenGL ES 3.0 (fogvol_gl_desc.gles). */
+enum { PROF_CORE = 0, PROF_COMPAT = 1, PROF_21 = 2, PROF_ES30 = 3 };
+
+/* glGetError that first returns a code the test queues (errors GL cannot raise on demand). */
+static GLenum g_fake_error;
+static GLenum APIENTRY fake_get_error(void)
+{
+    GLenum e = g_fake_error;
+    g_fake_error = GL_NO_ERROR;
+    return e != GL_NO_ERROR ? e : glGetError();
+}
+static void (*fake_proc(const char *name, void *user))(void)
+{
+    if (strcmp(name, "glGetError") == 0) return (void (*)(void))fake_get_error;
+    return glu_proc(name, user);
+}
 
 static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
 {
     fogvol_context_desc cd;
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
+    cd.gl.get_proc_address = fake_proc;
     cd.logger.func = logger;
     cd.logger.user_data = &e->lc;
     cd.tier = tier;
@@ -96,6 +111,10 @@ static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
     if (e->v21) {
         cd.gl.version_major = 2;
         cd.gl.version_minor = 1;
+    }
+    if (e->es30) {
+        cd.gl.version_major = 3;
+        cd.gl.gles = 1;
     }
     return fogvol_create_context(&cd, &e->fv);
 }
@@ -126,8 +145,9 @@ static void make_ramp(eng *e, int i, const float rgba[4])
 static void eng_open(eng *e, int prof, fogvol_tier tier)
 {
     memset(e, 0, sizeof *e);
-    e->core = prof == PROF_CORE;
+    e->core = prof == PROF_CORE || prof == PROF_ES30;
     e->v21 = prof == PROF_21;
+    e->es30 = prof == PROF_ES30;
     assert_true(glu_create(&e->g, W, H, e->core));
     e->cam.eye[2] = 6.0;
     e->cam.up[1] = 1.0;
@@ -455,19 +475,20 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     }
     glBindFramebuffer(GL_FRAMEBUFFER, f.fbo);
     glDrawBuffers(4, list);
-    if (prof != PROF_21) engine_blend_state();
+    if (prof == PROF_CORE || prof == PROF_COMPAT) engine_blend_state();
     take_snap(&e, &before);
     frame_desc(&e, &fd);
     fd.draw_buffer = named;
     snprintf(what, sizeof what, "%s, draw buffer %d of 4",
-             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : "GL 2.1 path", named);
+             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : prof == PROF_21 ? "GL 2.1 path" : "as ES 3.0",
+             named);
     check_thickness(&e, &fd, 1.0, what);
     take_snap(&e, &after);
     check_snap(&before, &after, what);
     assert_int_equal(glGetError(), GL_NO_ERROR);
     for (i = 0; i < 4; ++i) tex_read(f.tex[i], post[i]);
     snprintf(png, sizeof png, "four_attachments_%s_buffer%d",
-             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : "gl21", named);
+             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : prof == PROF_21 ? "gl21" : "es30", named);
     write_png4((const unsigned char *const *)post, png);
     /* reference: a one-attachment FBO with the same contents, default blend state */
     efbo_make(&ref, 1, GL_RGBA8);
@@ -475,7 +496,7 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, pre[named]);
     glBindTexture(GL_TEXTURE_2D, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, ref.fbo);
-    if (prof != PROF_21) {
+    if (prof == PROF_CORE || prof == PROF_COMPAT) {
         glDisablei(GL_BLEND, 0);
         glColorMaski(0, 1, 1, 1, 1);
     }
@@ -525,6 +546,11 @@ static void test_drawbuffers_21(void **st)
     (void)st;
     drawbuffers_case(PROF_21, 0, g_list4);
     drawbuffers_case(PROF_21, 1, g_list4);
+}
+static void test_drawbuffers_es30(void **st)
+{
+    (void)st;
+    drawbuffers_case(PROF_ES30, 0, g_list4);
 }
 
 /* A list that does not map position i to attachment i: position 2 names attachment 0. */
@@ -597,6 +623,15 @@ static void test_drawbuffers_refused(void **st)
     glDrawBuffers(4, g_list_gap);
     refuse_case(&e, 1, "draw buffer 1 is GL_NONE");
     refuse_case(&e, 9, "past GL_MAX_DRAW_BUFFERS");
+    efbo_free(&f);
+    eng_close(&e);
+    /* OpenGL ES: list position i can only name COLOR_ATTACHMENTi, so only the first buffer */
+    eng_open(&e, PROF_ES30, FOGVOL_TIER_PS20);
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    efbo_make(&f, 4, GL_RGBA8);
+    glDrawBuffers(4, g_list4);
+    refuse_case(&e, 1, "OpenGL ES, draw buffer 1");
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     frame_desc(&e, &fd);
     fd.draw_buffer = -1;
     assert_int_equal(fogvol_begin_frame(e.fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
@@ -910,6 +945,32 @@ static void test_errors_21(void **st)
     errors_case(PROF_21);
 }
 
+/* Codes GL cannot raise again on demand (out of memory, stack over/underflow, context loss) are logged. */
+static void test_errors_unraisable(void **st)
+{
+    static const GLenum codes[3] = {GL_OUT_OF_MEMORY, GL_STACK_OVERFLOW, GL_CONTEXT_LOST};
+    eng e;
+    fogvol_frame_desc fd;
+    int c;
+    char want[16];
+    (void)st;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    for (c = 0; c < 3; ++c) {
+        g_fake_error = codes[c];
+        e.lc.warnings = 0;
+        e.lc.last[0] = 0;
+        frame_desc(&e, &fd);
+        assert_int_equal(run(&e, &fd, NULL), FOGVOL_SUCCESS);
+        assert_int_equal(e.lc.warnings, 1);
+        snprintf(want, sizeof want, "0x%04x", codes[c]);
+        assert_non_null(strstr(e.lc.last, want));
+        print_message("# logged: %s\n", e.lc.last);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+    }
+    eng_close(&e);
+}
+
 /* ---- 5. alpha, 6. sRGB ---------------------------------------------------- */
 static double srgb_decode(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 static double srgb_encode(double l) { return l <= 0.0031308 ? l * 12.92 : 1.055 * pow(l, 1.0 / 2.4) - 0.055; }
@@ -1019,11 +1080,13 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_drawbuffers_core),  cmocka_unit_test(test_drawbuffers_compat),
-        cmocka_unit_test(test_drawbuffers_21),    cmocka_unit_test(test_drawbuffers_swizzled),
+        cmocka_unit_test(test_drawbuffers_21),    cmocka_unit_test(test_drawbuffers_es30),
+        cmocka_unit_test(test_drawbuffers_swizzled),
         cmocka_unit_test(test_drawbuffers_refused), cmocka_unit_test(test_geometry_core),
         cmocka_unit_test(test_geometry_21),       cmocka_unit_test(test_state_core),
         cmocka_unit_test(test_state_compat),      cmocka_unit_test(test_transform_feedback),
         cmocka_unit_test(test_errors_core),       cmocka_unit_test(test_errors_21),
+        cmocka_unit_test(test_errors_unraisable),
         cmocka_unit_test(test_alpha),             cmocka_unit_test(test_srgb),
         cmocka_unit_test(test_srgb_own_targets),
     };
