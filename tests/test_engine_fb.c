@@ -480,7 +480,10 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     frame_desc(&e, &fd);
     fd.draw_buffer = named;
     snprintf(what, sizeof what, "%s, draw buffer %d of 4",
-             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : prof == PROF_21 ? "GL 2.1 path" : "as ES 3.0",
+             prof == PROF_CORE     ? "core"
+             : prof == PROF_COMPAT ? "compat"
+             : prof == PROF_21     ? "GL 2.1 path"
+                                   : "as ES 3.0",
              named);
     check_thickness(&e, &fd, 1.0, what);
     take_snap(&e, &after);
