@@ -50,6 +50,10 @@ $(BUILD)/test_glstate: tests/test_glstate.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_glstate_san: tests/test_glstate.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_fb: tests/test_engine_fb.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_fb_san: tests/test_engine_fb.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_tiers: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_tiers_san: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
@@ -85,6 +89,7 @@ $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 
 TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
+            $(BUILD)/test_engine_fb $(BUILD)/test_engine_fb_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
             $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
@@ -111,6 +116,8 @@ test: deps-test deps-run
 	  "render_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_render_san" \
 	  "glstate=$(TAP) $(BUILD)/test_glstate" \
 	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san" \
+	  "engine_fb=$(TAP) $(BUILD)/test_engine_fb" \
+	  "engine_fb_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_fb_san" \
 	  "tiers=$(TAP) $(BUILD)/test_tiers" \
 	  "tiers_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_tiers_san" \
 	  "backend=$(TAP) $(BUILD)/test_backend" \

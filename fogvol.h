@@ -317,6 +317,19 @@ typedef enum fogvol_ramp_model {
     FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
 } fogvol_ramp_model;
 
+/* Colour space. Ramp colours are used as given: the texel bytes are the
+   fragment colour the composite outputs, and GL blends it with the engine's
+   target like any draw. So
+   - an sRGB engine target (e.g. GL_SRGB8_ALPHA8) with GL_FRAMEBUFFER_SRGB
+     enabled: the colours are linear; GL decodes the target, blends in linear
+     light and encodes the result (fogvol leaves FRAMEBUFFER_SRGB as the
+     engine set it);
+   - a linear-format target (RGBA8, the default framebuffer), or
+     FRAMEBUFFER_SRGB disabled: colours and blending are in the space of the
+     stored values (usually sRGB-encoded: give sRGB colours).
+   The gradient model interpolates the keys in the space they are given in.
+   fogvol's own RGBA8 and R32F targets are linear formats, which
+   FRAMEBUFFER_SRGB does not affect. */
 typedef enum fogvol_blend {
     FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
     FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, seeds/004) */
@@ -842,6 +855,9 @@ typedef struct fogvol_pass {
     unsigned stencil_bit;
     int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
                                every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
+    int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
+    int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
+    int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
@@ -879,6 +895,8 @@ typedef struct fogvol_frame_info {
     int depth_zero_to_one;
     int clip_upper_left;
     float depth_range[2];
+    int draw_buffer;  /* in: the engine draw buffer the composite writes (fogvol_frame_desc.draw_buffer);
+                         a backend that cannot write it returns an error from begin_frame */
 } fogvol_frame_info;
 
 typedef struct fogvol_backend {
@@ -950,9 +968,15 @@ typedef struct fogvol_gl_desc {
     int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
 } fogvol_gl_desc;
 
+/* Both composites write the same pixels with the same values and leave the
+   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
+   the window rectangle of each ramp group's volumes (the 8 corners of each
+   mesh's bounding box projected; the whole viewport when a box reaches behind
+   the near plane), which saves fill rate when the volumes cover little of the
+   screen. */
 typedef enum fogvol_composite {
-    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle */
-    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the volume geometry, guarded by one stencil bit */
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
 } fogvol_composite;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -976,6 +1000,11 @@ typedef enum fogvol_msaa {
     FOGVOL_MSAA_SINGLE_SAMPLE = 1,
     FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
 } fogvol_msaa;
+/* What the composite does to the alpha of the engine's colour target. */
+typedef enum fogvol_alpha {
+    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
+    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
+} fogvol_alpha;
 
 typedef struct fogvol_context_desc {
     fogvol_allocator allocator;
@@ -1053,7 +1082,16 @@ typedef struct fogvol_frame_desc {
                                depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
     int viewport[4];        /* x, y, width, height in the engine framebuffer */
     fogvol_composite composite;
-    unsigned stencil_bit;   /* geometry composite: 0 = 0x80 */
+    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
+                               source compatibility) */
+    /* The engine's draw buffer the composite writes (index into its
+       glDrawBuffers list; 0 = the first, the only one for most engines); the
+       other draw buffers stay byte-identical. GL: an index past
+       GL_MAX_DRAW_BUFFERS, one whose buffer is GL_NONE, or > 0 on the default
+       framebuffer or on OpenGL ES (where list position i can only name
+       COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
+    int draw_buffer;
+    fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
     int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta */
     /* Debug read-back of the decoded thickness (world units) per pixel of the
        viewport, rows bottom to top, for the group of debug_ramp (NULL = the
@@ -1079,7 +1117,15 @@ typedef struct fogvol_frame_desc {
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
    the GPU before end_frame. A begin_frame while a frame is open discards the
-   open frame (logged as a warning). */
+   open frame (logged as a warning).
+   GL backend, the engine's state (restored, or set for fogvol's passes and
+   restored: the list is in fogvol__gl_save_raster): GL errors the engine left
+   pending are still pending after every fogvol call (out-of-memory and
+   context-loss codes cannot be raised again: logged as a warning); an active
+   transform feedback is paused during the call (GL 4.0 / GLES 3.0; on GL 3.x,
+   where it cannot be queried, do not call fogvol inside one); fogvol must not
+   be called between glBeginConditionalRender and glEndConditionalRender (not
+   queryable: its passes could be skipped). */
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
 /* The callback runs inside the O pass with the depth-encode program bound:
@@ -3348,8 +3394,28 @@ struct fogvol_mesh {
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
-    float bmin[3], bmax[3]; /* object-space bounds of the vertices */
+    float bmin[3], bmax[3]; /* model-space bounds of the vertices (orthographic clip depth scale,
+                               geometry composite's scissor) */
 };
+
+/* The bounding box of the positions (finite: validated before). */
+static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
+{
+    size_t stride = desc->stride ? (size_t)desc->stride : 12u;
+    int i, c;
+    for (c = 0; c < 3; ++c) {
+        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
+        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
+    }
+    for (i = 0; i < desc->vertex_count; ++i) {
+        float p[3];
+        memcpy(p, (const unsigned char *)desc->positions + (size_t)i * stride, sizeof p);
+        for (c = 0; c < 3; ++c) {
+            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
+            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
+        }
+    }
+}
 
 struct fogvol_ramp {
     fogvol_handle texture;
@@ -3765,8 +3831,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         }
         if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
     }
-    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i) /* COMPOSITE_MESH: for engines only, the
+                                                                         geometry composite is scissored */
+        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
+            i != FOGVOL_PROGRAM_COMPOSITE_MESH)
             r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
@@ -3840,6 +3908,7 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(m, 0, sizeof *m);
+    fogvol__mesh_box(m, desc);
     md.positions = desc->positions;
     if (desc->stride && desc->stride != 12) {
         packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
@@ -3864,17 +3933,6 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     m->vertex_count = desc->vertex_count;
     m->index_count = desc->index_count;
     m->volume = rep.valid;
-    for (i = 0; i < 3; ++i) m->bmin[i] = m->bmax[i] = desc->vertex_count > 0 ? desc->positions[i] : 0.0f;
-    for (i = 0; i < desc->vertex_count; ++i) { /* bounds (orthographic clip depth scale) */
-        float q[3];
-        int j;
-        memcpy(q, (const unsigned char *)desc->positions + (size_t)i * (desc->stride ? (size_t)desc->stride : 12u),
-               sizeof q);
-        for (j = 0; j < 3; ++j) {
-            if (q[j] < m->bmin[j]) m->bmin[j] = q[j];
-            if (q[j] > m->bmax[j]) m->bmax[j] = q[j];
-        }
-    }
     ctx->live_meshes++;
     *out = m;
     return FOGVOL_SUCCESS;
@@ -4133,6 +4191,12 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     }
     r = fogvol__camera(ctx, d);
     if (r != FOGVOL_SUCCESS) return r;
+    if (d->draw_buffer < 0 || d->draw_buffer > 15 ||
+        (d->alpha != FOGVOL_ALPHA_KEEP && d->alpha != FOGVOL_ALPHA_COVERAGE)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: draw_buffer %d outside 0..15 or unknown alpha mode %d",
+                    d->draw_buffer, (int)d->alpha);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     ctx->frame = *d;
     ctx->nvol = ctx->nocc = 0;
     ctx->in_frame = 1;
@@ -4408,6 +4472,50 @@ static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp
     return ctx->frame.debug_thickness && !captured && (ctx->frame.debug_ramp == NULL || ctx->frame.debug_ramp == ramp);
 }
 
+/* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
+   ramp group can cover: the 8 corners of each mesh's box projected, rounded
+   out by a pixel, within the viewport. A corner nearer than the near plane
+   (perspective; NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole
+   viewport. An empty rectangle is 1x1 in the corner (nothing is drawn). */
+static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+{
+    const int *vp = ctx->frame.viewport;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, wmin;
+    int i, k, c;
+    wmin = ctx->frame.projection[15] == 0.0f ? (double)ctx->frame.znear * (1.0 - 1e-6) : 1e-12;
+    memcpy(rect, vp, 4 * sizeof(int));
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        double m[16], mvp[16];
+        if (v->ramp != ramp) continue;
+        fogvol__tod(m, v->model);
+        fogvol__mul4(mvp, ctx->viewproj, m);
+        for (k = 0; k < 8; ++k) {
+            double p[3], clip[4];
+            for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
+            for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
+            if (!(clip[3] >= wmin)) return; /* behind the near plane (or NaN): whole viewport */
+            for (c = 0; c < 2; ++c) {
+                double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
+                if (win < lo[c]) lo[c] = win;
+                if (win > hi[c]) hi[c] = win;
+            }
+        }
+    }
+    for (c = 0; c < 2; ++c) {
+        double a = FOGVOL_FLOOR(lo[c]) - 1.0, b = FOGVOL_FLOOR(hi[c]) + 2.0;
+        if (a < vp[c]) a = vp[c];
+        if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
+        rect[c] = (int)a;
+        rect[c + 2] = b > a ? (int)(b - a) : 0;
+    }
+    if (rect[2] <= 0 || rect[3] <= 0) { /* off screen: a 1x1 rectangle the volumes do not reach */
+        rect[0] = vp[0];
+        rect[1] = vp[1];
+        rect[2] = rect[3] = 1;
+    }
+}
+
 static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
 {
     ps->viewport[0] = ps->viewport[1] = 0;
@@ -4415,6 +4523,8 @@ static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
     ps->viewport[3] = ctx->target_h;
     ps->uniforms[FOGVOL_U_SCREEN][2] = ps->uniforms[FOGVOL_U_SCREEN][3] = 0.0f;
     ps->stencil_guard = 0;
+    memset(ps->scissor, 0, sizeof ps->scissor);
+    ps->draw_buffer = ps->alpha_coverage = 0;
     memset(ps->textures, 0, sizeof ps->textures);
     memset(ps->native_textures, 0, sizeof ps->native_textures);
     ps->textures[0] = ctx->tex_rg;
@@ -4483,6 +4593,7 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
 {
     fogvol_result r = FOGVOL_SUCCESS;
     memset(info, 0, sizeof *info);
+    info->draw_buffer = ctx->frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
     if (r != FOGVOL_SUCCESS)
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
@@ -4685,7 +4796,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     /* steps c-e per colour-ramp group, in order of first appearance */
     for (g = 0; g < ctx->nvol; ++g) {
         const fogvol_ramp *ramp = ctx->vols[g].ramp;
-        int seen = 0, has_pos = 0, has_neg = 0, guard;
+        int seen = 0, has_pos = 0, has_neg = 0;
         for (i = 0; i < g && !seen; ++i) seen = ctx->vols[i].ramp == ramp;
         if (seen) continue;
         for (i = g; i < ctx->nvol; ++i)
@@ -4762,12 +4873,6 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         }
 
         /* composite into the engine framebuffer */
-        guard = fd->composite == FOGVOL_COMPOSITE_GEOMETRY;
-        if (guard && info.stencil_bits <= 0) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                        "fogvol: geometry composite needs a stencil buffer; using the full-screen triangle");
-            guard = 0;
-        }
         ps.target = 0;
         ps.clear = 0;
         memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
@@ -4776,10 +4881,11 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.uniforms[FOGVOL_U_MISC][3] = 0.0f;
         ps.uniforms[FOGVOL_U_MISC][1] = 1.0f;
         ps.blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
-        ps.cull = guard ? FOGVOL_CULL_FRONT : FOGVOL_CULL_NONE;
-        ps.stencil_guard = guard;
-        ps.stencil_bit = fd->stencil_bit ? fd->stencil_bit : 0x80u;
-        ps.program = ctx->prog[guard ? FOGVOL_PROGRAM_COMPOSITE_MESH : FOGVOL_PROGRAM_COMPOSITE];
+        ps.cull = FOGVOL_CULL_NONE;
+        ps.draw_buffer = fd->draw_buffer;
+        ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
+        if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__group_rect(ctx, ramp, ps.scissor);
+        ps.program = ctx->prog[FOGVOL_PROGRAM_COMPOSITE];
         ps.textures[2] = ramp->texture;
         ps.uniforms[FOGVOL_U_RAMP][0] =
             (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
@@ -4787,8 +4893,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         st.passes++;
-        if (guard) fogvol__draw_group(ctx, ramp, 0);
-        else ctx->be.draw_fullscreen(ctx->be.user_data);
+        ctx->be.draw_fullscreen(ctx->be.user_data);
         fogvol__end_pass(ctx);
         fogvol__target_space(ctx, &ps); /* back to target-space settings for the next group */
     }
@@ -4893,7 +4998,14 @@ enum {
     FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0,
     FOGVOL__GL_DEPTH_RANGE = 0x0B70, FOGVOL__GL_CLIP_ORIGIN = 0x935C, FOGVOL__GL_CLIP_DEPTH_MODE = 0x935D,
     FOGVOL__GL_LOWER_LEFT = 0x8CA1, FOGVOL__GL_UPPER_LEFT = 0x8CA2, FOGVOL__GL_NEGATIVE_ONE_TO_ONE = 0x935E,
-    FOGVOL__GL_ZERO_TO_ONE = 0x935F
+    FOGVOL__GL_ZERO_TO_ONE = 0x935F,
+    FOGVOL__GL_INVALID_ENUM = 0x0500, FOGVOL__GL_INVALID_VALUE = 0x0501, FOGVOL__GL_INVALID_OPERATION = 0x0502,
+    FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION = 0x0506, FOGVOL__GL_MAX_DRAW_BUFFERS = 0x8824,
+    FOGVOL__GL_DRAW_BUFFER0 = 0x8825, FOGVOL__GL_MAX_CLIP_DISTANCES = 0x0D32, FOGVOL__GL_CLIP_DISTANCE0 = 0x3000,
+    FOGVOL__GL_PRIMITIVE_RESTART = 0x8F9D, FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX = 0x8D69,
+    FOGVOL__GL_DEPTH_CLAMP = 0x864F, FOGVOL__GL_SAMPLE_MASK = 0x8E51,
+    FOGVOL__GL_POLYGON_SMOOTH = 0x0B41, FOGVOL__GL_POLYGON_STIPPLE = 0x0B42,
+    FOGVOL__GL_TRANSFORM_FEEDBACK_ACTIVE = 0x8E24, FOGVOL__GL_TRANSFORM_FEEDBACK_PAUSED = 0x8E23
 };
 /* Multisampled targets and per-sample shading. */
 enum {
@@ -5003,6 +5115,21 @@ enum {
 #define FOGVOL__GL_DRAW_BUFFERS(X) X(void, DrawBuffers, (fogvol__GLsizei, const fogvol__GLenum *))
 #define FOGVOL__GL_3_DESKTOP(X) X(void, BindFragDataLocation, (fogvol__GLuint, fogvol__GLuint, const fogvol__GLchar *))
 
+/* Per-draw-buffer colour mask and blend enable: GL 3.0, GLES 3.2. */
+#define FOGVOL__GL_INDEXED_MASK(X) \
+    X(void, GetBooleani_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLboolean *)) \
+    X(void, GetIntegeri_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLint *)) \
+    X(fogvol__GLboolean, IsEnabledi, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, Enablei, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, Disablei, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, ColorMaski, (fogvol__GLuint, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean))
+/* Per-draw-buffer blend functions and equations: GL 4.0, GLES 3.2. */
+#define FOGVOL__GL_INDEXED_BLEND(X) \
+    X(void, BlendFuncSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
+    X(void, BlendEquationSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum))
+/* Pausing the engine's transform feedback: GL 4.0, GLES 3.0. */
+#define FOGVOL__GL_TF_PAUSE(X) X(void, PauseTransformFeedback, (void)) X(void, ResumeTransformFeedback, (void))
+
 /* Desktop only. */
 #define FOGVOL__GL_DESKTOP(X) \
     X(void, PolygonMode, (fogvol__GLenum, fogvol__GLenum)) \
@@ -5022,7 +5149,7 @@ enum {
 #define FOGVOL__GL_ALL(X) \
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
-            FOGVOL__GL_CLIP_CONTROL(X)
+            FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -5038,6 +5165,7 @@ FOGVOL__GL_ALL(FOGVOL__GL_PFN)
 #define FOGVOL__GL_PFN_MSAA(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
 #undef FOGVOL__GL_PFN_MSAA
+#define FOGVOL__GL_MAX_DB 8 /* draw buffers saved and restored (GL guarantees at least 8 on GL 3.0+) */
 
 typedef struct fogvol__gl_state {
     fogvol__GLint draw_fbo, read_fbo, renderbuffer, viewport[4], scissor_box[4], program, vao, array_buffer,
@@ -5056,10 +5184,20 @@ typedef struct fogvol__gl_state {
     fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
     void *a0_pointer;
     fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
-    fogvol__GLboolean en_multisample, en_sample_shading;
+    fogvol__GLboolean en_multisample;
     fogvol__GLfloat min_sample_shading;
     fogvol__GLboolean en_blend, en_depth, en_cull, en_scissor, en_stencil, en_dither, en_a2c, en_samplecov,
         en_polyoffset, en_discard, en_logicop, en_alphatest;
+    /* The engine framebuffer's draw buffers (an FBO's list; not read for the default framebuffer), and
+       per-draw-buffer blend state (GL 3.0 / 4.0, GLES 3.2) that the non-indexed calls overwrite. */
+    fogvol__GLint n_draw_buffers, draw_buffers[FOGVOL__GL_MAX_DB], draw_buffers_set;
+    fogvol__GLint n_indexed, bi_src_rgb[FOGVOL__GL_MAX_DB], bi_dst_rgb[FOGVOL__GL_MAX_DB],
+        bi_src_a[FOGVOL__GL_MAX_DB], bi_dst_a[FOGVOL__GL_MAX_DB], bi_eq_rgb[FOGVOL__GL_MAX_DB],
+        bi_eq_a[FOGVOL__GL_MAX_DB];
+    fogvol__GLboolean bi_mask[FOGVOL__GL_MAX_DB][4], bi_blend[FOGVOL__GL_MAX_DB];
+    /* Rasterisation, vertex fetch and fragment state fogvol's draws depend on (see fogvol__gl_save). */
+    fogvol__GLboolean en_restart, en_restart_fixed, en_clip[8], en_depth_clamp, en_sample_shading, en_sample_mask,
+        en_poly_smooth, en_poly_stipple;
 } fogvol__gl_state;
 
 /* Textures and targets share this header so either can be bound for sampling. */
@@ -5101,6 +5239,11 @@ typedef struct fogvol__gl {
 #define FOGVOL__GL_MEMBER_MSAA(ret, name, params) fogvol__PFN_##name name;
     FOGVOL__GL_MSAA(FOGVOL__GL_MEMBER_MSAA)
 #undef FOGVOL__GL_MEMBER_MSAA
+    int has_indexed_mask, has_indexed_blend, has_tf_pause, max_draw_buffers, n_clip;
+    int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
+    int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
+    fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
+    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error */
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -5143,8 +5286,7 @@ static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
     }
     gl->ActiveTexture((fogvol__GLenum)active);
     s->en_multisample = gl->IsEnabled(FOGVOL__GL_MULTISAMPLE);
-    s->en_sample_shading = gl->IsEnabled(FOGVOL__GL_SAMPLE_SHADING);
-    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading);
+    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading); /* the enable: save_raster */
 }
 
 static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
@@ -5157,7 +5299,6 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
     }
     gl->ActiveTexture((fogvol__GLenum)s->active_texture);
     fogvol__gl_enable(gl, FOGVOL__GL_MULTISAMPLE, s->en_multisample);
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, s->en_sample_shading);
     gl->MinSampleShading(s->min_sample_shading);
 }
 
@@ -5179,6 +5320,172 @@ static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
         gl->Enable(FOGVOL__GL_MULTISAMPLE);
         gl->MinSampleShading(1.0f);
     }
+}
+
+/* State beyond the GL 2.0 list of fogvol__gl_save that changes what fogvol draws; saved here, set to a
+   known value by fogvol__gl_set_raster in every pass, restored by fogvol__gl_restore_raster:
+   - the draw-buffer list of an engine FBO: the composite writes one buffer, the others stay intact;
+   - per-draw-buffer blend functions, equations, colour masks and blend enables: fogvol's non-indexed
+     calls overwrite every buffer's values;
+   - PRIMITIVE_RESTART (+ _FIXED_INDEX): would cut fogvol's index lists at the engine's restart index
+     (the index itself is never changed, so it is not saved);
+   - CLIP_DISTANCE0..7 (CLIP_PLANEi): fogvol's shaders write no gl_ClipDistance, so an enabled one is
+     undefined there;
+   - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
+   - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
+   - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
+   - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
+     GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
+   Judged irrelevant, not touched:
+   - MULTISAMPLE: fogvol's targets are single-sample; on a multisampled engine target the full-screen
+     composite covers every sample whether it is on or off;
+   - FRAMEBUFFER_SRGB: acts only on sRGB attachments, which fogvol's RGBA8/R32F targets are not; on an
+     sRGB engine target it selects the blending space the engine wants (see fogvol_ramp_desc);
+   - MIN_SAMPLE_SHADING_VALUE, PRIMITIVE_RESTART_INDEX: read only while their enables are on (fogvol
+     turns those off);
+   - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
+   - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
+   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
+     function reads them;
+   - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
+   - conditional rendering: it cannot be queried; fogvol must not be called between
+     glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
+static void fogvol__gl_save_raster(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    int i;
+    if (gl->max_draw_buffers > 0 && s->draw_fbo != 0)
+        for (i = 0; i < gl->max_draw_buffers; ++i) {
+            gl->GetIntegerv((fogvol__GLenum)(FOGVOL__GL_DRAW_BUFFER0 + i), &s->draw_buffers[i]);
+            if (s->draw_buffers[i] != FOGVOL__GL_NONE) s->n_draw_buffers = i + 1;
+        }
+    s->n_indexed = gl->has_indexed_mask ? gl->max_draw_buffers : 0;
+    for (i = 0; i < s->n_indexed; ++i) {
+        gl->GetBooleani_v(FOGVOL__GL_COLOR_WRITEMASK, (fogvol__GLuint)i, s->bi_mask[i]);
+        s->bi_blend[i] = gl->IsEnabledi(FOGVOL__GL_BLEND, (fogvol__GLuint)i);
+        if (!gl->has_indexed_blend) continue;
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_SRC_RGB, (fogvol__GLuint)i, &s->bi_src_rgb[i]);
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_DST_RGB, (fogvol__GLuint)i, &s->bi_dst_rgb[i]);
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_SRC_ALPHA, (fogvol__GLuint)i, &s->bi_src_a[i]);
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_DST_ALPHA, (fogvol__GLuint)i, &s->bi_dst_a[i]);
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_RGB, (fogvol__GLuint)i, &s->bi_eq_rgb[i]);
+        gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_ALPHA, (fogvol__GLuint)i, &s->bi_eq_a[i]);
+    }
+    if (gl->has_restart) s->en_restart = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART);
+    if (gl->has_restart_fixed) s->en_restart_fixed = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
+    for (i = 0; i < gl->n_clip; ++i) s->en_clip[i] = gl->IsEnabled((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
+    if (gl->has_depth_clamp) s->en_depth_clamp = gl->IsEnabled(FOGVOL__GL_DEPTH_CLAMP);
+    if (gl->has_sample_shading) s->en_sample_shading = gl->IsEnabled(FOGVOL__GL_SAMPLE_SHADING);
+    if (gl->has_sample_mask) s->en_sample_mask = gl->IsEnabled(FOGVOL__GL_SAMPLE_MASK);
+    if (!gl->gles) s->en_poly_smooth = gl->IsEnabled(FOGVOL__GL_POLYGON_SMOOTH);
+    if (!gl->gles && !gl->core) s->en_poly_stipple = gl->IsEnabled(FOGVOL__GL_POLYGON_STIPPLE);
+}
+
+/* Known values for every pass (fogvol__gl_save_raster says why each matters). */
+static void fogvol__gl_set_raster(fogvol__gl *gl)
+{
+    int i;
+    if (gl->has_restart) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART);
+    if (gl->has_restart_fixed) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
+    for (i = 0; i < gl->n_clip; ++i) gl->Disable((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
+    if (gl->has_depth_clamp) gl->Disable(FOGVOL__GL_DEPTH_CLAMP);
+    if (gl->has_sample_shading) gl->Disable(FOGVOL__GL_SAMPLE_SHADING);
+    if (gl->has_sample_mask) gl->Disable(FOGVOL__GL_SAMPLE_MASK);
+    if (!gl->gles) gl->Disable(FOGVOL__GL_POLYGON_SMOOTH);
+    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_POLYGON_STIPPLE);
+}
+
+/* Runs last in fogvol__gl_restore: the engine framebuffer is bound again and the non-indexed blend
+   state is back, so the per-buffer values go on top of it. */
+static void fogvol__gl_restore_raster(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    if (s->draw_buffers_set) {
+        fogvol__GLenum bufs[FOGVOL__GL_MAX_DB];
+        for (i = 0; i < s->n_draw_buffers; ++i) bufs[i] = (fogvol__GLenum)s->draw_buffers[i];
+        gl->DrawBuffers(s->n_draw_buffers, bufs);
+    }
+    for (i = 0; i < s->n_indexed; ++i) {
+        fogvol__GLuint u = (fogvol__GLuint)i;
+        if (gl->has_indexed_blend) {
+            gl->BlendFuncSeparatei(u, (fogvol__GLenum)s->bi_src_rgb[i], (fogvol__GLenum)s->bi_dst_rgb[i],
+                                   (fogvol__GLenum)s->bi_src_a[i], (fogvol__GLenum)s->bi_dst_a[i]);
+            gl->BlendEquationSeparatei(u, (fogvol__GLenum)s->bi_eq_rgb[i], (fogvol__GLenum)s->bi_eq_a[i]);
+        }
+        gl->ColorMaski(u, s->bi_mask[i][0], s->bi_mask[i][1], s->bi_mask[i][2], s->bi_mask[i][3]);
+        if (s->bi_blend[i]) gl->Enablei(FOGVOL__GL_BLEND, u);
+        else gl->Disablei(FOGVOL__GL_BLEND, u);
+    }
+    if (gl->has_restart) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART, s->en_restart);
+    if (gl->has_restart_fixed) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX, s->en_restart_fixed);
+    for (i = 0; i < gl->n_clip; ++i)
+        fogvol__gl_enable(gl, (fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i), s->en_clip[i]);
+    if (gl->has_depth_clamp) fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_CLAMP, s->en_depth_clamp);
+    if (gl->has_sample_shading) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, s->en_sample_shading);
+    if (gl->has_sample_mask) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_MASK, s->en_sample_mask);
+    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_SMOOTH, s->en_poly_smooth);
+    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_STIPPLE, s->en_poly_stipple);
+}
+
+/* The engine's pending GL errors. glGetError returns and clears them, so the first fogvol entry of a
+   call (depth 0) reads them all, fogvol's own checks then see only fogvol's errors, and the last exit
+   raises each again with a call that fails with exactly that code and changes no state. An active,
+   unpaused transform feedback is paused over the same span (fogvol's draws must not be captured). */
+static void fogvol__gl_host_enter(fogvol__gl *gl)
+{
+    fogvol__GLenum e;
+    int i, k;
+    if (gl->host_depth++ > 0) return;
+    gl->host_n = 0;
+    for (i = 0; i < 8 && (e = gl->GetError()) != FOGVOL__GL_NO_ERROR; ++i) { /* one flag per code at most */
+        for (k = 0; k < gl->host_n && gl->host_errors[k] != e; ++k) {
+        }
+        if (k == gl->host_n && gl->host_n < 4) gl->host_errors[gl->host_n++] = e;
+    }
+    gl->tf_paused = 0;
+    if (gl->has_tf_pause) {
+        fogvol__GLboolean active = 0, paused = 0;
+        gl->GetBooleanv(FOGVOL__GL_TRANSFORM_FEEDBACK_ACTIVE, &active);
+        gl->GetBooleanv(FOGVOL__GL_TRANSFORM_FEEDBACK_PAUSED, &paused);
+        if (active && !paused) {
+            gl->PauseTransformFeedback();
+            gl->tf_paused = 1;
+        }
+    }
+}
+
+static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
+{
+    fogvol__GLint v = 0;
+    fogvol__GLenum fb = gl->has_split_fbo ? FOGVOL__GL_DRAW_FRAMEBUFFER : FOGVOL__GL_FRAMEBUFFER;
+    switch (e) {
+    case FOGVOL__GL_INVALID_ENUM: gl->GetIntegerv(FOGVOL__GL_NONE, &v); break; /* no state is named 0 */
+    case FOGVOL__GL_INVALID_VALUE: gl->Viewport(0, 0, -1, -1); break;          /* negative size */
+    case FOGVOL__GL_INVALID_OPERATION: /* a shader object where a program object is expected */
+        if (!gl->err_shader) gl->err_shader = gl->CreateShader(FOGVOL__GL_VERTEX_SHADER);
+        gl->GetProgramiv(gl->err_shader, FOGVOL__GL_LINK_STATUS, &v);
+        break;
+    case FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION: /* clearing nothing through an FBO with no attachment */
+        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &v);
+        if (!gl->err_fbo) gl->GenFramebuffers(1, &gl->err_fbo);
+        gl->BindFramebuffer(fb, gl->err_fbo);
+        gl->Clear(0);
+        gl->BindFramebuffer(fb, (fogvol__GLuint)v);
+        break;
+    default:
+        fogvol__log(&gl->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the engine's pending GL error 0x%04x was read and cannot be raised again", e);
+        break;
+    }
+}
+
+static void fogvol__gl_host_leave(fogvol__gl *gl)
+{
+    int i;
+    if (gl->host_depth <= 0 || --gl->host_depth > 0) return;
+    if (gl->tf_paused) gl->ResumeTransformFeedback();
+    gl->tf_paused = 0;
+    for (i = 0; i < gl->host_n; ++i) fogvol__gl_raise(gl, gl->host_errors[i]);
+    gl->host_n = 0;
 }
 
 static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
@@ -5283,6 +5590,7 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
     if (gl->has_discard) s->en_discard = gl->IsEnabled(FOGVOL__GL_RASTERIZER_DISCARD);
     if (!gl->gles) s->en_logicop = gl->IsEnabled(FOGVOL__GL_COLOR_LOGIC_OP);
     if (!gl->gles && !gl->core) s->en_alphatest = gl->IsEnabled(FOGVOL__GL_ALPHA_TEST);
+    fogvol__gl_save_raster(gl, s);
 }
 
 static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
@@ -5371,12 +5679,12 @@ static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
     if (gl->has_discard) fogvol__gl_enable(gl, FOGVOL__GL_RASTERIZER_DISCARD, s->en_discard);
     if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_COLOR_LOGIC_OP, s->en_logicop);
     if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_ALPHA_TEST, s->en_alphatest);
+    fogvol__gl_restore_raster(gl, s);
 }
 
-/* Resource entries called outside a frame save and restore the state they touch. */
-static void fogvol__gl_enter(fogvol__gl *gl, fogvol__gl_state *s)
+/* Pixel-transfer state fogvol's uploads and read-backs assume. */
+static void fogvol__gl_pixel_defaults(fogvol__gl *gl)
 {
-    if (!gl->in_frame) fogvol__gl_save(gl, s);
     if (gl->has_pixel_buffers) {
         gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, 0);
         gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, 0);
@@ -5393,19 +5701,49 @@ static void fogvol__gl_enter(fogvol__gl *gl, fogvol__gl_state *s)
     gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, 4);
 }
 
+/* Resource entries called outside a frame save and restore the state they touch. */
+static void fogvol__gl_enter(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    fogvol__gl_host_enter(gl);
+    if (!gl->in_frame) fogvol__gl_save(gl, s);
+    fogvol__gl_pixel_defaults(gl);
+}
+
 static void fogvol__gl_leave(fogvol__gl *gl, const fogvol__gl_state *s)
 {
     if (!gl->in_frame) fogvol__gl_restore(gl, s);
+    fogvol__gl_host_leave(gl);
+}
+
+/* The engine draw buffer the composite writes: refused with a logged reason where GL cannot. */
+static fogvol_result fogvol__gl_check_draw_buffer(fogvol__gl *gl, int k)
+{
+    const char *why = NULL;
+    if (k > 0 && gl->saved.draw_fbo == 0) why = "the default framebuffer has one colour buffer";
+    else if (k > 0 && gl->gles) why = "OpenGL ES can only write list position i to COLOR_ATTACHMENTi";
+    else if (k >= (gl->max_draw_buffers > 0 ? gl->max_draw_buffers : 1)) why = "past GL_MAX_DRAW_BUFFERS";
+    else if (gl->saved.draw_fbo != 0 && gl->max_draw_buffers > 0 && gl->saved.draw_buffers[k] == FOGVOL__GL_NONE)
+        why = "the engine's draw buffer there is GL_NONE";
+    if (!why) return FOGVOL_SUCCESS;
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: cannot composite into draw buffer %d: %s", k, why);
+    return FOGVOL_ERROR_UNSUPPORTED;
 }
 
 static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLint bits = 0;
+    fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    fogvol__gl_host_enter(gl);
     fogvol__gl_save(gl, &gl->saved);
+    r = fogvol__gl_check_draw_buffer(gl, info->draw_buffer);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__gl_host_leave(gl);
+        return r;
+    }
     gl->in_frame = 1;
-    fogvol__gl_enter(gl, &gl->saved);
+    fogvol__gl_pixel_defaults(gl);
     if (gl->stencil_override > 0) {
         bits = gl->stencil_override;
     } else if (gl->core) {
@@ -5447,6 +5785,7 @@ static void fogvol__gl_end_frame(void *u)
     fogvol__gl_restore(gl, &gl->saved);
     gl->in_frame = 0;
     gl->program = NULL;
+    fogvol__gl_host_leave(gl);
 }
 
 static fogvol_result fogvol__gl_check(fogvol__gl *gl, const char *what)
@@ -5869,6 +6208,16 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
     }
     if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_ALPHA_TEST);
+    fogvol__gl_set_raster(gl);
+    if (!t && (gl->saved.n_draw_buffers > 1 || p->draw_buffer > 0)) { /* only the named engine buffer */
+        fogvol__GLenum buf = (fogvol__GLenum)gl->saved.draw_buffers[p->draw_buffer];
+        gl->DrawBuffers(1, &buf);
+        gl->saved.draw_buffers_set = 1;
+    }
+    if (p->scissor[2] > 0 && p->scissor[3] > 0) {
+        gl->Enable(FOGVOL__GL_SCISSOR_TEST);
+        gl->Scissor(p->scissor[0], p->scissor[1], p->scissor[2], p->scissor[3]);
+    }
     gl->ColorMask(1, 1, 1, 1);
     if (p->clear) {
         fogvol__GLbitfield bits = FOGVOL__GL_COLOR_BUFFER_BIT;
@@ -5888,12 +6237,12 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
         break;
     case FOGVOL_PASS_BLEND_FOG:
-        gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA, FOGVOL__GL_ONE_MINUS_SRC_ALPHA, FOGVOL__GL_ZERO, FOGVOL__GL_ONE);
-        break;
     case FOGVOL_PASS_BLEND_LIGHT:
         gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA, FOGVOL__GL_ONE, FOGVOL__GL_ZERO, FOGVOL__GL_ONE);
+        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
+                              p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
+                              p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
+                              p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
         break;
     default: gl->Disable(FOGVOL__GL_BLEND); break;
     }
@@ -6014,6 +6363,8 @@ static void fogvol__gl_destroy(void *u)
     if (!gl) return;
     fogvol__gl_free_mesh(gl, &gl->fullscreen);
     if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+    if (gl->err_shader) gl->DeleteShader(gl->err_shader);
+    if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -6066,6 +6417,27 @@ static int fogvol__gl_load_msaa(fogvol__gl *gl, const fogvol_gl_desc *desc)
         v4 ? "glMinSampleShading" : "glMinSampleShadingARB", desc->user_data);
     gl->has_msaa = gl->TexImage2DMultisample && gl->RenderbufferStorageMultisample && gl->MinSampleShading;
     return gl->has_msaa;
+}
+
+/* Which of the state that fogvol__gl_save_raster handles the context has. */
+static void fogvol__gl_raster_caps(fogvol__gl *gl)
+{
+    fogvol__GLint n = 0;
+    int es = gl->gles, v = gl->major * 10 + gl->minor;
+    if (gl->DrawBuffers) {
+        gl->GetIntegerv(FOGVOL__GL_MAX_DRAW_BUFFERS, &n);
+        gl->max_draw_buffers = n < 1 ? 1 : n > FOGVOL__GL_MAX_DB ? FOGVOL__GL_MAX_DB : n;
+    }
+    if (!es) { /* CLIP_PLANEi of GL 2.x are the same enables as CLIP_DISTANCEi */
+        n = 0;
+        gl->GetIntegerv(FOGVOL__GL_MAX_CLIP_DISTANCES, &n);
+        gl->n_clip = n < 0 ? 0 : n > 8 ? 8 : n;
+    }
+    gl->has_restart = !es && v >= 31;
+    gl->has_restart_fixed = es ? v >= 30 : v >= 43;
+    gl->has_depth_clamp = !es && v >= 32;
+    gl->has_sample_shading = (es ? v >= 32 : v >= 40) || gl->has_msaa; /* GL 3.2 + ARB_sample_shading */
+    gl->has_sample_mask = es ? v >= 31 : v >= 32;
 }
 
 /* Parse "M.m" at the first digit of s. */
@@ -6197,6 +6569,21 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_LOAD)
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_REQUIRE)
     }
+    gl->has_indexed_mask = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2) : gl->major >= 3;
+    gl->has_indexed_blend = gl->gles ? gl->has_indexed_mask : gl->major >= 4;
+    gl->has_tf_pause = gl->gles ? gl->major >= 3 : gl->major >= 4;
+    if (gl->has_indexed_mask) {
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD)
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_REQUIRE)
+    }
+    if (gl->has_indexed_blend) {
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD)
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_REQUIRE)
+    }
+    if (gl->has_tf_pause) {
+        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)
+        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_REQUIRE)
+    }
     if (gl->gles) {
         FOGVOL__GL_ES(FOGVOL__GL_LOAD)
         FOGVOL__GL_ES(FOGVOL__GL_REQUIRE)
@@ -6225,6 +6612,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     else if (gl->gles && (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_clip_control")
                                          : fogvol__has_ext(ext, "GL_EXT_clip_control")))
         gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControlEXT", desc->user_data);
+    fogvol__gl_raster_caps(gl);
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
         gl->GenSamplers(1, &gl->native_sampler);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);

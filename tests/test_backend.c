@@ -528,8 +528,8 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->vp[2] = A_W;
     x->vp[3] = A_H;
     x->blend = blend;
-    x->cull = geometry ? FOGVOL_CULL_FRONT : FOGVOL_CULL_NONE;
-    x->guard = geometry;
+    (void)geometry; /* both composites: the full-screen program, no stencil guard (geometry adds a scissor) */
+    x->cull = FOGVOL_CULL_NONE;
     x->program = program;
     x->tex[0] = b;
     x->tex[1] = f;
@@ -538,7 +538,7 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->screen[1] = 1.0f / A_H;
     x->screen[2] = -(float)A_X0 / A_W;
     x->screen[3] = -(float)A_Y0 / A_H;
-    x->fullscreen = geometry ? 0 : 1;
+    x->fullscreen = 1;
 }
 
 static void x_add_draw(xpass *x, fogvol_handle m) { x->draws[x->ndraw++] = m; }
@@ -764,7 +764,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     /* resources identified by what they are, not by creation order */
     enc = rec_program(r, FOGVOL_PROGRAM_ENCODE);
     face = rec_program(r, FOGVOL_PROGRAM_FACE);
-    comp = rec_program(r, geometry ? FOGVOL_PROGRAM_COMPOSITE_MESH : FOGVOL_PROGRAM_COMPOSITE);
+    comp = rec_program(r, FOGVOL_PROGRAM_COMPOSITE);
     rg = rec_texture_sized(r, 16, 16);          /* N x N */
     blue = rec_texture_sized(r, 16 * 32, 32);   /* (N*D) x D */
     dith = rec_texture_sized(r, 8, 8);          /* 8 x 8 */
@@ -838,10 +838,6 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     x_target_pass(&x[4], F, 0, FOGVOL_CULL_FRONT, face, faces);
     x_add_draw(&x[4], mh(s->vol[2]));
     x_composite(&x[5], FOGVOL_PASS_BLEND_LIGHT, geometry, comp, B, F, tl);
-    if (geometry) {
-        x_add_draw(&x[5], mh(s->vol[0]));
-        x_add_draw(&x[5], mh(s->vol[3]));
-    }
     /* fog group: V1, V4 */
     x_target_pass(&x[6], B, 1, FOGVOL_CULL_FRONT, face, faces);
     x_add_draw(&x[6], mh(s->vol[1]));
@@ -850,10 +846,6 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     x_add_draw(&x[7], mh(s->vol[1]));
     x_add_draw(&x[7], mh(s->vol[4]));
     x_composite(&x[8], FOGVOL_PASS_BLEND_FOG, geometry, comp, B, F, tf);
-    if (geometry) {
-        x_add_draw(&x[8], mh(s->vol[1]));
-        x_add_draw(&x[8], mh(s->vol[4]));
-    }
     for (i = 0; i < 9; ++i) check_pass(r, i, &x[i], geometry ? "geometry" : "fullscreen");
     for (i = 1; i < 9; ++i) { /* B/F clear to zero */
         if (r->nb.passes[i].clear) {
@@ -861,9 +853,15 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
             for (c = 0; c < 4; ++c) assert_close(r->nb.passes[i].clear_color[c], 0.0, 1e-7, "B/F clear colour");
         }
     }
-    if (geometry) {
-        assert_int_equal(r->nb.passes[5].stencil_bit, want_bit);
-        assert_int_equal(r->nb.passes[8].stencil_bit, want_bit);
+    (void)want_bit; /* the stencil bit is unused: no pass has a stencil guard (check_pass) */
+    for (i = 5; i < 9; i += 3) { /* geometry: a scissor inside the viewport; full-screen: none */
+        const int *sc = r->nb.passes[i].scissor;
+        if (geometry) {
+            assert_true(sc[2] > 0 && sc[3] > 0);
+            assert_true(sc[0] >= A_X0 && sc[1] >= A_Y0 && sc[0] + sc[2] <= A_X0 + A_W && sc[1] + sc[3] <= A_Y0 + A_H);
+        } else {
+            assert_int_equal(sc[2], 0);
+        }
     }
 
     /* uniforms */
@@ -936,13 +934,13 @@ static void test_a1_geometry_stencil_bit(void **state)
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
     (void)state;
     a1_build(s);
-    a1_check(s, 1, 0x04); /* the frame's stencil_bit reaches the composite passes */
+    a1_check(s, 1, 0x04); /* the frame's stencil_bit is ignored: no stencil guard */
     a1_free(s);
     free(s);
 }
 
-/* A geometry composite without an engine stencil buffer falls back to the full-screen
-   triangle (the guard needs a stencil bit), with a warning. */
+/* A geometry composite without an engine stencil buffer works as with one (it uses no stencil):
+   no warning, the full-screen triangle under a scissor. */
 static void test_a1_geometry_without_stencil(void **state)
 {
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
@@ -953,7 +951,8 @@ static void test_a1_geometry_without_stencil(void **state)
     log_reset(&s->lc);
     a1_submit(s, FOGVOL_COMPOSITE_GEOMETRY, 0, &st);
     assert_int_equal(st.passes, 9);
-    assert_true(s->lc.warnings >= 1);
+    assert_int_equal(s->lc.warnings, 0);
+    assert_true(s->r.nb.passes[5].scissor[2] > 0);
     assert_int_equal(s->r.nb.passes[5].stencil_guard, 0);
     assert_int_equal(s->r.nb.fullscreen[5], 1);
     assert_int_equal(s->r.nb.draws[5], 0);
@@ -1578,7 +1577,7 @@ static void test_a4_bad_input(void **state)
 /* ---- A5: fault injection ---- */
 
 /* n-th backend create call failing during context creation: 3 lookup textures (rg, blue,
-   dither index) and 4 programs = 7 creates, so n = 1..7 fail and n = 8 succeeds. */
+   dither index) and 3 programs (encode, face, composite) = 6 creates, so n = 1..6 fail and n = 7 succeeds. */
 static void test_a5_backend_create_faults(void **state)
 {
     int n;
@@ -1601,14 +1600,14 @@ static void test_a5_backend_create_faults(void **state)
         cd.allocator = cnt_allocator(&cnt);
         res = fogvol_create_context(&cd, &fv);
         if (res == FOGVOL_SUCCESS) {
-            assert_int_equal(n, 8);
-            assert_int_equal(r.nb.creates, 7);
+            assert_int_equal(n, 7);
+            assert_int_equal(r.nb.creates, 6);
             fogvol_destroy_context(fv);
             assert_int_equal(r.nb.creates, r.nb.destroys);
             assert_int_equal(cnt.live, 0);
             break;
         }
-        assert_true(n <= 7);
+        assert_true(n <= 6);
         assert_int_equal(res, FOGVOL_ERROR_BACKEND);
         assert_null(fv);
         assert_true(log_error_has(&lc, NULL));
@@ -2437,7 +2436,7 @@ static void test_b7_glsl100_renders_in_core(void **state)
         fail_msg("GLSL 100 context creation failed");
     }
     assert_int_equal(fogvol_context_tier(fv, NULL), FOGVOL_TIER_PS20); /* no float targets in GLSL ES 1.00 */
-    assert_int_equal(g_programs_seen, 4); /* PS20: encode, face, composite, composite (geometry) */
+    assert_int_equal(g_programs_seen, 3); /* PS20: encode, face, composite (the geometry composite uses it too) */
     assert_int_equal(g_version_ok, g_programs_seen);
     render_sphere(fv, 0.01, "GLSL ES 1.00 in the core context");
     fogvol_destroy_context(fv);
@@ -2481,7 +2480,7 @@ static void override_renders(int major, int minor, const char *version_line)
         log_dump(&lc);
         fail_msg("override %d.%d: context creation failed", major, minor);
     }
-    assert_true(g_programs_seen >= 4);
+    assert_true(g_programs_seen >= 3);
     assert_int_equal(g_version_ok, g_programs_seen);
     snprintf(what, sizeof what, "override %d.%d (%.12s)", major, minor, version_line);
     render_sphere(fv, 0.01, what);
