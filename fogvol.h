@@ -339,13 +339,32 @@ FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, un
    Volumes are closed hulls: every undirected edge used by exactly two
    triangles, in opposite directions; triangles counter-clockwise seen from
    outside. */
+typedef enum fogvol_index_type {
+    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
+    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
+    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
+} fogvol_index_type;
+
 typedef struct fogvol_mesh_desc {
-    const float *positions;    /* x, y, z floats per vertex */
+    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
     int vertex_count;
-    int stride;                /* bytes between vertices, 0 = 12 */
+    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
     const uint32_t *indices;   /* 3 per triangle */
     int index_count;
     int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
+    /* Engine vertex buffers as they are: offset is the byte offset of x inside
+       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
+       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
+       the GL backend among them, upload the bytes and read them in place). */
+    int offset;
+    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
+    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
+    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
+       most weld_distance from an earlier kept vertex is merged into it (seams of
+       UV spheres, per-face vertices of cubes); the validation, the report and
+       the uploaded indices then describe the welded mesh. 0 = off (indices as
+       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
+    float weld_distance;
 } fogvol_mesh_desc;
 
 typedef struct fogvol_mesh_report {
@@ -363,12 +382,17 @@ typedef struct fogvol_mesh_report {
     int consistent;            /* no inconsistent edge, no flipped face */
     int inverted;              /* closed, consistent, but wound inward (volume < 0) */
     int valid;                 /* usable as a fog volume */
+    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
+                                  vertices counts the rest */
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle) comes from alloc (NULL = default). Never
-   reads outside positions[0 .. vertex_count) or indices[0 .. index_count). */
+   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
+   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
+   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
+   stride, unknown index_type, missing arrays, bad weld_distance). */
 FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
                                               fogvol_mesh_report *report);
 
@@ -787,10 +811,17 @@ typedef struct fogvol_program_desc {
 } fogvol_program_desc;
 
 typedef struct fogvol_mesh_data {
-    const float *positions; /* tightly packed xyz */
+    const float *positions; /* tightly packed xyz (see stride, offset) */
     int vertex_count;
     const uint32_t *indices;
     int index_count;
+    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
+       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
+       offset + i * stride of positions (stride 0 = 12), and with index_type
+       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
+    int stride, offset;
+    fogvol_index_type index_type;
+    const uint16_t *indices16;
 } fogvol_mesh_data;
 
 typedef enum fogvol_pass_blend {
@@ -835,7 +866,8 @@ enum {
     FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
     FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
     FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
-    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3    /* the engine can sample its depth buffer */
+    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
+    FOGVOL_CAP_MESH_LAYOUT = 1u << 4      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
 };
 
 typedef struct fogvol_frame_info {
@@ -888,7 +920,7 @@ typedef struct fogvol_null_backend {
     int create_calls;
     int stencil_bits;       /* reported by begin_frame */
 } fogvol_null_backend;
-/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE (AUTO picks PS20);
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
    change table->caps before creating a context to test other choices. */
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
 
@@ -1528,8 +1560,172 @@ static uint32_t fogvol__uf_find(uint32_t *parent, unsigned char *parity, uint32_
     return root;
 }
 
+/* NULL for a usable layout, else what is wrong with it. */
+static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
+{
+    int stride;
+    if (!d || !d->positions) return "no positions";
+    if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
+        return "vertex_count must be > 0 and index_count a positive multiple of 3";
+    if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
+    stride = d->stride ? d->stride : 12;
+    if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
+    if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
+    if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
+    if (!fogvol__finite(d->weld_distance) || d->weld_distance < 0) return "weld_distance negative or not finite";
+    return NULL;
+}
+
+typedef struct fogvol__wkey {
+    float key;
+    uint32_t i;
+} fogvol__wkey;
+
+static int fogvol__wkey_less(const fogvol__wkey *x, const fogvol__wkey *y)
+{
+    return x->key < y->key || (x->key == y->key && x->i < y->i);
+}
+
+static void fogvol__sift_wkeys(fogvol__wkey *k, int root, int n)
+{
+    int child;
+    fogvol__wkey t;
+    for (; (child = 2 * root + 1) < n; root = child) {
+        if (child + 1 < n && fogvol__wkey_less(&k[child], &k[child + 1])) ++child;
+        if (!fogvol__wkey_less(&k[root], &k[child])) return;
+        t = k[root];
+        k[root] = k[child];
+        k[child] = t;
+    }
+}
+
+/* In-place heap sort (no allocation, O(n log n)). */
+static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
+{
+    int i;
+    fogvol__wkey t;
+    for (i = n / 2 - 1; i >= 0; --i) fogvol__sift_wkeys(k, i, n);
+    for (i = n - 1; i > 0; --i) {
+        t = k[0];
+        k[0] = k[i];
+        k[i] = t;
+        fogvol__sift_wkeys(k, 0, i);
+    }
+}
+
+/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on
+   every axis (i itself when none). A sweep along the axis of largest extent
+   (sorted keys) limits the candidates. Non-finite vertices stay alone. Returns
+   how many vertices were merged. */
+static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, uint32_t *rep, fogvol__wkey *keys)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3], w[3];
+    int i, a, b, k, axis = 0, merged = 0, any = 0;
+    for (i = 0; i < nv; ++i) {
+        memcpy(v, base + (size_t)i * stride, sizeof v);
+        rep[i] = (uint32_t)i;
+        if (!fogvol__finite_n(v, 3)) continue;
+        for (k = 0; k < 3; ++k) {
+            if (!any || v[k] < lo[k]) lo[k] = v[k];
+            if (!any || v[k] > hi[k]) hi[k] = v[k];
+        }
+        any = 1;
+    }
+    for (k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    for (i = 0; i < nv; ++i) {
+        memcpy(v, base + (size_t)i * stride, sizeof v);
+        keys[i].key = fogvol__finite_n(v, 3) ? v[axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].i = (uint32_t)i;
+    }
+    fogvol__sort_wkeys(keys, nv);
+    for (a = 0; a < nv; ++a) {
+        uint32_t self = keys[a].i, best = self;
+        memcpy(v, base + (size_t)self * stride, sizeof v);
+        if (!fogvol__finite_n(v, 3)) continue;
+        for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
+            uint32_t j = keys[b].i;
+            if (rep[j] != j || j > best) continue;
+            memcpy(w, base + (size_t)j * stride, sizeof w);
+            if (FOGVOL_FABS((double)w[0] - v[0]) <= dist && FOGVOL_FABS((double)w[1] - v[1]) <= dist &&
+                FOGVOL_FABS((double)w[2] - v[2]) <= dist)
+                best = j;
+        }
+        rep[self] = best;
+        merged += best != self;
+    }
+    return merged;
+}
+
+/* The desc's indices as 32 bits, welded when asked: *out is NULL when the
+   desc's own 32-bit array serves as it is, else an array from alloc. */
+static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvol_allocator *alloc, uint32_t **out,
+                                          int *welded)
+{
+    const unsigned char *base = (const unsigned char *)d->positions + d->offset;
+    int i, stride = d->stride ? d->stride : 12, weld = d->weld_distance > 0;
+    uint32_t *idx, *rep = NULL;
+    fogvol__wkey *keys = NULL;
+    *out = NULL;
+    *welded = 0;
+    if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
+    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
+    if (weld) {
+        rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
+        keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)d->vertex_count);
+    }
+    if (!idx || (weld && (!rep || !keys))) {
+        fogvol__free(alloc, idx);
+        fogvol__free(alloc, rep);
+        fogvol__free(alloc, keys);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < d->index_count; ++i)
+        idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
+    if (weld) {
+        *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, rep, keys);
+        for (i = 0; i < d->index_count; ++i)
+            if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
+    }
+    fogvol__free(alloc, rep);
+    fogvol__free(alloc, keys);
+    *out = idx;
+    return FOGVOL_SUCCESS;
+}
+
+static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
+                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep);
+
+/* Validation that hands the (welded, 32-bit) indices to create_mesh when idx_out is set. */
+static fogvol_result fogvol__check_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                        fogvol_mesh_report *rep, uint32_t **idx_out)
+{
+    uint32_t *idx = NULL;
+    int welded = 0;
+    fogvol_result r;
+    if (idx_out) *idx_out = NULL;
+    if (!rep) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(rep, 0, sizeof *rep);
+    if (fogvol__mesh_problem(desc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol__mesh_indices(desc, alloc, &idx, &welded);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__validate(desc, idx ? idx : desc->indices, alloc, rep);
+    rep->welded_vertices = welded;
+    rep->vertices -= welded;
+    if (idx_out && r != FOGVOL_ERROR_OUT_OF_MEMORY) *idx_out = idx;
+    else fogvol__free(alloc, idx);
+    return r;
+}
+
 FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
                                               fogvol_mesh_report *rep)
+{
+    return fogvol__check_mesh(desc, alloc, rep, NULL);
+}
+
+/* The topology and geometry checks on 32-bit indices (layout already checked). */
+static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
+                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep)
 {
     int ntri, t, stride;
     size_t ne = 0, i, j;
@@ -1538,13 +1734,8 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
     unsigned char *parity = NULL, *usable = NULL, *vbad = NULL;
     const unsigned char *base;
     double vol = 0;
-    if (!rep) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(rep, 0, sizeof *rep);
-    if (!desc || !desc->positions || !desc->indices || desc->vertex_count <= 0 || desc->index_count <= 0 ||
-        desc->index_count % 3 != 0 || desc->stride < 0 || (desc->stride != 0 && desc->stride < 12))
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
     stride = desc->stride ? desc->stride : 12;
-    base = (const unsigned char *)desc->positions;
+    base = (const unsigned char *)desc->positions + desc->offset;
     ntri = desc->index_count / 3;
     rep->vertices = desc->vertex_count;
     rep->triangles = ntri;
@@ -1581,7 +1772,7 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
         parity[t] = 0;
         usable[t] = 0;
         for (k = 0; k < 3; ++k) {
-            id[k] = desc->indices[3 * t + k];
+            id[k] = indices[3 * t + k];
             if (id[k] >= (uint32_t)desc->vertex_count) {
                 rep->out_of_range_indices++;
                 bad = 1;
@@ -3111,7 +3302,11 @@ static fogvol_result fogvol__null_create_program(void *u, const fogvol_program_d
 }
 static fogvol_result fogvol__null_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
 {
-    (void)d;
+    /* the layout fields as fogvol_create_mesh hands them (FOGVOL_CAP_MESH_LAYOUT) */
+    if (!d->positions || d->stride < 0 || (d->stride && d->stride < 12) || d->offset < 0 ||
+        d->offset > (d->stride ? d->stride : 12) - 12 ||
+        (d->index_type == FOGVOL_INDEX_UINT16 ? !d->indices16 : d->index_type != FOGVOL_INDEX_UINT32 || !d->indices))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
     return fogvol__null_create(u, out);
 }
 static void fogvol__null_begin_pass(void *u, const fogvol_pass *p)
@@ -3169,7 +3364,7 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     state->stencil_bits = 8;
     table->user_data = state;
     table->dialect = FOGVOL_GLSL_330;
-    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
+    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT;
     table->begin_frame = fogvol__null_begin_frame;
     table->end_frame = fogvol__null_end_frame;
     table->create_texture = fogvol__null_create_texture;
@@ -3578,54 +3773,86 @@ FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
     return FOGVOL_SUCCESS;
 }
 
+/* Hands the mesh to the backend: the engine's layout as it is to backends with
+   FOGVOL_CAP_MESH_LAYOUT, else packed xyz and 32-bit indices (idx: the welded or
+   widened indices, NULL = desc->indices). */
+static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx,
+                                         fogvol_handle *out)
+{
+    fogvol_mesh_data md;
+    float *packed = NULL;
+    fogvol_result r;
+    int i, stride = desc->stride ? desc->stride : 12;
+    memset(&md, 0, sizeof md);
+    md.positions = desc->positions;
+    md.vertex_count = desc->vertex_count;
+    md.indices = idx ? idx : desc->indices;
+    md.index_count = desc->index_count;
+    if (ctx->be.caps & FOGVOL_CAP_MESH_LAYOUT) {
+        md.stride = stride;
+        md.offset = desc->offset;
+        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->weld_distance <= 0) { /* 16-bit as given */
+            md.index_type = FOGVOL_INDEX_UINT16;
+            md.indices16 = desc->indices16;
+            md.indices = NULL;
+        }
+    } else if (stride != 12 || desc->offset != 0) {
+        packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
+        if (!packed) return FOGVOL_ERROR_OUT_OF_MEMORY;
+        for (i = 0; i < desc->vertex_count; ++i)
+            memcpy(packed + 3 * i, (const unsigned char *)desc->positions + desc->offset + (size_t)i * stride, 12);
+        md.positions = packed;
+    }
+    r = ctx->be.create_mesh(ctx->be.user_data, &md, out);
+    fogvol__free(&ctx->alloc, packed);
+    return r;
+}
+
 FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
                                             fogvol_mesh_report *report)
 {
     fogvol_mesh_report rep;
-    fogvol_mesh_data md;
     fogvol_mesh *m;
-    float *packed = NULL;
+    uint32_t *idx = NULL;
     fogvol_result r;
-    int i;
+    const char *problem;
     if (out) *out = NULL;
     if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    r = fogvol_validate_mesh(desc, &ctx->alloc, &rep);
+    problem = fogvol__mesh_problem(desc);
+    r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
     if (report) *report = rep;
     if (r == FOGVOL_ERROR_INVALID_ARGUMENT || r == FOGVOL_ERROR_OUT_OF_MEMORY) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s", fogvol_result_string(r));
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s%s%s", fogvol_result_string(r),
+                    problem ? ": " : "", problem ? problem : "");
         return r;
     }
     if (rep.nonfinite_vertices || rep.out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: mesh rejected: %d open edges, %d non-manifold edges, %d inconsistent edges, "
-                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s",
+                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s%s",
                     rep.open_edges, rep.nonmanifold_edges, rep.inconsistent_edges, rep.flipped_faces,
                     rep.nonfinite_vertices, rep.out_of_range_indices,
-                    rep.inverted ? ", wound inward (reverse the triangles)" : "");
+                    rep.inverted ? ", wound inward (reverse the triangles)" : "",
+                    rep.open_edges && desc->weld_distance <= 0
+                        ? " (vertices repeated at seams or per face? set fogvol_mesh_desc.weld_distance)"
+                        : "");
+        fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_INVALID_MESH;
     }
     if (rep.degenerate_triangles)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh has %d degenerate triangles",
                     rep.degenerate_triangles);
+    if (rep.welded_vertices)
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
+                    desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    memset(m, 0, sizeof *m);
-    md.positions = desc->positions;
-    if (desc->stride && desc->stride != 12) {
-        packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
-        if (!packed) {
-            fogvol__free(&ctx->alloc, m);
-            return FOGVOL_ERROR_OUT_OF_MEMORY;
-        }
-        for (i = 0; i < desc->vertex_count; ++i)
-            memcpy(packed + 3 * i, (const unsigned char *)desc->positions + (size_t)i * desc->stride, 12);
-        md.positions = packed;
+    if (!m) {
+        fogvol__free(&ctx->alloc, idx);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
-    md.vertex_count = desc->vertex_count;
-    md.indices = desc->indices;
-    md.index_count = desc->index_count;
-    r = ctx->be.create_mesh(ctx->be.user_data, &md, &m->handle);
-    fogvol__free(&ctx->alloc, packed);
+    memset(m, 0, sizeof *m);
+    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
         fogvol__free(&ctx->alloc, m);
@@ -4550,6 +4777,8 @@ typedef struct fogvol__gl_mesh {
     fogvol__GLuint vbo, ibo, vao;
     fogvol__GLsizei count;
     fogvol__GLenum index_type;
+    fogvol__GLsizei stride; /* the engine's vertex layout, read in place */
+    size_t offset;
 } fogvol__gl_mesh;
 
 typedef struct fogvol__gl {
@@ -5098,25 +5327,34 @@ static void fogvol__gl_bind_mesh(fogvol__gl *gl, const fogvol__gl_mesh *m)
         gl->BindVertexArray(m->vao);
     } else {
         gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
-        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, m->stride, (const void *)m->offset);
         gl->EnableVertexAttribArray(0);
         gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
     }
 }
 
-static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const float *pos, int nv,
-                                       const uint32_t *idx, int ni)
+/* Uploads the vertex bytes as the engine laid them out (stride, offset) and
+   the indices (16-bit as given, or 32-bit narrowed to 16 where they fit). */
+static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const fogvol_mesh_data *d)
 {
     fogvol__gl_state s;
     fogvol_result r;
     void *tmp = NULL;
+    const uint32_t *idx = d->indices;
     const void *data = idx;
-    size_t isz = 4;
-    int i;
+    size_t isz = 4, vbytes;
+    int i, nv = d->vertex_count, ni = d->index_count;
     memset(m, 0, sizeof *m);
     m->count = ni;
     m->index_type = FOGVOL__GL_UNSIGNED_INT;
-    if (idx && nv <= 65535) { /* 16-bit indices where they fit (GLES2 needs them) */
+    m->stride = d->stride ? d->stride : 12;
+    m->offset = (size_t)d->offset;
+    vbytes = m->offset + (size_t)(nv - 1) * (size_t)m->stride + 12u;
+    if (d->index_type == FOGVOL_INDEX_UINT16) {
+        data = d->indices16;
+        isz = 2;
+        m->index_type = FOGVOL__GL_UNSIGNED_SHORT;
+    } else if (idx && nv <= 65535) { /* 16-bit indices where they fit (GLES2 needs them) */
         uint16_t *s16 = (uint16_t *)fogvol__alloc(&gl->alloc, sizeof(uint16_t) * (size_t)ni);
         if (!s16) return FOGVOL_ERROR_OUT_OF_MEMORY;
         for (i = 0; i < ni; ++i) s16[i] = (uint16_t)idx[i];
@@ -5136,16 +5374,15 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
     }
     gl->GenBuffers(1, &m->vbo);
     gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
-    gl->BufferData(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLsizeiptr)(sizeof(float) * 3u * (size_t)nv), pos,
-                   FOGVOL__GL_STATIC_DRAW);
-    if (idx) {
+    gl->BufferData(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLsizeiptr)vbytes, d->positions, FOGVOL__GL_STATIC_DRAW);
+    if (data) {
         gl->GenBuffers(1, &m->ibo);
         gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
         gl->BufferData(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLsizeiptr)(isz * (size_t)ni), data,
                        FOGVOL__GL_STATIC_DRAW);
     }
     if (gl->has_vao) {
-        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, m->stride, (const void *)m->offset);
         gl->EnableVertexAttribArray(0);
     }
     r = fogvol__gl_check(gl, "create_mesh");
@@ -5179,7 +5416,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     *out = 0;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    r = fogvol__gl_upload(gl, m, d->positions, d->vertex_count, d->indices, d->index_count);
+    r = fogvol__gl_upload(gl, m, d);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&gl->alloc, m);
         return r;
@@ -5409,6 +5646,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
                                                   const fogvol_logger *logger, fogvol_backend *out)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
+    fogvol_mesh_data tri_data;
     fogvol__gl *gl;
     fogvol_logger silent;
     const char *ver, *ext = NULL;
@@ -5551,7 +5789,10 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
-    r = fogvol__gl_upload(gl, &gl->fullscreen, tri, 3, NULL, 0);
+    memset(&tri_data, 0, sizeof tri_data);
+    tri_data.positions = tri;
+    tri_data.vertex_count = 3;
+    r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
     if (r != FOGVOL_SUCCESS) {
         if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
         fogvol__free(alloc, gl);
@@ -5562,7 +5803,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
     out->user_data = gl;
     out->dialect = gl->dialect;
-    out->caps = gl->caps;
+    out->caps = gl->caps | FOGVOL_CAP_MESH_LAYOUT;
     out->native_texture = fogvol__gl_native_texture;
     out->target_attachment = fogvol__gl_target_attachment;
     out->begin_frame = fogvol__gl_begin_frame;
