@@ -903,6 +903,13 @@ typedef struct fogvol_backend {
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
+       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
+       bound at begin_frame; else framebuffer, an API object) into a
+       single-sample depth texture the backend owns, with the same texel
+       coordinates, and returns that texture's API object in *texture. */
+    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
+                                uintptr_t *texture);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -982,6 +989,13 @@ typedef struct fogvol_frame_stats {
     int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
 } fogvol_frame_stats;
 
+typedef enum fogvol_depth_source {
+    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
+    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
+    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
+    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
+} fogvol_depth_source;
+
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
@@ -998,6 +1012,17 @@ typedef struct fogvol_frame_desc {
     /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
        object, GL: texture name), depth range [0,1], sampled with its .r */
     uintptr_t engine_depth_texture;
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
+       The other sources are depth buffers that cannot be sampled (the default
+       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
+       copies the viewport's depth into a single-sample depth texture of its own
+       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
+       format, which resolves a multisampled source to one sample per pixel;
+       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED). */
+    fogvol_depth_source engine_depth_source;
+    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+                                           (GL: framebuffer name, 0 = the default framebuffer) */
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -1036,6 +1061,32 @@ typedef struct fogvol_mrt_info {
     float uniforms[8];
 } fogvol_mrt_info;
 FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
+
+/* Occluders drawn by the engine with its own programs, pipelines and vertex
+   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
+   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
+   before fogvol_end_frame: makes fogvol's O target the size of the viewport
+   (touches the GPU, state restored) and returns what the engine needs to draw
+   its occluders into it: attach texture as the only colour target of a
+   framebuffer of width x height with the engine's own depth buffer, clear
+   colour to clear_color and depth to "far", draw with a depth test that keeps
+   the nearest surface, and write fogvol_occluder_color(view_depth) from
+   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
+   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
+   uniforms. end_frame then uses what the engine drew instead of its own O
+   pass; fogvol_add_occluder* in the same frame is refused. */
+typedef struct fogvol_occluder_info {
+    uintptr_t texture;        /* backend API object (GL: texture name) */
+    int width, height;
+    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
+    float clear_color[4];
+    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
+} fogvol_occluder_info;
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
+/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
+   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
+   line and the engine's precision statements. */
+FOGVOL_API const char *fogvol_occluder_snippet(void);
 
 #ifndef FOGVOL_NO_GL
 /* The default GL backend on its own (fogvol_create_context makes one when the
@@ -1640,7 +1691,7 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     }
     fogvol__sort_wkeys(keys, nv);
     for (a = 0; a < nv; ++a) {
-        uint32_t self = keys[a].i, best = self;
+        uint32_t self = keys[a].i, best = 0xffffffffu;
         memcpy(v, base + (size_t)self * stride, sizeof v);
         if (!fogvol__finite_n(v, 3)) continue;
         for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
@@ -1651,8 +1702,9 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
                 FOGVOL_FABS((double)w[2] - v[2]) <= dist)
                 best = j;
         }
+        if (best == 0xffffffffu) continue; /* kept */
         rep[self] = best;
-        merged += best != self;
+        merged++;
     }
     return merged;
 }
@@ -3232,26 +3284,35 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 
 /* MRT tier: the engine's copy of the ALU encode, dither pattern by arithmetic
    (the same 8x8 ordered pattern as fogvol_make_dither_index). */
-static const char fogvol__mrt_snippet[] =
-    "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n"
-    "vec4 fogvol_encode_view_depth(float view_depth) {\n"
-    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
-    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
-    "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
-    "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n"
-    "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n"
-    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n"
-    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n"
-    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n"
-    "    float t = u * fogvol_mrt[0].w * n;\n"
-    "    float h = floor(t / n);\n"
-    "    float x = mod(floor(t * dd), n * dd);\n"
-    "    float q = floor((x + k) / dd) - 1.0;\n"
-    "    float a = q < 0.0 ? 1.0 : 0.0;\n"
-    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n"
+#define FOGVOL__MRT_SNIPPET_TEXT \
+    "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
+    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n" \
+    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n" \
+    "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n" \
+    "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n" \
+    "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n" \
+    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n" \
+    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
+    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
+    "    float t = u * fogvol_mrt[0].w * n;\n" \
+    "    float h = floor(t / n);\n" \
+    "    float x = mod(floor(t * dd), n * dd);\n" \
+    "    float q = floor((x + k) / dd) - 1.0;\n" \
+    "    float a = q < 0.0 ? 1.0 : 0.0;\n" \
+    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n" \
+    "}\n"
+static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
+/* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks the FLOAT tier's R32F target */
+static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
+    "vec4 fogvol_occluder_color(float view_depth) {\n"
+    "    if (fogvol_mrt[0].z == 0.0)\n"
+    "        return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
+    "    return fogvol_encode_view_depth(view_depth);\n"
     "}\n";
 
 FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
+FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_snippet; }
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
@@ -3430,6 +3491,7 @@ struct fogvol_context {
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     int target_w, target_h;
     int in_frame, in_occluder_pass, mrt_ready;
+    int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
     double viewproj[16];
     fogvol__volume *vols;
@@ -3934,6 +3996,7 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->in_frame = 0;
     ctx->nvol = ctx->nocc = 0;
+    ctx->engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -3963,6 +4026,10 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if ((int)d->engine_depth_source < 0 || d->engine_depth_source > FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown engine_depth_source %d", (int)d->engine_depth_source);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     ctx->frame = *d;
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
@@ -3998,6 +4065,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
     fogvol_result r;
     if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->engine_occluders) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
+                                                 "(fogvol_occluder_prepare): add_occluder refused");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
     if (!fogvol__finite_n(model, 16)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4020,6 +4092,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     fogvol_result r;
     if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->engine_occluders) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
+                                                 "(fogvol_occluder_prepare): add_occluder refused");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
     arr = ctx->occ;
     r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
     ctx->occ = (fogvol__occluder *)arr;
@@ -4297,6 +4374,52 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     return FOGVOL_SUCCESS;
 }
 
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info)
+{
+    fogvol_frame_info fi;
+    fogvol_constants k;
+    fogvol_result r;
+    int fl;
+    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    fl = ctx->tier == FOGVOL_TIER_FLOAT;
+    if (!ctx->in_frame || ctx->nocc > 0 || !ctx->be.native_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
+                                                 "fogvol_add_occluder* calls and a backend with native_texture");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
+        fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need tier PS20 or FLOAT without the "
+                                                 "COUNT, WIDE and ENGINE_DEPTH variants (tier %s, variants 0x%x)%s",
+                    fogvol_tier_name(ctx->tier), ctx->variants,
+                    ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    r = fogvol__begin_backend_frame(ctx, &fi);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    if (r != FOGVOL_SUCCESS) return r;
+    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, &k);
+    info->texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    info->width = ctx->target_w;
+    info->height = ctx->target_h;
+    info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (fl) info->clear_color[0] = 1.0f;
+    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    info->uniforms[0] = k.near_far[0];
+    info->uniforms[1] = k.near_far[1];
+    info->uniforms[2] = fl ? 0.0f : (float)ctx->enc.levels;
+    info->uniforms[3] = fl ? 0.0f : (float)ctx->enc.levels * (float)ctx->enc.levels;
+    info->uniforms[4] = fl ? 0.0f : k.depth_offset;
+    info->uniforms[5] = fl ? 1.0f : k.depth_max;
+    info->uniforms[6] = (float)ctx->enc.dither_steps;
+    info->uniforms[7] = ctx->dither && !fl ? 1.0f : 0.0f;
+    ctx->engine_occluders = 1;
+    return FOGVOL_SUCCESS;
+}
+
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
 {
     fogvol_frame_stats st;
@@ -4308,6 +4431,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     int i, w, h, g, overflow = 0, captured = 0;
     int single, count, rgba8;
     unsigned char *peak = NULL;
+    uintptr_t engine_depth;
     float zk;
     memset(&st, 0, sizeof st);
     if (stats) *stats = st;
@@ -4325,10 +4449,18 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && !fd->engine_depth_texture) {
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE &&
+        !fd->engine_depth_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
         fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE &&
+        !ctx->be.copy_depth) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
+                                                 "pass a depth texture (engine_depth_texture)");
+        fogvol_cancel_frame(ctx);
+        return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
     r = fogvol__begin_backend_frame(ctx, &info);
@@ -4338,6 +4470,17 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     }
     r = fogvol__ensure_targets(ctx, w, h);
     if (r != FOGVOL_SUCCESS) goto done;
+    engine_depth = fd->engine_depth_texture;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
+        r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
+                               fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
+                               &engine_depth);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
+                        fogvol_result_string(r));
+            goto done;
+        }
+    }
 
     /* pass uniforms common to every pass */
     memset(&ps, 0, sizeof ps);
@@ -4378,7 +4521,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     fogvol__target_space(ctx, &ps);
 
     /* step b: opaque depth into O (MRT: the engine wrote it; ENGINE_DEPTH: its depth texture) */
-    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE)) {
+    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) && !ctx->engine_occluders) {
         ps.target = ctx->tgt_o;
         ps.clear = 1;
         if (rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
@@ -4424,7 +4567,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
         ps.uniforms[FOGVOL_U_MISC][1] = count ? 0.0f : 1.0f;
         ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = fd->engine_depth_texture;
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = engine_depth;
         else ps.textures[3] = ctx->tgt_o;
         ps.textures[4] = ctx->tgt_o2;
         if (ctx->tier == FOGVOL_TIER_FLOAT) {
@@ -4528,6 +4671,7 @@ done:
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     ctx->in_frame = 0;
     ctx->mrt_ready = 0;
+    ctx->engine_occluders = 0;
     ctx->nvol = ctx->nocc = 0;
     if (stats) *stats = st;
     return r;
@@ -4614,7 +4758,13 @@ enum {
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
-    FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0
+    FOGVOL__GL_TEXTURE_COMPARE_MODE = 0x884C, FOGVOL__GL_NONE = 0,
+    FOGVOL__GL_DEPTH = 0x1801, FOGVOL__GL_DEPTH_COMPONENT = 0x1902, FOGVOL__GL_DEPTH_STENCIL = 0x84F9,
+    FOGVOL__GL_UNSIGNED_INT_24_8 = 0x84FA, FOGVOL__GL_DEPTH24_STENCIL8 = 0x88F0, FOGVOL__GL_DEPTH_COMPONENT32 = 0x81A7,
+    FOGVOL__GL_DEPTH_COMPONENT32F = 0x8CAC, FOGVOL__GL_DEPTH32F_STENCIL8 = 0x8CAD,
+    FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV = 0x8DAD, FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT = 0x821A,
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME = 0x8CD1, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216,
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE = 0x8211
 };
 
 /* X(return type, name without "gl", parameter list). Base: GL 2.0 / GLES 2.0. */
@@ -4711,6 +4861,11 @@ enum {
     X(void, DeleteSamplers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, SamplerParameteri, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint))
 
+/* Framebuffer blits: GL 3.0, GLES 3.0, ARB_framebuffer_object (the engine's depth buffer into a texture). */
+#define FOGVOL__GL_BLIT(X) \
+    X(void, BlitFramebuffer, (fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLint, \
+                              fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLbitfield, fogvol__GLenum))
+
 /* GL 3.0 / GLES 3.0: extension strings one by one. */
 #define FOGVOL__GL_3(X) X(const fogvol__GLubyte *, GetStringi, (fogvol__GLenum, fogvol__GLuint))
 
@@ -4730,7 +4885,7 @@ enum {
     X(void, GetShaderPrecisionFormat, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint *, fogvol__GLint *))
 
 #define FOGVOL__GL_ALL(X) \
-    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
+    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
@@ -4799,6 +4954,9 @@ typedef struct fogvol__gl {
     fogvol__gl_program *program;
     fogvol__gl_mesh fullscreen;
     fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
+    fogvol__GLuint depth_tex, depth_fbo; /* the engine's depth copied by copy_depth */
+    int depth_w, depth_h;
+    fogvol__GLenum depth_format;
 } fogvol__gl;
 
 static int fogvol__has_ext(const char *list, const char *name)
@@ -5568,6 +5726,113 @@ static void fogvol__gl_draw_fullscreen(void *u)
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
 
+/* The depth texture format that blits from the read framebuffer's depth
+   buffer (same depth bits and type, with the stencil of a packed buffer);
+   0 when there is no depth buffer or no such texture format. */
+static fogvol__GLenum fogvol__gl_depth_format(fogvol__gl *gl, int default_fb)
+{
+    fogvol__GLint type = 0, bits = 0, stencil = 0, ctype = 0, dname = 0, sname = 0, stype = 0;
+    fogvol__GLenum datt = default_fb ? FOGVOL__GL_DEPTH : FOGVOL__GL_DEPTH_ATTACHMENT;
+    fogvol__GLenum satt = default_fb ? FOGVOL__GL_STENCIL : FOGVOL__GL_STENCIL_ATTACHMENT;
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+    if (type == FOGVOL__GL_NONE) return 0;
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE, &bits);
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &ctype);
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &stype);
+    if (stype != FOGVOL__GL_NONE) {
+        gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE, &stencil);
+        if (!default_fb) { /* a separate stencil buffer is not part of the depth format */
+            gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                                    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &dname);
+            gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                                    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &sname);
+            if (dname != sname || type != stype) stencil = 0;
+        }
+    }
+    if (ctype == FOGVOL__GL_FLOAT)
+        return bits != 32 ? 0 : stencil ? FOGVOL__GL_DEPTH32F_STENCIL8 : FOGVOL__GL_DEPTH_COMPONENT32F;
+    if (stencil) return bits == 24 ? FOGVOL__GL_DEPTH24_STENCIL8 : 0;
+    if (bits == 16) return FOGVOL__GL_DEPTH_COMPONENT16;
+    if (bits == 24) return FOGVOL__GL_DEPTH_COMPONENT24;
+    return bits == 32 && !gl->gles ? FOGVOL__GL_DEPTH_COMPONENT32 : 0;
+}
+
+/* (Re)creates the copy texture and its framebuffer for a format and size. */
+static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h)
+{
+    static const fogvol__GLenum none = FOGVOL__GL_NONE;
+    int packed = format == FOGVOL__GL_DEPTH24_STENCIL8 || format == FOGVOL__GL_DEPTH32F_STENCIL8;
+    fogvol__GLenum type = format == FOGVOL__GL_DEPTH_COMPONENT16 ? FOGVOL__GL_UNSIGNED_SHORT
+                          : format == FOGVOL__GL_DEPTH24_STENCIL8 ? FOGVOL__GL_UNSIGNED_INT_24_8
+                          : format == FOGVOL__GL_DEPTH32F_STENCIL8 ? FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV
+                          : format == FOGVOL__GL_DEPTH_COMPONENT32F ? FOGVOL__GL_FLOAT
+                                                                    : FOGVOL__GL_UNSIGNED_INT;
+    if (gl->depth_tex && gl->depth_format == format && gl->depth_w == w && gl->depth_h == h) return;
+    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    gl->GenTextures(1, &gl->depth_tex);
+    gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, gl->depth_tex);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, (fogvol__GLint)format, w, h, 0,
+                   packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    gl->GenFramebuffers(1, &gl->depth_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_DRAW_FRAMEBUFFER,
+                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT,
+                             FOGVOL__GL_TEXTURE_2D, gl->depth_tex, 0);
+    gl->DrawBuffers(1, &none); /* depth only (framebuffer state of our own FBO) */
+    gl->depth_format = format;
+    gl->depth_w = w;
+    gl->depth_h = h;
+}
+
+static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int bound, const int rect[4],
+                                           uintptr_t *texture)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
+    fogvol__GLenum format;
+    fogvol_result r;
+    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3];
+    *texture = 0;
+    if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copying a depth buffer needs glBlitFramebuffer "
+                                                "(GL 3.0, GLES 3.0 or ARB_framebuffer_object)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (rect[0] < 0 || rect[1] < 0) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth: viewport origin (%d, %d) is negative", rect[0],
+                    rect[1]);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    gl->GetError();
+    gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
+    format = fogvol__gl_depth_format(gl, src == 0);
+    if (!format) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR,
+                    "fogvol: framebuffer %u has no depth buffer, or one whose format no depth texture matches", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_depth_target(gl, format, x1, y1);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
+    /* the same rectangle on both sides: required to resolve a multisampled source */
+    gl->BlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, FOGVOL__GL_DEPTH_BUFFER_BIT,
+                        FOGVOL__GL_NEAREST);
+    gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)gl->saved.read_fbo);
+    r = fogvol__gl_check(gl, "copy_depth (glBlitFramebuffer of the engine's depth)");
+    if (r == FOGVOL_SUCCESS) *texture = gl->depth_tex;
+    return r;
+}
+
 static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned char *rgba, size_t size)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -5594,6 +5859,8 @@ static void fogvol__gl_destroy(void *u)
     if (!gl) return;
     fogvol__gl_free_mesh(gl, &gl->fullscreen);
     if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -5749,6 +6016,9 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_SAMPLER(FOGVOL__GL_LOAD)
         FOGVOL__GL_SAMPLER(FOGVOL__GL_REQUIRE)
     }
+    if (gl->major >= 3 || (!gl->gles && fogvol__has_ext(ext, "GL_ARB_framebuffer_object"))) {
+        FOGVOL__GL_BLIT(FOGVOL__GL_LOAD) /* optional: without it copy_depth refuses */
+    }
     if (gl->major >= 3) {
         FOGVOL__GL_3(FOGVOL__GL_LOAD)
         FOGVOL__GL_3(FOGVOL__GL_REQUIRE)
@@ -5806,6 +6076,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     out->caps = gl->caps | FOGVOL_CAP_MESH_LAYOUT;
     out->native_texture = fogvol__gl_native_texture;
     out->target_attachment = fogvol__gl_target_attachment;
+    out->copy_depth = fogvol__gl_copy_depth;
     out->begin_frame = fogvol__gl_begin_frame;
     out->end_frame = fogvol__gl_end_frame;
     out->create_texture = fogvol__gl_create_texture;
