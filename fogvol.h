@@ -114,6 +114,17 @@
        glDrawBuffers(1, bufs);                             // before fogvol composites
        ... fogvol_add_volume ...; fogvol_end_frame(fv, NULL);
 
+   THE ENGINE'S OWN DEPTH, OCCLUDERS AND MESHES
+   ============================================
+       // depth buffers that are not textures (FLOAT + ENGINE_DEPTH): fogvol blits them
+       fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;  // or _FRAMEBUFFER_OBJECT + name
+       // occluders drawn by the engine's own pipelines (PS20, FLOAT)
+       fogvol_occluder_info oi; fogvol_occluder_prepare(fv, &oi); // O texture, size, clear colour, uniforms
+       // engine FBO: colour oi.texture + its own depth; shader: fogvol_occluder_snippet(),
+       // fogvol_mrt[2] = oi.uniforms, colour = fogvol_occluder_color(-view_space_z)
+       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
+       //         weld_distance > 0 for seams and per-face vertices
+
    ANALYTIC FOG VOLUMES (seeds/002, no render passes)
    ====================
    Per-vertex or per-pixel fog from distance fog, half-spaces, spheres and
