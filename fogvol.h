@@ -100,7 +100,7 @@
        lowp/mediump only (GLES2)            PS13    6 / 5
    Variants combine with tiers (FOGVOL_VARIANT_*): single target, Baker's
    inside/outside count, ALU encoding, near-plane vertex clamping, engine depth
-   texture (FLOAT), two-target precision (WIDE); fogvol_combination_supported()
+   (FLOAT, PS20), two-target precision (WIDE); fogvol_combination_supported()
    says which exist in a dialect. FLOAT and MRT need GLSL 130+ or 300 es.
 
    MRT TIER (the engine's opaque pass writes the opaque depth as a 2nd output)
@@ -463,7 +463,10 @@ enum {
        on near-plane clipping for a camera partly inside a volume. */
     FOGVOL_VARIANT_NEAR_CLAMP = 1u << 3,
     /* FLOAT: the opaque depth comes from the engine's depth texture
-       (fogvol_frame_desc.engine_depth_texture), linearised; no O pass. */
+       (fogvol_frame_desc.engine_depth_texture, or a depth buffer it names),
+       linearised; no O pass. PS20 (GLSL 130+ / 300 es, not with COUNT or
+       WIDE): a full-screen pass linearises and encodes it into O instead of
+       drawing occluders. fogvol_add_occluder* calls are not drawn. */
     FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
     /* PS20: more precision by spreading the encoding over two RGBA8 targets
        per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
@@ -2998,6 +3001,19 @@ static const char fogvol__fs_common[] =
     "#endif\n";
 
 static const char fogvol__fs_encode[] =
+    "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
+    "uniform sampler2D fv_opaque;\n"
+    "uniform vec4 fv_lin;\n"
+    "uniform vec4 fv_nf;\n"
+    "float fv_engine_view_depth(float depth) {\n" /* the engine's [0,1] depth -> view depth */
+    "    float z = depth * 2.0 - 1.0;\n"
+    "    return -(fv_lin.y - fv_lin.w * z) / (fv_lin.z * z - fv_lin.x);\n"
+    "}\n"
+    "void main() {\n"
+    "    float depth = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(depth) * fv_nf.x + fv_nf.y);\n"
+    "}\n"
+    "#else\n"
     "FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
     "#if defined(FV_WIDE)\n"
@@ -3012,7 +3028,8 @@ static const char fogvol__fs_encode[] =
     "#else\n"
     "    FV_FRAGCOLOR = fv_encode(fv_d);\n"
     "#endif\n"
-    "}\n";
+    "}\n"
+    "#endif\n";
 
 /* Volume faces. RGBA8: keep the lesser of face and opaque depth (PS 6 decoded
    compare, or PS 5 per-channel saturated compare on normalised digits), or
@@ -3171,7 +3188,10 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
                      FOGVOL_VARIANT_WIDE))
                    ? FOGVOL_ERROR_UNSUPPORTED
                    : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
+        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return FOGVOL_SUCCESS;
     case FOGVOL_TIER_MRT:
         if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
         return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
@@ -3264,7 +3284,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     for (i = 0; i < 6; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE)
+        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
+                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
                            ? fogvol__vs_fullscreen
                            : fogvol__vs_mesh;
     } else {
@@ -3688,7 +3709,8 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
         pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
-    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = pd.samplers[4] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[4] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) pd.samplers[3] = NULL;
     pd.label = labels[p];
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
@@ -4539,10 +4561,13 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         else ps.clear_color[0] = 1.0f;
         ps.depth_test = ps.depth_write = 1;
         ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = engine_depth;
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         st.passes++;
         ctx->in_occluder_pass = 1;
-        for (i = 0; i < ctx->nocc; ++i) {
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) /* PS20: encode the engine's depth, full-screen */
+            ctx->be.draw_fullscreen(ctx->be.user_data);
+        for (i = 0; i < ctx->nocc && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH); ++i) {
             const fogvol__occluder *o = &ctx->occ[i];
             if (o->fn) {
                 o->fn(ctx, o->user_data);
@@ -4555,6 +4580,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         }
         ctx->in_occluder_pass = 0;
         fogvol__end_pass(ctx);
+        ps.native_textures[3] = 0;
     }
     ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
     ps.depth_write = 0;
@@ -4578,7 +4604,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
         ps.uniforms[FOGVOL_U_MISC][1] = count ? 0.0f : 1.0f;
         ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = engine_depth;
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+            ps.native_textures[3] = engine_depth;
         else ps.textures[3] = ctx->tgt_o;
         ps.textures[4] = ctx->tgt_o2;
         if (ctx->tier == FOGVOL_TIER_FLOAT) {

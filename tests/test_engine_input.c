@@ -263,7 +263,8 @@ static GLuint compile(GLenum type, const char *const *src, int n)
 
 static void engine_init(engine *e)
 {
-    static const char *vs = "#version 330 core\nlayout(location = 3) in vec3 e_pos;\nlayout(location = 1) in vec2 e_uv;\n"
+    static const char *vs = "#version 330 core\nlayout(location = 3) in vec3 e_pos;\n"
+                            "layout(location = 1) in vec2 e_uv;\n"
                             "uniform mat4 e_mvp;\nuniform mat4 e_mv;\nout float e_vd;\nout vec2 e_t;\n"
                             "void main() { e_vd = -(e_mv * vec4(e_pos, 1.0)).z; e_t = e_uv;\n"
                             "    gl_Position = e_mvp * vec4(e_pos, 1.0); }\n";
@@ -337,6 +338,9 @@ typedef struct depth_case {
     GLenum format; /* 0: the default framebuffer */
     int samples, offset, by_name;
     int bits;      /* depth quantum 2^-bits (0: float, negligible) */
+    fogvol_tier tier;  /* 0: FLOAT */
+    unsigned variants; /* besides ENGINE_DEPTH */
+    int texture;       /* 1: a depth texture of this format (FOGVOL_DEPTH_SOURCE_TEXTURE) */
 } depth_case;
 
 static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *gt, const double *spread,
@@ -344,13 +348,17 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
 {
     rc_camera c = camera();
     engine e;
-    fogvol_context *fv = make_ctx(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH);
+    fogvol_tier tier = dc->tier ? dc->tier : FOGVOL_TIER_FLOAT;
+    fogvol_context *fv = make_ctx(tier, FOGVOL_VARIANT_ENGINE_DEPTH | dc->variants);
+    fogvol_frame_stats st;
+    fogvol_tier_info ti;
     fogvol_mesh *vol = mesh_of(fv, &o[0].m, 0);
     fogvol_ramp *ramp = ramp_of(fv);
     fogvol_frame_desc fd;
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
-    float *zb = (float *)malloc(sizeof(float) * (W + OX) * (H + OY)), *za = (float *)malloc(sizeof(float) * (W + OX) * (H + OY));
-    GLuint fbo = 0, rb[2] = {0, 0};
+    size_t zbytes = sizeof(float) * (W + OX) * (H + OY);
+    float *zb = (float *)malloc(zbytes), *za = (float *)malloc(zbytes);
+    GLuint fbo = 0, rb[2] = {0, 0}, dtex = 0;
     GLint draw_before = 0, read_before = 0, draw_after = -1, read_after = -1;
     int fw = W + (dc->offset ? OX : 0), fh = H + (dc->offset ? OY : 0), x0 = dc->offset ? OX : 0,
         y0 = dc->offset ? OY : 0, i, pixels;
@@ -363,11 +371,21 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
         glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
         glRenderbufferStorageMultisample(GL_RENDERBUFFER, dc->samples, GL_RGBA8, fw, fh);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
-        glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
-        glRenderbufferStorageMultisample(GL_RENDERBUFFER, dc->samples, dc->format, fw, fh);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER,
-                                  dc->format == GL_DEPTH24_STENCIL8 ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
-                                  GL_RENDERBUFFER, rb[1]);
+        if (dc->texture) { /* a depth texture, sampled directly */
+            glGenTextures(1, &dtex);
+            glBindTexture(GL_TEXTURE_2D, dtex);
+            glTexImage2D(GL_TEXTURE_2D, 0, (GLint)dc->format, fw, fh, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glBindTexture(GL_TEXTURE_2D, 0);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, dtex, 0);
+        } else {
+            glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+            glRenderbufferStorageMultisample(GL_RENDERBUFFER, dc->samples, dc->format, fw, fh);
+            glFramebufferRenderbuffer(GL_FRAMEBUFFER,
+                                      dc->format == GL_DEPTH24_STENCIL8 ? GL_DEPTH_STENCIL_ATTACHMENT
+                                                                       : GL_DEPTH_ATTACHMENT,
+                                      GL_RENDERBUFFER, rb[1]);
+        }
         glBindRenderbuffer(GL_RENDERBUFFER, 0);
         assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
     } else {
@@ -383,7 +401,9 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
     fd.viewport[1] = y0;
     engine_draw(&e, o, n, fd.view, fd.projection, NULL);
     if (dc->samples == 0) glReadPixels(0, 0, fw, fh, GL_DEPTH_COMPONENT, GL_FLOAT, zb);
-    if (dc->by_name) {
+    if (dc->texture) {
+        fd.engine_depth_texture = dtex;
+    } else if (dc->by_name) {
         fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT;
         fd.engine_depth_framebuffer = fbo;
         glBindFramebuffer(GL_FRAMEBUFFER, 0); /* another framebuffer bound: the name decides */
@@ -394,7 +414,9 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_before);
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
     add_volume(fv, vol, o[0].model, ramp);
-    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_get_tier_info(tier, FOGVOL_VARIANT_ENGINE_DEPTH | dc->variants, &ti), FOGVOL_SUCCESS);
+    assert_int_equal(st.passes, ti.library_passes);
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_after);
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_after);
     assert_int_equal(draw_after, draw_before);
@@ -405,9 +427,12 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
         glReadPixels(0, 0, fw, fh, GL_DEPTH_COMPONENT, GL_FLOAT, za);
         assert_memory_equal(za, zb, sizeof(float) * (size_t)fw * fh);
     }
-    if (!dc->format) save_png("engine_depth_default_fb", W, H);
-    /* fp32 sums (1e-4 of the range, as the FLOAT tier's other tests) + the depth quantum at the farthest occluder */
-    bound = 1e-4 * range + (dc->bits ? ldexp(1.0, -dc->bits) * wmax * wmax * range / (c.zfar * c.znear) : 0.0);
+    if (!dc->format)
+        save_png(tier == FOGVOL_TIER_FLOAT ? "engine_depth_default_fb_float" : "engine_depth_default_fb_ps20", W, H);
+    /* FLOAT: fp32 sums (1e-4 of the range, as the tier's other tests); PS20: 1 LSB of the 12-bit encoding
+       per pair of faces (one pair here); + the depth quantum at the farthest occluder */
+    bound = (tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0) +
+            (dc->bits ? ldexp(1.0, -dc->bits) * wmax * wmax * range / (c.zfar * c.znear) : 0.0);
     err = max_err(thick, gt, interior, &pixels);
     if (dc->samples) { /* one of the pixel's samples: the error beyond the occluder's depth spread over the pixel */
         double centre = err;
@@ -416,17 +441,18 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
             double out = fabs(thick[i] - gt[i]) - spread[i];
             if (interior[i] && out > err) err = out;
         }
-        print_message("  %-34s (vs the pixel centre %.3g of the range: the resolve keeps one sample)\n", dc->name,
-                      centre / range);
+        print_message("  %-5s %-34s (vs the pixel centre %.3g of the range: the resolve keeps one sample)\n",
+                      fogvol_tier_name(tier), dc->name, centre / range);
     }
-    print_message("  %-34s max |error| %.3g units = %.3g of the range (bound %.3g), %d fogged pixels\n", dc->name,
-                  err, err / range, bound / range, pixels);
+    print_message("  %-5s %-34s max |error| %.3g units = %.3g of the range (bound %.3g), %d fogged pixels\n",
+                  fogvol_tier_name(tier), dc->name, err, err / range, bound / range, pixels);
     assert_true(pixels > 1000);
     assert_true(err <= bound);
     *err_out = err / range;
     for (i = 0; i < 2; ++i)
         if (rb[i]) glDeleteRenderbuffers(1, &rb[i]);
     if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (dtex) glDeleteTextures(1, &dtex);
     glDeleteProgram(e.prog);
     fogvol_destroy_mesh(fv, vol);
     fogvol_destroy_ramp(fv, ramp);
@@ -439,10 +465,16 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
 static void test_engine_depth_buffers(void **state)
 {
     static const depth_case cases[] = {
-        {"default framebuffer (D24S8)", 0, 0, 0, 0, 24},
-        {"4x MSAA D24S8 renderbuffer, offset", GL_DEPTH24_STENCIL8, 4, 1, 1, 24},
-        {"DEPTH_COMPONENT32F renderbuffer", GL_DEPTH_COMPONENT32F, 0, 0, 0, 0},
-        {"DEPTH_COMPONENT16 renderbuffer", GL_DEPTH_COMPONENT16, 0, 1, 0, 16},
+        {"default framebuffer (D24S8)", 0, 0, 0, 0, 24, FOGVOL_TIER_FLOAT, 0, 0},
+        {"4x MSAA D24S8 renderbuffer, offset", GL_DEPTH24_STENCIL8, 4, 1, 1, 24, FOGVOL_TIER_FLOAT, 0, 0},
+        {"DEPTH_COMPONENT32F renderbuffer", GL_DEPTH_COMPONENT32F, 0, 0, 0, 0, FOGVOL_TIER_FLOAT, 0, 0},
+        {"DEPTH_COMPONENT16 renderbuffer", GL_DEPTH_COMPONENT16, 0, 1, 0, 16, FOGVOL_TIER_FLOAT, 0, 0},
+        /* PS20: a full-screen pass encodes the engine's depth into O */
+        {"default framebuffer (D24S8)", 0, 0, 0, 0, 24, FOGVOL_TIER_PS20, 0, 0},
+        {"4x MSAA D24S8 renderbuffer, offset", GL_DEPTH24_STENCIL8, 4, 1, 1, 24, FOGVOL_TIER_PS20, 0, 0},
+        {"DEPTH_COMPONENT24 texture, offset", GL_DEPTH_COMPONENT24, 0, 1, 0, 24, FOGVOL_TIER_PS20, 0, 1},
+        {"DEPTH_COMPONENT32F texture, ALU+single", GL_DEPTH_COMPONENT32F, 0, 0, 0, 0, FOGVOL_TIER_PS20,
+         FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, 1},
     };
     rc_camera c = camera();
     tobj o[2];
@@ -526,13 +558,24 @@ static void test_engine_depth_refusals(void **state)
     fogvol_destroy_mesh(fv, vol);
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
-    /* the engine's depth on the RGBA8 tiers stays refused by tier choice */
+    /* the engine's depth where no shader reads it: MRT (the engine writes O), PS20 with COUNT
+       or in GLSL 120 (no texelFetch), PS13 */
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = logger;
-    cd.tier = FOGVOL_TIER_PS20;
+    cd.tier = FOGVOL_TIER_MRT;
     cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    cd.tier = FOGVOL_TIER_PS13;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    cd.gl.dialect = FOGVOL_GLSL_120;
+    g_log[0] = 0;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    assert_non_null(strstr(g_log, "fogvol"));
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &tex);
     glu_destroy(&g);
