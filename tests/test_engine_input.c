@@ -558,6 +558,27 @@ static void test_engine_depth_refusals(void **state)
     fogvol_destroy_mesh(fv, vol);
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
+    { /* a backend without copy_depth: depth buffers refused, depth textures still fine */
+        fogvol_gl_desc gd;
+        fogvol_backend table;
+        memset(&gd, 0, sizeof gd);
+        gd.get_proc_address = glu_proc;
+        assert_int_equal(fogvol_gl_backend_create(&gd, NULL, NULL, &table), FOGVOL_SUCCESS);
+        table.copy_depth = NULL;
+        memset(&cd, 0, sizeof cd);
+        cd.backend = table;
+        cd.logger.func = logger;
+        cd.tier = FOGVOL_TIER_FLOAT;
+        cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        g_log[0] = 0;
+        assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_ERROR_UNSUPPORTED);
+        assert_non_null(strstr(g_log, "copy_depth"));
+        fogvol_destroy_context(fv);
+        table.destroy(table.user_data);
+    }
     /* the engine's depth where no shader reads it: MRT (the engine writes O), PS20 with COUNT
        or in GLSL 120 (no texelFetch), PS13 */
     memset(&cd, 0, sizeof cd);
