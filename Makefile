@@ -70,6 +70,10 @@ $(BUILD)/test_engine_depth: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_engine_depth_san: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_input: tests/test_engine_input.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_engine_input_san: tests/test_engine_input.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
 $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
@@ -91,6 +95,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_engine_fb $(BUILD)/test_engine_fb_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
+            $(BUILD)/test_engine_input $(BUILD)/test_engine_input_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
             $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
@@ -126,6 +131,8 @@ test: deps-test deps-run
 	  "engine_msaa_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_msaa_san" \
 	  "engine_depth=$(TAP) $(BUILD)/test_engine_depth" \
 	  "engine_depth_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_depth_san" \
+	  "engine_input=$(TAP) $(BUILD)/test_engine_input" \
+	  "engine_input_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_input_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \

@@ -109,7 +109,7 @@
        lowp/mediump only (GLES2)            PS13    6 / 5
    Variants combine with tiers (FOGVOL_VARIANT_*): single target, Baker's
    inside/outside count, ALU encoding, near-plane vertex clamping, engine depth
-   texture (FLOAT), two-target precision (WIDE); fogvol_combination_supported()
+   (FLOAT, PS20), two-target precision (WIDE); fogvol_combination_supported()
    says which exist in a dialect. FLOAT and MRT need GLSL 130+ or 300 es.
 
    MRT TIER (the engine's opaque pass writes the opaque depth as a 2nd output)
@@ -122,6 +122,17 @@
        //                second output = fogvol_encode_view_depth(-view_space_z)
        glDrawBuffers(1, bufs);                             // before fogvol composites
        ... fogvol_add_volume ...; fogvol_end_frame(fv, NULL);
+
+   THE ENGINE'S OWN DEPTH, OCCLUDERS AND MESHES
+   ============================================
+       // depth buffers that are not textures (FLOAT + ENGINE_DEPTH): fogvol blits them
+       fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;  // or _FRAMEBUFFER_OBJECT + name
+       // occluders drawn by the engine's own pipelines (PS20, FLOAT)
+       fogvol_occluder_info oi; fogvol_occluder_prepare(fv, &oi); // O texture, size, clear colour, uniforms
+       // engine FBO: colour oi.texture + its own depth; shader: fogvol_occluder_snippet(),
+       // fogvol_mrt[2] = oi.uniforms, colour = fogvol_occluder_color(-view_space_z)
+       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
+       //         weld_distance > 0 for seams and per-face vertices
 
    ANALYTIC FOG VOLUMES (seeds/002, no render passes)
    ====================
@@ -362,13 +373,32 @@ FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, un
    Volumes are closed hulls: every undirected edge used by exactly two
    triangles, in opposite directions; triangles counter-clockwise seen from
    outside. */
+typedef enum fogvol_index_type {
+    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
+    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
+    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
+} fogvol_index_type;
+
 typedef struct fogvol_mesh_desc {
-    const float *positions;    /* x, y, z floats per vertex */
+    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
     int vertex_count;
-    int stride;                /* bytes between vertices, 0 = 12 */
+    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
     const uint32_t *indices;   /* 3 per triangle */
     int index_count;
     int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
+    /* Engine vertex buffers as they are: offset is the byte offset of x inside
+       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
+       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
+       the GL backend among them, upload the bytes and read them in place). */
+    int offset;
+    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
+    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
+    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
+       most weld_distance from an earlier kept vertex is merged into it (seams of
+       UV spheres, per-face vertices of cubes); the validation, the report and
+       the uploaded indices then describe the welded mesh. 0 = off (indices as
+       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
+    float weld_distance;
 } fogvol_mesh_desc;
 
 typedef struct fogvol_mesh_report {
@@ -386,12 +416,17 @@ typedef struct fogvol_mesh_report {
     int consistent;            /* no inconsistent edge, no flipped face */
     int inverted;              /* closed, consistent, but wound inward (volume < 0) */
     int valid;                 /* usable as a fog volume */
+    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
+                                  vertices counts the rest */
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle) comes from alloc (NULL = default). Never
-   reads outside positions[0 .. vertex_count) or indices[0 .. index_count). */
+   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
+   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
+   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
+   stride, unknown index_type, missing arrays, bad weld_distance). */
 FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
                                               fogvol_mesh_report *report);
 
@@ -451,7 +486,10 @@ enum {
        on near-plane clipping for a camera partly inside a volume. */
     FOGVOL_VARIANT_NEAR_CLAMP = 1u << 3,
     /* FLOAT: the opaque depth comes from the engine's depth texture
-       (fogvol_frame_desc.engine_depth_texture), linearised; no O pass. */
+       (fogvol_frame_desc.engine_depth_texture, or a depth buffer it names),
+       linearised; no O pass. PS20 (GLSL 130+ / 300 es, not with COUNT or
+       WIDE): a full-screen pass linearises and encodes it into O instead of
+       drawing occluders. fogvol_add_occluder* calls are not drawn. */
     FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
     /* PS20: more precision by spreading the encoding over two RGBA8 targets
        per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
@@ -825,10 +863,17 @@ typedef struct fogvol_program_desc {
 } fogvol_program_desc;
 
 typedef struct fogvol_mesh_data {
-    const float *positions; /* tightly packed xyz */
+    const float *positions; /* tightly packed xyz (see stride, offset) */
     int vertex_count;
     const uint32_t *indices;
     int index_count;
+    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
+       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
+       offset + i * stride of positions (stride 0 = 12), and with index_type
+       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
+    int stride, offset;
+    fogvol_index_type index_type;
+    const uint16_t *indices16;
 } fogvol_mesh_data;
 
 typedef enum fogvol_pass_blend {
@@ -879,8 +924,9 @@ enum {
     FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
     FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
     FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
-    FOGVOL_CAP_MULTISAMPLE = 1u << 4      /* multisampled targets and per-sample shading
+    FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
                                              (GL 4.0, or GL 3.2 + ARB_sample_shading) */
+    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
 };
 
 typedef struct fogvol_frame_info {
@@ -928,6 +974,13 @@ typedef struct fogvol_backend {
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
+       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
+       bound at begin_frame; else framebuffer, an API object) into a
+       single-sample depth texture the backend owns, with the same texel
+       coordinates, and returns that texture's API object in *texture. */
+    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
+                                uintptr_t *texture);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -946,7 +999,7 @@ typedef struct fogvol_null_backend {
     int stencil_bits;       /* reported by begin_frame */
     int samples;            /* reported by begin_frame (engine framebuffer samples) */
 } fogvol_null_backend;
-/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE (AUTO picks PS20);
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
    change table->caps before creating a context to test other choices. */
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
 
@@ -1046,6 +1099,13 @@ typedef struct fogvol_frame_stats {
                                drew one fog value per pixel */
 } fogvol_frame_stats;
 
+typedef enum fogvol_depth_source {
+    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
+    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
+    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
+    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
+} fogvol_depth_source;
+
 /* What the frame's camera is given as (fogvol_frame_desc.camera). */
 typedef enum fogvol_camera {
     FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
@@ -1113,6 +1173,17 @@ typedef struct fogvol_frame_desc {
     fogvol_camera camera;
     float view_projection[16];
     float eye[3], forward[3];
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
+       The other sources are depth buffers that cannot be sampled (the default
+       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
+       copies the viewport's depth into a single-sample depth texture of its own
+       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
+       format, which resolves a multisampled source to one sample per pixel;
+       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED). */
+    fogvol_depth_source engine_depth_source;
+    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+                                           (GL: framebuffer name, 0 = the default framebuffer) */
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -1159,6 +1230,32 @@ typedef struct fogvol_mrt_info {
     float uniforms[8];
 } fogvol_mrt_info;
 FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
+
+/* Occluders drawn by the engine with its own programs, pipelines and vertex
+   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
+   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
+   before fogvol_end_frame: makes fogvol's O target the size of the viewport
+   (touches the GPU, state restored) and returns what the engine needs to draw
+   its occluders into it: attach texture as the only colour target of a
+   framebuffer of width x height with the engine's own depth buffer, clear
+   colour to clear_color and depth to "far", draw with a depth test that keeps
+   the nearest surface, and write fogvol_occluder_color(view_depth) from
+   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
+   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
+   uniforms. end_frame then uses what the engine drew instead of its own O
+   pass; fogvol_add_occluder* in the same frame is refused. */
+typedef struct fogvol_occluder_info {
+    uintptr_t texture;        /* backend API object (GL: texture name) */
+    int width, height;
+    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
+    float clear_color[4];
+    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
+} fogvol_occluder_info;
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
+/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
+   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
+   line and the engine's precision statements. */
+FOGVOL_API const char *fogvol_occluder_snippet(void);
 
 #ifndef FOGVOL_NO_GL
 /* The default GL backend on its own (fogvol_create_context makes one when the
@@ -1683,8 +1780,173 @@ static uint32_t fogvol__uf_find(uint32_t *parent, unsigned char *parity, uint32_
     return root;
 }
 
+/* NULL for a usable layout, else what is wrong with it. */
+static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
+{
+    int stride;
+    if (!d || !d->positions) return "no positions";
+    if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
+        return "vertex_count must be > 0 and index_count a positive multiple of 3";
+    if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
+    stride = d->stride ? d->stride : 12;
+    if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
+    if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
+    if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
+    if (!fogvol__finite(d->weld_distance) || d->weld_distance < 0) return "weld_distance negative or not finite";
+    return NULL;
+}
+
+typedef struct fogvol__wkey {
+    float key;
+    uint32_t i;
+} fogvol__wkey;
+
+static int fogvol__wkey_less(const fogvol__wkey *x, const fogvol__wkey *y)
+{
+    return x->key < y->key || (x->key == y->key && x->i < y->i);
+}
+
+static void fogvol__sift_wkeys(fogvol__wkey *k, int root, int n)
+{
+    int child;
+    fogvol__wkey t;
+    for (; (child = 2 * root + 1) < n; root = child) {
+        if (child + 1 < n && fogvol__wkey_less(&k[child], &k[child + 1])) ++child;
+        if (!fogvol__wkey_less(&k[root], &k[child])) return;
+        t = k[root];
+        k[root] = k[child];
+        k[child] = t;
+    }
+}
+
+/* In-place heap sort (no allocation, O(n log n)). */
+static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
+{
+    int i;
+    fogvol__wkey t;
+    for (i = n / 2 - 1; i >= 0; --i) fogvol__sift_wkeys(k, i, n);
+    for (i = n - 1; i > 0; --i) {
+        t = k[0];
+        k[0] = k[i];
+        k[i] = t;
+        fogvol__sift_wkeys(k, 0, i);
+    }
+}
+
+/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on
+   every axis (i itself when none). A sweep along the axis of largest extent
+   (sorted keys) limits the candidates. Non-finite vertices stay alone. Returns
+   how many vertices were merged. */
+static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, uint32_t *rep, fogvol__wkey *keys)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3], w[3];
+    int i, a, b, k, axis = 0, merged = 0, any = 0;
+    for (i = 0; i < nv; ++i) {
+        memcpy(v, base + (size_t)i * stride, sizeof v);
+        rep[i] = (uint32_t)i;
+        if (!fogvol__finite_n(v, 3)) continue;
+        for (k = 0; k < 3; ++k) {
+            if (!any || v[k] < lo[k]) lo[k] = v[k];
+            if (!any || v[k] > hi[k]) hi[k] = v[k];
+        }
+        any = 1;
+    }
+    for (k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    for (i = 0; i < nv; ++i) {
+        memcpy(v, base + (size_t)i * stride, sizeof v);
+        keys[i].key = fogvol__finite_n(v, 3) ? v[axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].i = (uint32_t)i;
+    }
+    fogvol__sort_wkeys(keys, nv);
+    for (a = 0; a < nv; ++a) {
+        uint32_t self = keys[a].i, best = 0xffffffffu;
+        memcpy(v, base + (size_t)self * stride, sizeof v);
+        if (!fogvol__finite_n(v, 3)) continue;
+        for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
+            uint32_t j = keys[b].i;
+            if (rep[j] != j || j > best) continue;
+            memcpy(w, base + (size_t)j * stride, sizeof w);
+            if (FOGVOL_FABS((double)w[0] - v[0]) <= dist && FOGVOL_FABS((double)w[1] - v[1]) <= dist &&
+                FOGVOL_FABS((double)w[2] - v[2]) <= dist)
+                best = j;
+        }
+        if (best == 0xffffffffu) continue; /* kept */
+        rep[self] = best;
+        merged++;
+    }
+    return merged;
+}
+
+/* The desc's indices as 32 bits, welded when asked: *out is NULL when the
+   desc's own 32-bit array serves as it is, else an array from alloc. */
+static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvol_allocator *alloc, uint32_t **out,
+                                          int *welded)
+{
+    const unsigned char *base = (const unsigned char *)d->positions + d->offset;
+    int i, stride = d->stride ? d->stride : 12, weld = d->weld_distance > 0;
+    uint32_t *idx, *rep = NULL;
+    fogvol__wkey *keys = NULL;
+    *out = NULL;
+    *welded = 0;
+    if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
+    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
+    if (weld) {
+        rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
+        keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)d->vertex_count);
+    }
+    if (!idx || (weld && (!rep || !keys))) {
+        fogvol__free(alloc, idx);
+        fogvol__free(alloc, rep);
+        fogvol__free(alloc, keys);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < d->index_count; ++i)
+        idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
+    if (weld) {
+        *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, rep, keys);
+        for (i = 0; i < d->index_count; ++i)
+            if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
+    }
+    fogvol__free(alloc, rep);
+    fogvol__free(alloc, keys);
+    *out = idx;
+    return FOGVOL_SUCCESS;
+}
+
+static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
+                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep);
+
+/* Validation that hands the (welded, 32-bit) indices to create_mesh when idx_out is set. */
+static fogvol_result fogvol__check_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                        fogvol_mesh_report *rep, uint32_t **idx_out)
+{
+    uint32_t *idx = NULL;
+    int welded = 0;
+    fogvol_result r;
+    if (idx_out) *idx_out = NULL;
+    if (!rep) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(rep, 0, sizeof *rep);
+    if (fogvol__mesh_problem(desc)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol__mesh_indices(desc, alloc, &idx, &welded);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__validate(desc, idx ? idx : desc->indices, alloc, rep);
+    rep->welded_vertices = welded;
+    rep->vertices -= welded;
+    if (idx_out && r != FOGVOL_ERROR_OUT_OF_MEMORY) *idx_out = idx;
+    else fogvol__free(alloc, idx);
+    return r;
+}
+
 FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
                                               fogvol_mesh_report *rep)
+{
+    return fogvol__check_mesh(desc, alloc, rep, NULL);
+}
+
+/* The topology and geometry checks on 32-bit indices (layout already checked). */
+static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
+                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep)
 {
     int ntri, t, stride;
     size_t ne = 0, i, j;
@@ -1693,13 +1955,8 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
     unsigned char *parity = NULL, *usable = NULL, *vbad = NULL;
     const unsigned char *base;
     double vol = 0;
-    if (!rep) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(rep, 0, sizeof *rep);
-    if (!desc || !desc->positions || !desc->indices || desc->vertex_count <= 0 || desc->index_count <= 0 ||
-        desc->index_count % 3 != 0 || desc->stride < 0 || (desc->stride != 0 && desc->stride < 12))
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
     stride = desc->stride ? desc->stride : 12;
-    base = (const unsigned char *)desc->positions;
+    base = (const unsigned char *)desc->positions + desc->offset;
     ntri = desc->index_count / 3;
     rep->vertices = desc->vertex_count;
     rep->triangles = ntri;
@@ -1736,7 +1993,7 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
         parity[t] = 0;
         usable[t] = 0;
         for (k = 0; k < 3; ++k) {
-            id[k] = desc->indices[3 * t + k];
+            id[k] = indices[3 * t + k];
             if (id[k] >= (uint32_t)desc->vertex_count) {
                 rep->out_of_range_indices++;
                 bad = 1;
@@ -2927,6 +3184,14 @@ static const char fogvol__fs_common[] =
     "#endif\n";
 
 static const char fogvol__fs_encode[] =
+    "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
+    "uniform sampler2D fv_opaque;\n"
+    "uniform vec4 fv_nf;\n"
+    "void main() {\n"
+    "    float depth = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
+    "}\n"
+    "#else\n"
     "FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
     "#if defined(FV_WIDE)\n"
@@ -2941,7 +3206,8 @@ static const char fogvol__fs_encode[] =
     "#else\n"
     "    FV_FRAGCOLOR = fv_encode(fv_d);\n"
     "#endif\n"
-    "}\n";
+    "}\n"
+    "#endif\n";
 
 /* Volume faces. RGBA8: keep the lesser of face and opaque depth (PS 6 decoded
    compare, or PS 5 per-channel saturated compare on normalised digits), or
@@ -3099,7 +3365,10 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
                      FOGVOL_VARIANT_WIDE))
                    ? FOGVOL_ERROR_UNSUPPORTED
                    : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
+        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return FOGVOL_SUCCESS;
     case FOGVOL_TIER_MRT:
         if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
         return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
@@ -3206,7 +3475,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
     if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE)
+        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
+                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
                            ? fogvol__vs_fullscreen
                            : fogvol__vs_mesh;
     } else {
@@ -3238,26 +3508,35 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 
 /* MRT tier: the engine's copy of the ALU encode, dither pattern by arithmetic
    (the same 8x8 ordered pattern as fogvol_make_dither_index). */
-static const char fogvol__mrt_snippet[] =
-    "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n"
-    "vec4 fogvol_encode_view_depth(float view_depth) {\n"
-    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
-    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
-    "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
-    "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n"
-    "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n"
-    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n"
-    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n"
-    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n"
-    "    float t = u * fogvol_mrt[0].w * n;\n"
-    "    float h = floor(t / n);\n"
-    "    float x = mod(floor(t * dd), n * dd);\n"
-    "    float q = floor((x + k) / dd) - 1.0;\n"
-    "    float a = q < 0.0 ? 1.0 : 0.0;\n"
-    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n"
+#define FOGVOL__MRT_SNIPPET_TEXT \
+    "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
+    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n" \
+    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n" \
+    "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n" \
+    "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n" \
+    "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n" \
+    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n" \
+    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
+    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
+    "    float t = u * fogvol_mrt[0].w * n;\n" \
+    "    float h = floor(t / n);\n" \
+    "    float x = mod(floor(t * dd), n * dd);\n" \
+    "    float q = floor((x + k) / dd) - 1.0;\n" \
+    "    float a = q < 0.0 ? 1.0 : 0.0;\n" \
+    "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n" \
+    "}\n"
+static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
+/* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks the FLOAT tier's R32F target */
+static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
+    "vec4 fogvol_occluder_color(float view_depth) {\n"
+    "    if (fogvol_mrt[0].z == 0.0)\n"
+    "        return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
+    "    return fogvol_encode_view_depth(view_depth);\n"
     "}\n";
 
 FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
+FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_snippet; }
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
@@ -3309,7 +3588,11 @@ static fogvol_result fogvol__null_create_program(void *u, const fogvol_program_d
 }
 static fogvol_result fogvol__null_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
 {
-    (void)d;
+    /* the layout fields as fogvol_create_mesh hands them (FOGVOL_CAP_MESH_LAYOUT) */
+    if (!d->positions || d->stride < 0 || (d->stride && d->stride < 12) || d->offset < 0 ||
+        d->offset > (d->stride ? d->stride : 12) - 12 ||
+        (d->index_type == FOGVOL_INDEX_UINT16 ? !d->indices16 : d->index_type != FOGVOL_INDEX_UINT32 || !d->indices))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
     return fogvol__null_create(u, out);
 }
 static void fogvol__null_begin_pass(void *u, const fogvol_pass *p)
@@ -3367,7 +3650,7 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     state->stencil_bits = 8;
     table->user_data = state;
     table->dialect = FOGVOL_GLSL_330;
-    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
+    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT;
     table->begin_frame = fogvol__null_begin_frame;
     table->end_frame = fogvol__null_end_frame;
     table->create_texture = fogvol__null_create_texture;
@@ -3402,6 +3685,7 @@ struct fogvol_mesh {
 static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
 {
     size_t stride = desc->stride ? (size_t)desc->stride : 12u;
+    const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
     int i, c;
     for (c = 0; c < 3; ++c) {
         m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
@@ -3409,7 +3693,7 @@ static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
     }
     for (i = 0; i < desc->vertex_count; ++i) {
         float p[3];
-        memcpy(p, (const unsigned char *)desc->positions + (size_t)i * stride, sizeof p);
+        memcpy(p, base + (size_t)i * stride, sizeof p);
         for (c = 0; c < 3; ++c) {
             if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
             if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
@@ -3459,6 +3743,7 @@ struct fogvol_context {
     int msaa_warned;
     fogvol_handle prog_alt[FOGVOL_PROGRAM_COUNT]; /* the other set (single-sample or per-sample), 0 = not built */
     int in_frame, in_occluder_pass, mrt_ready;
+    int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
     double viewproj[16];
     double eyerow[4];  /* view depth e = dot(eyerow, (world position, 1)) */
@@ -3690,7 +3975,8 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
         pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
-    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[3] = pd.samplers[4] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[4] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) pd.samplers[3] = NULL;
     pd.label = labels[p];
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
@@ -3876,55 +4162,87 @@ FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
     return FOGVOL_SUCCESS;
 }
 
+/* Hands the mesh to the backend: the engine's layout as it is to backends with
+   FOGVOL_CAP_MESH_LAYOUT, else packed xyz and 32-bit indices (idx: the welded or
+   widened indices, NULL = desc->indices). */
+static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx,
+                                         fogvol_handle *out)
+{
+    fogvol_mesh_data md;
+    float *packed = NULL;
+    fogvol_result r;
+    int i, stride = desc->stride ? desc->stride : 12;
+    memset(&md, 0, sizeof md);
+    md.positions = desc->positions;
+    md.vertex_count = desc->vertex_count;
+    md.indices = idx ? idx : desc->indices;
+    md.index_count = desc->index_count;
+    if (ctx->be.caps & FOGVOL_CAP_MESH_LAYOUT) {
+        md.stride = stride;
+        md.offset = desc->offset;
+        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->weld_distance <= 0) { /* 16-bit as given */
+            md.index_type = FOGVOL_INDEX_UINT16;
+            md.indices16 = desc->indices16;
+            md.indices = NULL;
+        }
+    } else if (stride != 12 || desc->offset != 0) {
+        packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
+        if (!packed) return FOGVOL_ERROR_OUT_OF_MEMORY;
+        for (i = 0; i < desc->vertex_count; ++i)
+            memcpy(packed + 3 * i, (const unsigned char *)desc->positions + desc->offset + (size_t)i * stride, 12);
+        md.positions = packed;
+    }
+    r = ctx->be.create_mesh(ctx->be.user_data, &md, out);
+    fogvol__free(&ctx->alloc, packed);
+    return r;
+}
+
 FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
                                             fogvol_mesh_report *report)
 {
     fogvol_mesh_report rep;
-    fogvol_mesh_data md;
     fogvol_mesh *m;
-    float *packed = NULL;
+    uint32_t *idx = NULL;
     fogvol_result r;
-    int i;
+    const char *problem;
     if (out) *out = NULL;
     if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    r = fogvol_validate_mesh(desc, &ctx->alloc, &rep);
+    problem = fogvol__mesh_problem(desc);
+    r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
     if (report) *report = rep;
     if (r == FOGVOL_ERROR_INVALID_ARGUMENT || r == FOGVOL_ERROR_OUT_OF_MEMORY) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s", fogvol_result_string(r));
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s%s%s", fogvol_result_string(r),
+                    problem ? ": " : "", problem ? problem : "");
         return r;
     }
     if (rep.nonfinite_vertices || rep.out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: mesh rejected: %d open edges, %d non-manifold edges, %d inconsistent edges, "
-                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s",
+                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s%s",
                     rep.open_edges, rep.nonmanifold_edges, rep.inconsistent_edges, rep.flipped_faces,
                     rep.nonfinite_vertices, rep.out_of_range_indices,
-                    rep.inverted ? ", wound inward (reverse the triangles)" : "");
+                    rep.inverted ? ", wound inward (reverse the triangles)" : "",
+                    rep.open_edges && desc->weld_distance <= 0
+                        ? " (vertices repeated at seams or per face? set fogvol_mesh_desc.weld_distance)"
+                        : "");
+        fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_INVALID_MESH;
     }
     if (rep.degenerate_triangles)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh has %d degenerate triangles",
                     rep.degenerate_triangles);
+    if (rep.welded_vertices)
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
+                    desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    if (!m) {
+        fogvol__free(&ctx->alloc, idx);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc);
-    md.positions = desc->positions;
-    if (desc->stride && desc->stride != 12) {
-        packed = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 3u * (size_t)desc->vertex_count);
-        if (!packed) {
-            fogvol__free(&ctx->alloc, m);
-            return FOGVOL_ERROR_OUT_OF_MEMORY;
-        }
-        for (i = 0; i < desc->vertex_count; ++i)
-            memcpy(packed + 3 * i, (const unsigned char *)desc->positions + (size_t)i * desc->stride, 12);
-        md.positions = packed;
-    }
-    md.vertex_count = desc->vertex_count;
-    md.indices = desc->indices;
-    md.index_count = desc->index_count;
-    r = ctx->be.create_mesh(ctx->be.user_data, &md, &m->handle);
-    fogvol__free(&ctx->alloc, packed);
+    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
         fogvol__free(&ctx->alloc, m);
@@ -4026,6 +4344,7 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->in_frame = 0;
     ctx->nvol = ctx->nocc = 0;
+    ctx->engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -4197,6 +4516,10 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
                     d->draw_buffer, (int)d->alpha);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    if ((int)d->engine_depth_source < 0 || d->engine_depth_source > FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown engine_depth_source %d", (int)d->engine_depth_source);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     ctx->frame = *d;
     ctx->nvol = ctx->nocc = 0;
     ctx->in_frame = 1;
@@ -4229,6 +4552,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
     fogvol_result r;
     if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->engine_occluders) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
+                                                 "(fogvol_occluder_prepare): add_occluder refused");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
     if (!fogvol__finite_n(model, 16)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4251,6 +4579,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     fogvol_result r;
     if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->engine_occluders) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
+                                                 "(fogvol_occluder_prepare): add_occluder refused");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
     arr = ctx->occ;
     r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
     ctx->occ = (fogvol__occluder *)arr;
@@ -4689,6 +5022,52 @@ static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_
     ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
 }
 
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info)
+{
+    fogvol_frame_info fi;
+    fogvol_constants k;
+    fogvol_result r;
+    int fl;
+    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    fl = ctx->tier == FOGVOL_TIER_FLOAT;
+    if (!ctx->in_frame || ctx->nocc > 0 || !ctx->be.native_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
+                                                 "fogvol_add_occluder* calls and a backend with native_texture");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
+        fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need tier PS20 or FLOAT without the "
+                                                 "COUNT, WIDE and ENGINE_DEPTH variants (tier %s, variants 0x%x)%s",
+                    fogvol_tier_name(ctx->tier), ctx->variants,
+                    ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    r = fogvol__begin_backend_frame(ctx, &fi);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    if (r != FOGVOL_SUCCESS) return r;
+    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, &k);
+    info->texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    info->width = ctx->target_w;
+    info->height = ctx->target_h;
+    info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (fl) info->clear_color[0] = 1.0f;
+    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    info->uniforms[0] = k.near_far[0];
+    info->uniforms[1] = k.near_far[1];
+    info->uniforms[2] = fl ? 0.0f : (float)ctx->enc.levels;
+    info->uniforms[3] = fl ? 0.0f : (float)ctx->enc.levels * (float)ctx->enc.levels;
+    info->uniforms[4] = fl ? 0.0f : k.depth_offset;
+    info->uniforms[5] = fl ? 1.0f : k.depth_max;
+    info->uniforms[6] = (float)ctx->enc.dither_steps;
+    info->uniforms[7] = ctx->dither && !fl ? 1.0f : 0.0f;
+    ctx->engine_occluders = 1;
+    return FOGVOL_SUCCESS;
+}
+
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
 {
     fogvol_frame_stats st;
@@ -4700,6 +5079,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     int i, w, h, g, overflow = 0, captured = 0;
     int single, count, rgba8;
     unsigned char *peak = NULL;
+    uintptr_t engine_depth;
     memset(&st, 0, sizeof st);
     if (stats) *stats = st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4716,10 +5096,18 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && !fd->engine_depth_texture) {
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE &&
+        !fd->engine_depth_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
         fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE &&
+        !ctx->be.copy_depth) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
+                                                 "pass a depth texture (engine_depth_texture)");
+        fogvol_cancel_frame(ctx);
+        return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
     r = fogvol__begin_backend_frame(ctx, &info);
@@ -4731,6 +5119,17 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     if (r != FOGVOL_SUCCESS) goto done;
     r = fogvol__ensure_targets(ctx, w, h);
     if (r != FOGVOL_SUCCESS) goto done;
+    engine_depth = fd->engine_depth_texture;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
+        r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
+                               fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
+                               &engine_depth);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
+                        fogvol_result_string(r));
+            goto done;
+        }
+    }
 
     /* pass uniforms common to every pass */
     memset(&ps, 0, sizeof ps);
@@ -4766,17 +5165,20 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     fogvol__target_space(ctx, &ps);
 
     /* step b: opaque depth into O (MRT: the engine wrote it; ENGINE_DEPTH: its depth texture) */
-    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE)) {
+    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) && !ctx->engine_occluders) {
         ps.target = ctx->tgt_o;
         ps.clear = 1;
         if (rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
         else ps.clear_color[0] = 1.0f;
         ps.depth_test = ps.depth_write = 1;
         ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = engine_depth;
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         st.passes++;
         ctx->in_occluder_pass = 1;
-        for (i = 0; i < ctx->nocc; ++i) {
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) /* PS20: encode the engine's depth, full-screen */
+            ctx->be.draw_fullscreen(ctx->be.user_data);
+        for (i = 0; i < ctx->nocc && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH); ++i) {
             const fogvol__occluder *o = &ctx->occ[i];
             if (o->fn) {
                 o->fn(ctx, o->user_data);
@@ -4789,6 +5191,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         }
         ctx->in_occluder_pass = 0;
         fogvol__end_pass(ctx);
+        ps.native_textures[3] = 0;
     }
     ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
     ps.depth_write = 0;
@@ -4811,7 +5214,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
         ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
         ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = fd->engine_depth_texture;
+        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+            ps.native_textures[3] = engine_depth;
         else ps.textures[3] = ctx->tgt_o;
         ps.textures[4] = ctx->tgt_o2;
         if (ctx->tier == FOGVOL_TIER_FLOAT) {
@@ -4909,6 +5313,7 @@ done:
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     ctx->in_frame = 0;
     ctx->mrt_ready = 0;
+    ctx->engine_occluders = 0;
     ctx->nvol = ctx->nocc = 0;
     if (stats) *stats = st;
     return r;
@@ -5005,7 +5410,13 @@ enum {
     FOGVOL__GL_PRIMITIVE_RESTART = 0x8F9D, FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX = 0x8D69,
     FOGVOL__GL_DEPTH_CLAMP = 0x864F, FOGVOL__GL_SAMPLE_MASK = 0x8E51,
     FOGVOL__GL_POLYGON_SMOOTH = 0x0B41, FOGVOL__GL_POLYGON_STIPPLE = 0x0B42,
-    FOGVOL__GL_TRANSFORM_FEEDBACK_ACTIVE = 0x8E24, FOGVOL__GL_TRANSFORM_FEEDBACK_PAUSED = 0x8E23
+    FOGVOL__GL_TRANSFORM_FEEDBACK_ACTIVE = 0x8E24, FOGVOL__GL_TRANSFORM_FEEDBACK_PAUSED = 0x8E23,
+    FOGVOL__GL_DEPTH = 0x1801, FOGVOL__GL_DEPTH_COMPONENT = 0x1902, FOGVOL__GL_DEPTH_STENCIL = 0x84F9,
+    FOGVOL__GL_UNSIGNED_INT_24_8 = 0x84FA, FOGVOL__GL_DEPTH24_STENCIL8 = 0x88F0, FOGVOL__GL_DEPTH_COMPONENT32 = 0x81A7,
+    FOGVOL__GL_DEPTH_COMPONENT32F = 0x8CAC, FOGVOL__GL_DEPTH32F_STENCIL8 = 0x8CAD,
+    FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV = 0x8DAD, FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT = 0x821A,
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME = 0x8CD1, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216,
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE = 0x8211
 };
 /* Multisampled targets and per-sample shading. */
 enum {
@@ -5108,6 +5519,11 @@ enum {
     X(void, DeleteSamplers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, SamplerParameteri, (fogvol__GLuint, fogvol__GLenum, fogvol__GLint))
 
+/* Framebuffer blits: GL 3.0, GLES 3.0, ARB_framebuffer_object (the engine's depth buffer into a texture). */
+#define FOGVOL__GL_BLIT(X) \
+    X(void, BlitFramebuffer, (fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLint, \
+                              fogvol__GLint, fogvol__GLint, fogvol__GLint, fogvol__GLbitfield, fogvol__GLenum))
+
 /* GL 3.0 / GLES 3.0: extension strings one by one. */
 #define FOGVOL__GL_3(X) X(const fogvol__GLubyte *, GetStringi, (fogvol__GLenum, fogvol__GLuint))
 
@@ -5147,7 +5563,7 @@ enum {
 #define FOGVOL__GL_CLIP_CONTROL(X) X(void, ClipControl, (fogvol__GLenum, fogvol__GLenum))
 
 #define FOGVOL__GL_ALL(X) \
-    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_3(X) \
+    FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
             FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X)
 
@@ -5224,6 +5640,8 @@ typedef struct fogvol__gl_mesh {
     fogvol__GLuint vbo, ibo, vao;
     fogvol__GLsizei count;
     fogvol__GLenum index_type;
+    fogvol__GLsizei stride; /* the engine's vertex layout, read in place */
+    size_t offset;
 } fogvol__gl_mesh;
 
 typedef struct fogvol__gl {
@@ -5253,6 +5671,9 @@ typedef struct fogvol__gl {
     fogvol__gl_program *program;
     fogvol__gl_mesh fullscreen;
     fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
+    fogvol__GLuint depth_tex, depth_fbo; /* the engine's depth copied by copy_depth */
+    int depth_w, depth_h;
+    fogvol__GLenum depth_format;
 } fogvol__gl;
 
 static int fogvol__has_ext(const char *list, const char *name)
@@ -6091,25 +6512,34 @@ static void fogvol__gl_bind_mesh(fogvol__gl *gl, const fogvol__gl_mesh *m)
         gl->BindVertexArray(m->vao);
     } else {
         gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
-        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, m->stride, (const void *)m->offset);
         gl->EnableVertexAttribArray(0);
         gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
     }
 }
 
-static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const float *pos, int nv,
-                                       const uint32_t *idx, int ni)
+/* Uploads the vertex bytes as the engine laid them out (stride, offset) and
+   the indices (16-bit as given, or 32-bit narrowed to 16 where they fit). */
+static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const fogvol_mesh_data *d)
 {
     fogvol__gl_state s;
     fogvol_result r;
     void *tmp = NULL;
+    const uint32_t *idx = d->indices;
     const void *data = idx;
-    size_t isz = 4;
-    int i;
+    size_t isz = 4, vbytes;
+    int i, nv = d->vertex_count, ni = d->index_count;
     memset(m, 0, sizeof *m);
     m->count = ni;
     m->index_type = FOGVOL__GL_UNSIGNED_INT;
-    if (idx && nv <= 65535) { /* 16-bit indices where they fit (GLES2 needs them) */
+    m->stride = d->stride ? d->stride : 12;
+    m->offset = (size_t)d->offset;
+    vbytes = m->offset + (size_t)(nv - 1) * (size_t)m->stride + 12u;
+    if (d->index_type == FOGVOL_INDEX_UINT16) {
+        data = d->indices16;
+        isz = 2;
+        m->index_type = FOGVOL__GL_UNSIGNED_SHORT;
+    } else if (idx && nv <= 65535) { /* 16-bit indices where they fit (GLES2 needs them) */
         uint16_t *s16 = (uint16_t *)fogvol__alloc(&gl->alloc, sizeof(uint16_t) * (size_t)ni);
         if (!s16) return FOGVOL_ERROR_OUT_OF_MEMORY;
         for (i = 0; i < ni; ++i) s16[i] = (uint16_t)idx[i];
@@ -6129,16 +6559,15 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
     }
     gl->GenBuffers(1, &m->vbo);
     gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, m->vbo);
-    gl->BufferData(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLsizeiptr)(sizeof(float) * 3u * (size_t)nv), pos,
-                   FOGVOL__GL_STATIC_DRAW);
-    if (idx) {
+    gl->BufferData(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLsizeiptr)vbytes, d->positions, FOGVOL__GL_STATIC_DRAW);
+    if (data) {
         gl->GenBuffers(1, &m->ibo);
         gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, m->ibo);
         gl->BufferData(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLsizeiptr)(isz * (size_t)ni), data,
                        FOGVOL__GL_STATIC_DRAW);
     }
     if (gl->has_vao) {
-        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, 12, NULL);
+        gl->VertexAttribPointer(0, 3, FOGVOL__GL_FLOAT, 0, m->stride, (const void *)m->offset);
         gl->EnableVertexAttribArray(0);
     }
     r = fogvol__gl_check(gl, "create_mesh");
@@ -6172,7 +6601,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     *out = 0;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    r = fogvol__gl_upload(gl, m, d->positions, d->vertex_count, d->indices, d->index_count);
+    r = fogvol__gl_upload(gl, m, d);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&gl->alloc, m);
         return r;
@@ -6336,6 +6765,113 @@ static void fogvol__gl_draw_fullscreen(void *u)
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
 
+/* The depth texture format that blits from the read framebuffer's depth
+   buffer (same depth bits and type, with the stencil of a packed buffer);
+   0 when there is no depth buffer or no such texture format. */
+static fogvol__GLenum fogvol__gl_depth_format(fogvol__gl *gl, int default_fb)
+{
+    fogvol__GLint type = 0, bits = 0, stencil = 0, ctype = 0, dname = 0, sname = 0, stype = 0;
+    fogvol__GLenum datt = default_fb ? FOGVOL__GL_DEPTH : FOGVOL__GL_DEPTH_ATTACHMENT;
+    fogvol__GLenum satt = default_fb ? FOGVOL__GL_STENCIL : FOGVOL__GL_STENCIL_ATTACHMENT;
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+    if (type == FOGVOL__GL_NONE) return 0;
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE, &bits);
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &ctype);
+    gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                            FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &stype);
+    if (stype != FOGVOL__GL_NONE) {
+        gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE, &stencil);
+        if (!default_fb) { /* a separate stencil buffer is not part of the depth format */
+            gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, datt,
+                                                    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &dname);
+            gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_READ_FRAMEBUFFER, satt,
+                                                    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &sname);
+            if (dname != sname || type != stype) stencil = 0;
+        }
+    }
+    if (ctype == FOGVOL__GL_FLOAT)
+        return bits != 32 ? 0 : stencil ? FOGVOL__GL_DEPTH32F_STENCIL8 : FOGVOL__GL_DEPTH_COMPONENT32F;
+    if (stencil) return bits == 24 ? FOGVOL__GL_DEPTH24_STENCIL8 : 0;
+    if (bits == 16) return FOGVOL__GL_DEPTH_COMPONENT16;
+    if (bits == 24) return FOGVOL__GL_DEPTH_COMPONENT24;
+    return bits == 32 && !gl->gles ? FOGVOL__GL_DEPTH_COMPONENT32 : 0;
+}
+
+/* (Re)creates the copy texture and its framebuffer for a format and size. */
+static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h)
+{
+    static const fogvol__GLenum none = FOGVOL__GL_NONE;
+    int packed = format == FOGVOL__GL_DEPTH24_STENCIL8 || format == FOGVOL__GL_DEPTH32F_STENCIL8;
+    fogvol__GLenum type = format == FOGVOL__GL_DEPTH_COMPONENT16 ? FOGVOL__GL_UNSIGNED_SHORT
+                          : format == FOGVOL__GL_DEPTH24_STENCIL8 ? FOGVOL__GL_UNSIGNED_INT_24_8
+                          : format == FOGVOL__GL_DEPTH32F_STENCIL8 ? FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV
+                          : format == FOGVOL__GL_DEPTH_COMPONENT32F ? FOGVOL__GL_FLOAT
+                                                                    : FOGVOL__GL_UNSIGNED_INT;
+    if (gl->depth_tex && gl->depth_format == format && gl->depth_w == w && gl->depth_h == h) return;
+    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    gl->GenTextures(1, &gl->depth_tex);
+    gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, gl->depth_tex);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, (fogvol__GLint)format, w, h, 0,
+                   packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    gl->GenFramebuffers(1, &gl->depth_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_DRAW_FRAMEBUFFER,
+                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT,
+                             FOGVOL__GL_TEXTURE_2D, gl->depth_tex, 0);
+    gl->DrawBuffers(1, &none); /* depth only (framebuffer state of our own FBO) */
+    gl->depth_format = format;
+    gl->depth_w = w;
+    gl->depth_h = h;
+}
+
+static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int bound, const int rect[4],
+                                           uintptr_t *texture)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
+    fogvol__GLenum format;
+    fogvol_result r;
+    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3];
+    *texture = 0;
+    if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copying a depth buffer needs glBlitFramebuffer "
+                                                "(GL 3.0, GLES 3.0 or ARB_framebuffer_object)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (rect[0] < 0 || rect[1] < 0) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth: viewport origin (%d, %d) is negative", rect[0],
+                    rect[1]);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    gl->GetError();
+    gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
+    format = fogvol__gl_depth_format(gl, src == 0);
+    if (!format) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR,
+                    "fogvol: framebuffer %u has no depth buffer, or one whose format no depth texture matches", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_depth_target(gl, format, x1, y1);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
+    /* the same rectangle on both sides: required to resolve a multisampled source */
+    gl->BlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, FOGVOL__GL_DEPTH_BUFFER_BIT,
+                        FOGVOL__GL_NEAREST);
+    gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)gl->saved.read_fbo);
+    r = fogvol__gl_check(gl, "copy_depth (glBlitFramebuffer of the engine's depth)");
+    if (r == FOGVOL_SUCCESS) *texture = gl->depth_tex;
+    return r;
+}
+
 static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned char *rgba, size_t size)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -6365,6 +6901,8 @@ static void fogvol__gl_destroy(void *u)
     if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     if (gl->err_shader) gl->DeleteShader(gl->err_shader);
     if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
+    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -6455,6 +6993,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
                                                   const fogvol_logger *logger, fogvol_backend *out)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
+    fogvol_mesh_data tri_data;
     fogvol__gl *gl;
     fogvol_logger silent;
     const char *ver, *ext = NULL;
@@ -6557,6 +7096,9 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_SAMPLER(FOGVOL__GL_LOAD)
         FOGVOL__GL_SAMPLER(FOGVOL__GL_REQUIRE)
     }
+    if (gl->major >= 3 || (!gl->gles && fogvol__has_ext(ext, "GL_ARB_framebuffer_object"))) {
+        FOGVOL__GL_BLIT(FOGVOL__GL_LOAD) /* optional: without it copy_depth refuses */
+    }
     if (gl->major >= 3) {
         FOGVOL__GL_3(FOGVOL__GL_LOAD)
         FOGVOL__GL_3(FOGVOL__GL_REQUIRE)
@@ -6621,7 +7163,10 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
-    r = fogvol__gl_upload(gl, &gl->fullscreen, tri, 3, NULL, 0);
+    memset(&tri_data, 0, sizeof tri_data);
+    tri_data.positions = tri;
+    tri_data.vertex_count = 3;
+    r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
     if (r != FOGVOL_SUCCESS) {
         if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
         fogvol__free(alloc, gl);
@@ -6632,9 +7177,10 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
     out->user_data = gl;
     out->dialect = gl->dialect;
-    out->caps = gl->caps;
+    out->caps = gl->caps | FOGVOL_CAP_MESH_LAYOUT;
     out->native_texture = fogvol__gl_native_texture;
     out->target_attachment = fogvol__gl_target_attachment;
+    out->copy_depth = fogvol__gl_copy_depth;
     out->begin_frame = fogvol__gl_begin_frame;
     out->end_frame = fogvol__gl_end_frame;
     out->create_texture = fogvol__gl_create_texture;
