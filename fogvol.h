@@ -415,6 +415,13 @@ typedef struct fogvol_mesh_report {
     int closed;                /* no open and no non-manifold edges */
     int consistent;            /* no inconsistent edge, no flipped face */
     int inverted;              /* closed, consistent, but wound inward (volume < 0) */
+    int inward_components;     /* components whose own signed volume is negative: harmless inside
+                                  another part (a cavity), refused where nothing encloses them */
+    int negative_winding;      /* probes that found a region of negative winding number (entered fewer
+                                  times than left): a part wound inward that no other part encloses,
+                                  or an inverted lobe of a self-intersecting hull; it would render
+                                  negative thickness and subtract from its ramp's other volumes */
+    int negative_triangle;     /* a triangle bounding such a region (index / 3 into the indices), -1: none */
     int valid;                 /* usable as a fog volume */
     int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
                                   vertices counts the rest */
@@ -1944,6 +1951,249 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
     return fogvol__check_mesh(desc, alloc, rep, NULL);
 }
 
+/* ---- winding number: parts wound inward that nothing encloses ----
+   A closed, consistent hull renders sum(back) - sum(front) = the length of the
+   ray inside, counted with the winding number of each stretch (entered minus
+   left). Regions of winding 1 (or more, overlaps) are fog; a region of negative
+   winding renders negative thickness. Two probes find such regions: a point
+   just inside every component wound inward (an enclosed cavity has winding 0
+   there, an exposed inward part -1), and a grid of rays along each axis whose
+   running winding must never drop below 0 (inverted lobes of self-intersecting
+   hulls). Rays that touch an edge or a vertex exactly are skipped. */
+typedef struct fogvol__wind {
+    const unsigned char *base;
+    int stride;
+    const uint32_t *idx;
+    int ntri;
+    const unsigned char *ok; /* 2: a triangle with area and finite corners */
+} fogvol__wind;
+
+#define FOGVOL__WIND_GRID 32
+
+static void fogvol__wind_tri(const fogvol__wind *w, int t, double p[3][3])
+{
+    int k, c;
+    float v[3];
+    for (k = 0; k < 3; ++k) {
+        memcpy(v, w->base + (size_t)w->idx[3 * t + k] * (size_t)w->stride, sizeof v);
+        for (c = 0; c < 3; ++c) p[k][c] = v[c];
+    }
+}
+
+/* Winding number at q: signed crossings of the ray q + s d (s > 0), +1 where it
+   leaves through a face (normal along d). Returns 0 when the ray touches an edge. */
+static int fogvol__winding_at(const fogvol__wind *w, const double q[3], const double d[3], int *wind)
+{
+    int t, k, n = 0;
+    for (t = 0; t < w->ntri; ++t) {
+        double p[3][3], e1[3], e2[3], h[3], s[3], qq[3], det, u, v, dist;
+        if (w->ok[t] != 2) continue;
+        fogvol__wind_tri(w, t, p);
+        for (k = 0; k < 3; ++k) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+            s[k] = q[k] - p[0][k];
+        }
+        h[0] = d[1] * e2[2] - d[2] * e2[1];
+        h[1] = d[2] * e2[0] - d[0] * e2[2];
+        h[2] = d[0] * e2[1] - d[1] * e2[0];
+        det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+        if (det == 0.0) continue; /* parallel to the ray */
+        u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / det;
+        qq[0] = s[1] * e1[2] - s[2] * e1[1];
+        qq[1] = s[2] * e1[0] - s[0] * e1[2];
+        qq[2] = s[0] * e1[1] - s[1] * e1[0];
+        v = (d[0] * qq[0] + d[1] * qq[1] + d[2] * qq[2]) / det;
+        dist = (e2[0] * qq[0] + e2[1] * qq[1] + e2[2] * qq[2]) / det;
+        if (dist <= 0.0 || u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+        if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9) return 0;
+        /* det = (e1 x e2) . d: > 0 when the face normal points along d (leaving) */
+        n += det > 0.0 ? 1 : -1;
+    }
+    *wind = n;
+    return 1;
+}
+
+/* Per component: its signed volume; a component wound inward is probed just
+   inside its largest triangle. */
+static fogvol_result fogvol__component_winding(const fogvol__wind *w, uint32_t *parent, unsigned char *parity,
+                                               double *tvol, fogvol_mesh_report *rep)
+{
+    static const double dirs[3][3] = {{0.5773, 0.5801, 0.5748}, {-0.3313, 0.8412, 0.4271}, {0.7071, -0.2093, -0.6753}};
+    double *cvol = tvol + w->ntri;
+    int t, k, c;
+    for (t = 0; t < w->ntri; ++t) cvol[t] = 0.0;
+    for (t = 0; t < w->ntri; ++t)
+        if (w->ok[t] == 2) cvol[fogvol__uf_find(parent, parity, (uint32_t)t)] += tvol[t];
+    for (t = 0; t < w->ntri; ++t) {
+        double p[3][3], n[3], q[3], len, best = -1.0;
+        int r, bt = -1, wind = 0, tries;
+        if (!(cvol[t] < 0.0)) continue;
+        rep->inward_components++;
+        for (r = 0; r < w->ntri; ++r) { /* the component's largest triangle */
+            if (w->ok[r] != 2 || fogvol__uf_find(parent, parity, (uint32_t)r) != (uint32_t)t) continue;
+            if (-tvol[r] > best || bt < 0) {
+                fogvol__wind_tri(w, r, p);
+                n[0] = (p[1][1] - p[0][1]) * (p[2][2] - p[0][2]) - (p[1][2] - p[0][2]) * (p[2][1] - p[0][1]);
+                n[1] = (p[1][2] - p[0][2]) * (p[2][0] - p[0][0]) - (p[1][0] - p[0][0]) * (p[2][2] - p[0][2]);
+                n[2] = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+                len = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+                if (len > best) {
+                    best = len;
+                    bt = r;
+                }
+            }
+        }
+        if (bt < 0) continue;
+        fogvol__wind_tri(w, bt, p);
+        n[0] = (p[1][1] - p[0][1]) * (p[2][2] - p[0][2]) - (p[1][2] - p[0][2]) * (p[2][1] - p[0][1]);
+        n[1] = (p[1][2] - p[0][2]) * (p[2][0] - p[0][0]) - (p[1][0] - p[0][0]) * (p[2][2] - p[0][2]);
+        n[2] = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+        len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        /* a point 1e-4 of the triangle's size in front of it: on the side its normal names */
+        for (c = 0; c < 3; ++c) q[c] = (p[0][c] + p[1][c] + p[2][c]) / 3.0 + n[c] / len * 1e-4 * FOGVOL_SQRT(len);
+        for (tries = 0, k = 0; k < 3 && !tries; ++k) tries = fogvol__winding_at(w, q, dirs[k], &wind);
+        if (tries && wind < 0) {
+            rep->negative_winding++;
+            if (rep->negative_triangle < 0) rep->negative_triangle = bt;
+        }
+    }
+    return FOGVOL_SUCCESS;
+}
+
+typedef struct fogvol__xing {
+    double t;
+    int sign; /* +1 entering, -1 leaving, travelling along +axis */
+    int tri;
+} fogvol__xing;
+
+/* Crossings of the triangle with the grid rays of axis a: counted (xs NULL) or stored. */
+static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const double step[3], int tri,
+                             uint32_t *count, unsigned char *skip, fogvol__xing *xs, const uint32_t *start)
+{
+    int u = (a + 1) % 3, v = (a + 2) % 3, i, j, i0, i1, j0, j1, k;
+    double area = (p[1][u] - p[0][u]) * (p[2][v] - p[0][v]) - (p[2][u] - p[0][u]) * (p[1][v] - p[0][v]);
+    double umin = p[0][u], umax = p[0][u], vmin = p[0][v], vmax = p[0][v];
+    const double off = 0.5123;
+    if (area == 0.0) return;
+    for (k = 1; k < 3; ++k) {
+        if (p[k][u] < umin) umin = p[k][u];
+        if (p[k][u] > umax) umax = p[k][u];
+        if (p[k][v] < vmin) vmin = p[k][v];
+        if (p[k][v] > vmax) vmax = p[k][v];
+    }
+    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - off);
+    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - off) + 1;
+    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - off);
+    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - off) + 1;
+    if (i0 < 0) i0 = 0;
+    if (j0 < 0) j0 = 0;
+    if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
+    if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
+    for (j = j0; j <= j1; ++j)
+        for (i = i0; i <= i1; ++i) {
+            double qu = lo[u] + (i + off) * step[u], qv = lo[v] + (j + off) * step[v], e[3];
+            int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
+            for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
+                const double *p0 = p[k], *p1 = p[(k + 1) % 3];
+                e[k] = ((p1[u] - p0[u]) * (qv - p0[v]) - (p1[v] - p0[v]) * (qu - p0[u])) * (area > 0 ? 1 : -1);
+            }
+            if (e[0] < 0 || e[1] < 0 || e[2] < 0) continue;
+            if (e[0] == 0 || e[1] == 0 || e[2] == 0) { /* on an edge: this ray cannot be trusted */
+                skip[ray] = 1;
+                continue;
+            }
+            if (!xs) {
+                count[ray]++;
+            } else {
+                fogvol__xing *x = &xs[start[ray] + count[ray]++];
+                double s = e[0] + e[1] + e[2]; /* = |area| */
+                x->t = (e[1] * p[0][a] + e[2] * p[1][a] + e[0] * p[2][a]) / s;
+                x->sign = area > 0 ? -1 : 1;
+                x->tri = tri;
+            }
+        }
+}
+
+static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_allocator *alloc,
+                                          fogvol_mesh_report *rep)
+{
+    enum { NR = 3 * FOGVOL__WIND_GRID * FOGVOL__WIND_GRID };
+    double lo[3], hi[3], step[3], p[3][3];
+    uint32_t *count, *start, total = 0;
+    unsigned char *skip;
+    fogvol__xing *xs = NULL;
+    int t, a, c, k, r, first = 1;
+    for (t = 0; t < w->ntri; ++t) {
+        if (w->ok[t] != 2) continue;
+        fogvol__wind_tri(w, t, p);
+        if (first)
+            for (c = 0; c < 3; ++c) lo[c] = hi[c] = p[0][c];
+        first = 0;
+        for (k = 0; k < 3; ++k)
+            for (c = 0; c < 3; ++c) {
+                if (p[k][c] < lo[c]) lo[c] = p[k][c];
+                if (p[k][c] > hi[c]) hi[c] = p[k][c];
+            }
+    }
+    if (first) return FOGVOL_SUCCESS;
+    for (c = 0; c < 3; ++c) step[c] = (hi[c] - lo[c]) / FOGVOL__WIND_GRID;
+    if (!(step[0] > 0 && step[1] > 0 && step[2] > 0)) return FOGVOL_SUCCESS; /* flat: nothing enclosed */
+    count = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * 2u * NR);
+    skip = (unsigned char *)fogvol__alloc(alloc, NR);
+    if (!count || !skip) {
+        fogvol__free(alloc, count);
+        fogvol__free(alloc, skip);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    start = count + NR;
+    memset(count, 0, sizeof(uint32_t) * NR);
+    memset(skip, 0, NR);
+    for (t = 0; t < w->ntri; ++t)
+        if (w->ok[t] == 2) {
+            fogvol__wind_tri(w, t, p);
+            for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, NULL, NULL);
+        }
+    for (r = 0; r < NR; ++r) {
+        start[r] = total;
+        total += count[r];
+        count[r] = 0;
+    }
+    if (total) xs = (fogvol__xing *)fogvol__alloc(alloc, sizeof(fogvol__xing) * total);
+    if (total && !xs) {
+        fogvol__free(alloc, count);
+        fogvol__free(alloc, skip);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    for (t = 0; t < w->ntri; ++t)
+        if (w->ok[t] == 2) {
+            fogvol__wind_tri(w, t, p);
+            for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, xs, start);
+        }
+    for (r = 0; r < NR; ++r) {
+        fogvol__xing *x = xs + start[r];
+        int n = (int)count[r], i, j, sum = 0;
+        if (skip[r] || n == 0) continue;
+        for (i = 1; i < n; ++i) { /* insertion sort by t, entries first at equal t */
+            fogvol__xing v = x[i];
+            for (j = i - 1; j >= 0 && (x[j].t > v.t || (x[j].t == v.t && x[j].sign < v.sign)); --j) x[j + 1] = x[j];
+            x[j + 1] = v;
+        }
+        for (i = 0; i < n; ++i) {
+            sum += x[i].sign;
+            if (sum < 0) {
+                rep->negative_winding++;
+                if (rep->negative_triangle < 0) rep->negative_triangle = x[i].tri;
+                break;
+            }
+        }
+    }
+    fogvol__free(alloc, xs);
+    fogvol__free(alloc, count);
+    fogvol__free(alloc, skip);
+    return FOGVOL_SUCCESS;
+}
+
 /* The topology and geometry checks on 32-bit indices (layout already checked). */
 static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
                                       const fogvol_allocator *alloc, fogvol_mesh_report *rep)
@@ -1954,7 +2204,8 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     uint32_t *parent = NULL, *cnt = NULL;
     unsigned char *parity = NULL, *usable = NULL, *vbad = NULL;
     const unsigned char *base;
-    double vol = 0;
+    double vol = 0, *tvol = NULL;
+    fogvol_result wr = FOGVOL_SUCCESS;
     stride = desc->stride ? desc->stride : 12;
     base = (const unsigned char *)desc->positions + desc->offset;
     ntri = desc->index_count / 3;
@@ -1968,7 +2219,9 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     parity = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
     usable = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
     vbad = (unsigned char *)fogvol__alloc(alloc, (size_t)desc->vertex_count);
-    if (!edges || !tmp || !parent || !cnt || !parity || !usable || !vbad) {
+    tvol = (double *)fogvol__alloc(alloc, sizeof(double) * 2u * (size_t)ntri);
+    if (!edges || !tmp || !parent || !cnt || !parity || !usable || !vbad || !tvol) {
+        fogvol__free(alloc, tvol);
         fogvol__free(alloc, edges);
         fogvol__free(alloc, tmp);
         fogvol__free(alloc, parent);
@@ -1992,6 +2245,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
         parent[t] = (uint32_t)t;
         parity[t] = 0;
         usable[t] = 0;
+        tvol[t] = 0.0;
         for (k = 0; k < 3; ++k) {
             id[k] = indices[3 * t + k];
             if (id[k] >= (uint32_t)desc->vertex_count) {
@@ -2027,7 +2281,9 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
             if (l3 > l1) l1 = l3;
             /* area below 1e-6 of the longest edge squared: a sliver that rasterises to nothing */
             if (len2 <= 1e-12 * l1 * l1) rep->degenerate_triangles++;
-            vol += (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
+            tvol[t] = (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
+            vol += tvol[t];
+            usable[t] = 2; /* with finite corners: takes part in the winding checks */
         }
         for (k = 0; k < 3; ++k) {
             uint32_t u = id[k], v = id[(k + 1) % 3];
@@ -2076,9 +2332,21 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     rep->closed = rep->open_edges == 0 && rep->nonmanifold_edges == 0;
     rep->consistent = rep->inconsistent_edges == 0 && rep->flipped_faces == 0;
     rep->inverted = rep->closed && rep->consistent && vol < 0;
+    rep->negative_triangle = -1;
+    if (rep->closed && rep->consistent && rep->nonfinite_vertices == 0 && rep->out_of_range_indices == 0) {
+        fogvol__wind wd;
+        wd.base = base;
+        wd.stride = stride;
+        wd.idx = indices;
+        wd.ntri = ntri;
+        wd.ok = usable;
+        wr = fogvol__component_winding(&wd, parent, parity, tvol, rep);
+        if (wr == FOGVOL_SUCCESS) wr = fogvol__grid_winding(&wd, alloc, rep);
+    }
     rep->valid = rep->closed && rep->consistent && !rep->inverted && rep->nonfinite_vertices == 0 &&
-                 rep->out_of_range_indices == 0 && vol > 0;
+                 rep->out_of_range_indices == 0 && vol > 0 && rep->negative_winding == 0;
 
+    fogvol__free(alloc, tvol);
     fogvol__free(alloc, edges);
     fogvol__free(alloc, tmp);
     fogvol__free(alloc, parent);
@@ -2086,6 +2354,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     fogvol__free(alloc, parity);
     fogvol__free(alloc, usable);
     fogvol__free(alloc, vbad);
+    if (wr != FOGVOL_SUCCESS) return wr;
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
 }
 
@@ -4218,9 +4487,10 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     if (rep.nonfinite_vertices || rep.out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: mesh rejected: %d open edges, %d non-manifold edges, %d inconsistent edges, "
-                    "%d flipped faces, %d non-finite vertices, %d indices out of range%s%s",
+                    "%d flipped faces, %d non-finite vertices, %d indices out of range, %d probes in regions of "
+                    "negative winding (a part wound inward that nothing encloses: triangle %d)%s%s",
                     rep.open_edges, rep.nonmanifold_edges, rep.inconsistent_edges, rep.flipped_faces,
-                    rep.nonfinite_vertices, rep.out_of_range_indices,
+                    rep.nonfinite_vertices, rep.out_of_range_indices, rep.negative_winding, rep.negative_triangle,
                     rep.inverted ? ", wound inward (reverse the triangles)" : "",
                     rep.open_edges && desc->weld_distance <= 0
                         ? " (vertices repeated at seams or per face? set fogvol_mesh_desc.weld_distance)"

@@ -36,6 +36,7 @@ extern "C" { /* cmocka 1.1.5's header has no C++ guards of its own */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "../fogvol.h"
+#include "shapes.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -1527,6 +1528,90 @@ static void ta_free(void *p, void *ud)
     free(p);
 }
 
+static fogvol_result validate_shp(const shp_mesh *m, fogvol_mesh_report *rep)
+{
+    return validate(m->pos, m->vcount, (const uint32_t *)m->idx, m->icount, rep);
+}
+
+/* A prism over a self-intersecting "bowtie" polygon: (-3,-1.5) (2,1) (2,-1) (-3,1.5), z in [0,1].
+   Its diagonals cross at the origin; the left lobe (area 4.5) is wound outward, the right lobe
+   (area 2) inward: closed, consistent, one component, total volume 2.5 > 0, and yet the right lobe
+   has winding number -1 (worked out by hand from the polygon's orientation). */
+static shp_mesh bowtie_prism(void)
+{
+    static const float xy[4][2] = {{-3.0f, -1.5f}, {2.0f, 1.0f}, {2.0f, -1.0f}, {-3.0f, 1.5f}};
+    shp_mesh m = shp__alloc(8, 24 + 12);
+    unsigned *p = m.idx;
+    int i;
+    for (i = 0; i < 4; ++i) {
+        shp__setv(&m, i, xy[i][0], xy[i][1], 0.0);
+        shp__setv(&m, 4 + i, xy[i][0], xy[i][1], 1.0);
+    }
+    for (i = 0; i < 4; ++i) shp__quad(&p, i, (i + 1) % 4, 4 + (i + 1) % 4, 4 + i); /* sides */
+    shp__tri(&p, 0, 2, 1); /* bottom, facing -z where the polygon runs counter-clockwise */
+    shp__tri(&p, 0, 3, 2);
+    shp__tri(&p, 4, 5, 6); /* top */
+    shp__tri(&p, 4, 6, 7);
+    return m;
+}
+
+/* Issue: one component wound inward, or an inverted lobe, while the total volume is positive.
+   The decision is per region (winding number), never by the total: a cavity (an inward shell
+   inside an outward one) is a valid volume, an inward part that nothing encloses is not. */
+static void test_mesh_winding(void **state)
+{
+    fogvol_mesh_report rep;
+    shp_mesh outer = shp_sphere(1.0f, 32, 16), inner = shp_sphere(0.5f, 32, 16), away = shp_sphere(0.5f, 32, 16);
+    shp_mesh hollow = shp__zero(), apart = shp__zero(), bow = bowtie_prism(), good = bowtie_prism();
+    float mv[16];
+    int outer_tris = outer.icount / 3;
+    (void)state;
+    assert_non_null(outer.pos);
+    /* hollow ball: outer outward, inner (radius 0.5) inward, inside it */
+    shp_flip(&inner);
+    assert_true(shp_append(&hollow, &outer));
+    assert_true(shp_append(&hollow, &inner));
+    assert_int_equal(validate_shp(&hollow, &rep), FOGVOL_SUCCESS);
+    assert_int_equal(rep.components, 2);
+    assert_int_equal(rep.inward_components, 1);
+    assert_int_equal(rep.negative_winding, 0);
+    assert_int_equal(rep.negative_triangle, -1);
+    assert_true(rep.valid);
+    /* the same inward sphere moved out of the ball (centre x = 3): total volume still positive
+       (4.19 - 0.52), but the small sphere renders negative thickness */
+    shp_flip(&away);
+    shp_mat_translate(mv, 3.0f, 0.0f, 0.0f);
+    shp_transform(&away, mv);
+    assert_true(shp_append(&apart, &outer));
+    assert_true(shp_append(&apart, &away));
+    assert_int_equal(validate_shp(&apart, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_true(rep.closed && rep.consistent && !rep.inverted && rep.volume > 3.0);
+    assert_int_equal(rep.inward_components, 1);
+    assert_true(rep.negative_winding > 0);
+    assert_true(rep.negative_triangle >= outer_tris); /* a triangle of the moved sphere */
+    assert_false(rep.valid);
+    /* the bowtie prism: one component, positive total, an inverted lobe */
+    assert_int_equal(validate_shp(&bow, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_true(rep.closed && rep.consistent);
+    assert_int_equal(rep.components, 1);
+    assert_int_equal(rep.inward_components, 0);
+    assert_true(fabs(rep.volume - 2.5) < 1e-6);
+    assert_true(rep.negative_winding > 0);
+    assert_true(rep.negative_triangle >= 0 && rep.negative_triangle < 12);
+    /* moving the crossing out of the polygon (a plain quadrilateral) makes it valid */
+    good.pos[3 * 1 + 1] = good.pos[3 * 5 + 1] = -1.0f; /* (2,1) -> (2,-1) and (2,-1) -> (2,1) */
+    good.pos[3 * 2 + 1] = good.pos[3 * 6 + 1] = 1.0f;
+    assert_int_equal(validate_shp(&good, &rep), FOGVOL_SUCCESS);
+    assert_int_equal(rep.negative_winding, 0);
+    shp_free(&outer);
+    shp_free(&inner);
+    shp_free(&away);
+    shp_free(&hollow);
+    shp_free(&apart);
+    shp_free(&bow);
+    shp_free(&good);
+}
+
 static void test_mesh_alloc_and_stride(void **state)
 {
     fogvol_mesh_report rep;
@@ -1632,6 +1717,7 @@ int main(void)
         cmocka_unit_test(test_mesh_cube),
         cmocka_unit_test(test_mesh_nonmanifold),
         cmocka_unit_test(test_mesh_torus),
+        cmocka_unit_test(test_mesh_winding),
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
     };
