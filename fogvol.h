@@ -484,7 +484,9 @@ enum {
     /* PS20/PS13: Baker's inside/outside count in alpha instead of the min
        compare: faces are depth-tested against the opaque depth, and the
        opaque depth is added once per missing back face. The camera must be
-       outside the volumes (or combine with NEAR_CLAMP). */
+       outside the volumes, and the near plane must not cut them: fogvol_end_frame
+       checks each volume's bounds and refuses such a frame
+       (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). */
     FOGVOL_VARIANT_COUNT = 1u << 1,
     /* PS20/MRT: RGB-encode by arithmetic in the fragment shader instead of
        ramp textures ("newer hardware can calculate the ramp values"). Same bytes. */
@@ -5338,6 +5340,34 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     return FOGVOL_SUCCESS;
 }
 
+/* COUNT adds the opaque depth once per back face without its front face, so it
+   needs every front face in front of the near plane: a volume that the near
+   plane may cut (the camera inside it or within znear of it) breaks the count.
+   Decided conservatively from the view depths of the corners of each volume's
+   bounds: some corner nearer than znear and some in front of the eye. Returns
+   the first such volume, or -1. */
+static int fogvol__count_near_cut(const fogvol_context *ctx)
+{
+    int i, c, j;
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        double emin = 0.0, emax = 0.0;
+        for (c = 0; c < 8; ++c) {
+            double p[3], e = ctx->eyerow[3];
+            p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
+            p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
+            p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
+            for (j = 0; j < 3; ++j)
+                e += ctx->eyerow[j] *
+                     (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
+            if (c == 0 || e < emin) emin = e;
+            if (c == 0 || e > emax) emax = e;
+        }
+        if (emin < ctx->frame.znear && emax > 0.0) return i;
+    }
+    return -1;
+}
+
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
 {
     fogvol_frame_stats st;
@@ -5376,6 +5406,14 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         !ctx->be.copy_depth) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
                                                  "pass a depth texture (engine_depth_texture)");
+        fogvol_cancel_frame(ctx);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (count && (i = fogvol__count_near_cut(ctx)) >= 0) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: COUNT variant: the near plane may cut volume %d (the camera is inside it or closer than "
+                    "znear), which breaks the face count; nothing drawn. Draw such views without COUNT",
+                    i);
         fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
