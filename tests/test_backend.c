@@ -1260,6 +1260,7 @@ static void test_a3_destroy_inside_frame(void **state)
     fogvol_destroy_mesh(fv, m[0]);
     fogvol_destroy_ramp(fv, fog);
     fogvol_destroy_context(fv);
+    shp_free(&box);
     assert_int_equal(r.nb.creates, r.nb.destroys);
 }
 
