@@ -3,9 +3,11 @@
    backend's occlusion queries (no read-back, read a frame or more later,
    never waiting) matches the debug read-back; the policies react to it.
 
-   Scenes: k concentric spheres (radius 0.2 + 0.025 i) seen from 8.6 units
-   away, so the depths sit at d = 0.78..0.92 of the range and the channel sums
-   are large. At L = 4 a target sums 16 faces (SINGLE_TARGET 8): 12 shells fit
+   Scenes: k concentric spheres in four groups (radius 0.25 + 0.2 g + 0.004 j:
+   the silhouettes of a group lie within about a pixel, so the rings between
+   them are interior pixels crossing k/4, k/2, 3k/4 and k shells) seen from 8.6
+   units away, so the depths sit at d = 0.75..0.95 of the range and the channel
+   sums are large (and from 5 units, d = 0.37..0.58). At L = 4 a target sums 16 faces (SINGLE_TARGET 8): 12 shells fit
    two targets but not one, 20 fit neither. WIDE (L = 3) sums 32: 24 and 40.
    Ground truth: the thickness ray-cast from the very triangles
    (tests/raycast.h: exact ray/triangle chords of the drawn shells). A pixel is
@@ -66,15 +68,15 @@ static void (*watch_proc(const char *name, void *user))(void)
 }
 
 /* ---- the shells ----------------------------------------------------------- */
-static tscene *shell_scene(int k)
+static tscene *shell_scene(int k, int near)
 {
     float m[16];
     int i;
-    tscene *s = new_scene("shells", 0.04, 0.03, 8.6, 0, 0, 0, 0.5, 10);
-    s->cam.fovy_deg = 11.0;
+    tscene *s = new_scene("shells", 0.04, 0.03, near ? 5.0 : 8.6, 0, 0, 0, 0.5, 10);
+    s->cam.fovy_deg = near ? 22.0 : 14.0;
     shp_mat_identity(m);
     for (i = 0; i < k; ++i) { /* one volume per shell; beyond MAX_OBJ a volume holds two shells */
-        shp_mesh one = shp_sphere(0.2f + 0.025f * (float)i, 40, 20);
+        shp_mesh one = shp_sphere(0.25f + 0.2f * (float)(i % 4) + 0.004f * (float)(i / 4), 40, 20);
         if (i < MAX_OBJ) {
             add(s, one, 1, m);
         } else {
@@ -86,24 +88,26 @@ static tscene *shell_scene(int k)
 }
 
 typedef struct truth {
-    int k;
+    int k, near;
     tscene *s;
     double *gt, tmax;
     int *pairs, max_faces;
     unsigned char *interior, *covered;
 } truth;
 
-static truth g_truth[4]; /* k = 12, 20, 24, 40 */
+#define NTRUTH 8
+static truth g_truth[NTRUTH]; /* k = 12, 20, 24, 40, far and near */
 
-static const truth *get_truth(int k)
+static const truth *get_truth(int k, int near)
 {
     int i;
-    for (i = 0; i < 4; ++i) {
+    for (i = 0; i < NTRUTH; ++i) {
         truth *t = &g_truth[i];
-        if (t->k == k) return t;
+        if (t->k == k && t->near == near) return t;
         if (t->k == 0) {
             t->k = k;
-            t->s = shell_scene(k);
+            t->near = near;
+            t->s = shell_scene(k, near);
             t->gt = (double *)malloc(sizeof(double) * W * H);
             t->pairs = (int *)malloc(sizeof(int) * W * H);
             t->interior = (unsigned char *)malloc(W * H);
@@ -139,11 +143,11 @@ static const combo g_combos[] = {
 
 typedef struct outcome {
     int wrong, wrong_unmarked, magenta, magenta_within_limit, readback_sat, late, late_frame, frames_to_count;
-    double max_err_lsb;
+    double max_err_lsb, min_wrong_lsb; /* the largest error; the smallest error of a wrong pixel */
     fogvol_result result;
 } outcome;
 
-static outcome g_out[NCOMBO][2];
+static outcome g_out[NCOMBO][3];
 
 /* A frame of the shells; MRT: the engine's part is a cleared O ("far": no occluders). */
 static fogvol_result shell_frame(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp,
@@ -191,10 +195,12 @@ static void write_png(const char *name, int k, const unsigned char *px)
     stbi_write_png(path, W, H, 4, px, W * 4);
 }
 
+/* which: 0 = within the two-target limit, 1 = beyond it, 2 = the first seen from 5 units (depths
+   0.37..0.58: smaller red digits; SINGLE_TARGET saturates in some channels of some pixels) */
 static void run_combo(int ci, int which)
 {
     const combo *c = &g_combos[ci];
-    const truth *t = get_truth(c->k[which]);
+    const truth *t = get_truth(c->k[which == 1], which == 2);
     const tscene *s = t->s;
     outcome *o = &g_out[ci][which];
     int single = (c->variants & FOGVOL_VARIANT_SINGLE_TARGET) != 0, i, frame;
@@ -244,12 +250,13 @@ static void run_combo(int ci, int which)
         if (!t->interior[i]) continue;
         wrong = err > t->pairs[i] + 1e-6 * range / lsb;
         if (err > o->max_err_lsb) o->max_err_lsb = err;
+        if (wrong && (o->min_wrong_lsb == 0 || err < o->min_wrong_lsb)) o->min_wrong_lsb = err;
         o->wrong += wrong;
         o->wrong_unmarked += wrong && !mag;
         o->magenta += mag;
         o->magenta_within_limit += mag && t->pairs[i] <= limit;
     }
-    if (which == 1 || single) write_png(c->name, c->k[which], px);
+    if (which == 1 || single) write_png(c->name, c->k[which == 1] + 1000 * (which == 2), px);
     /* the count of frame 0 arrives without a read-back, a frame or two later */
     o->late = -1;
     for (frame = 1; frame <= 3 && st.overflow_frame < 0; ++frame) {
@@ -269,18 +276,20 @@ static void run_combo(int ci, int which)
     free(thick);
     free(px);
 
-    print_message("  %-16s %2d shells (max %2d faces, limit %2d): %-22s read-back %4d saturated, GPU count %4d "
-                  "(frame %d, after %d frames); %4d wrong (max %6.1f LSB), %4d unmarked, %4d magenta, %d magenta "
+    print_message("  %-16s %2d %s shells (max %2d faces, limit %2d): %-22s read-back %4d saturated, GPU count %4d "
+                  "(frame %d, after %d frames); %4d wrong (%.1f..%.1f LSB), %4d unmarked, %4d magenta, %d magenta "
                   "within the limit\n",
-                  c->name, c->k[which], t->max_faces, limit, fogvol_result_string(o->result), o->readback_sat, o->late,
-                  o->late_frame, o->frames_to_count, o->wrong, o->max_err_lsb, o->wrong_unmarked, o->magenta,
+                  c->name, c->k[which == 1], which == 2 ? "near" : "far ", t->max_faces, limit, fogvol_result_string(o->result), o->readback_sat, o->late,
+                  o->late_frame, o->frames_to_count, o->wrong, o->min_wrong_lsb, o->max_err_lsb, o->wrong_unmarked, o->magenta,
                   o->magenta_within_limit);
     assert_int_equal(o->wrong_unmarked, 0);       /* every wrong pixel is magenta */
     assert_int_equal(o->magenta_within_limit, 0); /* and none where the faces fit */
     assert_int_equal(o->late_frame, 0);
     assert_true(o->frames_to_count <= 2);
     assert_int_equal(o->late, o->readback_sat); /* the GPU count is the read-back's */
-    if (t->max_faces <= limit) {
+    if (t->max_faces <= limit) assert_int_equal(o->readback_sat, 0); /* the faces fit: nothing saturates */
+    if (which == 1) assert_true(o->readback_sat > 0);                 /* the scene is built to overflow */
+    if (o->readback_sat == 0) { /* more faces than the limit need not saturate: then nothing is wrong */
         assert_int_equal(o->result, FOGVOL_SUCCESS);
         assert_int_equal(o->magenta, 0);
         assert_int_equal(o->late, 0);
@@ -304,7 +313,7 @@ static void test_combo(void **state)
    within the bound of the new encoding. */
 static void test_lower_bits(void **state)
 {
-    const truth *t = get_truth(20);
+    const truth *t = get_truth(20, 0);
     const tscene *s = t->s;
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
     glu_ctx g;
@@ -378,7 +387,7 @@ static void test_lower_bits(void **state)
 /* WARN_ONCE (the default): one warning however many frames overflow; COUNT_ONLY: none. */
 static void test_warn_once(void **state)
 {
-    const truth *t = get_truth(20);
+    const truth *t = get_truth(20, 0);
     glu_ctx g;
     int policy;
     (void)state;
@@ -425,7 +434,7 @@ static void test_warn_once(void **state)
    (GL would refuse it), the frame is not counted, no GL error reaches the engine. */
 static void test_engine_query_active(void **state)
 {
-    const truth *t = get_truth(20);
+    const truth *t = get_truth(20, 0);
     glu_ctx g;
     logcap lc;
     fogvol_context_desc cd;
@@ -677,18 +686,18 @@ static void test_bad_policy(void **state)
 
 int main(void)
 {
-    static int params[NCOMBO * 2][2];
-    struct CMUnitTest tests[NCOMBO * 2 + 8];
+    static int params[NCOMBO * 3][2];
+    struct CMUnitTest tests[NCOMBO * 3 + 8];
     int n = 0, i, j, fails;
-    char *names[NCOMBO * 2];
+    char *names[NCOMBO * 3];
     build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
     assert_int_equal(scene_index("sphere"), 0);
     for (i = 0; i < NCOMBO; ++i)
-        for (j = 0; j < 2; ++j) {
+        for (j = 0; j < 3; ++j) {
             params[n][0] = i;
             params[n][1] = j;
             names[n] = (char *)malloc(64);
-            snprintf(names[n], 64, "%s_%d_shells", g_combos[i].name, g_combos[i].k[j]);
+            snprintf(names[n], 64, "%s_%d_shells%s", g_combos[i].name, g_combos[i].k[j == 1], j == 2 ? "_near" : "");
             memset(&tests[n], 0, sizeof tests[n]);
             tests[n].name = names[n];
             tests[n].test_func = test_combo;
@@ -704,8 +713,8 @@ int main(void)
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) tests[n++] = more[i];
     }
     fails = _cmocka_run_group_tests("overflow", tests, (size_t)n, NULL, NULL);
-    for (i = 0; i < NCOMBO * 2; ++i) free(names[i]);
-    for (i = 0; i < 4; ++i) {
+    for (i = 0; i < NCOMBO * 3; ++i) free(names[i]);
+    for (i = 0; i < NTRUTH; ++i) {
         free(g_truth[i].gt);
         free(g_truth[i].pairs);
         free(g_truth[i].interior);
