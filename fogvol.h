@@ -878,10 +878,12 @@ typedef struct fogvol_backend {
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
-       the samples passing between begin_query and end_query, which fogvol calls around whole passes
-       inside a frame. create_query fails where the context has none. begin_query returns 0 when it
-       cannot start one now (GL: the engine has an occlusion query active). query_result never waits:
-       0 = not available yet, 1 = *samples set (GLES 3: 0 or 1, "any sample passed"). */
+       the samples passing between begin_query and end_query, which fogvol calls around the draws of
+       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
+       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
+       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
+       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
+       1, "any sample passed"). */
     fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
     void (*destroy_query)(void *user_data, fogvol_handle query);
     int (*begin_query)(void *user_data, fogvol_handle query);
@@ -944,8 +946,11 @@ typedef enum fogvol_overflow_policy {
     FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
     FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
     FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
-                                       half the precision: fogvol_context_encoding changes), logged as a
-                                       warning each time; frames from then on use it. At L = 1 it warns once */
+                                       3 bits less precision: fogvol_context_encoding changes, the lookup
+                                       textures are rebuilt after the frame), logged as a warning each
+                                       time; the next frame uses it (MRT: the engine takes the new snippet
+                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
+                                       change do not lower it again. At L = 1 it warns once */
     FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
     FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
 } fogvol_overflow_policy;
@@ -985,10 +990,11 @@ typedef struct fogvol_frame_stats {
     int volumes, occluders; /* drawn */
     int groups;             /* colour-ramp groups composited */
     int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
-    /* Overflow counted on the GPU every frame, no read-back, no stall: a check pass per sum (two with
-       SINGLE_TARGET: after the additions and after the subtractions) discards the pixels whose sums did
-       not saturate, and an occlusion query counts the rest; the result is read a frame or more later,
-       when the GPU has it. overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
+    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
+       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
+       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
+       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
+       that finds all 4 still waiting is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
        summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
        (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
     int overflow_pixels_late;
