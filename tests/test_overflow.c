@@ -481,6 +481,56 @@ static void test_engine_query_active(void **state)
     glu_destroy(&g);
 }
 
+/* GLES 3 (a desktop context treated as GLES 3.0, GLSL 300 es): ANY_SAMPLES_PASSED reports 1 for
+   a frame with overflow and 0 without. */
+static void test_gles3_any_samples(void **state)
+{
+    int which;
+    (void)state;
+    for (which = 0; which < 2; ++which) {
+        const truth *t = get_truth(which ? 20 : 12, 0);
+        glu_ctx g;
+        logcap lc;
+        fogvol_context_desc cd;
+        fogvol_context *fv;
+        fogvol_mesh *meshes[MAX_OBJ];
+        fogvol_ramp *ramp;
+        fogvol_ramp_desc rd;
+        fogvol_frame_stats st;
+        int i, frame;
+        memset(&lc, 0, sizeof lc);
+        assert_true(glu_create(&g, W, H, 1));
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = watch_proc;
+        cd.gl.gles = 1;
+        cd.gl.version_major = 3;
+        cd.logger.func = logger;
+        cd.logger.user_data = &lc;
+        cd.tier = FOGVOL_TIER_PS20;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        upload_meshes(fv, t->s, meshes);
+        memset(&rd, 0, sizeof rd);
+        rd.density = 0.4f;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        g_blocking_reads = 0;
+        for (frame = 0; frame < 3; ++frame) {
+            unsigned char px[4];
+            shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+            glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        }
+        print_message("  GLES 3, %d shells: late count %d (frame %lld)\n", t->k, st.overflow_pixels_late,
+                      (long long)st.overflow_frame);
+        assert_int_equal(st.overflow_frame, 1);
+        assert_int_equal(st.overflow_pixels_late, which);
+        assert_int_equal(g_blocking_reads, 0);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+        glu_destroy(&g);
+    }
+}
+
 /* ---- the null backend: the plumbing ------------------------------------- */
 typedef struct nullrig {
     fogvol_null_backend nb;
@@ -708,7 +758,7 @@ int main(void)
         const struct CMUnitTest more[] = {
             cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_bad_policy),
             cmocka_unit_test(test_lower_bits),      cmocka_unit_test(test_warn_once),
-            cmocka_unit_test(test_engine_query_active),
+            cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) tests[n++] = more[i];
     }
