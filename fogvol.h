@@ -941,7 +941,9 @@ typedef enum fogvol_composite {
 
 /* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
    reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
-   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. */
+   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
+   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
+   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
 typedef enum fogvol_overflow_policy {
     FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
     FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
