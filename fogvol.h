@@ -996,7 +996,7 @@ typedef struct fogvol_frame_stats {
        colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
        discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
        result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
-       that finds all 4 still waiting is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
+       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
        summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
        (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
     int overflow_pixels_late;
@@ -3333,7 +3333,7 @@ typedef struct fogvol__occluder {
 
 /* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
 #define FOGVOL__QFRAMES 4
-#define FOGVOL__QPER 16
+#define FOGVOL__QPER 32
 typedef struct fogvol__qframe {
     fogvol_handle q[FOGVOL__QPER]; /* created on first use, reused */
     int64_t frame;
