@@ -58,6 +58,10 @@ $(BUILD)/test_tiers: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_tiers_san: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_overflow: tests/test_overflow.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_overflow_san: tests/test_overflow.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_backend: tests/test_backend.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_backend_san: tests/test_backend.c $(HEADERS) | $(BUILD)
@@ -96,6 +100,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/test_engine_fb $(BUILD)/test_engine_fb_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/test_engine_input $(BUILD)/test_engine_input_san \
+            $(BUILD)/test_overflow $(BUILD)/test_overflow_san \
             $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
             $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
@@ -133,6 +138,8 @@ test: deps-test deps-run
 	  "engine_depth_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_depth_san" \
 	  "engine_input=$(TAP) $(BUILD)/test_engine_input" \
 	  "engine_input_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_input_san" \
+	  "overflow=$(TAP) $(BUILD)/test_overflow" \
+	  "overflow_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_overflow_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \

@@ -516,7 +516,10 @@ typedef enum fogvol_program {
     FOGVOL_PROGRAM_COMPOSITE = 2,      /* full-screen triangle: thickness -> ramp -> blend */
     FOGVOL_PROGRAM_COMPOSITE_MESH = 3, /* the same, driven by the volume geometry */
     FOGVOL_PROGRAM_RESOLVE = 4,        /* PS13: B - F with carries -> encoded thickness */
-    FOGVOL_PROGRAM_COUNT = 5,
+    FOGVOL_PROGRAM_CHECK = 5,          /* RGBA8 tiers: full-screen triangle over the sums (as COMPOSITE reads
+                                          them) that discards every pixel without a saturated channel and
+                                          writes 1 into the overflow mask V; counted by occlusion queries */
+    FOGVOL_PROGRAM_COUNT = 6,
     FOGVOL_PROGRAM_MAX_ENUM = 0x7fffffff
 } fogvol_program;
 
@@ -990,6 +993,18 @@ typedef struct fogvol_backend {
        coordinates, and returns that texture's API object in *texture. */
     fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
                                 uintptr_t *texture);
+    /* optional (overflow counting without read-back; all five or none): occlusion queries that count
+       the samples passing between begin_query and end_query, which fogvol calls around the draws of
+       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
+       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
+       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
+       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
+       1, "any sample passed"). */
+    fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
+    void (*destroy_query)(void *user_data, fogvol_handle query);
+    int (*begin_query)(void *user_data, fogvol_handle query);
+    void (*end_query)(void *user_data, fogvol_handle query);
+    int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -1007,6 +1022,12 @@ typedef struct fogvol_null_backend {
     int create_calls;
     int stencil_bits;       /* reported by begin_frame */
     int samples;            /* reported by begin_frame (engine framebuffer samples) */
+    /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
+       with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
+    int queries;
+    uint64_t query_samples;
+    int query_not_ready;
+    int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
 } fogvol_null_backend;
 /* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
    change table->caps before creating a context to test other choices. */
@@ -1067,6 +1088,23 @@ typedef enum fogvol_alpha {
     FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
     FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
 } fogvol_alpha;
+/* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
+   reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
+   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
+   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
+   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
+typedef enum fogvol_overflow_policy {
+    FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
+    FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
+    FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
+                                       3 bits less precision: fogvol_context_encoding changes, the lookup
+                                       textures are rebuilt after the frame), logged as a warning each
+                                       time; the next frame uses it (MRT: the engine takes the new snippet
+                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
+                                       change do not lower it again. At L = 1 it warns once */
+    FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
+    FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
+} fogvol_overflow_policy;
 
 typedef struct fogvol_context_desc {
     fogvol_allocator allocator;
@@ -1082,6 +1120,7 @@ typedef struct fogvol_context_desc {
     fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
     fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
     fogvol_gl_desc gl;     /* for the GL backend */
+    fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
 } fogvol_context_desc;
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
@@ -1106,6 +1145,17 @@ typedef struct fogvol_frame_stats {
     int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
     int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
                                drew one fog value per pixel */
+    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
+       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
+       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
+       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
+       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
+       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
+       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
+    int overflow_pixels_late;
+    int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
+    int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
+    int overflow_passes;     /* check passes issued this frame (not included in passes) */
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -1161,7 +1211,9 @@ typedef struct fogvol_frame_desc {
        COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
     int draw_buffer;
     fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
-    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta */
+    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
+                               variant; SINGLE_TARGET runs one check pass after its additions for it,
+                               into the overflow mask V); FLOAT cannot saturate */
     /* Debug read-back of the decoded thickness (world units) per pixel of the
        viewport, rows bottom to top, for the group of debug_ramp (NULL = the
        first group). Set debug_thickness to a width*height float buffer. */
@@ -3554,7 +3606,11 @@ static const char fogvol__fs_resolve[] =
 
 /* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F) (PS 4);
    COUNT adds the opaque depth once per missing back face; SINGLE decodes one
-   biased target; PS13 reads the resolved thickness; FLOAT the float sum. */
+   biased target; PS13 reads the resolved thickness; FLOAT the float sum.
+   A channel at 255 means saturation: with at most 2^(8-L) faces a channel sums
+   to at most 256 - 2^(8-L). SINGLE also reads the overflow mask V (fv_front),
+   where a check pass marked the channels that hit 255 before the subtraction
+   brought them down. FV_CHECK (the check pass) keeps only saturated pixels. */
 static const char fogvol__fs_composite[] =
     "uniform vec4 fv_rampmap;\n"
     "uniform FV_TARGET_SAMPLER fv_back;\n"
@@ -3578,10 +3634,15 @@ static const char fogvol__fs_composite[] =
     "    sat = b.a > 1.5 / 255.0 ? 1.0 : 0.0;\n"
     "#elif defined(FV_SINGLE)\n"
     "    vec4 s = b - vec4(128.0 / 255.0);\n"
-    "    if (s == vec4(0.0)) discard;\n"
+    "#ifdef FV_CHECK\n"
+    "    float peak = 0.0;\n"
+    "#else\n"
+    "    float peak = FV_TEXTURE(fv_front, st).r;\n"
+    "    if (s == vec4(0.0) && peak < 0.5) discard;\n"
+    "#endif\n"
     "    t = dot(s, fv_dec);\n"
-    "    sat = max(max(b.r, b.g), max(b.b, b.a)) > 254.5 / 255.0 || min(min(b.r, b.g), min(b.b, b.a)) < 0.5 / 255.0"
-    " ? 1.0 : 0.0;\n"
+    "    sat = peak > 0.5 || max(max(b.r, b.g), max(b.b, b.a)) > 254.5 / 255.0 ||"
+    " min(min(b.r, b.g), min(b.b, b.a)) < 0.5 / 255.0 ? 1.0 : 0.0;\n"
     "#else\n"
     "    vec4 f = FV_TEXTURE(fv_front, st);\n"
     "#ifndef FV_WIDE\n"
@@ -3601,8 +3662,13 @@ static const char fogvol__fs_composite[] =
     "    t = dot(b - f, fv_dec);\n"
     "#endif\n"
     "#endif\n"
+    "#ifdef FV_CHECK\n"
+    "    if (sat < 0.5) discard;\n"
+    "    FV_FRAGCOLOR = vec4(1.0);\n"
+    "#else\n"
     "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
     "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
+    "#endif\n"
     "}\n";
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
@@ -3670,6 +3736,7 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_pro
     case FOGVOL_PROGRAM_COMPOSITE:
     case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
     case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
+    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
     default: return 0;
     }
 }
@@ -3747,10 +3814,12 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
+                        d->program == FOGVOL_PROGRAM_CHECK ||
                         (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
                            ? fogvol__vs_fullscreen
                            : fogvol__vs_mesh;
     } else {
+        if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
         strings[n++] = fogvol__fs_common;
         switch (d->program) {
         case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
@@ -3913,6 +3982,39 @@ static fogvol_result fogvol__null_read_target(void *u, fogvol_handle t, unsigned
     return FOGVOL_SUCCESS;
 }
 
+static fogvol_result fogvol__null_create_query(void *u, fogvol_handle *out)
+{
+    if (!((fogvol_null_backend *)u)->queries) return FOGVOL_ERROR_UNSUPPORTED;
+    return fogvol__null_create(u, out);
+}
+static int fogvol__null_begin_query(void *u, fogvol_handle q)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    (void)q;
+    s->queries_begun++;
+    s->query_active++;
+    return 1;
+}
+static void fogvol__null_end_query(void *u, fogvol_handle q)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    (void)q;
+    s->queries_ended++;
+    s->query_active--;
+}
+static int fogvol__null_query_result(void *u, fogvol_handle q, uint64_t *samples)
+{
+    fogvol_null_backend *s = (fogvol_null_backend *)u;
+    (void)q;
+    s->query_polls++;
+    if (s->query_not_ready > 0) {
+        s->query_not_ready--;
+        return 0;
+    }
+    *samples = s->query_samples;
+    return 1;
+}
+
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table)
 {
     if (!state || !table) return;
@@ -3940,6 +4042,11 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     table->read_target = fogvol__null_read_target;
     table->target_attachment = fogvol__null_attachment;
     table->native_texture = fogvol__null_native;
+    table->create_query = fogvol__null_create_query;
+    table->destroy_query = fogvol__null_destroy;
+    table->begin_query = fogvol__null_begin_query;
+    table->end_query = fogvol__null_end_query;
+    table->query_result = fogvol__null_query_result;
 }
 
 /* >>renderer ============================================================== */
@@ -3993,6 +4100,15 @@ typedef struct fogvol__occluder {
     float model[16];
 } fogvol__occluder;
 
+/* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
+#define FOGVOL__QFRAMES 4
+#define FOGVOL__QPER 32
+typedef struct fogvol__qframe {
+    fogvol_handle q[FOGVOL__QPER]; /* created on first use, reused */
+    int64_t frame;
+    int used, ok, pending;
+} fogvol__qframe;
+
 struct fogvol_context {
     fogvol_allocator alloc;
     fogvol_logger log;
@@ -4027,6 +4143,11 @@ struct fogvol_context {
     fogvol__occluder *occ;
     int nocc, capocc;
     int live_meshes, live_ramps;
+    fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
+    fogvol_overflow_policy overflow_policy;
+    int counting, overflow_late, overflow_warned, qcur;
+    int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
+    fogvol__qframe qf[FOGVOL__QFRAMES];
 };
 
 /* column-major 4x4 helpers in double */
@@ -4105,6 +4226,8 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->tgt_b) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_b);
     if (ctx->tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_f);
     if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
+    if (ctx->tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_v);
+    ctx->tgt_v = 0;
     if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
     ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
     ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
@@ -4171,9 +4294,18 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
     return FOGVOL_SUCCESS;
 }
 
+static void fogvol__query_free(fogvol_context *ctx)
+{
+    int i, k;
+    for (i = 0; i < FOGVOL__QFRAMES; ++i)
+        for (k = 0; k < FOGVOL__QPER; ++k)
+            if (ctx->qf[i].q[k]) ctx->be.destroy_query(ctx->be.user_data, ctx->qf[i].q[k]);
+}
+
 static void fogvol__release(fogvol_context *ctx)
 {
     int i;
+    fogvol__query_free(ctx);
     fogvol__destroy_targets(ctx);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
         if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
@@ -4224,7 +4356,8 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back",   "fv_front", "fv_colors",
                                                                     "fv_opaque", "fv_back2", "fv_front2"};
     static const char *const labels[FOGVOL_PROGRAM_COUNT] = {"fogvol encode", "fogvol face", "fogvol composite",
-                                                             "fogvol composite (geometry)", "fogvol resolve"};
+                                                             "fogvol composite (geometry)", "fogvol resolve",
+                                                             "fogvol overflow check"};
     fogvol_program_desc pd;
     fogvol_shader_desc sd;
     fogvol_result r;
@@ -4321,6 +4454,8 @@ static fogvol_result fogvol__resolve_bits(const fogvol_context_desc *desc, int *
     return FOGVOL_SUCCESS;
 }
 
+static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy);
+
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
 {
     fogvol_context *ctx;
@@ -4344,6 +4479,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     }
     r = fogvol__resolve_bits(desc, &bits);
     if (r != FOGVOL_SUCCESS) return r;
+    if ((unsigned)desc->overflow_policy > (unsigned)FOGVOL_OVERFLOW_OFF) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown overflow_policy %d", (int)desc->overflow_policy);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     ctx = (fogvol_context *)fogvol__alloc(a, sizeof *ctx);
     if (!ctx) {
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: out of memory for the context");
@@ -4388,11 +4527,13 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         }
         if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
     }
-    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i) /* COMPOSITE_MESH: for engines only, the
-                                                                         geometry composite is scissored */
+    /* COMPOSITE_MESH: for engines only (the geometry composite is scissored); CHECK: made when a
+       frame first runs a check pass */
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
-            i != FOGVOL_PROGRAM_COMPOSITE_MESH)
+            i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK)
             r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+    if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
         fogvol__release(ctx);
@@ -5368,6 +5509,215 @@ static int fogvol__count_near_cut(const fogvol_context *ctx)
     return -1;
 }
 
+/* >>overflow checks ======================================================= */
+
+/* Counting needs the five query entries and one query that can be created. */
+static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy)
+{
+    const fogvol_backend *b = &ctx->be;
+    ctx->overflow_policy = policy;
+    ctx->overflow_late = -1;
+    ctx->overflow_frame = -1;
+    ctx->qcur = -1;
+    if (ctx->tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
+    if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
+        b->create_query(b->user_data, &ctx->qf[0].q[0]) != FOGVOL_SUCCESS) {
+        ctx->qf[0].q[0] = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                    "fogvol: no occlusion queries: overflow is not counted per frame (show_overflow and the "
+                    "debug read-back still see it)");
+        return;
+    }
+    ctx->counting = 1;
+}
+
+/* Reads the queries of earlier frames without waiting; a frame counts when all its queries are
+   done. Returns 1 when a newer frame's count arrived. */
+static int fogvol__overflow_poll(fogvol_context *ctx)
+{
+    int i, k, fresh = 0;
+    for (i = 0; i < FOGVOL__QFRAMES; ++i) {
+        fogvol__qframe *f = &ctx->qf[i];
+        uint64_t sum = 0, v = 0;
+        if (!f->pending) continue;
+        for (k = 0; k < f->used; ++k) {
+            if (!ctx->be.query_result(ctx->be.user_data, f->q[k], &v)) break;
+            sum += v;
+        }
+        if (k < f->used) continue;
+        f->pending = 0;
+        if (f->frame > ctx->overflow_frame) {
+            ctx->overflow_frame = f->frame;
+            ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
+            fresh = 1;
+        }
+    }
+    return fresh;
+}
+
+/* Picks a free record for this frame's queries; 0 when every record still waits for the GPU
+   (the frame is then not counted: nothing ever waits). */
+static int fogvol__overflow_open(fogvol_context *ctx)
+{
+    int i;
+    ctx->qcur = -1;
+    if (!ctx->counting) return 0;
+    for (i = 0; i < FOGVOL__QFRAMES; ++i)
+        if (!ctx->qf[i].pending) {
+            ctx->qcur = i;
+            ctx->qf[i].used = 0;
+            ctx->qf[i].ok = 1;
+            ctx->qf[i].frame = ctx->frame_no;
+            return 1;
+        }
+    return 0;
+}
+
+static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
+{
+    fogvol__qframe *f;
+    fogvol_handle *q;
+    if (ctx->qcur < 0) return 0;
+    f = &ctx->qf[ctx->qcur];
+    q = &f->q[f->used < FOGVOL__QPER ? f->used : 0];
+    if (!f->ok || f->used >= FOGVOL__QPER) {
+        f->ok = 0; /* more check passes than queries: the frame is not counted */
+        return 0;
+    }
+    if (!*q && ctx->be.create_query(ctx->be.user_data, q) != FOGVOL_SUCCESS) *q = 0;
+    if (!*q || !ctx->be.begin_query(ctx->be.user_data, *q)) {
+        f->ok = 0;
+        return 0;
+    }
+    f->used++;
+    return *q;
+}
+
+/* After the frame's passes: its queries wait for the GPU; a frame without check passes drew no
+   volume and counts 0 now. */
+static void fogvol__overflow_close(fogvol_context *ctx)
+{
+    fogvol__qframe *f;
+    if (ctx->qcur < 0) return;
+    f = &ctx->qf[ctx->qcur];
+    ctx->qcur = -1;
+    if (!f->ok) return;
+    if (f->used > 0) {
+        f->pending = 1;
+    } else if (f->frame > ctx->overflow_frame) {
+        ctx->overflow_frame = f->frame;
+        ctx->overflow_late = 0;
+    }
+}
+
+/* The program and the mask target of the check passes, made on first use. */
+static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
+{
+    fogvol_target_desc td;
+    fogvol_result r = FOGVOL_SUCCESS;
+    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
+    if (r == FOGVOL_SUCCESS && !ctx->tgt_v) {
+        memset(&td, 0, sizeof td);
+        td.width = ctx->target_w;
+        td.height = ctx->target_h;
+        td.depth = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+        td.label = "fogvol V (overflow mask)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_v);
+        if (r != FOGVOL_SUCCESS) ctx->tgt_v = 0;
+    }
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create the overflow check pass: %s",
+                    fogvol_result_string(r));
+    return r;
+}
+
+/* One check pass into the mask V: pixels with a saturated sum are written (and counted by a query),
+   the rest discarded. base: the pass state of the composite (target space). SINGLE runs it after the
+   additions (first: clears V and its depth) and after the subtractions, whose depth test skips the
+   pixels already marked, so each pixel counts once. */
+static void fogvol__check_pass(fogvol_context *ctx, const fogvol_pass *base, int first, fogvol_frame_stats *st)
+{
+    fogvol_pass cp = *base;
+    fogvol_handle q;
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    cp.target = ctx->tgt_v;
+    cp.clear = first;
+    memset(cp.clear_color, 0, sizeof cp.clear_color);
+    cp.blend = FOGVOL_PASS_BLEND_NONE;
+    cp.cull = FOGVOL_CULL_NONE;
+    cp.depth_test = cp.depth_write = single;
+    cp.stencil_guard = 0;
+    cp.program = ctx->prog[FOGVOL_PROGRAM_CHECK];
+    memset(cp.native_textures, 0, sizeof cp.native_textures);
+    if (single) { /* the one sum target; V is the target here, not a texture */
+        memset(cp.textures, 0, sizeof cp.textures);
+        cp.textures[0] = ctx->tgt_b;
+    }
+    ctx->be.begin_pass(ctx->be.user_data, &cp);
+    q = fogvol__query_begin(ctx);
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    if (q) ctx->be.end_query(ctx->be.user_data, q);
+    fogvol__end_pass(ctx);
+    st->overflow_passes++;
+}
+
+/* FOGVOL_OVERFLOW_LOWER_BITS: L - 1 and the lookup textures that depend on it (programs and
+   targets do not). Outside a frame; on failure the old encoding stays. */
+static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
+{
+    fogvol_encoding old = ctx->enc;
+    fogvol_handle t[3] = {0, 0, 0}, *cur[3];
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
+    cur[0] = &ctx->tex_rg;
+    cur[1] = &ctx->tex_blue;
+    cur[2] = &ctx->tex_dither;
+    fogvol_encoding_init(&ctx->enc, old.bits - 1);
+    for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
+        if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
+    if (r != FOGVOL_SUCCESS) {
+        for (i = 0; i < 3; ++i)
+            if (t[i]) ctx->be.destroy_texture(ctx->be.user_data, t[i]);
+        ctx->enc = old;
+        return r;
+    }
+    for (i = 0; i < 3; ++i)
+        if (*cur[i]) {
+            ctx->be.destroy_texture(ctx->be.user_data, *cur[i]);
+            *cur[i] = t[i];
+        }
+    return FOGVOL_SUCCESS;
+}
+
+/* After a frame: the overflow policy, for a count that arrived in it (frames drawn before the last
+   change of L are not acted upon). */
+static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
+{
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), from = ctx->enc.bits;
+    int faces = single ? ctx->enc.max_faces_single : ctx->enc.max_faces;
+    if (!fresh || ctx->overflow_late <= 0 || ctx->overflow_frame < ctx->overflow_epoch) return;
+    if (ctx->overflow_policy == FOGVOL_OVERFLOW_COUNT_ONLY) return;
+    if (ctx->overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
+        fogvol_result r = fogvol__lower_bits(ctx);
+        if (r == FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                        "fogvol: %d pixels of frame %lld have more than %d faces along the ray: encoding_bits "
+                        "lowered from %d to %d (%d faces) from frame %lld on",
+                        ctx->overflow_late, (long long)ctx->overflow_frame, faces, from, ctx->enc.bits,
+                        single ? ctx->enc.max_faces_single : ctx->enc.max_faces, (long long)ctx->frame_no + 1);
+            ctx->overflow_epoch = ctx->frame_no + 1;
+            return;
+        }
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot lower encoding_bits: %s", fogvol_result_string(r));
+    }
+    if (ctx->overflow_warned) return;
+    ctx->overflow_warned = 1;
+    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                "fogvol: %d pixels of frame %lld have more than %d faces along the ray (%d-bit encoding): their "
+                "thickness is wrong (show_overflow marks them; logged once)",
+                ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
+}
+
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
 {
     fogvol_frame_stats st;
@@ -5377,10 +5727,12 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     fogvol_result r = FOGVOL_SUCCESS, rr;
     const fogvol_frame_desc *fd;
     int i, w, h, g, overflow = 0, captured = 0;
-    int single, count, rgba8;
+    int single, count, rgba8, counted = 0, checks = 0, fresh = 0;
     unsigned char *peak = NULL;
     uintptr_t engine_depth;
     memset(&st, 0, sizeof st);
+    st.overflow_pixels_late = -1;
+    st.overflow_frame = -1;
     if (stats) *stats = st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
@@ -5437,6 +5789,14 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
                         fogvol_result_string(r));
             goto done;
         }
+    }
+    /* overflow: earlier frames' counts (never waiting), this frame's check passes */
+    fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
+    counted = rgba8 && fogvol__overflow_open(ctx);
+    checks = counted || (rgba8 && single && fd->show_overflow);
+    if (checks && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) {
+        counted = checks = 0;
+        ctx->qcur = -1;
     }
 
     /* pass uniforms common to every pass */
@@ -5540,6 +5900,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
             ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
             st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp,
                                           has_neg);
+            if (checks) fogvol__check_pass(ctx, &ps, 1, &st); /* saturation at the peak of the sum */
             if (fogvol__want_debug(ctx, ramp, captured)) {
                 peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)w * (size_t)h);
                 rr = peak ? fogvol__single_peak(ctx, peak) : FOGVOL_ERROR_OUT_OF_MEMORY;
@@ -5583,6 +5944,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
             ps.textures[0] = ctx->tgt_t;
             ps.textures[1] = 0;
         }
+        if (counted) fogvol__check_pass(ctx, &ps, !single, &st);
+        if (single) ps.textures[1] = ctx->tgt_v; /* the mask of the peak check, for show_overflow */
 
         /* composite into the engine framebuffer */
         ps.target = 0;
@@ -5609,6 +5972,11 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol__end_pass(ctx);
         fogvol__target_space(ctx, &ps); /* back to target-space settings for the next group */
     }
+    if (counted) fogvol__overflow_close(ctx);
+    if (!rgba8) { /* float sums cannot saturate */
+        ctx->overflow_late = 0;
+        ctx->overflow_frame = ctx->frame_no;
+    }
     st.overflow_pixels = overflow;
     if (overflow > 0 && r == FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
@@ -5619,6 +5987,11 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
 done:
     fogvol__free(&ctx->alloc, peak);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    st.frame = ctx->frame_no;
+    st.overflow_pixels_late = ctx->overflow_late;
+    st.overflow_frame = ctx->overflow_frame;
+    fogvol__overflow_react(ctx, fresh);
+    ctx->frame_no++;
     ctx->in_frame = 0;
     ctx->mrt_ready = 0;
     ctx->engine_occluders = 0;
@@ -5724,7 +6097,10 @@ enum {
     FOGVOL__GL_DEPTH_COMPONENT32F = 0x8CAC, FOGVOL__GL_DEPTH32F_STENCIL8 = 0x8CAD,
     FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV = 0x8DAD, FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT = 0x821A,
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME = 0x8CD1, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE = 0x8216,
-    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE = 0x8211
+    FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE = 0x8211,
+    FOGVOL__GL_SAMPLES_PASSED = 0x8914, FOGVOL__GL_ANY_SAMPLES_PASSED = 0x8C2F,
+    FOGVOL__GL_ANY_SAMPLES_PASSED_CONSERVATIVE = 0x8D6A, FOGVOL__GL_CURRENT_QUERY = 0x8865,
+    FOGVOL__GL_QUERY_RESULT = 0x8866, FOGVOL__GL_QUERY_RESULT_AVAILABLE = 0x8867
 };
 /* Multisampled targets and per-sample shading. */
 enum {
@@ -5870,10 +6246,20 @@ enum {
 /* Optional: clip control (GL 4.5, ARB_clip_control; GLES: EXT_clip_control as glClipControlEXT). */
 #define FOGVOL__GL_CLIP_CONTROL(X) X(void, ClipControl, (fogvol__GLenum, fogvol__GLenum))
 
+/* Occlusion queries: GL 1.5, GLES 3.0 (optional: per-frame overflow counting). */
+#define FOGVOL__GL_QUERY(X) \
+    X(void, GenQueries, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(void, DeleteQueries, (fogvol__GLsizei, const fogvol__GLuint *)) \
+    X(void, BeginQuery, (fogvol__GLenum, fogvol__GLuint)) \
+    X(void, EndQuery, (fogvol__GLenum)) \
+    X(void, GetQueryiv, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint *)) \
+    X(void, GetQueryObjectuiv, (fogvol__GLuint, fogvol__GLenum, fogvol__GLuint *))
+
 #define FOGVOL__GL_ALL(X) \
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
-            FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X)
+            FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X) \
+                FOGVOL__GL_QUERY(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -5982,6 +6368,7 @@ typedef struct fogvol__gl {
     fogvol__GLuint depth_tex, depth_fbo; /* the engine's depth copied by copy_depth */
     int depth_w, depth_h;
     fogvol__GLenum depth_format;
+    int has_query; /* occlusion queries loaded (GL 1.5+, GLES 3.0+) */
 } fogvol__gl;
 
 static int fogvol__has_ext(const char *list, const char *name)
@@ -7200,6 +7587,61 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
     return r;
 }
 
+/* Occlusion queries (names as handles): SAMPLES_PASSED, or on GLES 3 ANY_SAMPLES_PASSED (0 or 1). */
+static fogvol_result fogvol__gl_create_query(void *u, fogvol_handle *out)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLuint id = 0;
+    gl->GenQueries(1, &id); /* names only: no state */
+    *out = (fogvol_handle)id;
+    return id ? FOGVOL_SUCCESS : FOGVOL_ERROR_BACKEND;
+}
+
+static void fogvol__gl_destroy_query(void *u, fogvol_handle q)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLuint id = (fogvol__GLuint)q;
+    gl->DeleteQueries(1, &id);
+}
+
+/* Not while the engine has an occlusion query running: BeginQuery would fail (and add its error to
+   the engine's), and the engine's count would include fogvol's pixels. */
+static int fogvol__gl_begin_query(void *u, fogvol_handle q)
+{
+    static const fogvol__GLenum kinds[3] = {FOGVOL__GL_SAMPLES_PASSED, FOGVOL__GL_ANY_SAMPLES_PASSED,
+                                            FOGVOL__GL_ANY_SAMPLES_PASSED_CONSERVATIVE};
+    fogvol__gl *gl = (fogvol__gl *)u;
+    int i, first = gl->gles ? 1 : 0, n;
+    n = gl->gles || gl->major > 4 || (gl->major == 4 && gl->minor >= 3) ? 3
+        : gl->major > 3 || (gl->major == 3 && gl->minor >= 3)          ? 2
+                                                                        : 1;
+    for (i = first; i < n; ++i) {
+        fogvol__GLint cur = 0;
+        gl->GetQueryiv(kinds[i], FOGVOL__GL_CURRENT_QUERY, &cur);
+        if (cur) return 0;
+    }
+    gl->BeginQuery(gl->gles ? FOGVOL__GL_ANY_SAMPLES_PASSED : FOGVOL__GL_SAMPLES_PASSED, (fogvol__GLuint)q);
+    return 1;
+}
+
+static void fogvol__gl_end_query(void *u, fogvol_handle q)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    (void)q;
+    gl->EndQuery(gl->gles ? FOGVOL__GL_ANY_SAMPLES_PASSED : FOGVOL__GL_SAMPLES_PASSED);
+}
+
+static int fogvol__gl_query_result(void *u, fogvol_handle q, uint64_t *samples)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol__GLuint avail = 0, v = 0;
+    gl->GetQueryObjectuiv((fogvol__GLuint)q, FOGVOL__GL_QUERY_RESULT_AVAILABLE, &avail);
+    if (!avail) return 0; /* never wait for the GPU */
+    gl->GetQueryObjectuiv((fogvol__GLuint)q, FOGVOL__GL_QUERY_RESULT, &v);
+    *samples = v;
+    return 1;
+}
+
 static void fogvol__gl_destroy(void *u)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -7434,6 +7876,12 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)
         FOGVOL__GL_TF_PAUSE(FOGVOL__GL_REQUIRE)
     }
+    if (!gl->gles || gl->major >= 3) { /* optional */
+        FOGVOL__GL_QUERY(FOGVOL__GL_LOAD)
+#define FOGVOL__GL_HAVE(ret, name, params) &&gl->name
+        gl->has_query = 1 FOGVOL__GL_QUERY(FOGVOL__GL_HAVE);
+#undef FOGVOL__GL_HAVE
+    }
     if (gl->gles) {
         FOGVOL__GL_ES(FOGVOL__GL_LOAD)
         FOGVOL__GL_ES(FOGVOL__GL_REQUIRE)
@@ -7506,6 +7954,13 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     out->end_pass = fogvol__gl_end_pass;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
+    if (gl->has_query) {
+        out->create_query = fogvol__gl_create_query;
+        out->destroy_query = fogvol__gl_destroy_query;
+        out->begin_query = fogvol__gl_begin_query;
+        out->end_query = fogvol__gl_end_query;
+        out->query_result = fogvol__gl_query_result;
+    }
     return FOGVOL_SUCCESS;
 }
 

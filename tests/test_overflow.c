@@ -1,0 +1,775 @@
+/* test_overflow.c - depth-complexity overflow: show_overflow marks every wrong
+   pixel on every RGBA8 tier and variant, and the per-frame count from the
+   backend's occlusion queries (no read-back, read a frame or more later,
+   never waiting) matches the debug read-back; the policies react to it.
+
+   Scenes: k concentric spheres in four groups (radius 0.25 + 0.2 g + 0.004 j:
+   the silhouettes of a group lie within about a pixel, so the rings between
+   them are interior pixels crossing k/4, k/2, 3k/4 and k shells) seen from 8.6
+   units away, so the depths sit at d = 0.75..0.95 of the range and the channel
+   sums are large (and from 5 units, d = 0.37..0.58). At L = 4 a target sums 16 faces (SINGLE_TARGET 8): 12 shells fit
+   two targets but not one, 20 fit neither. WIDE (L = 3) sums 32: 24 and 40.
+   Ground truth: the thickness ray-cast from the very triangles
+   (tests/raycast.h: exact ray/triangle chords of the drawn shells). A pixel is
+   wrong when |error| > 1 LSB per pair of faces (the tiers' bound). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#include "tests/gl_util.h"
+#include <GL/glext.h>
+#include "tests/raycast.h"
+#include "tests/shapes.h"
+#include "tests/scenes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <sys/stat.h>
+
+/* ---- logging and a GL loader that watches query reads --------------------- */
+typedef struct logcap {
+    int warnings, errors;
+    char last[512];
+} logcap;
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    logcap *c = (logcap *)u;
+    if (l == FOGVOL_LOG_ERROR) c->errors++;
+    if (l == FOGVOL_LOG_WARNING) c->warnings++;
+    if (l <= FOGVOL_LOG_WARNING) snprintf(c->last, sizeof c->last, "%s", m);
+    if (l == FOGVOL_LOG_ERROR) print_message("  [fogvol error] %s\n", m);
+}
+
+/* A blocking read is GL_QUERY_RESULT on a query whose GL_QUERY_RESULT_AVAILABLE was not
+   just seen true: counted in g_blocking_reads. */
+static GLuint g_avail_id;
+static int g_blocking_reads, g_result_reads;
+
+static void APIENTRY watch_get_query_object(GLuint id, GLenum pname, GLuint *out)
+{
+    glGetQueryObjectuiv(id, pname, out);
+    if (pname == GL_QUERY_RESULT_AVAILABLE) g_avail_id = *out ? id : 0;
+    if (pname == GL_QUERY_RESULT) {
+        g_result_reads++;
+        if (g_avail_id != id) g_blocking_reads++;
+        g_avail_id = 0;
+    }
+}
+
+static void (*watch_proc(const char *name, void *user))(void)
+{
+    if (strcmp(name, "glGetQueryObjectuiv") == 0) return (void (*)(void))watch_get_query_object;
+    return glu_proc(name, user);
+}
+
+/* ---- the shells ----------------------------------------------------------- */
+static tscene *shell_scene(int k, int near)
+{
+    float m[16];
+    int i;
+    tscene *s = new_scene("shells", 0.04, 0.03, near ? 5.0 : 8.6, 0, 0, 0, 0.5, 10);
+    s->cam.fovy_deg = near ? 22.0 : 14.0;
+    shp_mat_identity(m);
+    for (i = 0; i < k; ++i) { /* one volume per shell; beyond MAX_OBJ a volume holds two shells */
+        shp_mesh one = shp_sphere(0.25f + 0.2f * (float)(i % 4) + 0.004f * (float)(i / 4), 40, 20);
+        if (i < MAX_OBJ) {
+            add(s, one, 1, m);
+        } else {
+            shp_append(&s->obj[i % MAX_OBJ].mesh, &one);
+            shp_free(&one);
+        }
+    }
+    return s;
+}
+
+typedef struct truth {
+    int k, near;
+    tscene *s;
+    double *gt, tmax;
+    int *pairs, max_faces;
+    unsigned char *interior, *covered;
+} truth;
+
+#define NTRUTH 8
+static truth g_truth[NTRUTH]; /* k = 12, 20, 24, 40, far and near */
+
+static const truth *get_truth(int k, int near)
+{
+    int i;
+    for (i = 0; i < NTRUTH; ++i) {
+        truth *t = &g_truth[i];
+        if (t->k == k && t->near == near) return t;
+        if (t->k == 0) {
+            t->k = k;
+            t->near = near;
+            t->s = shell_scene(k, near);
+            t->gt = (double *)malloc(sizeof(double) * W * H);
+            t->pairs = (int *)malloc(sizeof(int) * W * H);
+            t->interior = (unsigned char *)malloc(W * H);
+            t->covered = (unsigned char *)malloc(W * H);
+            ground_truth(t->s, t->gt, t->pairs, t->interior, t->covered, &t->max_faces, &t->tmax);
+            return t;
+        }
+    }
+    fail_msg("truth cache full");
+    return NULL;
+}
+
+typedef struct combo {
+    fogvol_tier tier;
+    unsigned variants;
+    const char *name;
+    int bits;
+    int k[2]; /* shells: within the two-target limit, beyond it */
+} combo;
+
+static const combo g_combos[] = {
+    {FOGVOL_TIER_PS20, 0, "PS20", 4, {12, 20}},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 4, {12, 20}},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_ALU, "PS20+alu+single", 4, {12, 20}},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 4, {12, 20}},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, "PS20+wide", 3, {24, 40}},
+    {FOGVOL_TIER_PS13, 0, "PS13", 4, {12, 20}},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 4, {12, 20}},
+    {FOGVOL_TIER_MRT, 0, "MRT", 4, {12, 20}},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single", 4, {12, 20}},
+};
+#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
+
+typedef struct outcome {
+    int wrong, wrong_unmarked, magenta, magenta_within_limit, readback_sat, late, late_frame, frames_to_count;
+    double max_err_lsb, min_wrong_lsb; /* the largest error; the smallest error of a wrong pixel */
+    fogvol_result result;
+} outcome;
+
+static outcome g_out[NCOMBO][3];
+
+/* A frame of the shells; MRT: the engine's part is a cleared O ("far": no occluders). */
+static fogvol_result shell_frame(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp,
+                                 float *thick, fogvol_frame_stats *st)
+{
+    fogvol_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&s->cam, fd.view, fd.projection);
+    fd.znear = (float)s->cam.znear;
+    fd.zfar = (float)s->cam.zfar;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.show_overflow = 1;
+    fd.debug_thickness = thick;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    if (fogvol_context_tier(fv, NULL) == FOGVOL_TIER_MRT) {
+        fogvol_mrt_info mrt;
+        GLuint fbo;
+        assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+        glGenFramebuffers(1, &fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)mrt.texture, 0);
+        glClearBufferfv(GL_COLOR, 0, mrt.clear_color);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glDeleteFramebuffers(1, &fbo);
+    }
+    add_scene(fv, s, meshes, ramp, 1);
+    return fogvol_end_frame(fv, st);
+}
+
+static int is_magenta(const unsigned char *p) { return p[0] == 255 && p[1] == 0 && p[2] == 255; }
+
+static void write_png(const char *name, int k, const unsigned char *px)
+{
+    char path[256], *q;
+    mkdir("build", 0777);
+    mkdir("build/overflow", 0777);
+    snprintf(path, sizeof path, "build/overflow/%s_%d.png", name, k);
+    for (q = path + 15; *q; ++q)
+        if (*q == '+') *q = '_';
+    stbi_flip_vertically_on_write(1);
+    stbi_write_png(path, W, H, 4, px, W * 4);
+}
+
+/* which: 0 = within the two-target limit, 1 = beyond it, 2 = the first seen from 5 units (depths
+   0.37..0.58: smaller red digits; SINGLE_TARGET saturates in some channels of some pixels) */
+static void run_combo(int ci, int which)
+{
+    const combo *c = &g_combos[ci];
+    const truth *t = get_truth(c->k[which == 1], which == 2);
+    const tscene *s = t->s;
+    outcome *o = &g_out[ci][which];
+    int single = (c->variants & FOGVOL_VARIANT_SINGLE_TARGET) != 0, i, frame;
+    double range = s->cam.zfar - s->cam.znear;
+    double lsb = range / pow(2.0, ((c->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * c->bits);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    unsigned char *px = (unsigned char *)malloc((size_t)W * H * 4);
+    glu_ctx g;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st;
+    int limit;
+    memset(o, 0, sizeof *o);
+    memset(&lc, 0, sizeof lc);
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = watch_proc;
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    cd.tier = c->tier;
+    cd.variants = c->variants;
+    cd.encoding_bits = c->bits;
+    cd.disable_dither = 1;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    limit = single ? fogvol_context_encoding(fv)->max_faces_single : fogvol_context_encoding(fv)->max_faces;
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.2f;
+    rd.color[1] = 0.8f;
+    rd.color[2] = 0.3f;
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+
+    g_blocking_reads = g_result_reads = 0;
+    o->result = shell_frame(fv, s, meshes, ramp, thick, &st);
+    assert_int_equal(st.frame, 0);
+    assert_int_equal(st.overflow_pixels_late, -1); /* nothing known yet: the GPU has not been asked */
+    o->readback_sat = st.overflow_pixels;
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    for (i = 0; i < W * H; ++i) {
+        double err = fabs(thick[i] - t->gt[i]) / lsb;
+        int wrong, mag = is_magenta(px + 4 * i);
+        if (!t->interior[i]) continue;
+        wrong = err > t->pairs[i] + 1e-6 * range / lsb;
+        if (err > o->max_err_lsb) o->max_err_lsb = err;
+        if (wrong && (o->min_wrong_lsb == 0 || err < o->min_wrong_lsb)) o->min_wrong_lsb = err;
+        o->wrong += wrong;
+        o->wrong_unmarked += wrong && !mag;
+        o->magenta += mag;
+        o->magenta_within_limit += mag && t->pairs[i] <= limit;
+    }
+    if (which == 1 || single) write_png(c->name, c->k[which == 1] + 1000 * (which == 2), px);
+    /* the count of frame 0 arrives without a read-back, a frame or two later */
+    o->late = -1;
+    for (frame = 1; frame <= 3 && st.overflow_frame < 0; ++frame) {
+        shell_frame(fv, s, meshes, ramp, NULL, &st);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px); /* what an engine's swap would do */
+    }
+    o->frames_to_count = frame - 1;
+    o->late = st.overflow_pixels_late;
+    o->late_frame = (int)st.overflow_frame;
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_int_equal(g_blocking_reads, 0);
+    assert_true(g_result_reads > 0);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free(thick);
+    free(px);
+
+    print_message("  %-16s %2d %s shells (max %2d faces, limit %2d): %-22s read-back %4d saturated, GPU count %4d "
+                  "(frame %d, after %d frames); %4d wrong (%.1f..%.1f LSB), %4d unmarked, %4d magenta, %d magenta "
+                  "within the limit\n",
+                  c->name, c->k[which == 1], which == 2 ? "near" : "far ", t->max_faces, limit, fogvol_result_string(o->result), o->readback_sat, o->late,
+                  o->late_frame, o->frames_to_count, o->wrong, o->min_wrong_lsb, o->max_err_lsb, o->wrong_unmarked, o->magenta,
+                  o->magenta_within_limit);
+    assert_int_equal(o->wrong_unmarked, 0);       /* every wrong pixel is magenta */
+    assert_int_equal(o->magenta_within_limit, 0); /* and none where the faces fit */
+    assert_int_equal(o->late_frame, 0);
+    assert_true(o->frames_to_count <= 2);
+    assert_int_equal(o->late, o->readback_sat); /* the GPU count is the read-back's */
+    if (t->max_faces <= limit) assert_int_equal(o->readback_sat, 0); /* the faces fit: nothing saturates */
+    if (which == 1) assert_true(o->readback_sat > 0);                 /* the scene is built to overflow */
+    if (o->readback_sat == 0) { /* more faces than the limit need not saturate: then nothing is wrong */
+        assert_int_equal(o->result, FOGVOL_SUCCESS);
+        assert_int_equal(o->magenta, 0);
+        assert_int_equal(o->late, 0);
+        assert_int_equal(o->wrong, 0);
+    } else {
+        assert_int_equal(o->result, FOGVOL_ERROR_DEPTH_OVERFLOW);
+        assert_true(o->late > 0);
+        assert_true(o->magenta > 0);
+    }
+}
+
+static void test_combo(void **state)
+{
+    const int *p = (const int *)*state;
+    run_combo(p[0], p[1]);
+}
+
+/* ---- policies on the GPU -------------------------------------------------- */
+/* LOWER_BITS: 20 shells at L = 4 overflow; the count arrives, L drops to 3 once (frames drawn
+   before the change report overflow too, and must not lower it again), and the next frames are
+   within the bound of the new encoding. */
+static void test_lower_bits(void **state)
+{
+    const truth *t = get_truth(20, 0);
+    const tscene *s = t->s;
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    glu_ctx g;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st;
+    fogvol_result r;
+    double range = s->cam.zfar - s->cam.znear, max_before = 0, max_after = 0;
+    int frame, i, lowered_at = -1, bad_after = 0;
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = watch_proc;
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.encoding_bits = 4;
+    cd.disable_dither = 1;
+    cd.overflow_policy = FOGVOL_OVERFLOW_LOWER_BITS;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    for (frame = 0; frame < 6; ++frame) {
+        int bits = fogvol_context_encoding(fv)->bits;
+        double lsb = range / pow(2.0, 3.0 * bits), max = 0;
+        unsigned char px[4];
+        r = shell_frame(fv, s, meshes, ramp, thick, &st);
+        glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        for (i = 0; i < W * H; ++i) {
+            double err;
+            if (!t->interior[i]) continue;
+            err = fabs(thick[i] - t->gt[i]) / lsb;
+            if (err > max) max = err;
+            if (bits == 3 && err > t->pairs[i] + 1e-6 * range / lsb) ++bad_after;
+        }
+        print_message("  lower_bits frame %d: L = %d, %s, late count %d (frame %lld), max error %.1f LSB\n", frame, bits,
+                      fogvol_result_string(r), st.overflow_pixels_late, (long long)st.overflow_frame, max);
+        if (bits == 4) {
+            assert_int_equal(r, FOGVOL_ERROR_DEPTH_OVERFLOW);
+            if (max > max_before) max_before = max;
+        } else {
+            assert_int_equal(bits, 3);
+            assert_int_equal(r, FOGVOL_SUCCESS);
+            assert_int_equal(st.overflow_pixels, 0);
+            if (max > max_after) max_after = max;
+        }
+        if (lowered_at < 0 && fogvol_context_encoding(fv)->bits == 3) lowered_at = frame;
+    }
+    print_message("  lower_bits: lowered after frame %d; max error %.1f LSB (L=4) -> %.2f LSB (L=3); %d warnings\n",
+                  lowered_at, max_before, max_after, lc.warnings);
+    assert_true(lowered_at >= 0 && lowered_at <= 2);
+    assert_int_equal(fogvol_context_encoding(fv)->bits, 3); /* once, not again for the frames drawn at L = 4 */
+    assert_int_equal(bad_after, 0);
+    assert_int_equal(st.overflow_pixels_late, 0); /* the GPU agrees: frames at L = 3 fit */
+    assert_true(max_before > 16);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free(thick);
+}
+
+/* WARN_ONCE (the default): one warning however many frames overflow; COUNT_ONLY: none. */
+static void test_warn_once(void **state)
+{
+    const truth *t = get_truth(20, 0);
+    glu_ctx g;
+    int policy;
+    (void)state;
+    for (policy = 0; policy < 2; ++policy) {
+        logcap lc;
+        fogvol_context_desc cd;
+        fogvol_context *fv;
+        fogvol_mesh *meshes[MAX_OBJ];
+        fogvol_ramp *ramp;
+        fogvol_ramp_desc rd;
+        fogvol_frame_stats st;
+        int frame, i;
+        memset(&lc, 0, sizeof lc);
+        assert_true(glu_create(&g, W, H, 1));
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.logger.func = logger;
+        cd.logger.user_data = &lc;
+        cd.tier = FOGVOL_TIER_PS20;
+        cd.overflow_policy = policy ? FOGVOL_OVERFLOW_COUNT_ONLY : FOGVOL_OVERFLOW_WARN_ONCE;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        upload_meshes(fv, t->s, meshes);
+        memset(&rd, 0, sizeof rd);
+        rd.density = 0.4f;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        for (frame = 0; frame < 5; ++frame) {
+            unsigned char px[4];
+            assert_int_equal(shell_frame(fv, t->s, meshes, ramp, NULL, &st), FOGVOL_SUCCESS); /* no read-back */
+            glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        }
+        assert_true(st.overflow_pixels_late > 0);
+        assert_int_equal(st.overflow_frame, 3);
+        assert_int_equal(lc.warnings, policy ? 0 : 1);
+        if (!policy) assert_non_null(strstr(lc.last, "logged once"));
+        assert_int_equal(fogvol_context_encoding(fv)->bits, 4);
+        for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+        glu_destroy(&g);
+    }
+}
+
+/* An engine's own occlusion query running across fogvol's frame: fogvol does not start its own
+   (GL would refuse it), the frame is not counted, no GL error reaches the engine. */
+static void test_engine_query_active(void **state)
+{
+    const truth *t = get_truth(20, 0);
+    glu_ctx g;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st;
+    GLuint q;
+    GLint cur = 0;
+    int i, frame;
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    cd.tier = FOGVOL_TIER_PS20;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    upload_meshes(fv, t->s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    glGenQueries(1, &q);
+    for (frame = 0; frame < 3; ++frame) {
+        glBeginQuery(GL_SAMPLES_PASSED, q);
+        shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+        glGetQueryiv(GL_SAMPLES_PASSED, GL_CURRENT_QUERY, &cur);
+        assert_int_equal((GLuint)cur, q); /* still the engine's */
+        glEndQuery(GL_SAMPLES_PASSED);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+    }
+    assert_int_equal(st.overflow_pixels_late, -1);
+    shell_frame(fv, t->s, meshes, ramp, NULL, &st); /* the engine's query ended: counted again */
+    glFinish();
+    shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+    assert_int_equal(st.overflow_frame, 3);
+    assert_true(st.overflow_pixels_late > 0);
+    glDeleteQueries(1, &q);
+    for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+}
+
+/* GLES 3 (a desktop context treated as GLES 3.0, GLSL 300 es): ANY_SAMPLES_PASSED reports 1 for
+   a frame with overflow and 0 without. */
+static void test_gles3_any_samples(void **state)
+{
+    int which;
+    (void)state;
+    for (which = 0; which < 2; ++which) {
+        const truth *t = get_truth(which ? 20 : 12, 0);
+        glu_ctx g;
+        logcap lc;
+        fogvol_context_desc cd;
+        fogvol_context *fv;
+        fogvol_mesh *meshes[MAX_OBJ];
+        fogvol_ramp *ramp;
+        fogvol_ramp_desc rd;
+        fogvol_frame_stats st;
+        int i, frame;
+        memset(&lc, 0, sizeof lc);
+        assert_true(glu_create(&g, W, H, 1));
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = watch_proc;
+        cd.gl.gles = 1;
+        cd.gl.version_major = 3;
+        cd.logger.func = logger;
+        cd.logger.user_data = &lc;
+        cd.tier = FOGVOL_TIER_PS20;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        upload_meshes(fv, t->s, meshes);
+        memset(&rd, 0, sizeof rd);
+        rd.density = 0.4f;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        g_blocking_reads = 0;
+        for (frame = 0; frame < 3; ++frame) {
+            unsigned char px[4];
+            shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+            glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        }
+        print_message("  GLES 3, %d shells: late count %d (frame %lld)\n", t->k, st.overflow_pixels_late,
+                      (long long)st.overflow_frame);
+        assert_int_equal(st.overflow_frame, 1);
+        assert_int_equal(st.overflow_pixels_late, which);
+        assert_int_equal(g_blocking_reads, 0);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+        glu_destroy(&g);
+    }
+}
+
+/* ---- the null backend: the plumbing ------------------------------------- */
+typedef struct nullrig {
+    fogvol_null_backend nb;
+    fogvol_context *fv;
+    fogvol_mesh *mesh;
+    fogvol_ramp *ramp;
+    logcap lc;
+} nullrig;
+
+static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned caps, int queries,
+                      fogvol_overflow_policy policy)
+{
+    static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t idx[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    fogvol_context_desc cd;
+    fogvol_mesh_desc md;
+    fogvol_ramp_desc rd;
+    memset(n, 0, sizeof *n);
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&n->nb, &cd.backend);
+    cd.backend.caps = caps;
+    n->nb.queries = queries;
+    cd.tier = tier;
+    cd.variants = variants;
+    cd.overflow_policy = policy;
+    cd.logger.func = logger;
+    cd.logger.user_data = &n->lc;
+    assert_int_equal(fogvol_create_context(&cd, &n->fv), FOGVOL_SUCCESS);
+    memset(&md, 0, sizeof md);
+    md.positions = pos;
+    md.vertex_count = 4;
+    md.indices = idx;
+    md.index_count = 12;
+    assert_int_equal(fogvol_create_mesh(n->fv, &md, &n->mesh, NULL), FOGVOL_SUCCESS);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 1;
+    assert_int_equal(fogvol_create_ramp(n->fv, &rd, &n->ramp), FOGVOL_SUCCESS);
+}
+
+static fogvol_result null_frame(nullrig *n, int show_overflow, int volumes, fogvol_frame_stats *st)
+{
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    memset(&fd, 0, sizeof fd);
+    glu_identity(fd.view);
+    glu_perspective(fd.projection, 60, 1, 0.5, 10);
+    fd.znear = 0.5f;
+    fd.zfar = 10;
+    fd.viewport[2] = 16;
+    fd.viewport[3] = 16;
+    fd.show_overflow = show_overflow;
+    assert_int_equal(fogvol_begin_frame(n->fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = n->mesh;
+    vd.ramp = n->ramp;
+    glu_translate_scale(vd.model, 0, 0, -3, 1);
+    if (volumes) assert_int_equal(fogvol_add_volume(n->fv, &vd), FOGVOL_SUCCESS);
+    return fogvol_end_frame(n->fv, st);
+}
+
+static void null_close(nullrig *n)
+{
+    fogvol_destroy_mesh(n->fv, n->mesh);
+    fogvol_destroy_ramp(n->fv, n->ramp);
+    fogvol_destroy_context(n->fv);
+    assert_int_equal(n->nb.creates, n->nb.destroys);
+    assert_int_equal(n->nb.query_active, 0);
+}
+
+static void test_null_plumbing(void **state)
+{
+    nullrig n;
+    fogvol_frame_stats st;
+    int f;
+    (void)state;
+    /* PS20: one check pass per frame, bracketed by a query, after the sums, before the composite */
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_WARN_ONCE);
+    n.nb.query_samples = 1234;
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.passes, 4);           /* O, B, F, composite: as before */
+    assert_int_equal(st.overflow_passes, 1);  /* + the check */
+    assert_int_equal(n.nb.pass_count, 5);
+    assert_int_equal(n.nb.fullscreen[3], 1);
+    assert_int_equal(n.nb.passes[3].blend, FOGVOL_PASS_BLEND_NONE);
+    assert_true(n.nb.passes[3].target != 0);
+    assert_int_equal(n.nb.passes[3].textures[0], n.nb.passes[1].target); /* reads B ... */
+    assert_int_equal(n.nb.passes[3].textures[1], n.nb.passes[2].target); /* ... and F */
+    assert_int_equal(n.nb.passes[4].target, 0);                          /* then the composite */
+    assert_int_equal(n.nb.queries_begun, 1);
+    assert_int_equal(n.nb.queries_ended, 1);
+    assert_int_equal(st.overflow_pixels_late, -1);
+    assert_int_equal(st.overflow_frame, -1);
+    assert_int_equal(n.lc.warnings, 0);
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.frame, 1);
+    assert_int_equal(st.overflow_pixels_late, 1234); /* frame 0's count, read in frame 1 */
+    assert_int_equal(st.overflow_frame, 0);
+    assert_int_equal(n.lc.warnings, 1);
+    /* the GPU lags: polls answer "not yet", nothing waits, the count comes when it is there */
+    n.nb.query_not_ready = 3;
+    n.nb.query_samples = 7;
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_frame, 0); /* frame 1 not ready yet: still frame 0's */
+    assert_int_equal(st.overflow_pixels_late, 1234);
+    for (f = 0; f < 3 && st.overflow_frame < 2; ++f) null_frame(&n, 0, 1, &st);
+    assert_true(st.overflow_frame >= 2);
+    assert_int_equal(st.overflow_pixels_late, 7);
+    assert_int_equal(n.lc.warnings, 1); /* once */
+    /* a frame without volumes counts 0 at once */
+    n.nb.query_samples = 0;
+    assert_int_equal(null_frame(&n, 0, 0, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_passes, 0);
+    assert_int_equal(st.overflow_frame, st.frame);
+    assert_int_equal(st.overflow_pixels_late, 0);
+    /* the GPU more than four frames behind: frames go uncounted, none waits */
+    n.nb.query_not_ready = 1000;
+    for (f = 0; f < 8; ++f) assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_true(n.nb.queries_begun - n.nb.queries_ended == 0);
+    n.nb.query_not_ready = 0;
+    null_frame(&n, 0, 1, &st);
+    null_frame(&n, 0, 1, &st);
+    assert_true(st.overflow_frame > 5);
+    null_close(&n);
+
+    /* SINGLE_TARGET: a check after the additions (clears the mask, depth-tested) and one after the
+       subtractions; the composite reads the mask as its second texture */
+    null_open(&n, FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_CAP_HIGHP_FRAGMENT, 1,
+              FOGVOL_OVERFLOW_WARN_ONCE);
+    assert_int_equal(null_frame(&n, 1, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.passes, 4);
+    assert_int_equal(st.overflow_passes, 2);
+    assert_int_equal(n.nb.pass_count, 6); /* O, S+, check, S-, check, composite */
+    assert_int_equal(n.nb.passes[2].clear, 1);
+    assert_int_equal(n.nb.passes[2].depth_test, 1);
+    assert_int_equal(n.nb.passes[2].depth_write, 1);
+    assert_int_equal(n.nb.passes[2].textures[0], n.nb.passes[1].target);
+    assert_int_equal(n.nb.passes[3].blend, FOGVOL_PASS_BLEND_SUBTRACT);
+    assert_int_equal(n.nb.passes[4].clear, 0);
+    assert_int_equal(n.nb.passes[4].target, n.nb.passes[2].target);
+    assert_int_equal(n.nb.passes[5].textures[1], n.nb.passes[2].target);
+    assert_int_equal(n.nb.queries_begun, 2);
+    null_close(&n);
+
+    /* no queries (the default null backend): the single-target peak check still runs for
+       show_overflow, nothing is counted */
+    null_open(&n, FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_CAP_HIGHP_FRAGMENT, 0,
+              FOGVOL_OVERFLOW_WARN_ONCE);
+    assert_int_equal(null_frame(&n, 1, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_passes, 1);
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_passes, 0);
+    assert_int_equal(st.overflow_pixels_late, -1);
+    assert_int_equal(n.nb.queries_begun, 0);
+    null_close(&n);
+
+    /* OFF: no check pass, no query even with queries */
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_OFF);
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_passes, 0);
+    assert_int_equal(n.nb.pass_count, 4);
+    assert_int_equal(st.overflow_pixels_late, -1);
+    assert_int_equal(n.nb.create_calls, n.nb.creates); /* no query was even created */
+    null_close(&n);
+
+    /* FLOAT cannot overflow: 0, for this very frame, with no check pass */
+    null_open(&n, FOGVOL_TIER_FLOAT, 0, FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_FLOAT_BLEND, 1,
+              FOGVOL_OVERFLOW_WARN_ONCE);
+    assert_int_equal(null_frame(&n, 1, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.overflow_passes, 0);
+    assert_int_equal(st.overflow_pixels_late, 0);
+    assert_int_equal(st.overflow_frame, st.frame);
+    assert_int_equal(n.nb.queries_begun, 0);
+    null_close(&n);
+
+    /* LOWER_BITS on the null backend: L 4 -> 3 -> 2 -> 1 as counts keep coming, then a warning */
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_LOWER_BITS);
+    n.nb.query_samples = 5;
+    for (f = 0; f < 12; ++f) null_frame(&n, 0, 1, &st);
+    assert_int_equal(fogvol_context_encoding(n.fv)->bits, 1);
+    assert_int_equal(n.lc.warnings, 4); /* three lowerings, then "cannot" once */
+    null_close(&n);
+}
+
+static void test_bad_policy(void **state)
+{
+    fogvol_null_backend nb;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    logcap lc;
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&nb, &cd.backend);
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    cd.overflow_policy = (fogvol_overflow_policy)7;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_null(fv);
+    assert_int_equal(lc.errors, 1);
+    assert_int_equal(nb.creates, 0);
+}
+
+int main(void)
+{
+    static int params[NCOMBO * 3][2];
+    struct CMUnitTest tests[NCOMBO * 3 + 8];
+    int n = 0, i, j, fails;
+    char *names[NCOMBO * 3];
+    build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
+    assert_int_equal(scene_index("sphere"), 0);
+    for (i = 0; i < NCOMBO; ++i)
+        for (j = 0; j < 3; ++j) {
+            params[n][0] = i;
+            params[n][1] = j;
+            names[n] = (char *)malloc(64);
+            snprintf(names[n], 64, "%s_%d_shells%s", g_combos[i].name, g_combos[i].k[j == 1], j == 2 ? "_near" : "");
+            memset(&tests[n], 0, sizeof tests[n]);
+            tests[n].name = names[n];
+            tests[n].test_func = test_combo;
+            tests[n].initial_state = params[n];
+            ++n;
+        }
+    {
+        const struct CMUnitTest more[] = {
+            cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_bad_policy),
+            cmocka_unit_test(test_lower_bits),      cmocka_unit_test(test_warn_once),
+            cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
+        };
+        for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) tests[n++] = more[i];
+    }
+    fails = _cmocka_run_group_tests("overflow", tests, (size_t)n, NULL, NULL);
+    for (i = 0; i < NCOMBO * 3; ++i) free(names[i]);
+    for (i = 0; i < NTRUTH; ++i) {
+        free(g_truth[i].gt);
+        free(g_truth[i].pairs);
+        free(g_truth[i].interior);
+        free(g_truth[i].covered);
+    }
+    free_scenes();
+    return fails;
+}
