@@ -1214,9 +1214,11 @@ typedef struct fogvol_frame_desc {
     int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
                                variant; SINGLE_TARGET runs one check pass after its additions for it,
                                into the overflow mask V); FLOAT cannot saturate */
-    /* Debug read-back of the decoded thickness (world units) per pixel of the
-       viewport, rows bottom to top, for the group of debug_ramp (NULL = the
-       first group). Set debug_thickness to a width*height float buffer. */
+    /* Debug read-back of the decoded thickness per pixel of the viewport, rows
+       bottom to top, for the group of debug_ramp (NULL = the first group). Set
+       debug_thickness to a width*height float buffer. Units: view-space w (the
+       distance along the view axis, world units when the view matrix has no
+       scale), between znear and zfar; this read-back stalls, for debugging only. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
