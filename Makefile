@@ -1,4 +1,5 @@
 # fogvol.h - tests, demo and examples. The library itself is fogvol.h alone.
+#   make check  the fast inner loop (CPU, null backend, GL smoke tests, README blocks: < 1 min)
 #   make test   build and run every test (installs missing Debian packages)
 #   make demo   render the headless demo into build/demo/*.png
 #   make images refresh the README pictures in docs/ from the demo
@@ -19,7 +20,7 @@ FUZZ_TIME ?= 60
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean
+.PHONY: all check test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean
 
 all: test
 
@@ -106,6 +107,13 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
 TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
 TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
+
+# the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
+# validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
+check: deps-test
+	@$(MAKE) --no-print-directory -j2 $(BUILD)/test_cpu $(BUILD)/test_backend
+	@LOGDIR=$(BUILD)/logs tests/run.sh "cpu=$(TAP) $(BUILD)/test_cpu" "backend=$(TAP) $(BUILD)/test_backend" \
+	  "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh"
 
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory $(TEST_BINS)
