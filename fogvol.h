@@ -5348,9 +5348,23 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
     return r;
 }
 
-FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info)
+/* For the *_prepare calls: fogvol's targets sized to the frame (touches the
+   GPU, state restored), the frame's constants and O's API object. */
+static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
 {
     fogvol_frame_info fi;
+    fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    if (r != FOGVOL_SUCCESS) return r;
+    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, k);
+    *texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info)
+{
     fogvol_constants k;
     fogvol_result r;
     if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -5360,13 +5374,8 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
                                                  "backend with native_texture");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    r = fogvol__begin_backend_frame(ctx, &fi);
+    r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
-    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    if (r != FOGVOL_SUCCESS) return r;
-    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, &k);
-    info->texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
     info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
     info->uniforms[0] = k.near_far[0];
     info->uniforms[1] = k.near_far[1];
@@ -5439,7 +5448,6 @@ static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_
 
 FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info)
 {
-    fogvol_frame_info fi;
     fogvol_constants k;
     fogvol_result r;
     int fl;
@@ -5459,13 +5467,8 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
                     ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    r = fogvol__begin_backend_frame(ctx, &fi);
+    r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
-    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    if (r != FOGVOL_SUCCESS) return r;
-    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, &k);
-    info->texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
     info->width = ctx->target_w;
     info->height = ctx->target_h;
     info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
