@@ -4351,6 +4351,25 @@ static fogvol_result fogvol__make_texture(fogvol_context *ctx, int which, fogvol
     return r;
 }
 
+/* Texture units of fogvol's programs, as fogvol__make_program binds their samplers. The encode and
+   face programs read the lookup textures and the opaque depth; the resolve, check and composite
+   programs read the sums. */
+enum {
+    FOGVOL__UNIT_RG = 0,      /* fv_rg: red/green ramp of the encoding */
+    FOGVOL__UNIT_BLUE = 1,    /* fv_blue: blue ramp (low digits, dithered) */
+    FOGVOL__UNIT_DITHER = 2,  /* fv_dither: the dither pattern */
+    FOGVOL__UNIT_OPAQUE = 3,  /* fv_opaque: encoded opaque depth O (or the engine's depth texture) */
+    FOGVOL__UNIT_OPAQUE2 = 4  /* fv_opaque2: WIDE, O's second attachment */
+};
+enum {
+    FOGVOL__UNIT_BACK = 0,    /* fv_back: sum of back faces B (PS13: the resolved difference T) */
+    FOGVOL__UNIT_FRONT = 1,   /* fv_front: sum of front faces F (SINGLE_TARGET: the overflow mask V) */
+    FOGVOL__UNIT_RAMP = 2,    /* fv_colors: the ramp's colour texture */
+    FOGVOL__UNIT_COUNTS = 3,  /* fv_opaque: COUNT, the opaque depth O whose alpha holds the counts */
+    FOGVOL__UNIT_BACK2 = 4,   /* fv_back2, fv_front2: WIDE, second attachments */
+    FOGVOL__UNIT_FRONT2 = 5
+};
+
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
 {
     static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg",     "fv_blue",    "fv_dither",
@@ -4381,8 +4400,9 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
         pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
-    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[4] = NULL;
-    if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) pd.samplers[3] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[FOGVOL__UNIT_OPAQUE2] = NULL;
+    if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH))
+        pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
     pd.label = labels[p];
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
@@ -5275,9 +5295,9 @@ static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
     ps->draw_buffer = ps->alpha_coverage = 0;
     memset(ps->textures, 0, sizeof ps->textures);
     memset(ps->native_textures, 0, sizeof ps->native_textures);
-    ps->textures[0] = ctx->tex_rg;
-    ps->textures[1] = ctx->tex_blue;
-    ps->textures[2] = ctx->tex_dither;
+    ps->textures[FOGVOL__UNIT_RG] = ctx->tex_rg;
+    ps->textures[FOGVOL__UNIT_BLUE] = ctx->tex_blue;
+    ps->textures[FOGVOL__UNIT_DITHER] = ctx->tex_dither;
 }
 
 /* Make ctx->prog the per-sample set (ms = 1) or the single-sample set, building
@@ -5656,7 +5676,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol_pass *base, int
     memset(cp.native_textures, 0, sizeof cp.native_textures);
     if (single) { /* the one sum target; V is the target here, not a texture */
         memset(cp.textures, 0, sizeof cp.textures);
-        cp.textures[0] = ctx->tgt_b;
+        cp.textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
     }
     ctx->be.begin_pass(ctx->be.user_data, &cp);
     q = fogvol__query_begin(ctx);
@@ -5723,286 +5743,340 @@ static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
                 ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
 }
 
-FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
-{
+/* One fogvol_end_frame: what its passes share. */
+typedef struct fogvol__run {
     fogvol_frame_stats st;
     fogvol_frame_info info;
-    fogvol_constants k;
-    fogvol_pass ps;
-    fogvol_result r = FOGVOL_SUCCESS, rr;
-    const fogvol_frame_desc *fd;
-    int i, w, h, g, overflow = 0, captured = 0;
-    int single, count, rgba8, counted = 0, checks = 0, fresh = 0;
-    unsigned char *peak = NULL;
-    uintptr_t engine_depth;
-    memset(&st, 0, sizeof st);
-    st.overflow_pixels_late = -1;
-    st.overflow_frame = -1;
-    if (stats) *stats = st;
-    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    fd = &ctx->frame;
-    w = fd->viewport[2];
-    h = fd->viewport[3];
-    single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
-    rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
+    fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
+    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    int w, h, single, count, rgba8;
+    int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
+    int captured, overflow;     /* debug read-back done; its overflow pixel count */
+    fogvol_result r;            /* the last error that did not stop the frame */
+} fogvol__run;
+
+/* Frames fogvol refuses before touching the backend (logged; the caller cancels the frame). */
+static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
     if (ctx->tier == FOGVOL_TIER_MRT && !ctx->mrt_ready) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: MRT tier: call fogvol_mrt_prepare and let the engine "
                                                  "write O before fogvol_end_frame");
-        fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE &&
-        !fd->engine_depth_texture) {
+    if (engine && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE && !fd->engine_depth_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
-        fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE &&
-        !ctx->be.copy_depth) {
+    if (engine && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE && !ctx->be.copy_depth) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
                                                  "pass a depth texture (engine_depth_texture)");
-        fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    if (count && (i = fogvol__count_near_cut(ctx)) >= 0) {
+    if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) && (i = fogvol__count_near_cut(ctx)) >= 0) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: COUNT variant: the near plane may cut volume %d (the camera is inside it or closer than "
                     "znear), which breaks the face count; nothing drawn. Draw such views without COUNT",
                     i);
-        fogvol_cancel_frame(ctx);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
-    r = fogvol__begin_backend_frame(ctx, &info);
-    if (r != FOGVOL_SUCCESS) {
-        fogvol_cancel_frame(ctx);
-        return r;
-    }
-    r = fogvol__frame_samples(ctx, &info, &st);
-    if (r != FOGVOL_SUCCESS) goto done;
-    r = fogvol__ensure_targets(ctx, w, h);
-    if (r != FOGVOL_SUCCESS) goto done;
-    engine_depth = fd->engine_depth_texture;
+    return FOGVOL_SUCCESS;
+}
+
+/* Inside the backend frame, before any pass: sample count, targets, the engine's depth, and the
+   overflow count (earlier frames' queries polled without waiting; this frame's check passes). */
+static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
+    if (r == FOGVOL_SUCCESS) r = fogvol__ensure_targets(ctx, run->w, run->h);
+    if (r != FOGVOL_SUCCESS) return r;
+    run->engine_depth = fd->engine_depth_texture;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
         r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
                                fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
-                               &engine_depth);
+                               &run->engine_depth);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
                         fogvol_result_string(r));
-            goto done;
+            return r;
         }
     }
-    /* overflow: earlier frames' counts (never waiting), this frame's check passes */
-    fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
-    counted = rgba8 && fogvol__overflow_open(ctx);
-    checks = counted || (rgba8 && single && fd->show_overflow);
-    if (checks && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) {
-        counted = checks = 0;
+    run->fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
+    run->counted = run->rgba8 && fogvol__overflow_open(ctx);
+    run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
+    if (run->checks && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without checks */
+        run->counted = run->checks = 0;
         ctx->qcur = -1;
+        run->r = r;
     }
+    return FOGVOL_SUCCESS;
+}
 
-    /* pass uniforms common to every pass */
-    memset(&ps, 0, sizeof ps);
-    ps.per_sample = ctx->samples > 1;
-    ps.uniforms[FOGVOL_U_ENC][0] = (float)ctx->enc.levels;
-    ps.uniforms[FOGVOL_U_ENC][1] = (float)ctx->enc.levels * (float)ctx->enc.levels;
-    ps.uniforms[FOGVOL_U_ENC][2] = k.depth_offset;
-    ps.uniforms[FOGVOL_U_ENC][3] = k.depth_max;
-    ps.uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
-    ps.uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
-    ps.uniforms[FOGVOL_U_DITHER][2] = (float)ctx->enc.dither_steps;
-    ps.uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)w;
-    ps.uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)h;
-    if (rgba8) {
-        memcpy(ps.uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
-        if (count || ctx->tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
-            ps.uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
+/* The uniforms every pass of the frame gets, in run->base (target space, lookup textures bound). */
+static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_pass *ps = &run->base;
+    fogvol_constants k;
+    fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
+    memset(ps, 0, sizeof *ps);
+    ps->per_sample = ctx->samples > 1;
+    ps->uniforms[FOGVOL_U_ENC][0] = (float)ctx->enc.levels;
+    ps->uniforms[FOGVOL_U_ENC][1] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    ps->uniforms[FOGVOL_U_ENC][2] = k.depth_offset;
+    ps->uniforms[FOGVOL_U_ENC][3] = k.depth_max;
+    ps->uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
+    ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
+    ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->enc.dither_steps;
+    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)run->w;
+    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)run->h;
+    if (run->rgba8) {
+        memcpy(ps->uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
+        if (run->count || ctx->tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
+            ps->uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
         if (fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) { /* u = clamp(d, 0, 1 - N^-6), no offset */
             double n6 = (double)ctx->enc.levels * ctx->enc.levels * ctx->enc.levels;
             n6 *= n6;
-            ps.uniforms[FOGVOL_U_ENC][2] = 0.0f;
-            ps.uniforms[FOGVOL_U_ENC][3] = (float)(1.0 - 1.0 / n6);
+            ps->uniforms[FOGVOL_U_ENC][2] = 0.0f;
+            ps->uniforms[FOGVOL_U_ENC][3] = (float)(1.0 - 1.0 / n6);
         }
     } else {
-        ps.uniforms[FOGVOL_U_DECODE][0] = fd->zfar - fd->znear;
+        ps->uniforms[FOGVOL_U_DECODE][0] = fd->zfar - fd->znear;
     }
-    fogvol__clip_uniforms(ctx, &info, &ps);
-    ps.uniforms[FOGVOL_U_MISC][1] = 1.0f; /* fogvol's own clip z in every pass */
-    ps.uniforms[FOGVOL_U_NEARFAR][0] = k.near_far[0];
-    ps.uniforms[FOGVOL_U_NEARFAR][1] = k.near_far[1];
-    ps.uniforms[FOGVOL_U_NEARFAR][2] = (float)fd->viewport[0]; /* ENGINE_DEPTH: target pixel -> engine texel */
-    ps.uniforms[FOGVOL_U_NEARFAR][3] = (float)fd->viewport[1];
-    fogvol__target_space(ctx, &ps);
+    fogvol__clip_uniforms(ctx, &run->info, ps);
+    ps->uniforms[FOGVOL_U_MISC][1] = 1.0f; /* fogvol's own clip z in every pass */
+    ps->uniforms[FOGVOL_U_NEARFAR][0] = k.near_far[0];
+    ps->uniforms[FOGVOL_U_NEARFAR][1] = k.near_far[1];
+    ps->uniforms[FOGVOL_U_NEARFAR][2] = (float)fd->viewport[0]; /* ENGINE_DEPTH: target pixel -> engine texel */
+    ps->uniforms[FOGVOL_U_NEARFAR][3] = (float)fd->viewport[1];
+    fogvol__target_space(ctx, ps);
+}
 
-    /* step b: opaque depth into O (MRT: the engine wrote it; ENGINE_DEPTH: its depth texture) */
-    if (fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) && !ctx->engine_occluders) {
-        ps.target = ctx->tgt_o;
-        ps.clear = 1;
-        if (rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
-        else ps.clear_color[0] = 1.0f;
-        ps.depth_test = ps.depth_write = 1;
-        ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[3] = engine_depth;
-        ctx->be.begin_pass(ctx->be.user_data, &ps);
-        st.passes++;
-        ctx->in_occluder_pass = 1;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) /* PS20: encode the engine's depth, full-screen */
-            ctx->be.draw_fullscreen(ctx->be.user_data);
-        for (i = 0; i < ctx->nocc && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH); ++i) {
-            const fogvol__occluder *o = &ctx->occ[i];
-            if (o->fn) {
-                o->fn(ctx, o->user_data);
-            } else {
-                fogvol_draw dr;
-                fogvol__draw_for(ctx, o->model, &dr);
-                ctx->be.draw_mesh(ctx->be.user_data, o->mesh->handle, &dr);
-            }
-            st.occluders++;
-        }
-        ctx->in_occluder_pass = 0;
-        fogvol__end_pass(ctx);
-        ps.native_textures[3] = 0;
-    }
-    ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
-    ps.depth_write = 0;
-
-    /* steps c-e per colour-ramp group, in order of first appearance */
-    for (g = 0; g < ctx->nvol; ++g) {
-        const fogvol_ramp *ramp = ctx->vols[g].ramp;
-        int seen = 0, has_pos = 0, has_neg = 0;
-        for (i = 0; i < g && !seen; ++i) seen = ctx->vols[i].ramp == ramp;
-        if (seen) continue;
-        for (i = g; i < ctx->nvol; ++i)
-            if (ctx->vols[i].ramp == ramp) {
-                if (ctx->vols[i].negative) has_neg = 1;
-                else has_pos = 1;
-            }
-        if (!has_pos) continue; /* negative volumes alone subtract from nothing */
-        st.groups++;
-        for (i = g; i < ctx->nvol; ++i) st.volumes += ctx->vols[i].ramp == ramp;
-
-        ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
-        ps.depth_test = count; /* COUNT: against the opaque depth shared from O */
-        ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
-            ps.native_textures[3] = engine_depth;
-        else ps.textures[3] = ctx->tgt_o;
-        ps.textures[4] = ctx->tgt_o2;
-        if (ctx->tier == FOGVOL_TIER_FLOAT) {
-            /* c+d in one pass: every face, signed by gl_FrontFacing */
-            ps.target = ctx->tgt_b;
-            ps.clear = 1;
-            ps.cull = FOGVOL_CULL_NONE;
-            ps.blend = FOGVOL_PASS_BLEND_ADD;
-            ctx->be.begin_pass(ctx->be.user_data, &ps);
-            fogvol__draw_group(ctx, ramp, -1);
-            fogvol__end_pass(ctx);
-            st.passes++;
-        } else if (single) {
-            ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
-            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp,
-                                          has_neg);
-            if (checks) fogvol__check_pass(ctx, &ps, 1, &st); /* saturation at the peak of the sum */
-            if (fogvol__want_debug(ctx, ramp, captured)) {
-                peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)w * (size_t)h);
-                rr = peak ? fogvol__single_peak(ctx, peak) : FOGVOL_ERROR_OUT_OF_MEMORY;
-                if (rr != FOGVOL_SUCCESS) r = rr;
-            }
-            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp,
-                                          has_neg);
-            ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 0.0f;
+/* The opaque depth O, encoded like the volumes' depth: the occluders drawn by fogvol (or by the
+   engine's callbacks), or PS20 + ENGINE_DEPTH: the engine's depth texture encoded full-screen. Not
+   drawn where the engine wrote O (MRT, fogvol_occluder_prepare) or the tier reads no O. */
+static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol_pass ps = run->base;
+    int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
+    if (!fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) || ctx->engine_occluders) return;
+    ps.target = ctx->tgt_o;
+    ps.clear = 1;
+    if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    else ps.clear_color[0] = 1.0f;
+    ps.depth_test = ps.depth_write = 1;
+    ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+    if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    ctx->be.begin_pass(ctx->be.user_data, &ps);
+    run->st.passes++;
+    ctx->in_occluder_pass = 1;
+    if (engine) ctx->be.draw_fullscreen(ctx->be.user_data);
+    for (i = 0; i < ctx->nocc && !engine; ++i) {
+        const fogvol__occluder *o = &ctx->occ[i];
+        if (o->fn) {
+            o->fn(ctx, o->user_data);
         } else {
-            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp,
-                                          has_neg);
-            st.passes += fogvol__sum_pass(ctx, &ps, ctx->tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp,
-                                          has_neg);
+            fogvol_draw dr;
+            fogvol__draw_for(ctx, o->model, &dr);
+            ctx->be.draw_mesh(ctx->be.user_data, o->mesh->handle, &dr);
         }
-        ps.depth_test = 0;
-        ps.cull = FOGVOL_CULL_NONE;
-
-        if (fogvol__want_debug(ctx, ramp, captured)) {
-            rr = fogvol__debug_capture(ctx, peak, &overflow);
-            captured = 1;
-            if (rr != FOGVOL_SUCCESS) r = rr;
-            fogvol__free(&ctx->alloc, peak);
-            peak = NULL;
-        }
-        memset(ps.textures, 0, sizeof ps.textures);
-        memset(ps.native_textures, 0, sizeof ps.native_textures);
-        ps.textures[0] = ctx->tgt_b;
-        ps.textures[1] = ctx->tgt_f;
-        ps.textures[3] = count ? ctx->tgt_o : 0;
-        ps.textures[4] = ctx->tgt_b2;
-        ps.textures[5] = ctx->tgt_f2;
-        if (ctx->tier == FOGVOL_TIER_PS13) { /* resolve B - F into T */
-            ps.target = ctx->tgt_t;
-            ps.clear = 0;
-            ps.blend = FOGVOL_PASS_BLEND_NONE;
-            ps.program = ctx->prog[FOGVOL_PROGRAM_RESOLVE];
-            ctx->be.begin_pass(ctx->be.user_data, &ps);
-            ctx->be.draw_fullscreen(ctx->be.user_data);
-            fogvol__end_pass(ctx);
-            st.passes++;
-            ps.textures[0] = ctx->tgt_t;
-            ps.textures[1] = 0;
-        }
-        if (counted) fogvol__check_pass(ctx, &ps, !single, &st);
-        if (single) ps.textures[1] = ctx->tgt_v; /* the mask of the peak check, for show_overflow */
-
-        /* composite into the engine framebuffer */
-        ps.target = 0;
-        ps.clear = 0;
-        memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
-        ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)w;
-        ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)h;
-        ps.uniforms[FOGVOL_U_MISC][3] = 0.0f;
-        ps.uniforms[FOGVOL_U_MISC][1] = 1.0f;
-        ps.blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
-        ps.cull = FOGVOL_CULL_NONE;
-        ps.draw_buffer = fd->draw_buffer;
-        ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-        if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__group_rect(ctx, ramp, ps.scissor);
-        ps.program = ctx->prog[FOGVOL_PROGRAM_COMPOSITE];
-        ps.textures[2] = ramp->texture;
-        ps.uniforms[FOGVOL_U_RAMP][0] =
-            (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
-        ps.uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
-        ps.uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
-        ctx->be.begin_pass(ctx->be.user_data, &ps);
-        st.passes++;
-        ctx->be.draw_fullscreen(ctx->be.user_data);
-        fogvol__end_pass(ctx);
-        fogvol__target_space(ctx, &ps); /* back to target-space settings for the next group */
+        run->st.occluders++;
     }
-    if (counted) fogvol__overflow_close(ctx);
-    if (!rgba8) { /* float sums cannot saturate */
+    ctx->in_occluder_pass = 0;
+    fogvol__end_pass(ctx);
+}
+
+/* The face sums of one ramp group: FLOAT one signed pass into B; SINGLE_TARGET back faces up and
+   front faces down in B (with the overflow check at the peak); else back faces into B and front
+   faces into F. The debug read-back, when asked for this group, follows the sums. */
+static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, int has_neg)
+{
+    fogvol_pass ps = run->base;
+    unsigned char *peak = NULL;
+    fogvol_result r;
+    ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
+    ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
+    ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+        ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
+    ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->tgt_o2;
+    if (ctx->tier == FOGVOL_TIER_FLOAT) { /* every face, signed by gl_FrontFacing */
+        ps.target = ctx->tgt_b;
+        ps.clear = 1;
+        ps.blend = FOGVOL_PASS_BLEND_ADD;
+        ctx->be.begin_pass(ctx->be.user_data, &ps);
+        fogvol__draw_group(ctx, ramp, -1);
+        fogvol__end_pass(ctx);
+        run->st.passes++;
+    } else if (run->single) {
+        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
+        run->st.passes +=
+            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+        if (run->checks) fogvol__check_pass(ctx, &ps, 1, &run->st); /* saturation at the peak of the sum */
+        if (fogvol__want_debug(ctx, ramp, run->captured)) {
+            peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)run->w * (size_t)run->h);
+            r = peak ? fogvol__single_peak(ctx, peak) : FOGVOL_ERROR_OUT_OF_MEMORY;
+            if (r != FOGVOL_SUCCESS) run->r = r;
+        }
+        run->st.passes +=
+            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp, has_neg);
+    } else {
+        run->st.passes +=
+            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+        run->st.passes +=
+            fogvol__sum_pass(ctx, &ps, ctx->tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+    }
+    if (fogvol__want_debug(ctx, ramp, run->captured)) {
+        r = fogvol__debug_capture(ctx, peak, &run->overflow);
+        run->captured = 1;
+        if (r != FOGVOL_SUCCESS) run->r = r;
+    }
+    fogvol__free(&ctx->alloc, peak);
+}
+
+/* *ps: target-space state reading the sums (composite texture units); PS13 first resolves B - F
+   into T, which the later passes read instead. */
+static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps)
+{
+    *ps = run->base;
+    memset(ps->textures, 0, sizeof ps->textures);
+    ps->textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
+    ps->textures[FOGVOL__UNIT_FRONT] = ctx->tgt_f;
+    ps->textures[FOGVOL__UNIT_COUNTS] = run->count ? ctx->tgt_o : 0;
+    ps->textures[FOGVOL__UNIT_BACK2] = ctx->tgt_b2;
+    ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
+    if (ctx->tier != FOGVOL_TIER_PS13) return;
+    ps->target = ctx->tgt_t;
+    ps->program = ctx->prog[FOGVOL_PROGRAM_RESOLVE];
+    ctx->be.begin_pass(ctx->be.user_data, ps);
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    fogvol__end_pass(ctx);
+    run->st.passes++;
+    ps->textures[FOGVOL__UNIT_BACK] = ctx->tgt_t;
+    ps->textures[FOGVOL__UNIT_FRONT] = 0;
+}
+
+/* Composite one ramp group into the engine framebuffer: thickness -> ramp colour and alpha, blended
+   as fog or light. ps: the state of fogvol__sum_sources. */
+static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, const fogvol_ramp *ramp)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    ps->target = 0;
+    ps->clear = 0;
+    memcpy(ps->viewport, fd->viewport, sizeof ps->viewport);
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
+    ps->draw_buffer = fd->draw_buffer;
+    ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
+    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__group_rect(ctx, ramp, ps->scissor);
+    ps->program = ctx->prog[FOGVOL_PROGRAM_COMPOSITE];
+    ps->textures[FOGVOL__UNIT_RAMP] = ramp->texture;
+    ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
+    ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
+    ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
+    ctx->be.begin_pass(ctx->be.user_data, ps);
+    run->st.passes++;
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    fogvol__end_pass(ctx);
+}
+
+/* The passes of the colour-ramp group of volume g, unless an earlier volume shares its ramp (the
+   groups come in order of first appearance) or the group holds negative volumes only (they
+   subtract from nothing). */
+static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    const fogvol_ramp *ramp = ctx->vols[g].ramp;
+    fogvol_pass ps;
+    int i, has_pos = 0, has_neg = 0;
+    for (i = 0; i < g; ++i)
+        if (ctx->vols[i].ramp == ramp) return;
+    for (i = g; i < ctx->nvol; ++i)
+        if (ctx->vols[i].ramp == ramp) {
+            if (ctx->vols[i].negative) has_neg = 1;
+            else has_pos = 1;
+        }
+    if (!has_pos) return;
+    run->st.groups++;
+    for (i = g; i < ctx->nvol; ++i) run->st.volumes += ctx->vols[i].ramp == ramp;
+    fogvol__sum_passes(ctx, run, ramp, has_neg);
+    fogvol__sum_sources(ctx, run, &ps);
+    if (run->counted) fogvol__check_pass(ctx, &ps, !run->single, &run->st);
+    if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
+    fogvol__composite_pass(ctx, run, &ps, ramp);
+}
+
+/* After the groups: close this frame's overflow queries; the debug read-back's overflow count. */
+static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol_result r = run->r;
+    if (run->counted) fogvol__overflow_close(ctx);
+    if (!run->rgba8) { /* float sums cannot saturate */
         ctx->overflow_late = 0;
         ctx->overflow_frame = ctx->frame_no;
     }
-    st.overflow_pixels = overflow;
-    if (overflow > 0 && r == FOGVOL_SUCCESS) {
+    run->st.overflow_pixels = run->overflow;
+    if (run->overflow > 0 && r == FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)", overflow,
-                    ctx->enc.precision_bits, single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
+                    "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)",
+                    run->overflow, ctx->enc.precision_bits,
+                    run->single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
         r = FOGVOL_ERROR_DEPTH_OVERFLOW;
     }
-done:
-    fogvol__free(&ctx->alloc, peak);
+    return r;
+}
+
+/* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
+static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run, fogvol_result r,
+                                         fogvol_frame_stats *stats)
+{
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    st.frame = ctx->frame_no;
-    st.overflow_pixels_late = ctx->overflow_late;
-    st.overflow_frame = ctx->overflow_frame;
-    fogvol__overflow_react(ctx, fresh);
+    run->st.frame = ctx->frame_no;
+    run->st.overflow_pixels_late = ctx->overflow_late;
+    run->st.overflow_frame = ctx->overflow_frame;
+    fogvol__overflow_react(ctx, run->fresh);
     ctx->frame_no++;
     ctx->in_frame = 0;
     ctx->mrt_ready = 0;
     ctx->engine_occluders = 0;
     ctx->nvol = ctx->nocc = 0;
-    if (stats) *stats = st;
+    if (stats) *stats = run->st;
     return r;
+}
+
+FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats)
+{
+    fogvol__run run;
+    fogvol_result r;
+    int g;
+    memset(&run, 0, sizeof run);
+    run.st.overflow_pixels_late = -1;
+    run.st.overflow_frame = -1;
+    if (stats) *stats = run.st;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    r = fogvol__frame_refusal(ctx);
+    if (r == FOGVOL_SUCCESS) r = fogvol__begin_backend_frame(ctx, &run.info);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol_cancel_frame(ctx);
+        return r;
+    }
+    run.w = ctx->frame.viewport[2];
+    run.h = ctx->frame.viewport[3];
+    run.single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    run.count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
+    run.rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
+    r = fogvol__frame_setup(ctx, &run);
+    if (r == FOGVOL_SUCCESS) {
+        fogvol__frame_uniforms(ctx, &run);
+        fogvol__opaque_pass(ctx, &run);
+        for (g = 0; g < ctx->nvol; ++g) fogvol__group(ctx, &run, g);
+        r = fogvol__frame_overflow(ctx, &run);
+    }
+    return fogvol__frame_finish(ctx, &run, r, stats);
 }
 
 /* >>gl backend ============================================================ */
