@@ -2250,61 +2250,99 @@ static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_al
     return FOGVOL_SUCCESS;
 }
 
-/* The topology and geometry checks on 32-bit indices (layout already checked). */
-static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
-                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep)
+/* The working arrays of one mesh validation. */
+typedef struct fogvol__vwork {
+    const unsigned char *base; /* vertex 0's x */
+    const uint32_t *indices;
+    int stride, ntri, nvert;
+    size_t ne;                 /* edges used */
+    fogvol__edge *edges, *tmp; /* 3 per triangle, and the sort's scratch */
+    uint32_t *parent, *cnt;    /* union-find of triangles across shared edges; orientation counts */
+    unsigned char *parity;     /* orientation relative to the component's root */
+    unsigned char *usable;     /* 0: bad indices or degenerate; 1: topology only; 2: finite corners too */
+    unsigned char *vbad;       /* per vertex: a non-finite coordinate */
+    double *tvol, vol;         /* signed volume per triangle (tetrahedron with the origin), total */
+} fogvol__vwork;
+
+static void fogvol__vwork_free(const fogvol_allocator *alloc, fogvol__vwork *w)
 {
-    int ntri, t, stride;
-    size_t ne = 0, i, j;
-    fogvol__edge *edges = NULL, *tmp = NULL;
-    uint32_t *parent = NULL, *cnt = NULL;
-    unsigned char *parity = NULL, *usable = NULL, *vbad = NULL;
-    const unsigned char *base;
-    double vol = 0, *tvol = NULL;
-    fogvol_result wr = FOGVOL_SUCCESS;
-    stride = desc->stride ? desc->stride : 12;
-    base = (const unsigned char *)desc->positions + desc->offset;
-    ntri = desc->index_count / 3;
-    rep->vertices = desc->vertex_count;
-    rep->triangles = ntri;
+    fogvol__free(alloc, w->tvol);
+    fogvol__free(alloc, w->edges);
+    fogvol__free(alloc, w->tmp);
+    fogvol__free(alloc, w->parent);
+    fogvol__free(alloc, w->cnt);
+    fogvol__free(alloc, w->parity);
+    fogvol__free(alloc, w->usable);
+    fogvol__free(alloc, w->vbad);
+}
 
-    edges = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * (size_t)ntri);
-    tmp = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * (size_t)ntri);
-    parent = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)ntri);
-    cnt = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * 2u * (size_t)ntri);
-    parity = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
-    usable = (unsigned char *)fogvol__alloc(alloc, (size_t)ntri);
-    vbad = (unsigned char *)fogvol__alloc(alloc, (size_t)desc->vertex_count);
-    tvol = (double *)fogvol__alloc(alloc, sizeof(double) * 2u * (size_t)ntri);
-    if (!edges || !tmp || !parent || !cnt || !parity || !usable || !vbad || !tvol) {
-        fogvol__free(alloc, tvol);
-        fogvol__free(alloc, edges);
-        fogvol__free(alloc, tmp);
-        fogvol__free(alloc, parent);
-        fogvol__free(alloc, cnt);
-        fogvol__free(alloc, parity);
-        fogvol__free(alloc, usable);
-        fogvol__free(alloc, vbad);
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
+static fogvol_result fogvol__vwork_alloc(const fogvol_allocator *alloc, fogvol__vwork *w)
+{
+    size_t nt = (size_t)w->ntri;
+    w->edges = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * nt);
+    w->tmp = (fogvol__edge *)fogvol__alloc(alloc, sizeof(fogvol__edge) * 3u * nt);
+    w->parent = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * nt);
+    w->cnt = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * 2u * nt);
+    w->parity = (unsigned char *)fogvol__alloc(alloc, nt);
+    w->usable = (unsigned char *)fogvol__alloc(alloc, nt);
+    w->vbad = (unsigned char *)fogvol__alloc(alloc, (size_t)w->nvert);
+    w->tvol = (double *)fogvol__alloc(alloc, sizeof(double) * 2u * nt);
+    if (w->edges && w->tmp && w->parent && w->cnt && w->parity && w->usable && w->vbad && w->tvol)
+        return FOGVOL_SUCCESS;
+    fogvol__vwork_free(alloc, w);
+    return FOGVOL_ERROR_OUT_OF_MEMORY;
+}
+
+/* Triangle t with finite corners id: slivers counted as degenerate, its signed volume added. */
+static void fogvol__triangle_geometry(fogvol__vwork *w, int t, const uint32_t id[3], fogvol_mesh_report *rep)
+{
+    float a[3], b[3], c[3];
+    double e1[3], e2[3], cr[3], len2, l1, l2, l3;
+    int k;
+    memcpy(a, w->base + id[0] * (size_t)w->stride, sizeof a);
+    memcpy(b, w->base + id[1] * (size_t)w->stride, sizeof b);
+    memcpy(c, w->base + id[2] * (size_t)w->stride, sizeof c);
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)b[k] - a[k];
+        e2[k] = (double)c[k] - a[k];
     }
+    cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    len2 = cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2];
+    l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    l3 = (e2[0] - e1[0]) * (e2[0] - e1[0]) + (e2[1] - e1[1]) * (e2[1] - e1[1]) + (e2[2] - e1[2]) * (e2[2] - e1[2]);
+    if (l2 > l1) l1 = l2;
+    if (l3 > l1) l1 = l3;
+    /* area below 1e-6 of the longest edge squared: a sliver that rasterises to nothing */
+    if (len2 <= 1e-12 * l1 * l1) rep->degenerate_triangles++;
+    w->tvol[t] = (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
+    w->vol += w->tvol[t];
+    w->usable[t] = 2; /* with finite corners: takes part in the winding checks */
+}
 
-    for (i = 0; i < (size_t)desc->vertex_count; ++i) {
+/* Per vertex: finite or not. Per triangle: indices in range, not degenerate, its geometry, and
+   its three edges (for the topology). */
+static void fogvol__validate_triangles(fogvol__vwork *w, fogvol_mesh_report *rep)
+{
+    int t, k;
+    for (t = 0; t < w->nvert; ++t) {
         float v[3];
-        memcpy(v, base + i * (size_t)stride, sizeof v);
-        vbad[i] = !fogvol__finite_n(v, 3);
-        rep->nonfinite_vertices += vbad[i];
+        memcpy(v, w->base + (size_t)t * (size_t)w->stride, sizeof v);
+        w->vbad[t] = !fogvol__finite_n(v, 3);
+        rep->nonfinite_vertices += w->vbad[t];
     }
-
-    for (t = 0; t < ntri; ++t) {
+    for (t = 0; t < w->ntri; ++t) {
         uint32_t id[3];
-        int k, bad = 0;
-        parent[t] = (uint32_t)t;
-        parity[t] = 0;
-        usable[t] = 0;
-        tvol[t] = 0.0;
+        int bad = 0;
+        w->parent[t] = (uint32_t)t;
+        w->parity[t] = 0;
+        w->usable[t] = 0;
+        w->tvol[t] = 0.0;
         for (k = 0; k < 3; ++k) {
-            id[k] = indices[3 * t + k];
-            if (id[k] >= (uint32_t)desc->vertex_count) {
+            id[k] = w->indices[3 * t + k];
+            if (id[k] >= (uint32_t)w->nvert) {
                 rep->out_of_range_indices++;
                 bad = 1;
             }
@@ -2314,102 +2352,95 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
             rep->degenerate_triangles++;
             continue; /* no area, no edges: left out of the topology */
         }
-        usable[t] = 1;
-        if (!vbad[id[0]] && !vbad[id[1]] && !vbad[id[2]]) {
-            float a[3], b[3], c[3];
-            double e1[3], e2[3], cr[3], len2, l1, l2, l3;
-            memcpy(a, base + id[0] * (size_t)stride, sizeof a);
-            memcpy(b, base + id[1] * (size_t)stride, sizeof b);
-            memcpy(c, base + id[2] * (size_t)stride, sizeof c);
-            for (k = 0; k < 3; ++k) {
-                e1[k] = (double)b[k] - a[k];
-                e2[k] = (double)c[k] - a[k];
-            }
-            cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
-            len2 = cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2];
-            l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
-            l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
-            l3 = (e2[0] - e1[0]) * (e2[0] - e1[0]) + (e2[1] - e1[1]) * (e2[1] - e1[1]) +
-                 (e2[2] - e1[2]) * (e2[2] - e1[2]);
-            if (l2 > l1) l1 = l2;
-            if (l3 > l1) l1 = l3;
-            /* area below 1e-6 of the longest edge squared: a sliver that rasterises to nothing */
-            if (len2 <= 1e-12 * l1 * l1) rep->degenerate_triangles++;
-            tvol[t] = (a[0] * cr[0] + a[1] * cr[1] + a[2] * cr[2]) / 6.0;
-            vol += tvol[t];
-            usable[t] = 2; /* with finite corners: takes part in the winding checks */
-        }
+        w->usable[t] = 1;
+        if (!w->vbad[id[0]] && !w->vbad[id[1]] && !w->vbad[id[2]]) fogvol__triangle_geometry(w, t, id, rep);
         for (k = 0; k < 3; ++k) {
             uint32_t u = id[k], v = id[(k + 1) % 3];
-            fogvol__edge *e = &edges[ne++];
+            fogvol__edge *e = &w->edges[w->ne++];
             e->lo = u < v ? u : v;
             e->hi = u < v ? v : u;
             e->tri = (uint32_t)t;
             e->fwd = u < v;
         }
     }
+}
 
-    fogvol__sort_edges(edges, tmp, ne);
-    for (i = 0; i < ne; i = j) {
-        for (j = i + 1; j < ne && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi; ++j) {
+/* Open, non-manifold and inconsistent edges; the triangles joined into components across shared
+   edges, with their orientation relative to the component; flipped faces = each component's
+   minority orientation. */
+static void fogvol__validate_topology(fogvol__vwork *w, fogvol_mesh_report *rep)
+{
+    size_t i, j;
+    int t;
+    fogvol__sort_edges(w->edges, w->tmp, w->ne);
+    for (i = 0; i < w->ne; i = j) {
+        for (j = i + 1; j < w->ne && w->edges[j].lo == w->edges[i].lo && w->edges[j].hi == w->edges[i].hi; ++j) {
         }
         if (j - i == 1) {
             rep->open_edges++;
         } else if (j - i > 2) {
             rep->nonmanifold_edges++;
         } else {
-            uint32_t a = edges[i].tri, b = edges[i + 1].tri;
-            unsigned want = edges[i].fwd == edges[i + 1].fwd; /* same direction: opposite orientation */
-            uint32_t ra = fogvol__uf_find(parent, parity, a), rb = fogvol__uf_find(parent, parity, b);
+            uint32_t a = w->edges[i].tri, b = w->edges[i + 1].tri;
+            unsigned want = w->edges[i].fwd == w->edges[i + 1].fwd; /* same direction: opposite orientation */
+            uint32_t ra = fogvol__uf_find(w->parent, w->parity, a), rb = fogvol__uf_find(w->parent, w->parity, b);
             if (want) rep->inconsistent_edges++;
             if (ra != rb) {
-                parent[rb] = ra;
-                parity[rb] = (unsigned char)(parity[a] ^ parity[b] ^ want);
+                w->parent[rb] = ra;
+                w->parity[rb] = (unsigned char)(w->parity[a] ^ w->parity[b] ^ want);
             }
         }
     }
-    /* flipped faces: per component, the minority orientation */
-    memset(cnt, 0, sizeof(uint32_t) * 2u * (size_t)ntri);
-    for (t = 0; t < ntri; ++t) {
+    memset(w->cnt, 0, sizeof(uint32_t) * 2u * (size_t)w->ntri);
+    for (t = 0; t < w->ntri; ++t) {
         uint32_t r;
-        if (!usable[t]) continue;
-        r = fogvol__uf_find(parent, parity, (uint32_t)t);
-        cnt[2 * r + parity[t]]++;
+        if (!w->usable[t]) continue;
+        r = fogvol__uf_find(w->parent, w->parity, (uint32_t)t);
+        w->cnt[2 * r + w->parity[t]]++;
     }
-    for (t = 0; t < ntri; ++t) {
-        uint32_t c0 = cnt[2 * t], c1 = cnt[2 * t + 1];
+    for (t = 0; t < w->ntri; ++t) {
+        uint32_t c0 = w->cnt[2 * t], c1 = w->cnt[2 * t + 1];
         if (c0 + c1 == 0) continue;
         rep->components++;
         rep->flipped_faces += (int)(c0 < c1 ? c0 : c1);
     }
-    rep->volume = vol;
+}
+
+/* The topology and geometry checks on 32-bit indices (layout already checked). */
+static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32_t *indices,
+                                      const fogvol_allocator *alloc, fogvol_mesh_report *rep)
+{
+    fogvol__vwork w;
+    fogvol_result wr = FOGVOL_SUCCESS;
+    memset(&w, 0, sizeof w);
+    w.stride = desc->stride ? desc->stride : 12;
+    w.base = (const unsigned char *)desc->positions + desc->offset;
+    w.indices = indices;
+    w.ntri = desc->index_count / 3;
+    w.nvert = desc->vertex_count;
+    rep->vertices = desc->vertex_count;
+    rep->triangles = w.ntri;
+    if (fogvol__vwork_alloc(alloc, &w) != FOGVOL_SUCCESS) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    fogvol__validate_triangles(&w, rep);
+    fogvol__validate_topology(&w, rep);
+    rep->volume = w.vol;
     rep->closed = rep->open_edges == 0 && rep->nonmanifold_edges == 0;
     rep->consistent = rep->inconsistent_edges == 0 && rep->flipped_faces == 0;
-    rep->inverted = rep->closed && rep->consistent && vol < 0;
+    rep->inverted = rep->closed && rep->consistent && w.vol < 0;
     rep->negative_triangle = -1;
     if (rep->closed && rep->consistent && rep->nonfinite_vertices == 0 && rep->out_of_range_indices == 0) {
         fogvol__wind wd;
-        wd.base = base;
-        wd.stride = stride;
+        wd.base = w.base;
+        wd.stride = w.stride;
         wd.idx = indices;
-        wd.ntri = ntri;
-        wd.ok = usable;
-        wr = fogvol__component_winding(&wd, parent, parity, tvol, rep);
+        wd.ntri = w.ntri;
+        wd.ok = w.usable;
+        wr = fogvol__component_winding(&wd, w.parent, w.parity, w.tvol, rep);
         if (wr == FOGVOL_SUCCESS) wr = fogvol__grid_winding(&wd, alloc, rep);
     }
     rep->valid = rep->closed && rep->consistent && !rep->inverted && rep->nonfinite_vertices == 0 &&
-                 rep->out_of_range_indices == 0 && vol > 0 && rep->negative_winding == 0;
-
-    fogvol__free(alloc, tvol);
-    fogvol__free(alloc, edges);
-    fogvol__free(alloc, tmp);
-    fogvol__free(alloc, parent);
-    fogvol__free(alloc, cnt);
-    fogvol__free(alloc, parity);
-    fogvol__free(alloc, usable);
-    fogvol__free(alloc, vbad);
+                 rep->out_of_range_indices == 0 && w.vol > 0 && rep->negative_winding == 0;
+    fogvol__vwork_free(alloc, &w);
     if (wr != FOGVOL_SUCCESS) return wr;
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
 }
