@@ -4509,16 +4509,11 @@ static fogvol_result fogvol__resolve_bits(const fogvol_context_desc *desc, int *
 
 static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy);
 
-FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
+/* The context desc checked and its defaults resolved (encoding bits); logged when refused. */
+static fogvol_result fogvol__context_desc(const fogvol_context_desc *desc, int *bits)
 {
-    fogvol_context *ctx;
+    const fogvol_allocator *a = &desc->allocator;
     fogvol_result r;
-    int i, bits;
-    const fogvol_allocator *a;
-    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!desc) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    a = &desc->allocator;
     if ((a->alloc != NULL) != (a->free != NULL)) {
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: allocator needs both alloc and free");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4530,67 +4525,94 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
                     (int)desc->tier, desc->variants, (int)desc->msaa);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    r = fogvol__resolve_bits(desc, &bits);
-    if (r != FOGVOL_SUCCESS) return r;
-    if ((unsigned)desc->overflow_policy > (unsigned)FOGVOL_OVERFLOW_OFF) {
+    r = fogvol__resolve_bits(desc, bits);
+    if (r == FOGVOL_SUCCESS && (unsigned)desc->overflow_policy > (unsigned)FOGVOL_OVERFLOW_OFF) {
         fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: unknown overflow_policy %d", (int)desc->overflow_policy);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    ctx = (fogvol_context *)fogvol__alloc(a, sizeof *ctx);
-    if (!ctx) {
-        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: out of memory for the context");
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
-    }
-    memset(ctx, 0, sizeof *ctx);
-    ctx->alloc = *a;
-    ctx->log = desc->logger;
-    ctx->dither = !desc->disable_dither;
-    ctx->variants = desc->variants;
-    ctx->msaa = desc->msaa;
-    fogvol_encoding_init(&ctx->enc, bits);
-    if (desc->backend.create_texture) {
-        const fogvol_backend *b = &desc->backend;
+    return r;
+}
+
+/* ctx->be: the engine's backend table (every required entry present) or, without one, the GL backend. */
+static fogvol_result fogvol__attach_backend(fogvol_context *ctx, const fogvol_context_desc *desc)
+{
+    const fogvol_backend *b = &desc->backend;
+    if (b->create_texture) {
         if (!b->destroy_texture || !b->create_target || !b->destroy_target || !b->create_program ||
             !b->destroy_program || !b->create_mesh || !b->destroy_mesh || !b->begin_pass || !b->draw_mesh ||
             !b->draw_fullscreen || !b->set_draw) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend table lacks a required entry");
-            fogvol__free(a, ctx);
             return FOGVOL_ERROR_INVALID_ARGUMENT;
         }
         ctx->be = *b;
-    } else {
-#ifndef FOGVOL_NO_GL
-        r = fogvol_gl_backend_create(&desc->gl, &ctx->alloc, &ctx->log, &ctx->be);
-        if (r != FOGVOL_SUCCESS) {
-            fogvol__free(a, ctx);
-            return r;
-        }
-        ctx->owns_backend = 1;
-#else
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no backend table and FOGVOL_NO_GL is defined");
-        fogvol__free(a, ctx);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-#endif
+        return FOGVOL_SUCCESS;
     }
-    r = fogvol__choose_tier(ctx, desc);
-    if (r == FOGVOL_SUCCESS && ctx->tier != FOGVOL_TIER_FLOAT) {
+#ifndef FOGVOL_NO_GL
+    {
+        fogvol_result r = fogvol_gl_backend_create(&desc->gl, &ctx->alloc, &ctx->log, &ctx->be);
+        ctx->owns_backend = r == FOGVOL_SUCCESS;
+        return r;
+    }
+#else
+    fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no backend table and FOGVOL_NO_GL is defined");
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
+#endif
+}
+
+/* The tier's lookup textures and programs. COMPOSITE_MESH is for engines only (the geometry composite
+   is scissored); CHECK is made when a frame first runs a check pass. */
+static fogvol_result fogvol__context_resources(fogvol_context *ctx)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
+    if (ctx->tier != FOGVOL_TIER_FLOAT) {
         if (!fogvol__has(ctx, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_WIDE)) {
             r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
             if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
         }
         if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
     }
-    /* COMPOSITE_MESH: for engines only (the geometry composite is scissored); CHECK: made when a
-       frame first runs a check pass */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
             i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK)
             r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+    return r;
+}
+
+FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
+{
+    fogvol_context *ctx;
+    fogvol_result r;
+    int bits;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!desc) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    r = fogvol__context_desc(desc, &bits);
+    if (r != FOGVOL_SUCCESS) return r;
+    ctx = (fogvol_context *)fogvol__alloc(&desc->allocator, sizeof *ctx);
+    if (!ctx) {
+        fogvol__log(&desc->logger, FOGVOL_LOG_ERROR, "fogvol: out of memory for the context");
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
+    memset(ctx, 0, sizeof *ctx);
+    ctx->alloc = desc->allocator;
+    ctx->log = desc->logger;
+    ctx->dither = !desc->disable_dither;
+    ctx->variants = desc->variants;
+    ctx->msaa = desc->msaa;
+    fogvol_encoding_init(&ctx->enc, bits);
+    r = fogvol__attach_backend(ctx, desc);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(&desc->allocator, ctx);
+        return r;
+    }
+    r = fogvol__choose_tier(ctx, desc);
+    if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
         fogvol__release(ctx);
-        fogvol__free(a, ctx);
+        fogvol__free(&desc->allocator, ctx);
         return r;
     }
     fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
