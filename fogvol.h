@@ -1843,6 +1843,12 @@ static uint32_t fogvol__uf_find(uint32_t *parent, unsigned char *parity, uint32_
     return root;
 }
 
+/* fogvol_mesh_desc's defaults: a zero stride means tightly packed xyz. */
+static int fogvol__mesh_stride(const fogvol_mesh_desc *d)
+{
+    return d->stride ? d->stride : 12;
+}
+
 /* NULL for a usable layout, else what is wrong with it. */
 static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
 {
@@ -1851,7 +1857,7 @@ static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
     if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
         return "vertex_count must be > 0 and index_count a positive multiple of 3";
     if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
-    stride = d->stride ? d->stride : 12;
+    stride = fogvol__mesh_stride(d);
     if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
     if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
     if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
@@ -1947,7 +1953,7 @@ static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvo
                                           int *welded)
 {
     const unsigned char *base = (const unsigned char *)d->positions + d->offset;
-    int i, stride = d->stride ? d->stride : 12, weld = d->weld_distance > 0;
+    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0;
     uint32_t *idx, *rep = NULL;
     fogvol__wkey *keys = NULL;
     *out = NULL;
@@ -2413,7 +2419,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     fogvol__vwork w;
     fogvol_result wr = FOGVOL_SUCCESS;
     memset(&w, 0, sizeof w);
-    w.stride = desc->stride ? desc->stride : 12;
+    w.stride = fogvol__mesh_stride(desc);
     w.base = (const unsigned char *)desc->positions + desc->offset;
     w.indices = indices;
     w.ntri = desc->index_count / 3;
@@ -4095,7 +4101,7 @@ struct fogvol_mesh {
 /* The bounding box of the positions (finite: validated before). */
 static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
 {
-    size_t stride = desc->stride ? (size_t)desc->stride : 12u;
+    size_t stride = (size_t)fogvol__mesh_stride(desc);
     const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
     int i, c;
     for (c = 0; c < 3; ++c) {
@@ -4658,7 +4664,7 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     fogvol_mesh_data md;
     float *packed = NULL;
     fogvol_result r;
-    int i, stride = desc->stride ? desc->stride : 12;
+    int i, stride = fogvol__mesh_stride(desc);
     memset(&md, 0, sizeof md);
     md.positions = desc->positions;
     md.vertex_count = desc->vertex_count;
