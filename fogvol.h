@@ -31,6 +31,8 @@
      FOGVOL_API             decoration of every public function (default extern)
      FOGVOL_NO_GL           leave out the GL backend (math, textures, shaders,
                             renderer and the null backend remain)
+     FOGVOL_NO_ANALYTIC     leave out the analytic fog volumes (they share
+                            nothing with the renderer)
      FOGVOL_ASSERT(x)       assertion (default: assert from <assert.h>)
      FOGVOL_SQRT, FOGVOL_EXP, FOGVOL_FLOOR, FOGVOL_FABS, FOGVOL_POW
                             maths hooks (default: <math.h>)
@@ -100,7 +102,7 @@
 
    TIERS (fogvol_context_desc.tier; 0 = automatic, in this order)
    =====
-       context has                          tier    passes (seed / fogvol)
+       context has                          tier    passes (white paper / fogvol)
        R32F + float blending (GL 3.0,       FLOAT   3 / 3  (2 with the engine's
          GLES3 + EXT_color_buffer_float                     depth texture)
          + EXT_float_blend)
@@ -134,12 +136,13 @@
        // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
        //         weld_distance > 0 for seams and per-face vertices
 
-   ANALYTIC FOG VOLUMES (seeds/002, no render passes)
+   ANALYTIC FOG VOLUMES (no render passes; FOGVOL_NO_ANALYTIC leaves them out)
    ====================
+   After JCAB, "Implementing Volumetric Fog Without Using Texture Stages" (GDC 2001).
    Per-vertex or per-pixel fog from distance fog, half-spaces, spheres and
    affine transforms of the unit sphere, cube and cylinder, each with density
    and colour; separate volumes front to back or interpenetrating volumes by the
-   seed's sorted event list; linear or exponential law. fogvol_analytic_prepare
+   paper's sorted event list; linear or exponential law. fogvol_analytic_prepare
    once, then fogvol_analytic_batch over vertex arrays (no allocation, order
    carried between frames) or the GLSL of fogvol_analytic_shader_strings with
    the uniforms of fogvol_analytic_pack_uniforms; fogvol_fold_fog folds fog into
@@ -256,7 +259,7 @@ FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int ma
 /* Encoding with the most faces that still gives at least precision_bits (1..24).
    precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
 FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits);
-/* The table of every L = 1..8 (the seed's Figure 3). Returns the row count (8);
+/* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
    writes min(count, capacity) rows when rows != NULL. */
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
 
@@ -323,7 +326,7 @@ FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row);
 /* Thickness -> colour ramps. */
 typedef enum fogvol_ramp_model {
     FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
-    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, seeds/002) */
+    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, the GDC 2001 analytic fog law) */
     FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
     FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
 } fogvol_ramp_model;
@@ -343,7 +346,7 @@ typedef enum fogvol_ramp_model {
    FRAMEBUFFER_SRGB does not affect. */
 typedef enum fogvol_blend {
     FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
-    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, seeds/004) */
+    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, Baker's "Image-Space Rendering Techniques") */
     FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
 } fogvol_blend;
 
@@ -451,8 +454,9 @@ typedef enum fogvol_dialect {
     FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
 } fogvol_dialect;
 
-/* Tiers: the shader-model tiers of the seed, in GLSL terms.
-   passes = screen passes per frame for one colour-ramp group as the seed
+/* Tiers: the shader-model tiers of the "Fog Polygon Volumes" white paper (ps.1.3, ps.2.0,
+   MRT, float blending), in GLSL terms.
+   passes = screen passes per frame for one colour-ramp group as the white paper
    counts them (the engine's own opaque pass included):
      PS13   6  RGBA8; engine, O, B, F, resolve B-F to an encoded thickness,
               composite decoding by dependent lookup; per-channel compare
@@ -563,7 +567,7 @@ FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned varian
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
 
 typedef struct fogvol_tier_info {
-    int seed_passes;    /* as the seed counts them, the engine's opaque pass included */
+    int seed_passes;    /* as the white paper counts them, the engine's opaque pass included */
     int library_passes; /* passes fogvol issues per frame for one colour-ramp group
                            (+1 per negative group pass in the RGBA8 tiers) */
     int targets;        /* render targets fogvol allocates */
@@ -580,7 +584,8 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 
-/* ---- analytic fog volumes (seeds/002, JCAB GDC 2001) ---------------------
+#ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
+/* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
    Per-vertex (or per-pixel) fog from simple analytic volumes, without render
    passes or textures: for every vertex V the ray X = eye + t (V - eye) is cut
    by each volume into an entry/exit pair t1 <= t2, clamped to [0, 1] (t = 0 at
@@ -592,11 +597,11 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 
    Fog factor f: 1 = no fog, 0 = fully fogged; fog colour C: what the fog adds.
    The fogged colour of a surface is  surface * f + C * (1 - f)  (or fold the
-   two into the vertex colours with fogvol_fold_fog, the seed's trick).
-     FOGVOL_FOG_LINEAR       f = 1 - clamp01(distance * density)  (the seed's law);
+   two into the vertex colours with fogvol_fold_fog, the paper's trick).
+     FOGVOL_FOG_LINEAR       f = 1 - clamp01(distance * density)  (the paper's law);
                              several volumes add up: f = 1 - sum, stopped at 0
      FOGVOL_FOG_EXP          f = exp(-distance * density); transmittances multiply
-     FOGVOL_FOG_LINEAR_SEED  the linear f with the seed's colour formula verbatim
+     FOGVOL_FOG_LINEAR_SEED  the linear f with the paper's colour formula verbatim
                              (C = volume colour * f + C * (1 - f), front to back).
                              It is exact when the ray ends fully fogged but
                              otherwise over-weights the volumes further back:
@@ -608,10 +613,10 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 
    Combination (fogvol_fog_mix):
      FOGVOL_MIX_SEPARATE         volumes sorted front to back by t1, each taken
-                                 whole (the seed's "several fog volumes"), with
+                                 whole (the paper's "several fog volumes"), with
                                  early exit once fully fogged. Right for volumes
                                  that do not overlap along the rays.
-     FOGVOL_MIX_INTERPENETRATING the seed's event list: (t1, +colour*density,
+     FOGVOL_MIX_INTERPENETRATING the paper's event list: (t1, +colour*density,
                                  +density), (t2, -colour*density, -density) per
                                  volume, sorted by t (ties: entry before exit,
                                  then volume order), and every stretch between
@@ -673,7 +678,7 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 typedef enum fogvol_analytic_shape {
     FOGVOL_SHAPE_DISTANCE = 0,   /* min_distance <= |X - eye| <= max_distance (max <= 0: no bound) */
     FOGVOL_SHAPE_HALF_SPACE = 1, /* plane[0] x + plane[1] y + plane[2] z + plane[3] >= 0: the normal
-                                    points into the fog (the seed's (X - P).N > 0); negate the
+                                    points into the fog (the paper's (X - P).N > 0); negate the
                                     plane for the other side */
     FOGVOL_SHAPE_SPHERE = 2,     /* |X - center| <= radius */
     FOGVOL_SHAPE_ELLIPSOID = 3,  /* transform * unit sphere */
@@ -777,7 +782,7 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
                                                int color_stride, fogvol_analytic_order *order, int *invalid);
-/* The seed's register trick: new_diffuse = diffuse * fog, new_specular =
+/* The paper's register trick: new_diffuse = diffuse * fog, new_specular =
    specular * fog + fog_color * (1 - fog), on rgb (alpha unchanged); then
    texture * new_diffuse + new_specular = fogged (texture * diffuse + specular).
    fog is clamped to [0, 1] (NaN: 1). Outputs may alias the inputs; a NULL
@@ -800,6 +805,8 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
    Returns the number of strings (3, to be passed in order); writes
    min(3, capacity) of them when strings != NULL. */
 FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
+
+#endif /* FOGVOL_NO_ANALYTIC */
 
 /* ---- backend table -------------------------------------------------------
    Contract. Every entry gets the table's user_data first. Handles are
@@ -1073,8 +1080,8 @@ typedef enum fogvol_composite {
    occluders inside fog come out wrong by up to the full fog contrast); logged
    as a warning once and reported in fogvol_frame_stats.msaa_fallback.
    Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
-   fragment work and 4x the target memory of fogvol's passes (measured in
-   tests/test_engine_msaa.c, FLOAT at 640x480 on llvmpipe: 4x per sample took
+   fragment work and 4x the target memory of fogvol's passes (measured by
+   fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
    3.9-4.6x the time of the same scene on a single-sample framebuffer, one
    run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
    29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
@@ -2451,6 +2458,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
 }
 
+#ifndef FOGVOL_NO_ANALYTIC
 /* >>analytic ============================================================== */
 /* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
    ways of combining volumes, the batch over vertex arrays, and the same maths
@@ -3389,6 +3397,8 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
     return 3;
 }
 
+#endif /* FOGVOL_NO_ANALYTIC */
+
 /* >>shaders =============================================================== */
 /* One body per program, written with small compatibility macros; one prelude
    per dialect defines FV_ATTRIB, FV_VARYING_OUT (vertex), FV_VARYING_IN,
@@ -3571,8 +3581,8 @@ static const char fogvol__fs_encode[] =
     "}\n"
     "#endif\n";
 
-/* Volume faces. RGBA8: keep the lesser of face and opaque depth (PS 6 decoded
-   compare, or PS 5 per-channel saturated compare on normalised digits), or
+/* Volume faces. RGBA8: keep the lesser of face and opaque depth (a decoded
+   compare, or PS13's per-channel saturated compare on normalised digits), or
    with COUNT rely on the depth test and count faces in alpha. FLOAT: signed
    depth of every face in one pass, the sign from gl_FrontFacing. */
 static const char fogvol__fs_face[] =
@@ -3643,7 +3653,7 @@ static const char fogvol__fs_resolve[] =
     "    FV_FRAGCOLOR = vec4(d.r < 0.0 ? vec3(0.0) : d / 255.0, covered * (1.0 + sat) / 255.0);\n"
     "}\n";
 
-/* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F) (PS 4);
+/* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F);
    COUNT adds the opaque depth once per missing back face; SINGLE decodes one
    biased target; PS13 reads the resolved thickness; FLOAT the float sum.
    A channel at 255 means saturation: with at most 2^(8-L) faces a channel sums

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The header compiles clean (-Wall -Wextra -pedantic -Werror) as C99, C11, C++11,
-# C++17 with gcc and clang: implementation in one TU, static mode, FOGVOL_NO_GL,
+# C++17 with gcc and clang: implementation in one TU, static mode, FOGVOL_NO_GL, FOGVOL_NO_ANALYTIC,
 # and implementation in one of two TUs (linked and run).
 set -u
 out=${BUILD:-build}/compile
@@ -18,6 +18,7 @@ for cc in gcc clang g++ clang++; do
     check "$tag single TU" $cc -std=$std $flags $lang tests/compile/single.c -o "$out/single-$tag" -lm
     check "$tag static" $cc -std=$std $flags $lang -DFOGVOL_STATIC tests/compile/single.c -o "$out/static-$tag" -lm
     check "$tag FOGVOL_NO_GL" $cc -std=$std $flags $lang -DFOGVOL_NO_GL tests/compile/single.c -o "$out/nogl-$tag" -lm
+    check "$tag FOGVOL_NO_ANALYTIC" $cc -std=$std $flags $lang -DFOGVOL_NO_ANALYTIC tests/compile/single.c -o "$out/noan-$tag" -lm
     check "$tag two TUs" bash -c "$cc -std=$std $flags $lang -c tests/compile/impl.c -o $out/impl-$tag.o && \
       $cc -std=$std $flags $lang -c tests/compile/user.c -o $out/user-$tag.o && \
       $cc $out/impl-$tag.o $out/user-$tag.o -o $out/two-$tag -lm && $out/two-$tag >/dev/null"
