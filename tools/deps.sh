@@ -4,7 +4,7 @@
 # FOGVOL_NO_INSTALL=1 turns installing off (provide the packages yourself, e.g. on a non-Debian system).
 set -euo pipefail
 what=${1:-test}
-pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind"
+pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
 pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth cmake pkg-config libosmesa6-dev libstb-dev"
 case "$what" in
@@ -21,7 +21,7 @@ if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>
   cat >&2 <<EOF2
 deps: this is not a Debian-like system (no dpkg-query/apt-get), so nothing is installed.
 deps: '$what' needs these Debian packages or their equivalents: $pkgs
-deps:   (OSMesa: mesa's libOSMesa + headers; cmocka; stb_image_write.h under <stb/>; glslangValidator;
+deps:   (OSMesa: mesa's libOSMesa + headers; Mesa's EGL with the surfaceless platform + GLES headers; cmocka; stb_image_write.h under <stb/>; glslangValidator;
 deps:    GLFW 3 and Xvfb for the windowed demo; cmake and pkg-config for the packaging tests)
 deps: install them, then run again with FOGVOL_NO_INSTALL=1.
 EOF2

@@ -1,0 +1,763 @@
+/* test_gles.c - fogvol in real OpenGL ES contexts: Mesa's EGL surfaceless
+   platform (llvmpipe), an ES 2.0 context (GLSL ES 1.00), the driver's highest
+   ES 3.x context (3.2 on Mesa 22.3) and an ES 3.0 context (GLSL ES 3.00; plain
+   tiers only), each in its own process, GL loaded only through eglGetProcAddress
+   (tests/egl_util.h). Without an EGL device every test fails: the packages
+   (libegl-mesa0, libegl-dev, libgles-dev) are part of the test dependencies.
+
+   Per context:
+   - the automatic choice: GLSL dialect and tier as the header documents them
+     (GLES 2 -> 100, GLES 3 -> 300 es; FLOAT if the context has float render
+     targets and float blending, else PS20 with highp fragment shaders, else
+     PS13), the rule evaluated here from the context's own strings, and the
+     functions the backend asks for (none desktop-only, none above the
+     context's version);
+   - every tier and variant that exists in the context's dialect, on scenes
+     with occluders, negative volumes, the camera inside a volume
+     (tests/scenes.h), against the ray-cast ground truth with the bounds of
+     desktop GL (tests/test_tiers.c): RGBA8 tiers |error| <= 1 LSB per pair
+     of faces, mean <= 0.5 LSB per pair; FLOAT |error| <= 3e-5 (far - near);
+     the composite within 2/255; no GL error; the engine's GL state the same
+     before and after fogvol_end_frame;
+   - overflow: 20 nested shells at L = 4 are reported, painted magenta where
+     wrong (show_overflow), and counted late by occlusion queries on ES 3.
+   Pictures: build/gles/<context>_<combo>.png (the layered scene), and
+   build/gles/<context>_overflow.png. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+#include <time.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#include "tests/egl_util.h"
+#include "tests/raycast.h"
+#include "tests/shapes.h"
+#include "tests/scenes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct es_ctx {
+    const char *name, *file; /* for messages and picture names */
+    const char *override;    /* MESA_GLES_VERSION_OVERRIDE, NULL: the driver's highest */
+    int major;               /* the ES major version the test expects */
+    int plain_tiers_only;    /* 1: the tiers without variants (ES 3.0: the non-indexed blend state) */
+} es_ctx;
+
+static const es_ctx g_ctx[] = {
+    {"ES 2.0", "es20", "2.0", 2, 0}, {"ES 3.x", "es3x", NULL, 3, 0}, {"ES 3.0", "es30", "3.0", 3, 1}};
+#define NCTX 3
+
+typedef struct combo {
+    fogvol_tier tier;
+    unsigned variants;
+    const char *name;
+    int bits; /* 0: the scene's */
+} combo;
+
+static const combo g_combos[] = {
+    {FOGVOL_TIER_PS13, 0, "PS13", 0},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 0},
+    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp", 0},
+    {FOGVOL_TIER_PS20, 0, "PS20", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, "PS20+enginedepth", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, "PS20+wide(L=3)", 3},
+    {FOGVOL_TIER_MRT, 0, "MRT", 0},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu", 0},
+    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single", 0},
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp", 0},
+};
+#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
+
+static const char *const g_scene_names[] = {"sphere",
+                                            "two_spheres",
+                                            "plane_cuts_sphere",
+                                            "negative_sphere_in_box",
+                                            "negative_pokes_out",
+                                            "layers_opaque_between",
+                                            "camera_inside_sphere"};
+#define NSCENE ((int)(sizeof g_scene_names / sizeof g_scene_names[0]))
+
+typedef struct gt_cache {
+    double *gt;
+    int *pairs;
+    unsigned char *interior, *covered;
+    int max_faces;
+    double tmax;
+} gt_cache;
+
+static gt_cache g_gt[NSCENE];
+/* measured: max error per context, combo, scene (LSB per pair of faces, or units of 3e-5 range on FLOAT) */
+static double g_err[NCTX][NCOMBO][NSCENE], g_mean[NCTX][NCOMBO], g_comp[NCTX][NCOMBO];
+static int g_ran[NCTX][NCOMBO];
+static char g_version[NCTX][2][96]; /* GL_VERSION, GL_SHADING_LANGUAGE_VERSION */
+static fogvol_tier g_auto_tier[NCTX];
+static fogvol_dialect g_auto_dialect[NCTX];
+static double g_seconds[NCTX];
+static int g_cur; /* the context kind this process tests */
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l == FOGVOL_LOG_ERROR) print_message("  [fogvol error] %s\n", m);
+}
+
+static void context_up(int ci, eglu_ctx *c)
+{
+    if (!eglu_create(c, g_ctx[ci].override, W, H))
+        fail_msg("no OpenGL ES context from Mesa's EGL surfaceless platform (%s): %s. The tests need the Debian "
+                 "packages libegl-mesa0, libegl-dev and libgles-dev (tools/deps.sh test).",
+                 g_ctx[ci].name, c->error);
+    if (c->major != g_ctx[ci].major) fail_msg("asked for %s, got ES %d.%d", g_ctx[ci].name, c->major, c->minor);
+    snprintf(g_version[ci][0], sizeof g_version[ci][0], "%s", (const char *)glGetString(GL_VERSION));
+    snprintf(g_version[ci][1], sizeof g_version[ci][1], "%s", (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
+}
+
+/* ---- the automatic choice and the functions asked for ---------------------- */
+typedef struct proc_log {
+    char names[160][48];
+    int n;
+} proc_log;
+
+static void (*logging_proc(const char *name, void *user))(void)
+{
+    proc_log *pl = (proc_log *)user;
+    if (pl->n < 160) snprintf(pl->names[pl->n++], sizeof pl->names[0], "%s", name);
+    return eglu_proc(name, NULL);
+}
+
+static int asked(const proc_log *pl, const char *name)
+{
+    int i;
+    for (i = 0; i < pl->n; ++i)
+        if (strcmp(pl->names[i], name) == 0) return 1;
+    return 0;
+}
+
+static int has_ext(const char *name)
+{
+    GLint i, n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (i = 0; i < n; ++i)
+        if (strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i), name) == 0) return 1;
+    return 0;
+}
+
+static void test_auto_choice(void **state)
+{
+    static const char *const desktop[] = {"glClearDepth", "glDepthRange", "glGetDoublev", "glPolygonMode",
+                                          "glBindFragDataLocation", "glTexImage2DMultisample", "glClipControl",
+                                          "glMinSampleShading", "glGenFramebuffersEXT"};
+    static const char *const es3[] = {"glGenVertexArrays", "glGetStringi", "glBindSampler", "glBlitFramebuffer",
+                                      "glDrawBuffers", "glGenQueries", "glPauseTransformFeedback"};
+    int ci = (int)(intptr_t)*state, i;
+    eglu_ctx c;
+    proc_log pl;
+    fogvol_backend b;
+    fogvol_gl_desc gd;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    GLint range[2], precision = 0;
+    fogvol_tier want;
+    context_up(ci, &c);
+    memset(&pl, 0, sizeof pl);
+    memset(&gd, 0, sizeof gd);
+    gd.get_proc_address = logging_proc;
+    gd.user_data = &pl;
+    assert_int_equal(fogvol_gl_backend_create(&gd, NULL, NULL, &b), FOGVOL_SUCCESS);
+    /* the header: GLES 2 / WebGL 1 -> 100, GLES 3 / WebGL 2 -> 300 es */
+    assert_int_equal(b.dialect, c.major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100);
+    b.destroy(b.user_data);
+    print_message("  %s: %s | %s | %d functions asked for\n", g_ctx[ci].name, g_version[ci][0], g_version[ci][1],
+                  pl.n);
+    for (i = 0; i < (int)(sizeof desktop / sizeof desktop[0]); ++i)
+        if (asked(&pl, desktop[i])) fail_msg("%s: the backend asked for desktop-only %s", g_ctx[ci].name, desktop[i]);
+    for (i = 0; c.major < 3 && i < (int)(sizeof es3 / sizeof es3[0]); ++i)
+        if (asked(&pl, es3[i])) fail_msg("ES 2.0: the backend asked for ES 3 function %s", es3[i]);
+    for (i = 0; i < pl.n; ++i) /* whatever it loaded exists in this context's library */
+        if (!eglu_proc(pl.names[i], NULL)) print_message("  (optional %s: not available)\n", pl.names[i]);
+    /* the tier rule of the header, from the context's own answers: float render targets and float
+       blending (GLES 3 + EXT_color_buffer_float + EXT_float_blend) -> FLOAT, else highp fragment
+       shaders -> PS20, else PS13 */
+    glGetShaderPrecisionFormat(GL_FRAGMENT_SHADER, GL_HIGH_FLOAT, range, &precision);
+    if (c.major >= 3 && has_ext("GL_EXT_color_buffer_float") && has_ext("GL_EXT_float_blend")) want = FOGVOL_TIER_FLOAT;
+    else want = precision > 0 ? FOGVOL_TIER_PS20 : FOGVOL_TIER_PS13;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = eglu_proc;
+    cd.logger.func = logger;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    g_auto_tier[ci] = fogvol_context_tier(fv, NULL);
+    g_auto_dialect[ci] = c.major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
+    print_message("  %s: automatic tier %s (rule says %s), GLSL %s\n", g_ctx[ci].name,
+                  fogvol_tier_name(g_auto_tier[ci]), fogvol_tier_name(want), fogvol_dialect_name(g_auto_dialect[ci]));
+    assert_int_equal(g_auto_tier[ci], want);
+    fogvol_destroy_context(fv);
+    if (c.major < 3) { /* FLOAT does not exist in GLSL ES 1.00: asked for, refused with a code */
+        cd.tier = FOGVOL_TIER_FLOAT;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_ERROR_UNSUPPORTED);
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    eglu_destroy(&c);
+}
+
+/* ---- the engine: occluders into its framebuffer, the MRT output on ES 3 ----- */
+typedef struct engine {
+    GLuint prog, vbo, ibo, dummy_tex, dummy_buf;
+    GLint u_mvp, u_mv, u_mrt;
+} engine;
+
+static GLuint compile(GLenum type, const char *const *src, int n)
+{
+    GLint ok = 0;
+    GLuint sh = glCreateShader(type);
+    glShaderSource(sh, n, src, NULL);
+    glCompileShader(sh);
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[1024];
+        glGetShaderInfoLog(sh, sizeof log, NULL, log);
+        fail_msg("engine shader: %s", log);
+    }
+    return sh;
+}
+
+static void engine_init(engine *e, int es3)
+{
+    static const char *vs2 = "#version 100\nattribute vec3 p;\nuniform mat4 mvp;\n"
+                             "void main() { gl_Position = mvp * vec4(p, 1.0); }\n";
+    static const char *fs2 = "#version 100\nprecision mediump float;\n"
+                             "void main() { gl_FragColor = vec4(0.35, 0.3, 0.25, 1.0); }\n";
+    static const char *vs3 = "#version 300 es\nlayout(location = 0) in vec3 p;\nuniform mat4 mvp;\nuniform mat4 mv;\n"
+                             "out float view_depth;\n"
+                             "void main() { view_depth = -(mv * vec4(p, 1.0)).z; gl_Position = mvp * vec4(p, 1.0); }\n";
+    const char *fs3[3];
+    GLuint vs, fs;
+    GLint ok = 0;
+    fs3[0] = "#version 300 es\nprecision highp float;\n";
+    fs3[1] = fogvol_mrt_snippet();
+    fs3[2] = "in float view_depth;\nlayout(location = 0) out vec4 color;\nlayout(location = 1) out vec4 fogvol_o;\n"
+             "void main() { color = vec4(0.35, 0.3, 0.25, 1.0); fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
+    vs = compile(GL_VERTEX_SHADER, es3 ? &vs3 : &vs2, 1);
+    fs = es3 ? compile(GL_FRAGMENT_SHADER, fs3, 3) : compile(GL_FRAGMENT_SHADER, &fs2, 1);
+    e->prog = glCreateProgram();
+    glAttachShader(e->prog, vs);
+    glAttachShader(e->prog, fs);
+    glBindAttribLocation(e->prog, 0, "p");
+    glLinkProgram(e->prog);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
+    assert_true(ok);
+    e->u_mvp = glGetUniformLocation(e->prog, "mvp");
+    e->u_mv = glGetUniformLocation(e->prog, "mv");
+    e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
+    glGenBuffers(1, &e->vbo);
+    glGenBuffers(1, &e->ibo);
+    glGenBuffers(1, &e->dummy_buf);
+    glGenTextures(1, &e->dummy_tex);
+    glBindTexture(GL_TEXTURE_2D, e->dummy_tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, 4, 4, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+static void engine_free(engine *e)
+{
+    glUseProgram(0);
+    glDeleteProgram(e->prog);
+    glDeleteBuffers(1, &e->vbo);
+    glDeleteBuffers(1, &e->ibo);
+    glDeleteBuffers(1, &e->dummy_buf);
+    glDeleteTextures(1, &e->dummy_tex);
+}
+
+/* The engine's opaque pass into its framebuffer; with mrt also the encoded
+   depth into fogvol's O texture as colour attachment 1. */
+static void engine_draw(engine *e, const eglu_ctx *c, const tscene *s, const float view[16], const float proj[16],
+                        const fogvol_mrt_info *mrt)
+{
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    int i;
+    glBindFramebuffer(GL_FRAMEBUFFER, c->fbo);
+    if (mrt) {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, (GLuint)mrt->texture, 0);
+        glDrawBuffers(2, bufs);
+        glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
+    }
+    glViewport(0, 0, W, H);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_SCISSOR_TEST);
+    glClearColor(0.2f, 0.5f, 0.8f, 1.0f);
+    glClearDepthf(1.0f);
+    glClearStencil(0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST); /* its own state, whatever the last frame left */
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDisable(GL_SCISSOR_TEST);
+    glUseProgram(e->prog);
+    if (mrt) glUniform4fv(e->u_mrt, 2, mrt->uniforms);
+    for (i = 0; i < s->n; ++i) {
+        float mv[16], mvp[16];
+        if (s->obj[i].sign != 0) continue;
+        shp_mat_mul(mv, view, s->obj[i].model);
+        shp_mat_mul(mvp, proj, mv);
+        glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, mvp);
+        glUniformMatrix4fv(e->u_mv, 1, GL_FALSE, mv);
+        glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)s->obj[i].mesh.vcount), s->obj[i].mesh.pos,
+                     GL_STREAM_DRAW);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+        glEnableVertexAttribArray(0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)s->obj[i].mesh.icount), s->obj[i].mesh.idx,
+                     GL_STREAM_DRAW);
+        glDrawElements(GL_TRIANGLES, s->obj[i].mesh.icount, GL_UNSIGNED_INT, NULL); /* OES_element_index_uint */
+    }
+    glDisableVertexAttribArray(0);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+    if (mrt) {
+        glDrawBuffers(1, bufs); /* fogvol composites into attachment 0 only */
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+    }
+}
+
+/* ---- the engine's state around fogvol_end_frame ---------------------------- */
+typedef struct gl_snapshot {
+    GLint fbo, program, active, tex3, array_buf, viewport[4], scissor[4], depth_func, cull, blend_src, blend_dst;
+    GLint attrib0_enabled;
+    GLboolean depth_test, cull_face, blend, scissor_test, stencil_test, depth_mask, color_mask[4];
+    GLfloat clear[4];
+} gl_snapshot;
+
+static void snapshot(gl_snapshot *s)
+{
+    memset(s, 0, sizeof *s);
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &s->fbo);
+    glGetIntegerv(GL_CURRENT_PROGRAM, &s->program);
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &s->active);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &s->tex3);
+    glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &s->array_buf);
+    glGetIntegerv(GL_VIEWPORT, s->viewport);
+    glGetIntegerv(GL_SCISSOR_BOX, s->scissor);
+    glGetIntegerv(GL_DEPTH_FUNC, &s->depth_func);
+    glGetIntegerv(GL_CULL_FACE_MODE, &s->cull);
+    glGetIntegerv(GL_BLEND_SRC_RGB, &s->blend_src);
+    glGetIntegerv(GL_BLEND_DST_RGB, &s->blend_dst);
+    glGetVertexAttribiv(0, GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->attrib0_enabled);
+    s->depth_test = glIsEnabled(GL_DEPTH_TEST);
+    s->cull_face = glIsEnabled(GL_CULL_FACE);
+    s->blend = glIsEnabled(GL_BLEND);
+    s->scissor_test = glIsEnabled(GL_SCISSOR_TEST);
+    s->stencil_test = glIsEnabled(GL_STENCIL_TEST);
+    glGetBooleanv(GL_DEPTH_WRITEMASK, &s->depth_mask);
+    glGetBooleanv(GL_COLOR_WRITEMASK, s->color_mask);
+    glGetFloatv(GL_COLOR_CLEAR_VALUE, s->clear);
+}
+
+/* What an engine leaves set mid-frame (none of it may change fogvol's picture). */
+static void engine_leaves_state(const engine *e)
+{
+    glUseProgram(e->prog);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_FRONT);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, W, H);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, e->dummy_tex);
+    glBindBuffer(GL_ARRAY_BUFFER, e->dummy_buf);
+    glEnableVertexAttribArray(0);
+    glClearColor(0.1f, 0.2f, 0.3f, 0.4f);
+}
+
+static void write_png(const char *ctx_file, const char *what, const unsigned char *px)
+{
+    char path[256], *q;
+    mkdir("build", 0777);
+    mkdir("build/gles", 0777);
+    snprintf(path, sizeof path, "build/gles/%s_%s.png", ctx_file, what);
+    for (q = path + 11; *q; ++q)
+        if (*q == '(' || *q == ')' || *q == '=' || *q == '+') *q = '_';
+    stbi_flip_vertically_on_write(1); /* the first row read back is the bottom */
+    stbi_write_png(path, W, H, 4, px, W * 4);
+}
+
+static fogvol_context *make_context(const combo *cb, int bits)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = eglu_proc;
+    cd.logger.func = logger;
+    cd.tier = cb->tier;
+    cd.variants = cb->variants;
+    cd.encoding_bits = bits;
+    cd.disable_dither = 1;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    return fv;
+}
+
+/* One frame of scene s as an engine would draw it, the engine's state checked
+   around fogvol_end_frame. base: the engine's picture before the fog. */
+static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine *e, const tscene *s,
+                                  fogvol_mesh **meshes, const fogvol_ramp *ramp, int mrt_tier, float *thick,
+                                  unsigned char *base, unsigned char *fogged, fogvol_frame_stats *st)
+{
+    fogvol_frame_desc fd;
+    fogvol_mrt_info mrt;
+    gl_snapshot before, after;
+    fogvol_result r;
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&s->cam, fd.view, fd.projection);
+    fd.znear = (float)s->cam.znear;
+    fd.zfar = (float)s->cam.zfar;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.debug_thickness = thick;
+    fd.engine_depth_texture = c->depth_tex;
+    fd.show_overflow = 1; /* where nothing overflows, a magenta pixel fails the composite check */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    if (mrt_tier) assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+    engine_draw(e, c, s, fd.view, fd.projection, mrt_tier ? &mrt : NULL);
+    add_scene(fv, s, meshes, ramp, !mrt_tier);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, base);
+    engine_leaves_state(e);
+    assert_int_equal(glGetError(), GL_NO_ERROR); /* the engine's own calls are clean */
+    snapshot(&before);
+    r = fogvol_end_frame(fv, st);
+    snapshot(&after);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_memory_equal(&before, &after, sizeof before);
+    assert_int_equal(after.fbo, (GLint)c->fbo);
+    assert_int_equal(after.active, GL_TEXTURE3);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, fogged);
+    return r;
+}
+
+typedef struct scene_out {
+    double max_err, sum_pp, comp_max; /* max_err: LSB per pair of faces (FLOAT: units of 3e-5 of the range) */
+    int n, bad;
+} scene_out;
+
+/* Thickness against the ray cast and the composite against mix(engine, fog, 1 - exp(-density t)). */
+static void compare(const combo *cb, const tscene *s, const gt_cache *t, const float *thick,
+                    const unsigned char *base, const unsigned char *fogged, scene_out *o)
+{
+    double range = s->cam.zfar - s->cam.znear;
+    int bits = cb->bits ? cb->bits : s->bits, i, ch;
+    double lsb = cb->tier == FOGVOL_TIER_FLOAT ? 3e-5 * range
+                 : range / pow(2.0, ((cb->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * bits);
+    memset(o, 0, sizeof *o);
+    for (i = 0; i < W * H; ++i) {
+        double err, a;
+        if (!t->interior[i]) continue;
+        err = fabs(thick[i] - t->gt[i]) / lsb;
+        if ((cb->tier == FOGVOL_TIER_FLOAT ? err : err / t->pairs[i]) > o->max_err)
+            o->max_err = cb->tier == FOGVOL_TIER_FLOAT ? err : err / t->pairs[i];
+        /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits) */
+        if (err > (cb->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb)) {
+            if (o->bad < 3)
+                print_message("  %s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units)\n", cb->name, s->name, i % W, i / W,
+                              thick[i], t->gt[i], err);
+            ++o->bad;
+        }
+        if (!t->covered[i]) continue;
+        o->sum_pp += err / t->pairs[i];
+        ++o->n;
+        a = 1.0 - exp(-(double)s->density * (t->gt[i] > 0 ? t->gt[i] : 0));
+        for (ch = 0; ch < 3; ++ch) {
+            double want = base[4 * i + ch] / 255.0 + (0.8 - base[4 * i + ch] / 255.0) * a;
+            double got = fogged[4 * i + ch] / 255.0;
+            if (fabs(got - want) > o->comp_max) o->comp_max = fabs(got - want);
+        }
+    }
+}
+
+typedef struct tcase {
+    int ctx, combo;
+} tcase;
+
+/* One combo on one scene in the current context. */
+static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, unsigned char *base,
+                      unsigned char *fogged, scene_out *o)
+{
+    const combo *cb = &g_combos[tc->combo];
+    const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
+    fogvol_context *fv = make_context(cb, cb->bits ? cb->bits : s->bits);
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st;
+    fogvol_tier_info ti;
+    fogvol_result r;
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    int i, has_neg = 0, passes;
+    /* Baker's count needs the camera outside the volumes: inside, end_frame refuses the frame and
+       leaves the engine's picture alone */
+    int refused = (cb->variants & FOGVOL_VARIANT_COUNT) && strcmp(s->name, "camera_inside_sphere") == 0;
+    upload_meshes(fv, s, meshes);
+    for (i = 0; i < s->n; ++i) has_neg |= s->obj[i].sign < 0;
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    r = engine_frame(fv, c, e, s, meshes, ramp, cb->tier == FOGVOL_TIER_MRT, thick, base, fogged, &st);
+    memset(o, 0, sizeof *o);
+    if (refused) {
+        assert_int_equal(r, FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(st.passes, 0);
+        assert_memory_equal(base, fogged, (size_t)W * H * 4);
+    } else {
+        assert_int_equal(r, FOGVOL_SUCCESS);
+        compare(cb, s, &g_gt[sc], thick, base, fogged, o);
+        /* passes as the tier info says: + 2 sum passes for the negative volumes (RGBA8 tiers) */
+        assert_int_equal(fogvol_get_tier_info(cb->tier, cb->variants, &ti), FOGVOL_SUCCESS);
+        passes = ti.library_passes + (has_neg && cb->tier != FOGVOL_TIER_FLOAT ? 2 : 0);
+        assert_int_equal(st.passes, passes);
+        if (strcmp(s->name, "layers_opaque_between") == 0) write_png(g_ctx[tc->ctx].file, cb->name, fogged);
+    }
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    free(thick);
+}
+
+static void test_combo(void **state)
+{
+    const tcase *tc = (const tcase *)*state;
+    const combo *cb = &g_combos[tc->combo];
+    unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged = (unsigned char *)malloc((size_t)W * H * 4);
+    double t0 = now(), sum_pp = 0, comp = 0;
+    int sc, n = 0, bad = 0;
+    eglu_ctx c;
+    engine e;
+    context_up(tc->ctx, &c);
+    engine_init(&e, c.major >= 3);
+    for (sc = 0; sc < NSCENE; ++sc) {
+        scene_out o;
+        run_scene(tc, &c, &e, sc, base, fogged, &o);
+        g_err[tc->ctx][tc->combo][sc] = o.max_err;
+        sum_pp += o.sum_pp;
+        n += o.n;
+        bad += o.bad;
+        if (o.comp_max > comp) comp = o.comp_max;
+    }
+    engine_free(&e);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    eglu_destroy(&c);
+    free(base);
+    free(fogged);
+    g_mean[tc->ctx][tc->combo] = n ? sum_pp / n : 0;
+    g_comp[tc->ctx][tc->combo] = comp * 255.0;
+    g_ran[tc->ctx][tc->combo] = 1;
+    g_seconds[tc->ctx] += now() - t0;
+    if (comp > 2.0 / 255.0) print_message("  %s/%s: composite off by %.2f/255\n", g_ctx[tc->ctx].name, cb->name, comp * 255);
+    assert_int_equal(bad, 0);
+    assert_true(n > 1000);
+    assert_true(g_mean[tc->ctx][tc->combo] <= 0.5);
+    assert_true(comp <= 2.0 / 255.0);
+}
+
+static int is_magenta(const unsigned char *p) { return p[0] == 255 && p[1] == 0 && p[2] == 255; }
+
+/* 20 nested shells at L = 4 (16 faces): PS20 reports the saturated sums, paints every wrong pixel
+   magenta, and (ES 3, occlusion queries) counts them a frame or more later without a read-back. */
+static void test_overflow(void **state)
+{
+    int ci = (int)(intptr_t)*state, i, sc = scene_index("overflow_shells"), wrong = 0, unmarked = 0, magenta = 0;
+    const tscene *s = &g_scenes[sc];
+    static const combo cb = {FOGVOL_TIER_PS20, 0, "PS20", 0};
+    double *gt = (double *)calloc((size_t)W * H, sizeof(double)), tmax, lsb = (s->cam.zfar - s->cam.znear) / 4096.0;
+    int *pairs = (int *)calloc((size_t)W * H, sizeof(int)), max_faces, frame;
+    unsigned char *interior = (unsigned char *)calloc((size_t)W * H, 1), *covered = (unsigned char *)calloc((size_t)W * H, 1);
+    unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged = (unsigned char *)malloc((size_t)W * H * 4);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    double t0 = now();
+    eglu_ctx c;
+    engine e;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st, first;
+    int es3;
+    ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax);
+    context_up(ci, &c);
+    es3 = c.major >= 3;
+    engine_init(&e, es3);
+    fv = make_context(&cb, s->bits);
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 0, thick, base, fogged, &st),
+                     FOGVOL_ERROR_DEPTH_OVERFLOW);
+    first = st;
+    for (i = 0; i < W * H; ++i) {
+        int bad = interior[i] && fabs(thick[i] - gt[i]) / lsb > pairs[i] + 1e-3;
+        magenta += is_magenta(fogged + 4 * i);
+        wrong += bad;
+        unmarked += bad && !is_magenta(fogged + 4 * i);
+    }
+    write_png(g_ctx[ci].file, "overflow", fogged);
+    for (frame = 1; frame <= 3 && st.overflow_frame < 0; ++frame)
+        engine_frame(fv, &c, &e, s, meshes, ramp, 0, NULL, base, fogged, &st);
+    print_message("  %s overflow: %d pixels reported saturated, %d wrong, %d painted magenta, %d wrong unmarked; "
+                  "late count %d (frame %lld)\n", g_ctx[ci].name, first.overflow_pixels, wrong, magenta, unmarked,
+                  st.overflow_pixels_late, (long long)st.overflow_frame);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    engine_free(&e);
+    eglu_destroy(&c);
+    g_seconds[ci] += now() - t0;
+    assert_true(first.overflow_pixels > 0);
+    assert_true(wrong > 0);
+    assert_int_equal(unmarked, 0);
+    assert_true(magenta >= wrong);
+    /* ES 3: an occlusion query of boolean kind, 1 = some pixels overflowed; ES 2: no queries, -1 */
+    assert_int_equal(st.overflow_pixels_late, es3 ? 1 : -1);
+    free(gt);
+    free(pairs);
+    free(interior);
+    free(covered);
+    free(base);
+    free(fogged);
+    free(thick);
+}
+
+static int setup_all(void **state)
+{
+    int i;
+    (void)state;
+    build_scenes();
+    for (i = 0; i < NSCENE; ++i) {
+        gt_cache *t = &g_gt[i];
+        t->gt = (double *)calloc((size_t)W * H, sizeof(double));
+        t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
+        t->interior = (unsigned char *)calloc((size_t)W * H, 1);
+        t->covered = (unsigned char *)calloc((size_t)W * H, 1);
+        ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
+                     &t->max_faces, &t->tmax);
+    }
+    return 0;
+}
+
+/* The figures: per context, versions, automatic choice, and per combo the max error per scene. */
+static int print_table(void **state)
+{
+    int ci = g_cur, k, sc;
+    (void)state;
+    {
+        print_message("\n%s: GL_VERSION \"%s\", GLSL \"%s\"; automatic: %s with GLSL %s; %.1f s\n", g_ctx[ci].name,
+                      g_version[ci][0], g_version[ci][1], fogvol_tier_name(g_auto_tier[ci]),
+                      fogvol_dialect_name(g_auto_dialect[ci]), g_seconds[ci]);
+        print_message("| combo (unit) |");
+        for (sc = 0; sc < NSCENE; ++sc) print_message(" %s |", g_scene_names[sc]);
+        print_message(" mean/pair | composite |\n|---|");
+        for (sc = 0; sc < NSCENE + 2; ++sc) print_message("---|");
+        print_message("\n");
+        for (k = 0; k < NCOMBO; ++k) {
+            if (!g_ran[ci][k]) continue;
+            print_message("| %s (%s) |", g_combos[k].name, g_combos[k].tier == FOGVOL_TIER_FLOAT ? "3e-5 range" : "LSB/pair");
+            for (sc = 0; sc < NSCENE; ++sc) print_message(" %.3f |", g_err[ci][k][sc]);
+            print_message(" %.3f | %.1f/255 |\n", g_mean[ci][k], g_comp[ci][k]);
+        }
+    }
+    print_message("(max |error| over interior pixels, bound 1 (+ 1e-6 range for fp32 vertex maths); mean per pair "
+                  "over covered pixels, bound 0.5; composite bound 2/255; "
+                  "PS13/PS20+count on camera_inside_sphere: refused, 0)\n\n");
+    for (sc = 0; sc < NSCENE; ++sc) {
+        free(g_gt[sc].gt);
+        free(g_gt[sc].pairs);
+        free(g_gt[sc].interior);
+        free(g_gt[sc].covered);
+    }
+    free_scenes();
+    return 0;
+}
+
+/* One process per context kind (tests/egl_util.h): a child runs the group of
+   context ci, the parent waits for it. */
+static int run_context(int ci)
+{
+    static tcase cases[NCOMBO];
+    static struct CMUnitTest tests[NCOMBO + 2];
+    static char names[NCOMBO + 2][64], group[32];
+    fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
+    int k, n = 0, nc = 0;
+    g_cur = ci;
+    snprintf(names[n], sizeof names[n], "%s_auto_choice", g_ctx[ci].file);
+    tests[n].name = names[n];
+    tests[n].test_func = test_auto_choice;
+    tests[n].initial_state = (void *)(intptr_t)ci;
+    ++n;
+    for (k = 0; k < NCOMBO; ++k) {
+        if (fogvol_combination_supported(g_combos[k].tier, g_combos[k].variants, d) != FOGVOL_SUCCESS) continue;
+        if (g_ctx[ci].plain_tiers_only && g_combos[k].variants) continue;
+        cases[nc].ctx = ci;
+        cases[nc].combo = k;
+        snprintf(names[n], sizeof names[n], "%s_%s", g_ctx[ci].file, g_combos[k].name);
+        tests[n].name = names[n];
+        tests[n].test_func = test_combo;
+        tests[n].initial_state = &cases[nc++];
+        ++n;
+    }
+    snprintf(names[n], sizeof names[n], "%s_overflow", g_ctx[ci].file);
+    tests[n].name = names[n];
+    tests[n].test_func = test_overflow;
+    tests[n].initial_state = (void *)(intptr_t)ci;
+    ++n;
+    snprintf(group, sizeof group, "gles_%s", g_ctx[ci].file);
+    return _cmocka_run_group_tests(group, tests, (size_t)n, setup_all, print_table);
+}
+
+int main(void)
+{
+    int ci, failed = 0;
+    for (ci = 0; ci < NCTX; ++ci) {
+        int status = 0;
+        pid_t pid;
+        fflush(stdout);
+        fflush(stderr);
+        pid = fork();
+        if (pid < 0) {
+            fprintf(stderr, "test_gles: fork failed\n");
+            return 1;
+        }
+        if (pid == 0) exit(run_context(ci) != 0); /* exit: LeakSanitizer runs in the child */
+        if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+            printf("not ok - %s: the process exited with status 0x%x\n", g_ctx[ci].name, (unsigned)status);
+            failed = 1;
+        }
+    }
+    return failed;
+}
