@@ -252,13 +252,13 @@ typedef struct fogvol_encoding {
 #define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
 
 /* Fill *out for L = bits (1..8). */
-FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits);
+FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out);
 /* Most precise encoding that sums at least max_faces faces (1..128).
    max_faces < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 128: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces);
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out);
 /* Encoding with the most faces that still gives at least precision_bits (1..24).
    precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits);
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out);
 /* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
    writes min(count, capacity) rows when rows != NULL. */
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
@@ -282,6 +282,9 @@ typedef struct fogvol_constants {
 FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar,
                                                   float scale, fogvol_constants *out);
 
+/* CPU reference of the GPU arithmetic. The renderer does not call these: they
+   model byte for byte what the encode, blend and decode passes compute, for
+   tests (fogvol's own and a custom backend's) and for offline tools. */
 /* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
    depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
    row 0 is the undithered (round-to-nearest) row. */
@@ -289,7 +292,7 @@ FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double 
                                              unsigned char out_rgba[4]);
 /* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
    Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
-FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4]);
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
 /* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
    tells whether any channel saturated. */
 FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
@@ -567,13 +570,13 @@ FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned varian
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
 
 typedef struct fogvol_tier_info {
-    int seed_passes;    /* as the white paper counts them, the engine's opaque pass included */
+    int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
     int library_passes; /* passes fogvol issues per frame for one colour-ramp group
                            (+1 per negative group pass in the RGBA8 tiers) */
     int targets;        /* render targets fogvol allocates */
     const char *name;
 } fogvol_tier_info;
-FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
+FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
 
 /* MRT tier: GLSL for the engine's opaque fragment shader. It declares
@@ -1445,7 +1448,7 @@ static int fogvol__finite_n(const float *v, int n)
 
 /* ---- encoding ---- */
 
-FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits)
+FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out)
 {
     if (!out || bits < 1 || bits > 8) return FOGVOL_ERROR_INVALID_ARGUMENT;
     out->bits = bits;
@@ -1459,37 +1462,37 @@ FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits)
     return FOGVOL_SUCCESS;
 }
 
-FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces)
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out)
 {
     int bits;
     if (!out || max_faces < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (max_faces > 128) return FOGVOL_ERROR_UNSUPPORTED;
     for (bits = 8; bits >= 1; --bits)
-        if ((1 << (8 - bits)) >= max_faces) return fogvol_encoding_init(out, bits);
+        if ((1 << (8 - bits)) >= max_faces) return fogvol_encoding_init(bits, out);
     return FOGVOL_ERROR_UNSUPPORTED;
 }
 
-FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits)
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out)
 {
     int bits;
     if (!out || precision_bits < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (precision_bits > 24) return FOGVOL_ERROR_UNSUPPORTED;
     for (bits = 1; bits <= 8; ++bits)
-        if (3 * bits >= precision_bits) return fogvol_encoding_init(out, bits);
+        if (3 * bits >= precision_bits) return fogvol_encoding_init(bits, out);
     return FOGVOL_ERROR_UNSUPPORTED;
 }
 
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity)
 {
     int i;
-    for (i = 0; rows && i < 8 && i < capacity; ++i) fogvol_encoding_init(&rows[i], i + 1);
+    for (i = 0; rows && i < 8 && i < capacity; ++i) fogvol_encoding_init(i + 1, &rows[i]);
     return 8;
 }
 
 static int fogvol__enc_ok(const fogvol_encoding *e)
 {
     fogvol_encoding ref;
-    if (!e || fogvol_encoding_init(&ref, e->bits) != FOGVOL_SUCCESS) return 0;
+    if (!e || fogvol_encoding_init(e->bits, &ref) != FOGVOL_SUCCESS) return 0;
     return ref.levels == e->levels && ref.dither_steps == e->dither_steps;
 }
 
@@ -1574,7 +1577,7 @@ FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double 
     return FOGVOL_SUCCESS;
 }
 
-FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4])
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4])
 {
     int i, sat = 0;
     for (i = 0; i < 4; ++i) {
@@ -1594,7 +1597,7 @@ FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int cou
     int i, sat = 0;
     if (!out_rgba || count < 0 || (count > 0 && !values)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out_rgba, 0, 4);
-    for (i = 0; i < count; ++i) sat |= fogvol_sum_rgba8(out_rgba, values + 4 * i);
+    for (i = 0; i < count; ++i) sat |= fogvol_sum_rgba8(values + 4 * i, out_rgba);
     if (saturated) *saturated = sat;
     return FOGVOL_SUCCESS;
 }
@@ -3790,7 +3793,7 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_pro
     }
 }
 
-FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
+FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
 {
     int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -3798,22 +3801,22 @@ FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned v, fogv
     out->name = fogvol_tier_name(tier);
     switch (tier) {
     case FOGVOL_TIER_PS13:
-        out->seed_passes = 6;
+        out->paper_passes = 6;
         out->library_passes = 5;
         out->targets = single ? 3 : 4; /* O, B, F, T */
         break;
     case FOGVOL_TIER_PS20:
-        out->seed_passes = 5;
+        out->paper_passes = 5;
         out->library_passes = 4;
         out->targets = single ? 2 : 3;
         break;
     case FOGVOL_TIER_MRT:
-        out->seed_passes = 4;
+        out->paper_passes = 4;
         out->library_passes = 3;
         out->targets = single ? 2 : 3; /* O is written by the engine */
         break;
     case FOGVOL_TIER_FLOAT:
-        out->seed_passes = 3;
+        out->paper_passes = 3;
         out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
         out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
         break;
@@ -4616,7 +4619,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->dither = !desc->disable_dither;
     ctx->variants = desc->variants;
     ctx->msaa = desc->msaa;
-    fogvol_encoding_init(&ctx->enc, bits);
+    fogvol_encoding_init(bits, &ctx->enc);
     r = fogvol__attach_backend(ctx, desc);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&desc->allocator, ctx);
@@ -5766,7 +5769,7 @@ static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
     cur[0] = &ctx->tex_rg;
     cur[1] = &ctx->tex_blue;
     cur[2] = &ctx->tex_dither;
-    fogvol_encoding_init(&ctx->enc, old.bits - 1);
+    fogvol_encoding_init(old.bits - 1, &ctx->enc);
     for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
         if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
     if (r != FOGVOL_SUCCESS) {

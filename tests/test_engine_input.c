@@ -415,7 +415,7 @@ static void run_depth_case(const depth_case *dc, tobj *o, int n, const double *g
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
     add_volume(fv, vol, o[0].model, ramp);
     assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_get_tier_info(tier, FOGVOL_VARIANT_ENGINE_DEPTH | dc->variants, &ti), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_tier_costs(tier, FOGVOL_VARIANT_ENGINE_DEPTH | dc->variants, &ti), FOGVOL_SUCCESS);
     assert_int_equal(st.passes, ti.library_passes);
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_after);
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_after);

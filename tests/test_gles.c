@@ -538,7 +538,7 @@ static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, uns
         assert_int_equal(r, FOGVOL_SUCCESS);
         compare(cb, s, &g_gt[sc], thick, base, fogged, o);
         /* passes as the tier info says: + 2 sum passes for the negative volumes (RGBA8 tiers) */
-        assert_int_equal(fogvol_get_tier_info(cb->tier, cb->variants, &ti), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_tier_costs(cb->tier, cb->variants, &ti), FOGVOL_SUCCESS);
         passes = ti.library_passes + (has_neg && cb->tier != FOGVOL_TIER_FLOAT ? 2 : 0);
         assert_int_equal(st.passes, passes);
         if (strcmp(s->name, "layers_opaque_between") == 0) write_png(g_ctx[tc->ctx].file, cb->name, fogged);

@@ -334,7 +334,7 @@ static void run(int ci, int di)
         }
         assert_int_equal(glGetError(), GL_NO_ERROR);
         /* passes as the tier info says: +1 per sum pass for the negative volumes */
-        assert_int_equal(fogvol_get_tier_info(c->tier, c->variants, &ti), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_tier_costs(c->tier, c->variants, &ti), FOGVOL_SUCCESS);
         j = ti.library_passes;
         if (has_neg && c->tier != FOGVOL_TIER_FLOAT) j += 2;
         if (c->variants & FOGVOL_VARIANT_SINGLE_TARGET) j += 0; /* S+, S- replace B, F */
@@ -537,7 +537,7 @@ static void test_single_target_limit(void **state)
     double err;
     fogvol_encoding e;
     (void)state;
-    fogvol_encoding_init(&e, 4);
+    fogvol_encoding_init(4, &e);
     assert_int_equal(e.max_faces_single, e.max_faces / 2);
     shells(8, FOGVOL_VARIANT_SINGLE_TARGET, &r, &ov, &err);
     print_message("  single target, 8 shells: %s, %d saturated pixels, centre error %.2f LSB\n",
@@ -561,26 +561,26 @@ static void test_pass_counts(void **state)
 {
     fogvol_tier_info ti;
     (void)state;
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS13, 0, &ti), 0);
-    assert_int_equal(ti.seed_passes, 6);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, 0, &ti), 0);
-    assert_int_equal(ti.seed_passes, 5);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_MRT, 0, &ti), 0);
-    assert_int_equal(ti.seed_passes, 4);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, 0, &ti), 0);
-    assert_int_equal(ti.seed_passes, 3);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_PS13, 0, &ti), 0);
+    assert_int_equal(ti.paper_passes, 6);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_PS20, 0, &ti), 0);
+    assert_int_equal(ti.paper_passes, 5);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_MRT, 0, &ti), 0);
+    assert_int_equal(ti.paper_passes, 4);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_FLOAT, 0, &ti), 0);
+    assert_int_equal(ti.paper_passes, 3);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
     assert_int_equal(ti.library_passes, 2);
     /* targets: O, B, F (+ T for PS13's resolve); one sum target S when single; FLOAT: O and the float sum */
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS13, 0, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_PS13, 0, &ti), 0);
     assert_int_equal(ti.targets, 4);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, 0, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_PS20, 0, &ti), 0);
     assert_int_equal(ti.targets, 3);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, &ti), 0);
     assert_int_equal(ti.targets, 2);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, 0, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_FLOAT, 0, &ti), 0);
     assert_int_equal(ti.targets, 2);
-    assert_int_equal(fogvol_get_tier_info(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
+    assert_int_equal(fogvol_tier_costs(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, &ti), 0);
     assert_int_equal(ti.targets, 1);
     print_message("  passes (seed / fogvol): PS13 6/5, PS20 5/4, MRT 4/3, FLOAT 3/3, FLOAT+engine depth -/2\n");
 }
