@@ -88,8 +88,8 @@ typedef struct shot {
 
 static void camera(int view, int w, int h, float v[16], float p[16])
 {
-    static const double eye[3][3] = {{1.0, 5.2, 13.5}, {-7.0, 1.7, 8.0}, {2.4, 0.45, -1.5}};
-    static const double at[3][3] = {{0.0, 1.0, -2.5}, {1.0, 1.4, -3.0}, {-3.0, 1.0, -7.2}};
+    static const double eye[3][3] = {{1.0, 5.2, 13.5}, {-7.0, 1.7, 8.0}, {-7.0, 0.5, -1.5}};
+    static const double at[3][3] = {{0.0, 1.0, -2.5}, {1.0, 1.4, -3.0}, {2.0, 1.4, -6.0}};
     static const double up[3] = {0, 1, 0};
     glu_look_at(v, eye[view], at[view], up);
     glu_perspective(p, 55.0, (double)w / h, 0.1, 40.0);

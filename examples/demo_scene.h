@@ -53,7 +53,12 @@ typedef struct ds_scene {
 } ds_scene;
 
 /* sun direction (towards the sun) and the sky colours, shared by the sky and the surfaces */
-#define DS_SUN "vec3(0.47, 0.50, 0.73)"
+#define DS_SUN_X 0.72
+#define DS_SUN_Y 0.52
+#define DS_SUN_Z 0.46
+#define DS__STR2(x) #x
+#define DS__STR(x) DS__STR2(x)
+#define DS_SUN "vec3(" DS__STR(DS_SUN_X) ", " DS__STR(DS_SUN_Y) ", " DS__STR(DS_SUN_Z) ")"
 
 /* ---- meshes -------------------------------------------------------------------- */
 
@@ -286,9 +291,13 @@ static inline void ds_scene_free(ds_scene *s)
 
 typedef struct ds_gl {
     GLuint prog, sky, vao[DS_MAX_MESHES], vbo[DS_MAX_MESHES], ebo[DS_MAX_MESHES], empty_vao;
-    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv;
+    GLuint shadow_prog, shadow_fbo, shadow_tex; /* the sun's shadow map, rendered once */
+    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv, u_shadow_vp, u_shadow_map, u_shadow_mvp;
     int count[DS_MAX_MESHES];
+    float shadow_vp[16];
 } ds_gl;
+
+#define DS_SHADOW_SIZE 2048
 
 #define DS_GLSL_COMMON                                                                                              \
     "#version 330 core\n"                                                                                           \
@@ -346,16 +355,29 @@ static const char *const ds__fs_albedo =
     "}\n";
 
 static const char *const ds__fs_main =
+    "uniform mat4 shadow_vp; uniform sampler2DShadow shadow_map;\n"
+    "float sunlight(vec3 n) {\n"
+    "  vec4 s = shadow_vp * vec4(wp + n * 0.04, 1.0); vec3 q = s.xyz / s.w * 0.5 + 0.5; float l = 0.0;\n"
+    "  for (int i = 0; i < 4; ++i) {\n"
+    "    vec2 o = (vec2(i & 1, i >> 1) - 0.5) * (1.5 / " DS__STR(DS_SHADOW_SIZE) ".0);\n"
+    "    l += texture(shadow_map, vec3(q.xy + o, q.z - 0.0015)); }\n"
+    "  return 0.25 * l * max(dot(n, sun), 0.0);\n"
+    "}\n"
     "void main() {\n"
     "  vec3 n = normalize(cross(dFdx(wp), dFdy(wp)));\n"
     "  vec3 a = albedo(n);\n"
-    "  float d = max(dot(n, sun), 0.0);\n"
+    "  float d = sunlight(n);\n"
     "  vec3 amb = mix(vec3(0.26, 0.23, 0.18), vec3(0.42, 0.52, 0.68), 0.5 + 0.5 * n.y);\n"
     "  vec3 c = material == 7 ? color * 1.4 : a * (amb * 0.85 + vec3(1.15, 1.0, 0.8) * d);\n"
     "  vec3 v = wp - eye; float dist = length(v);\n"
     "  c = mix(c, sky_color(normalize(vec3(v.x, 0.02 * dist, v.z))), 1.0 - exp(-0.018 * dist));\n"
     "  o = vec4(c, 1.0);\n"
     "}\n";
+
+static const char *const ds__shadow_vs = "#version 330 core\n"
+                                   "layout(location = 0) in vec3 p; uniform mat4 mvp;\n"
+                                   "void main() { gl_Position = mvp * vec4(p, 1.0); }\n";
+static const char *const ds__shadow_fs = "void main() { }\n";
 
 static const char *const ds__sky_vs = "#version 330 core\n"
                                 "uniform mat4 inv_vp; out vec3 dir;\n"
@@ -393,7 +415,74 @@ static inline GLuint ds__program(const char *vs, const char *fs_a, const char *f
     return p;
 }
 
-/* compile the programs and upload the opaque meshes (positions and indices as they are) */
+/* The sun's view: orthographic, looking down -sun onto the courtyard. */
+static inline void ds__sun_matrix(float vp[16])
+{
+    static const double sun[3] = {DS_SUN_X, DS_SUN_Y, DS_SUN_Z}, c[3] = {0.0, 0.0, -2.5};
+    double l = sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]), f[3], r[3], u[3], e[3], n;
+    float v[16], p[16];
+    int k;
+    for (k = 0; k < 3; ++k) f[k] = -sun[k] / l, e[k] = c[k] - 30.0 * f[k];
+    r[0] = f[2], r[1] = 0, r[2] = -f[0]; /* f x (0,1,0), normalised */
+    n = sqrt(r[0] * r[0] + r[2] * r[2]), r[0] /= n, r[2] /= n;
+    u[0] = r[1] * f[2] - r[2] * f[1], u[1] = r[2] * f[0] - r[0] * f[2], u[2] = r[0] * f[1] - r[1] * f[0];
+    shp_mat_identity(v);
+    for (k = 0; k < 3; ++k) v[4 * k] = (float)r[k], v[4 * k + 1] = (float)u[k], v[4 * k + 2] = (float)-f[k];
+    v[12] = (float)-(r[0] * e[0] + r[1] * e[1] + r[2] * e[2]);
+    v[13] = (float)-(u[0] * e[0] + u[1] * e[1] + u[2] * e[2]);
+    v[14] = (float)(f[0] * e[0] + f[1] * e[1] + f[2] * e[2]);
+    shp_mat_scale(p, 1.0f / 15.0f, 1.0f / 15.0f, -2.0f / 50.0f); /* x, y in [-15, 15], depth 5 .. 55 */
+    p[14] = -60.0f / 50.0f;
+    shp_mat_mul(vp, p, v);
+}
+
+/* Render the shadow map once (the opaque scene does not move); the framebuffer
+   binding and viewport are restored. */
+static inline void ds__shadow_map(ds_gl *g, const ds_scene *s)
+{
+    GLint fb = 0, vpt[4];
+    float mvp[16];
+    int i;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fb);
+    glGetIntegerv(GL_VIEWPORT, vpt);
+    glGenTextures(1, &g->shadow_tex);
+    glBindTexture(GL_TEXTURE_2D, g->shadow_tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, DS_SHADOW_SIZE, DS_SHADOW_SIZE, 0, GL_DEPTH_COMPONENT,
+                 GL_UNSIGNED_INT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &g->shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, g->shadow_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g->shadow_tex, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glViewport(0, 0, DS_SHADOW_SIZE, DS_SHADOW_SIZE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    ds__sun_matrix(g->shadow_vp);
+    glUseProgram(g->shadow_prog);
+    for (i = 0; i < s->count; ++i) {
+        if (s->obj[i].kind != DS_OPAQUE) continue;
+        shp_mat_mul(mvp, g->shadow_vp, s->obj[i].model);
+        glUniformMatrix4fv(g->u_shadow_mvp, 1, GL_FALSE, mvp);
+        glBindVertexArray(g->vao[s->obj[i].mesh]);
+        glDrawElements(GL_TRIANGLES, g->count[s->obj[i].mesh], GL_UNSIGNED_INT, (void *)0);
+    }
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)fb);
+    glViewport(vpt[0], vpt[1], vpt[2], vpt[3]);
+}
+
+/* compile the programs, upload the opaque meshes (positions and indices as they are),
+   render the shadow map */
 static inline void ds_gl_init(ds_gl *g, const ds_scene *s)
 {
     int i;
@@ -406,6 +495,10 @@ static inline void ds_gl_init(ds_gl *g, const ds_scene *s)
     g->u_material = glGetUniformLocation(g->prog, "material");
     g->u_eye = glGetUniformLocation(g->prog, "eye");
     g->u_sky_inv = glGetUniformLocation(g->sky, "inv_vp");
+    g->u_shadow_vp = glGetUniformLocation(g->prog, "shadow_vp");
+    g->u_shadow_map = glGetUniformLocation(g->prog, "shadow_map");
+    g->shadow_prog = ds__program(ds__shadow_vs, "#version 330 core\n", ds__shadow_fs, NULL);
+    g->u_shadow_mvp = glGetUniformLocation(g->shadow_prog, "mvp");
     glGenVertexArrays(1, &g->empty_vao);
     for (i = 0; i < s->mesh_count; ++i) {
         const shp_mesh *m = &s->mesh[i];
@@ -422,6 +515,7 @@ static inline void ds_gl_init(ds_gl *g, const ds_scene *s)
         g->count[i] = m->icount;
     }
     glBindVertexArray(0);
+    ds__shadow_map(g, s);
 }
 
 static inline void ds_gl_free(ds_gl *g)
@@ -434,6 +528,9 @@ static inline void ds_gl_free(ds_gl *g)
             glDeleteBuffers(1, &g->ebo[i]);
         }
     glDeleteVertexArrays(1, &g->empty_vao);
+    glDeleteFramebuffers(1, &g->shadow_fbo);
+    glDeleteTextures(1, &g->shadow_tex);
+    glDeleteProgram(g->shadow_prog);
     glDeleteProgram(g->prog);
     glDeleteProgram(g->sky);
     memset(g, 0, sizeof *g);
@@ -486,6 +583,10 @@ static inline void ds_draw(ds_gl *g, const ds_scene *s, const float view[16], co
     glDepthFunc(GL_LESS);
     glUseProgram(g->prog);
     if (ds_invert(iv, view)) glUniform3f(g->u_eye, iv[12], iv[13], iv[14]);
+    glUniformMatrix4fv(g->u_shadow_vp, 1, GL_FALSE, g->shadow_vp);
+    glUniform1i(g->u_shadow_map, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g->shadow_tex);
     for (i = 0; i < s->count; ++i) {
         const ds_object *o = &s->obj[i];
         if (o->kind != DS_OPAQUE) continue;
@@ -498,6 +599,7 @@ static inline void ds_draw(ds_gl *g, const ds_scene *s, const float view[16], co
         glDrawElements(GL_TRIANGLES, g->count[o->mesh], GL_UNSIGNED_INT, (void *)0);
     }
     glDisable(GL_DEPTH_TEST);
+    glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
     glBindVertexArray(0);
 }
