@@ -9,7 +9,7 @@
    opaque objects cut the volumes. It writes PNGs:
      scene_overview.png, scene_low.png, scene_inside_fog_bank.png  three viewpoints
      tiers.png        the same frame per tier: PS13 | PS20 | FLOAT
-     dither.png       L = 2 bits per channel (6-bit depth precision) and dense fog,
+     dither.png       L = 2 bits per channel (6-bit depth precision), close to the fog sphere,
                       dithering off | on (the banding and its cure)
      ramps.png        colour ramps: extinction | linear | artist gradient
      thickness.png    the raw thickness of the fog group as false colour
@@ -88,8 +88,9 @@ typedef struct shot {
 
 static void camera(int view, int w, int h, float v[16], float p[16])
 {
-    static const double eye[3][3] = {{1.0, 5.2, 13.5}, {-7.0, 1.7, 8.0}, {-7.0, 0.5, -1.5}};
-    static const double at[3][3] = {{0.0, 1.0, -2.5}, {1.0, 1.4, -3.0}, {2.0, 1.4, -6.0}};
+    /* overview, low, inside the mist bank, close to the fog sphere (for dither.png) */
+    static const double eye[4][3] = {{1.0, 5.2, 13.5}, {-7.0, 1.7, 8.0}, {-7.0, 0.5, -1.5}, {2.8, 1.4, 5.4}};
+    static const double at[4][3] = {{0.0, 1.0, -2.5}, {1.0, 1.4, -3.0}, {2.0, 1.4, -6.0}, {5.3, 0.5, 0.6}};
     static const double up[3] = {0, 1, 0};
     glu_look_at(v, eye[view], at[view], up);
     glu_perspective(p, 55.0, (double)w / h, 0.1, 40.0);
@@ -352,7 +353,7 @@ int main(int argc, char **argv)
     }
     for (k = 0; k < 3; ++k) free_shot(&sh[k]);
 
-    /* side by side at half size: the tiers, dithering at 6 bits, the colour ramps */
+    /* side by side at half size: the tiers, dithering at L = 2 (6-bit depth), the colour ramps */
     {
         settings v[3];
         for (k = 0; k < 3; ++k) {
@@ -365,10 +366,10 @@ int main(int argc, char **argv)
         v[1].tier = FOGVOL_TIER_PS20;
         v[2].tier = FOGVOL_TIER_FLOAT;
         row(&d, dir, "tiers.png", v, 3, 1);
-        for (k = 0; k < 2; ++k) { /* banding at low precision (dense fog) and its cure */
+        for (k = 0; k < 2; ++k) { /* banding at low precision (close to the fog sphere) and its cure */
             v[k].tier = FOGVOL_TIER_PS20;
             v[k].bits = 2;
-            v[k].fog_scale = 4.0f;
+            v[k].view = 3;
             v[k].dither = k;
         }
         row(&d, dir, "dither.png", v, 2, 0);
