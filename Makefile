@@ -164,14 +164,14 @@ test: deps-test deps-run
 	  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
 
 # --- demo --------------------------------------------------------------------------
-$(BUILD)/demo_headless: examples/demo_headless.c $(HEADERS) | $(BUILD)
+$(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ $(GL_LIBS)
 
 demo: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
 	@$(BUILD)/demo_headless $(BUILD)/demo
 
-$(BUILD)/demo_glfw: examples/demo_glfw.c fogvol.h tests/shapes.h | $(BUILD)
+$(BUILD)/demo_glfw: examples/demo_glfw.c examples/demo_scene.h fogvol.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lglfw -lGL -lm
 
 # the interactive demo; without a display: 120 frames under Xvfb into $(BUILD)/demo_glfw.png

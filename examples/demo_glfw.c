@@ -1,9 +1,12 @@
 /* demo_glfw.c - fogvol.h in a window (GLFW, OpenGL 3.3 core).
 
-   A floor and pillars drawn by the demo's own flat shader, cut through by fog
-   volumes: a sphere, a torus, an animated twisted blob (deformed on the CPU and
-   re-uploaded every frame), a long fog bank with a negative sphere carving a
-   hole in it, and a light beam blended additively (FOGVOL_BLEND_LIGHT).
+   The demo's place (examples/demo_scene.h, shared with demo_headless.c): a
+   sunlit courtyard with a cobbled path, a house, columns, an arch gate, rocks,
+   pine trees and a lamp post, drawn by the demo's own shaders. fogvol adds the
+   fog volumes placed in it: a fog sphere around the rocks, a ring turning in the
+   arch, a writhing cloud (deformed on the CPU and re-uploaded every frame), a
+   low mist bank with a drifting clearing carved by a negative sphere, and a
+   sunbeam and the lamp's cone blended additively (FOGVOL_BLEND_LIGHT).
 
    Controls
      mouse          look around (click into the window to capture the mouse, Tab releases it)
@@ -11,16 +14,20 @@
      T              cycle tier PS13 -> PS20 -> FLOAT (tiers the context refuses are skipped)
      B              cycle encoding bits per channel 3, 4, 5, 6 (precision vs. faces per pixel)
      G              dithering on / off            R   colour ramp: extinction, linear, gradient
-     L              fog / light blend of the main group (sphere, torus, blob)
+     L              fog / light blend of the main group (sphere, ring, cloud)
      O              paint pixels whose face sums overflowed in magenta
      P              pause the animation           Esc quit
    The window title shows the frame time and the current settings.
 
    usage: demo_glfw [--frames N] [--screenshot FILE.png] [--size WxH] [--tier ps13|ps20|float] [--bits L]
                     [--camera x,y,z,yaw,pitch] [--keys KEYS]
-     --keys KEYS     press these keys, one per frame from the first (e.g. TTB: two tiers on, then bits)
      --frames N      render N frames (fixed 1/60 s animation steps) and exit
      --screenshot F  write the last frame to F as PNG
+     --size WxH      window size (default 960x540)
+     --tier T        start with this tier (default: the best the context has)
+     --bits L        start with L bits per channel (default 4)
+     --camera ...    start position and yaw / pitch in degrees (yaw 0 looks down -z)
+     --keys KEYS     press these keys, one per frame from the first (e.g. TTB: two tiers on, then bits)
 
    build: cc -std=c99 -I. examples/demo_glfw.c -o demo_glfw -lglfw -lGL -lm */
 #define FOGVOL_IMPLEMENTATION
@@ -28,7 +35,7 @@
 #define GL_GLEXT_PROTOTYPES
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
-#include "tests/shapes.h"
+#include "examples/demo_scene.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <stdio.h>
@@ -38,127 +45,20 @@
 
 #define ZNEAR 0.1f
 #define ZFAR 60.0f
-#define NPILLARS 5
 
-/* ---- the demo's own opaque renderer: flat-shaded meshes ------------------------ */
-typedef struct flat_mesh {
-    GLuint vao, vbo;
-    int count;
-} flat_mesh;
-
-static GLuint g_flat_prog;
-static GLint g_u_mvp, g_u_model, g_u_color;
-
-static GLuint compile(GLenum type, const char *src)
-{
-    GLuint s = glCreateShader(type);
-    GLint ok = 0;
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[1024];
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        fprintf(stderr, "shader: %s\n", log);
-        exit(1);
-    }
-    return s;
-}
-
-static void flat_init(void)
-{
-    static const char *vs = "#version 330 core\n"
-                            "layout(location = 0) in vec3 p; layout(location = 1) in vec3 n;\n"
-                            "uniform mat4 mvp, model; out vec3 wn, wp;\n"
-                            "void main() {\n"
-                            "  wn = mat3(model) * n; wp = (model * vec4(p, 1.0)).xyz;\n"
-                            "  gl_Position = mvp * vec4(p, 1.0);\n"
-                            "}\n";
-    static const char *fs = "#version 330 core\n"
-                            "in vec3 wn, wp; uniform vec4 color; out vec4 o;\n"
-                            "void main() {\n"
-                            "  vec3 sun = normalize(vec3(0.38, 0.83, 0.41));\n"
-                            "  float l = 0.35 + 0.65 * max(dot(normalize(wn), sun), 0.0);\n"
-                            "  float check = mod(floor(wp.x) + floor(wp.z), 2.0);\n" /* color.a: checker strength */
-                            "  o = vec4(color.rgb * l * (1.0 - color.a * check), 1.0);\n"
-                            "}\n";
-    GLuint v = compile(GL_VERTEX_SHADER, vs), f = compile(GL_FRAGMENT_SHADER, fs);
-    g_flat_prog = glCreateProgram();
-    glAttachShader(g_flat_prog, v);
-    glAttachShader(g_flat_prog, f);
-    glLinkProgram(g_flat_prog);
-    glDeleteShader(v);
-    glDeleteShader(f);
-    g_u_mvp = glGetUniformLocation(g_flat_prog, "mvp");
-    g_u_model = glGetUniformLocation(g_flat_prog, "model");
-    g_u_color = glGetUniformLocation(g_flat_prog, "color");
-}
-
-/* expand the triangles with face normals, once */
-static flat_mesh flat_upload(const shp_mesh *m)
-{
-    flat_mesh f;
-    float *buf = (float *)malloc(sizeof(float) * 6 * (size_t)m->icount);
-    int t, k;
-    for (t = 0; t < m->icount / 3; ++t) {
-        const float *a = m->pos + 3 * m->idx[3 * t], *b = m->pos + 3 * m->idx[3 * t + 1];
-        const float *c = m->pos + 3 * m->idx[3 * t + 2];
-        float e1[3], e2[3], n[3];
-        for (k = 0; k < 3; ++k) e1[k] = b[k] - a[k], e2[k] = c[k] - a[k];
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        for (k = 0; k < 3; ++k) {
-            const float *p = k == 0 ? a : k == 1 ? b : c;
-            memcpy(buf + 18 * t + 6 * k, p, 12);
-            memcpy(buf + 18 * t + 6 * k + 3, n, 12);
-        }
-    }
-    f.count = m->icount;
-    glGenVertexArrays(1, &f.vao);
-    glGenBuffers(1, &f.vbo);
-    glBindVertexArray(f.vao);
-    glBindBuffer(GL_ARRAY_BUFFER, f.vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 6 * (size_t)m->icount), buf, GL_STATIC_DRAW);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 24, (void *)12);
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
-    free(buf);
-    return f;
-}
-
-static void flat_draw(const flat_mesh *f, const float model[16], const float vp[16], float r, float g, float b,
-                      float checker)
-{
-    float mvp[16];
-    shp_mat_mul(mvp, vp, model);
-    glUseProgram(g_flat_prog);
-    glUniformMatrix4fv(g_u_mvp, 1, GL_FALSE, mvp);
-    glUniformMatrix4fv(g_u_model, 1, GL_FALSE, model);
-    glUniform4f(g_u_color, r, g, b, checker);
-    glBindVertexArray(f->vao);
-    glDrawArrays(GL_TRIANGLES, 0, f->count);
-}
-
-/* ---- scene data ------------------------------------------------------------------ */
-static const float k_pillars[NPILLARS][2] = {
-    {-2.5f, -1.0f}, {0.3f, -2.2f}, {2.4f, 0.8f}, {-0.6f, 2.4f}, {4.5f, -4.0f}};
 static const fogvol_tier k_tiers[3] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
 static const int k_bits[4] = {3, 4, 5, 6};
 static const char *const k_ramp_names[3] = {"extinction", "linear", "gradient"};
 
-enum { M_FLOOR, M_PILLAR, M_SPHERE, M_TORUS, M_BANK, M_HOLE, M_BEAM, M_BLOB, M_COUNT }; /* meshes */
-enum { R_MAIN, R_BANK, R_LIGHT, R_COUNT };                                             /* colour ramps */
+enum { R_MAIN, R_BANK, R_LIGHT, R_COUNT }; /* colour ramps, in the order of ds_group() */
 
 typedef struct app {
     GLFWwindow *win;
-    shp_mesh cpu[M_COUNT]; /* CPU meshes */
-    float *blob_base;      /* the blob before deformation */
-    flat_mesh floor_f, pillar_f;
+    ds_scene scene; /* the place: meshes, opaque objects, volumes */
+    ds_gl gl;       /* its opaque renderer */
     /* fogvol objects: they belong to the context and are rebuilt with it */
     fogvol_context *fv;
-    fogvol_mesh *vol[M_COUNT];
+    fogvol_mesh *vol[DS_MAX_MESHES]; /* one per scene mesh */
     fogvol_ramp *ramp[R_COUNT];
     /* settings */
     int tier_i, bits_i, dither, ramp_model, main_light, paused, show_overflow;
@@ -205,8 +105,8 @@ static void make_main_ramp(app *a)
     a->ramp[R_MAIN] = NULL;
     memset(&rd, 0, sizeof rd);
     rd.model = (fogvol_ramp_model)a->ramp_model;
-    rd.color[0] = 0.85f, rd.color[1] = 0.88f, rd.color[2] = 0.95f;
-    rd.density = a->ramp_model == FOGVOL_RAMP_LINEAR ? 0.3f : 0.55f;
+    rd.color[0] = 0.70f, rd.color[1] = 0.78f, rd.color[2] = 0.90f;
+    rd.density = a->ramp_model == FOGVOL_RAMP_LINEAR ? 0.45f : 1.1f;
     rd.keys = keys;
     rd.key_count = 4;
     rd.blend = a->main_light ? FOGVOL_BLEND_LIGHT : FOGVOL_BLEND_FOG;
@@ -217,7 +117,7 @@ static void destroy_fog(app *a)
 {
     int i;
     if (!a->fv) return;
-    for (i = 0; i < M_COUNT; ++i) fogvol_destroy_mesh(a->fv, a->vol[i]), a->vol[i] = NULL;
+    for (i = 0; i < DS_MAX_MESHES; ++i) fogvol_destroy_mesh(a->fv, a->vol[i]), a->vol[i] = NULL;
     for (i = 0; i < R_COUNT; ++i) fogvol_destroy_ramp(a->fv, a->ramp[i]), a->ramp[i] = NULL;
     fogvol_destroy_context(a->fv);
     a->fv = NULL;
@@ -244,12 +144,12 @@ static int build_fog(app *a, fogvol_tier tier, int bits)
         if (k_tiers[i] == fogvol_context_tier(fv, NULL)) a->tier_i = i;
     for (i = 0; i < 4; ++i)
         if (k_bits[i] == fogvol_context_encoding(fv)->bits) a->bits_i = i;
-    for (i = 0; i < M_COUNT; ++i) a->vol[i] = upload(fv, &a->cpu[i]);
+    for (i = 0; i < a->scene.mesh_count; ++i) a->vol[i] = upload(fv, &a->scene.mesh[i]);
     make_main_ramp(a);
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.72f, rd.color[1] = 0.78f, rd.color[2] = 0.86f, rd.density = 0.8f;
+    rd.color[0] = 0.74f, rd.color[1] = 0.80f, rd.color[2] = 0.86f, rd.density = 0.35f;
     fogvol_create_ramp(fv, &rd, &a->ramp[R_BANK]);
-    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.35f, rd.blend = FOGVOL_BLEND_LIGHT;
+    rd.color[0] = 1.0f, rd.color[1] = 0.78f, rd.color[2] = 0.42f, rd.density = 0.30f, rd.blend = FOGVOL_BLEND_LIGHT;
     fogvol_create_ramp(fv, &rd, &a->ramp[R_LIGHT]);
     return 1;
 }
@@ -261,24 +161,6 @@ static void cycle_tier(app *a)
         int i = (a->tier_i + k) % 3;
         if (build_fog(a, k_tiers[i], k_bits[a->bits_i])) return;
         fprintf(stderr, "demo: tier %s refused by this context, skipped\n", fogvol_tier_name(k_tiers[i]));
-    }
-}
-
-/* The blob: a sphere twisted about y and wobbled radially (star-shaped, so it
-   stays a closed, consistently oriented hull whatever the time). */
-static void deform_blob(app *a)
-{
-    double t = a->anim_t;
-    int i;
-    for (i = 0; i < a->cpu[M_BLOB].vcount; ++i) {
-        const float *p = a->blob_base + 3 * i;
-        double x = p[0], y = p[2] * 1.5, z = -p[1]; /* rotated: the sphere's pole axis z becomes y, stretched */
-        double w = 1.0 + 0.22 * sin(3.0 * x + 2.1 * t) * sin(2.5 * y + 1.3 * t) + 0.12 * cos(4.0 * z - 1.7 * t);
-        double ang = 0.9 * sin(0.7 * t) * y, c = cos(ang), s = sin(ang);
-        x *= w, y *= w, z *= w;
-        a->cpu[M_BLOB].pos[3 * i + 0] = (float)(c * x + s * z);
-        a->cpu[M_BLOB].pos[3 * i + 1] = (float)y;
-        a->cpu[M_BLOB].pos[3 * i + 2] = (float)(-s * x + c * z);
     }
 }
 
@@ -397,48 +279,25 @@ static void perspective(float m[16], float fovy_deg, float aspect, float n, floa
     m[14] = 2.0f * f * n / (n - f);
 }
 
-static void trs(float out[16], float tx, float ty, float tz, float angle, float ax, float ay, float az)
-{
-    float r[16], t[16];
-    shp_mat_rotate(r, angle, ax, ay, az);
-    shp_mat_translate(t, tx, ty, tz);
-    shp_mat_mul(out, t, r);
-}
-
 /* ---- one frame ------------------------------------------------------------------- */
 static fogvol_frame_stats render(app *a, int w, int h)
 {
-    float view[16], proj[16], vp[16], m[16];
+    float view[16], proj[16];
     fogvol_frame_desc fd;
-    fogvol_volume_desc vd;
     fogvol_frame_stats st;
-    double t = a->anim_t;
     int i;
     memset(&st, 0, sizeof st);
     view_matrix(a, view);
     perspective(proj, 60.0f, (float)w / (float)h, ZNEAR, ZFAR);
-    shp_mat_mul(vp, proj, view);
-
-    /* the opaque scene */
-    glViewport(0, 0, w, h);
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_CULL_FACE);
-    glClearColor(0.32f, 0.45f, 0.62f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    shp_mat_translate(m, 0.0f, -1.0f, 0.0f);
-    flat_draw(&a->floor_f, m, vp, 0.58f, 0.55f, 0.5f, 0.12f);
-    for (i = 0; i < NPILLARS; ++i) {
-        shp_mat_translate(m, k_pillars[i][0], 1.0f, k_pillars[i][1]);
-        flat_draw(&a->pillar_f, m, vp, 0.7f, 0.66f, 0.6f, 0.0f);
-    }
+    ds_scene_animate(&a->scene, a->anim_t);
+    ds_draw(&a->gl, &a->scene, view, proj, w, h); /* the opaque scene: sky, ground, buildings ... */
     if (!a->fv) return st;
 
-    /* the blob's new shape: one fogvol mesh per frame, re-created before the frame opens
-       (fogvol_destroy_mesh inside an open frame would cancel it) */
-    if (!a->paused || !a->vol[M_BLOB]) {
-        deform_blob(a);
-        fogvol_destroy_mesh(a->fv, a->vol[M_BLOB]);
-        a->vol[M_BLOB] = upload(a->fv, &a->cpu[M_BLOB]);
+    /* the cloud's new shape: one fogvol mesh per frame, re-created before the frame opens
+       (fogvol_destroy_mesh inside an open frame would take it out of the frame) */
+    if (!a->paused || !a->vol[a->scene.blob_mesh]) {
+        fogvol_destroy_mesh(a->fv, a->vol[a->scene.blob_mesh]);
+        a->vol[a->scene.blob_mesh] = upload(a->fv, &a->scene.mesh[a->scene.blob_mesh]);
     }
 
     memset(&fd, 0, sizeof fd);
@@ -450,38 +309,21 @@ static fogvol_frame_stats render(app *a, int w, int h)
     fd.viewport[3] = h;
     fd.show_overflow = a->show_overflow;
     fogvol_begin_frame(a->fv, &fd);
-    shp_mat_translate(m, 0.0f, -1.0f, 0.0f);
-    fogvol_add_occluder(a->fv, a->vol[M_FLOOR], m);
-    for (i = 0; i < NPILLARS; ++i) {
-        shp_mat_translate(m, k_pillars[i][0], 1.0f, k_pillars[i][1]);
-        fogvol_add_occluder(a->fv, a->vol[M_PILLAR], m);
-    }
-    memset(&vd, 0, sizeof vd);
-    vd.ramp = a->ramp[R_MAIN]; /* main group: sphere, torus, blob */
-    vd.mesh = a->vol[M_SPHERE];
-    shp_mat_translate(vd.model, -2.2f, 0.4f, -0.8f);
-    fogvol_add_volume(a->fv, &vd);
-    vd.mesh = a->vol[M_TORUS];
-    trs(vd.model, 2.0f, 0.5f, -1.2f, 70.0f + 25.0f * (float)sin(0.5 * t), 1.0f, 0.0f, 0.3f);
-    fogvol_add_volume(a->fv, &vd);
-    if (a->vol[M_BLOB]) {
-        vd.mesh = a->vol[M_BLOB];
-        shp_mat_translate(vd.model, 0.0f, 0.9f + 0.2f * (float)sin(0.8 * t), 1.8f);
+    for (i = 0; i < a->scene.count; ++i) {
+        const ds_object *o = &a->scene.obj[i];
+        fogvol_volume_desc vd;
+        if (!a->vol[o->mesh]) continue;
+        if (o->kind == DS_OPAQUE) { /* opaque things cut the fog */
+            fogvol_add_occluder(a->fv, a->vol[o->mesh], o->model);
+            continue;
+        }
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = a->vol[o->mesh];
+        vd.ramp = a->ramp[ds_group(o->kind)]; /* main group, mist bank, light */
+        vd.negative = o->kind == DS_HOLE;     /* the clearing in the mist */
+        memcpy(vd.model, o->model, sizeof vd.model);
         fogvol_add_volume(a->fv, &vd);
     }
-    vd.ramp = a->ramp[R_BANK]; /* the long, low fog bank with a hole carved by a negative sphere */
-    vd.mesh = a->vol[M_BANK];
-    shp_mat_translate(vd.model, 0.0f, -0.4f, -3.8f);
-    fogvol_add_volume(a->fv, &vd);
-    vd.mesh = a->vol[M_HOLE];
-    vd.negative = 1;
-    shp_mat_translate(vd.model, 3.0f * (float)sin(0.4 * t), 0.25f, -3.8f);
-    fogvol_add_volume(a->fv, &vd);
-    vd.negative = 0;
-    vd.ramp = a->ramp[R_LIGHT]; /* a light beam, added to the scene */
-    vd.mesh = a->vol[M_BEAM];
-    trs(vd.model, 0.2f, 1.2f, -2.5f, 18.0f, 0.0f, 0.0f, 1.0f);
-    fogvol_add_volume(a->fv, &vd);
     fogvol_end_frame(a->fv, &st); /* renders, composites, restores the GL state */
     return st;
 }
@@ -567,23 +409,11 @@ int main(int argc, char **argv)
     glfwSetMouseButtonCallback(a.win, button_cb);
     glfwSetCursorPosCallback(a.win, cursor_cb);
 
-    a.cpu[M_FLOOR] = shp_box(12.0f, 0.1f, 12.0f);
-    a.cpu[M_PILLAR] = shp_box(0.25f, 2.0f, 0.25f);
-    a.cpu[M_SPHERE] = shp_sphere(1.3f, 64, 32);
-    a.cpu[M_TORUS] = shp_torus(1.3f, 0.45f, 96, 32);
-    a.cpu[M_BANK] = shp_box(9.0f, 0.7f, 2.2f);
-    a.cpu[M_HOLE] = shp_sphere(1.1f, 48, 24);
-    a.cpu[M_BEAM] = shp_box(0.6f, 3.0f, 0.6f);
-    a.cpu[M_BLOB] = shp_sphere(0.9f, 48, 24);
-    a.blob_base = (float *)malloc(sizeof(float) * 3 * (size_t)a.cpu[M_BLOB].vcount);
-    memcpy(a.blob_base, a.cpu[M_BLOB].pos, sizeof(float) * 3 * (size_t)a.cpu[M_BLOB].vcount);
-    deform_blob(&a);
-    flat_init();
-    a.floor_f = flat_upload(&a.cpu[M_FLOOR]);
-    a.pillar_f = flat_upload(&a.cpu[M_PILLAR]);
+    ds_scene_build(&a.scene);
+    ds_gl_init(&a.gl, &a.scene);
 
     a.dither = 1;
-    a.cam[0] = 0.0f, a.cam[1] = 3.4f, a.cam[2] = 8.0f, a.pitch = -20.0f;
+    a.cam[0] = 1.0f, a.cam[1] = 5.2f, a.cam[2] = 13.5f, a.yaw = -3.5f, a.pitch = -14.5f;
     if (cam_n == 5) a.cam[0] = cam[0], a.cam[1] = cam[1], a.cam[2] = cam[2], a.yaw = cam[3], a.pitch = cam[4];
     if (!build_fog(&a, tier, bits)) {
         fprintf(stderr, "demo: fogvol_create_context failed\n");
@@ -625,13 +455,8 @@ int main(int argc, char **argv)
     }
 
     destroy_fog(&a);
-    glDeleteVertexArrays(1, &a.floor_f.vao);
-    glDeleteBuffers(1, &a.floor_f.vbo);
-    glDeleteVertexArrays(1, &a.pillar_f.vao);
-    glDeleteBuffers(1, &a.pillar_f.vbo);
-    glDeleteProgram(g_flat_prog);
-    for (i = 0; i < M_COUNT; ++i) shp_free(&a.cpu[i]);
-    free(a.blob_base);
+    ds_gl_free(&a.gl);
+    ds_scene_free(&a.scene);
     glfwDestroyWindow(a.win);
     glfwTerminate();
     return rc;

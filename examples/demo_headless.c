@@ -1,12 +1,16 @@
 #define _POSIX_C_SOURCE 199309L
-/* demo_headless.c - fogvol.h without a window. OSMesa renders a floor and
-   pillars (opaque, drawn by this program's own shader) cutting through fog
-   volumes: a sphere, a torus, a wobbling blob, a long fog bank the camera can
-   stand in, a negative sphere carving a hole into the bank, and a beam of
-   light. It writes PNGs:
+/* demo_headless.c - fogvol.h without a window. OSMesa renders the demo's place
+   (examples/demo_scene.h: a sunlit courtyard with a cobbled path, a house,
+   columns, an arch gate, rocks, pine trees and a lamp post, drawn by the demo's
+   own shaders as the engine's opaque pass), and fogvol adds the fog volumes
+   placed in it: a fog sphere around the rocks, a ring standing in the arch, a
+   drifting cloud, a low mist bank the camera can stand in with a clearing
+   carved by a negative sphere, a sunbeam and the lamp's cone of light. The
+   opaque objects cut the volumes. It writes PNGs:
      scene_overview.png, scene_low.png, scene_inside_fog_bank.png  three viewpoints
      tiers.png        the same frame per tier: PS13 | PS20 | FLOAT
-     dither.png       6-bit encoding, dithering off | on (the banding and its cure)
+     dither.png       L = 2 bits per channel (6-bit depth precision), close to the fog sphere,
+                      dithering off | on (the banding and its cure)
      ramps.png        colour ramps: extinction | linear | artist gradient
      thickness.png    the raw thickness of the fog group as false colour
    and prints where they went, the tier, the pass count and the frame time.
@@ -19,7 +23,7 @@
 #define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
 #include "tests/gl_util.h"
 #include <GL/glext.h>
-#include "tests/shapes.h"
+#include "examples/demo_scene.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -27,81 +31,6 @@
 
 #define DW 640
 #define DH 360
-
-/* A tiny opaque renderer standing in for the engine: flat-shaded meshes, GLSL 330. */
-typedef struct engine {
-    GLuint prog, vao, vbo;
-    GLint u_mvp, u_color, u_light;
-} engine;
-
-static void engine_init(engine *e)
-{
-    static const char *vs = "#version 330 core\nlayout(location=0) in vec3 p; layout(location=1) in vec3 n;\n"
-                            "uniform mat4 mvp; out vec3 vn; void main(){ vn = n; gl_Position = mvp*vec4(p,1.0); }\n";
-    static const char *fs = "#version 330 core\nin vec3 vn; uniform vec4 color; uniform vec4 light; out vec4 o;\n"
-                            "void main(){ float l = 0.35 + 0.65*max(dot(normalize(vn), light.xyz), 0.0);\n"
-                            " o = vec4(color.rgb*l, 1.0); }\n";
-    GLuint v, f;
-    v = glCreateShader(GL_VERTEX_SHADER);
-    glShaderSource(v, 1, &vs, NULL);
-    glCompileShader(v);
-    f = glCreateShader(GL_FRAGMENT_SHADER);
-    glShaderSource(f, 1, &fs, NULL);
-    glCompileShader(f);
-    e->prog = glCreateProgram();
-    glAttachShader(e->prog, v);
-    glAttachShader(e->prog, f);
-    glLinkProgram(e->prog);
-    e->u_mvp = glGetUniformLocation(e->prog, "mvp");
-    e->u_color = glGetUniformLocation(e->prog, "color");
-    e->u_light = glGetUniformLocation(e->prog, "light");
-    glGenVertexArrays(1, &e->vao);
-    glGenBuffers(1, &e->vbo);
-}
-
-/* draw a mesh as flat triangles (expanded, face normals) */
-static void engine_draw(engine *e, const shp_mesh *m, const float model[16], const float vp[16], const float rgb[3])
-{
-    float *buf = (float *)malloc(sizeof(float) * 18 * (size_t)(m->icount / 3)), mvp[16];
-    int t, k;
-    for (t = 0; t < m->icount / 3; ++t) {
-        const float *a = m->pos + 3 * m->idx[3 * t], *b = m->pos + 3 * m->idx[3 * t + 1], *c = m->pos + 3 * m->idx[3 * t + 2];
-        float e1[3], e2[3], n[3], l, wn[3];
-        for (k = 0; k < 3; ++k) {
-            e1[k] = b[k] - a[k];
-            e2[k] = c[k] - a[k];
-        }
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        for (k = 0; k < 3; ++k) wn[k] = model[k] * n[0] + model[4 + k] * n[1] + model[8 + k] * n[2];
-        l = sqrtf(wn[0] * wn[0] + wn[1] * wn[1] + wn[2] * wn[2]) + 1e-20f;
-        for (k = 0; k < 3; ++k) {
-            float *o = buf + 18 * t + 6 * k;
-            const float *p = k == 0 ? a : k == 1 ? b : c;
-            o[0] = p[0];
-            o[1] = p[1];
-            o[2] = p[2];
-            o[3] = wn[0] / l;
-            o[4] = wn[1] / l;
-            o[5] = wn[2] / l;
-        }
-    }
-    shp_mat_mul(mvp, vp, model);
-    glUseProgram(e->prog);
-    glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, mvp);
-    glUniform4f(e->u_color, rgb[0], rgb[1], rgb[2], 1);
-    glUniform4f(e->u_light, 0.38f, 0.83f, 0.41f, 0);
-    glBindVertexArray(e->vao);
-    glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 18 * (size_t)(m->icount / 3)), buf, GL_STREAM_DRAW);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 24, (void *)12);
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
-    glDrawArrays(GL_TRIANGLES, 0, m->icount);
-    free(buf);
-}
 
 static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m, int occluder)
 {
@@ -136,15 +65,10 @@ static double now_ms(void)
 }
 
 
-#define NOBJ 12
-
 typedef struct demo {
     glu_ctx g;
-    engine e;
-    shp_mesh mesh[NOBJ];
-    float model[NOBJ][16];
-    int kind[NOBJ]; /* 0 occluder, 1 fog, 2 bank, 3 bank hole (negative), 4 light */
-    int n;
+    ds_scene scene; /* examples/demo_scene.h: the place, its opaque objects and fog volumes */
+    ds_gl gl;
 } demo;
 
 typedef struct settings {
@@ -162,103 +86,25 @@ typedef struct shot {
     double ms;
 } shot;
 
-static void add_obj(demo *d, shp_mesh m, int kind, const float model[16])
-{
-    if (d->n == NOBJ) {
-        fprintf(stderr, "demo: more than NOBJ objects\n");
-        exit(1);
-    }
-    d->mesh[d->n] = m;
-    d->kind[d->n] = kind;
-    memcpy(d->model[d->n], model, sizeof d->model[0]);
-    d->n++;
-}
-
-/* a sphere whose radius wobbles with direction: still closed and outward */
-static shp_mesh blob(float t)
-{
-    shp_mesh m = shp_sphere(1.0f, 64, 32);
-    int i;
-    for (i = 0; i < m.vcount; ++i) {
-        float *p = m.pos + 3 * i;
-        float th = atan2f(p[1], p[0]), ph = acosf(p[2] < -1 ? -1 : p[2] > 1 ? 1 : p[2]);
-        float r = 0.8f + 0.22f * sinf(3 * th + t) * sinf(2 * ph) + 0.08f * sinf(5 * ph - t);
-        p[0] *= r, p[1] *= r, p[2] *= r;
-    }
-    return m;
-}
-
-static void build(demo *d)
-{
-    static const float pillars[4][2] = {{-2.5f, -1.0f}, {0.3f, -2.2f}, {2.4f, 0.8f}, {-0.6f, 2.4f}};
-    float m[16], r[16], t[16];
-    int i;
-    shp_mat_translate(m, 0, -1.0f, 0);
-    add_obj(d, shp_box(12, 0.1f, 12), 0, m);
-    for (i = 0; i < 4; ++i) {
-        shp_mat_translate(m, pillars[i][0], 1.0f, pillars[i][1]);
-        add_obj(d, shp_box(0.25f, 2.0f, 0.25f), 0, m);
-    }
-    shp_mat_translate(m, -2.2f, 0.4f, -0.8f);
-    add_obj(d, shp_sphere(1.3f, 64, 32), 1, m);
-    shp_mat_rotate(r, 70, 1, 0, 0.3f);
-    shp_mat_translate(t, 2.0f, 0.5f, -1.2f);
-    shp_mat_mul(m, t, r);
-    add_obj(d, shp_torus(1.3f, 0.45f, 96, 32), 1, m);
-    shp_mat_translate(m, 0.3f, 1.6f, 1.2f);
-    add_obj(d, blob(0.7f), 1, m);
-    shp_mat_translate(m, 0, -0.6f, -3.0f);
-    add_obj(d, shp_box(12, 0.7f, 12), 2, m);
-    shp_mat_translate(m, 0.2f, -0.6f, 1.0f);
-    add_obj(d, shp_sphere(1.1f, 48, 24), 3, m);
-    shp_mat_rotate(r, 18, 0, 0, 1);
-    shp_mat_translate(t, 0.2f, 1.2f, -2.5f);
-    shp_mat_mul(m, t, r);
-    add_obj(d, shp_box(0.6f, 3.0f, 0.6f), 4, m);
-}
-
 static void camera(int view, int w, int h, float v[16], float p[16])
 {
-    static const double eye[3][3] = {{0.0, 3.2, 9.5}, {-4.5, 0.9, 6.0}, {1.5, -0.3, 5.5}};
-    static const double at[3][3] = {{0, 0.3, 0}, {0.5, 0.2, -1.0}, {0, 0.6, -3}};
+    /* overview, low, inside the mist bank, close to the fog sphere (for dither.png) */
+    static const double eye[4][3] = {{1.0, 5.2, 13.5}, {-7.0, 1.7, 8.0}, {-7.0, 0.5, -1.5}, {2.8, 1.4, 5.4}};
+    static const double at[4][3] = {{0.0, 1.0, -2.5}, {1.0, 1.4, -3.0}, {2.0, 1.4, -6.0}, {5.3, 0.5, 0.6}};
     static const double up[3] = {0, 1, 0};
     glu_look_at(v, eye[view], at[view], up);
     glu_perspective(p, 55.0, (double)w / h, 0.1, 40.0);
 }
 
-/* One frame: the engine's opaque pass, then fogvol with these settings.
-   Returns 0 if the context could not be created (tier not available). */
-static int render(demo *d, const settings *s, int with_fog, shot *out)
+/* the three colour ramps: the fog group (model and density from the settings), the mist bank, the light */
+static void make_ramps(fogvol_context *fv, const settings *s, fogvol_ramp *ramp[3])
 {
-    fogvol_context_desc cd;
-    fogvol_context *fv;
-    fogvol_mesh *fm[NOBJ];
-    fogvol_ramp *ramp[3];
     fogvol_ramp_desc rd;
     fogvol_color_key keys[4];
-    float v[16], p[16], vp[16];
-    int i, grp, captures;
-    static const float grey[3] = {0.55f, 0.52f, 0.48f}, stone[3] = {0.7f, 0.66f, 0.6f};
-    if (!glu_create(&d->g, s->w, s->h, 1)) return 0;
-    engine_init(&d->e);
-    camera(s->view, s->w, s->h, v, p);
-    shp_mat_mul(vp, p, v);
-    memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = log_cb;
-    cd.tier = s->tier;
-    cd.encoding_bits = s->bits;
-    cd.disable_dither = !s->dither;
-    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
-        glu_destroy(&d->g);
-        return 0;
-    }
-    out->tier = fogvol_context_tier(fv, NULL);
-    for (i = 0; i < d->n; ++i) fm[i] = upload(fv, &d->mesh[i], d->kind[i] == 0);
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.85f, rd.color[1] = 0.88f, rd.color[2] = 0.95f, rd.density = 0.55f * s->fog_scale;
+    rd.color[0] = 0.70f, rd.color[1] = 0.78f, rd.color[2] = 0.90f, rd.density = 1.1f * s->fog_scale;
     rd.model = s->ramp == 1 ? FOGVOL_RAMP_LINEAR : s->ramp == 2 ? FOGVOL_RAMP_GRADIENT : FOGVOL_RAMP_EXTINCTION;
-    if (s->ramp == 1) rd.density = 0.3f * s->fog_scale;
+    if (s->ramp == 1) rd.density = 0.45f * s->fog_scale;
     keys[0].thickness = 0.0f, keys[0].rgba[0] = 0.2f, keys[0].rgba[1] = 0.9f, keys[0].rgba[2] = 0.7f, keys[0].rgba[3] = 0.0f;
     keys[1].thickness = 0.8f, keys[1].rgba[0] = 0.3f, keys[1].rgba[1] = 0.8f, keys[1].rgba[2] = 1.0f, keys[1].rgba[3] = 0.45f;
     keys[2].thickness = 1.8f, keys[2].rgba[0] = 0.9f, keys[2].rgba[1] = 0.4f, keys[2].rgba[2] = 0.9f, keys[2].rgba[3] = 0.75f;
@@ -267,22 +113,65 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
     rd.key_count = 4;
     fogvol_create_ramp(fv, &rd, &ramp[0]);
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.18f;
+    rd.color[0] = 0.74f, rd.color[1] = 0.80f, rd.color[2] = 0.86f, rd.density = 0.35f;
     fogvol_create_ramp(fv, &rd, &ramp[1]);
-    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.35f, rd.blend = FOGVOL_BLEND_LIGHT;
+    rd.color[0] = 1.0f, rd.color[1] = 0.78f, rd.color[2] = 0.42f, rd.density = 0.30f, rd.blend = FOGVOL_BLEND_LIGHT;
     fogvol_create_ramp(fv, &rd, &ramp[2]);
+}
+
+/* fogvol's part of a frame: the opaque objects as occluders, the volumes by group */
+static void add_scene(fogvol_context *fv, const ds_scene *sc, fogvol_mesh *const *fm, fogvol_ramp *const *ramp)
+{
+    int i;
+    for (i = 0; i < sc->count; ++i) {
+        const ds_object *o = &sc->obj[i];
+        fogvol_volume_desc vd;
+        if (o->kind == DS_OPAQUE) {
+            fogvol_add_occluder(fv, fm[o->mesh], o->model);
+            continue;
+        }
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = fm[o->mesh];
+        vd.ramp = ramp[ds_group(o->kind)];
+        vd.negative = o->kind == DS_HOLE;
+        memcpy(vd.model, o->model, sizeof vd.model);
+        fogvol_add_volume(fv, &vd);
+    }
+}
+
+/* One frame: the engine's opaque pass (ds_draw), then fogvol with these settings.
+   Returns 0 if the context could not be created (tier not available). */
+static int render(demo *d, const settings *s, int with_fog, shot *out)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *fm[DS_MAX_MESHES];
+    fogvol_ramp *ramp[3];
+    float v[16], p[16];
+    int i, grp, captures;
+    if (!glu_create(&d->g, s->w, s->h, 1)) return 0;
+    ds_gl_init(&d->gl, &d->scene);
+    camera(s->view, s->w, s->h, v, p);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = log_cb;
+    cd.tier = s->tier;
+    cd.encoding_bits = s->bits;
+    cd.disable_dither = !s->dither;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
+        ds_gl_free(&d->gl);
+        glu_destroy(&d->g);
+        return 0;
+    }
+    out->tier = fogvol_context_tier(fv, NULL);
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    make_ramps(fv, s, ramp);
 
     captures = with_fog ? 3 : 1; /* one frame per group whose thickness is read back, the first one timed */
     for (grp = 0; grp < captures; ++grp) {
         fogvol_frame_desc fd;
         double t0;
-        glViewport(0, 0, s->w, s->h);
-        glEnable(GL_DEPTH_TEST);
-        glClearColor(0.32f, 0.45f, 0.62f, 1);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        for (i = 0; i < d->n; ++i)
-            if (d->kind[i] == 0) engine_draw(&d->e, &d->mesh[i], d->model[i], vp, i == 0 ? grey : stone);
-        glDisable(GL_DEPTH_TEST);
+        ds_draw(&d->gl, &d->scene, v, p, s->w, s->h);
         if (!with_fog) break;
         memset(&fd, 0, sizeof fd);
         memcpy(fd.view, v, sizeof v);
@@ -296,19 +185,7 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
         glFinish();
         t0 = now_ms();
         fogvol_begin_frame(fv, &fd);
-        for (i = 0; i < d->n; ++i) {
-            fogvol_volume_desc vd;
-            if (d->kind[i] == 0) {
-                fogvol_add_occluder(fv, fm[i], d->model[i]);
-                continue;
-            }
-            memset(&vd, 0, sizeof vd);
-            vd.mesh = fm[i];
-            vd.ramp = ramp[d->kind[i] == 1 ? 0 : d->kind[i] == 4 ? 2 : 1];
-            vd.negative = d->kind[i] == 3;
-            memcpy(vd.model, d->model[i], sizeof vd.model);
-            fogvol_add_volume(fv, &vd);
-        }
+        add_scene(fv, &d->scene, fm, ramp);
         fogvol_end_frame(fv, grp == 0 ? &out->st : NULL);
         glFinish();
         if (grp == 0) out->ms = now_ms() - t0;
@@ -318,9 +195,10 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
         glFinish();
         memcpy(out->rgba, d->g.pixels, (size_t)s->w * s->h * 4);
     }
-    for (i = 0; i < d->n; ++i) fogvol_destroy_mesh(fv, fm[i]);
+    for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
     for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
     fogvol_destroy_context(fv);
+    ds_gl_free(&d->gl);
     glu_destroy(&d->g);
     return 1;
 }
@@ -421,7 +299,8 @@ int main(int argc, char **argv)
     mkdir("build", 0777);
     mkdir(dir, 0777);
     memset(&d, 0, sizeof d);
-    build(&d);
+    ds_scene_build(&d.scene);
+    ds_scene_animate(&d.scene, 0.7);
     stbi_flip_vertically_on_write(0);
     memset(&s, 0, sizeof s);
     s.w = DW;
@@ -474,7 +353,7 @@ int main(int argc, char **argv)
     }
     for (k = 0; k < 3; ++k) free_shot(&sh[k]);
 
-    /* side by side at half size: the tiers, dithering at 6 bits, the colour ramps */
+    /* side by side at half size: the tiers, dithering at L = 2 (6-bit depth), the colour ramps */
     {
         settings v[3];
         for (k = 0; k < 3; ++k) {
@@ -487,10 +366,10 @@ int main(int argc, char **argv)
         v[1].tier = FOGVOL_TIER_PS20;
         v[2].tier = FOGVOL_TIER_FLOAT;
         row(&d, dir, "tiers.png", v, 3, 1);
-        for (k = 0; k < 2; ++k) { /* banding at low precision (dense fog) and its cure */
+        for (k = 0; k < 2; ++k) { /* banding at low precision (close to the fog sphere) and its cure */
             v[k].tier = FOGVOL_TIER_PS20;
             v[k].bits = 2;
-            v[k].fog_scale = 4.0f;
+            v[k].view = 3;
             v[k].dither = k;
         }
         row(&d, dir, "dither.png", v, 2, 0);
@@ -501,7 +380,7 @@ int main(int argc, char **argv)
         }
         row(&d, dir, "ramps.png", v, 3, 0);
     }
-    for (i = 0; i < d.n; ++i) shp_free(&d.mesh[i]);
+    ds_scene_free(&d.scene);
     if (do_check) printf("1..%d\n", g_tap);
     return failures ? 1 : 0;
 }

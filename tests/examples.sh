@@ -80,7 +80,7 @@ else
   note '^demo:'
   if png_ok "$out/demo_glfw.png"; then ok "demo_glfw.png written"; else not_ok "demo_glfw.png written"; fi
   run "demo_glfw: camera inside the fog bank, PS20, screenshot" "${xrun[@]}" "$out/demo_glfw" --frames 4 --size 640x360 \
-    --tier ps20 --camera -5,-0.6,-3.6,90,3 --screenshot "$out/demo_glfw_inside.png"
+    --tier ps20 --camera -7,0.5,-1.5,63,5 --screenshot "$out/demo_glfw_inside.png"
   expect "demo_glfw --tier ps20 runs PS20" '\[T\] PS20'
   run "demo_glfw: keys T B G R L re-create the context and ramps" "${xrun[@]}" "$out/demo_glfw" --frames 7 --size 480x270 \
     --keys TBGRLOP --screenshot "$out/demo_glfw_keys.png"
