@@ -133,8 +133,8 @@ static void save_png(const char *name, const unsigned char *px)
 {
     char path[256];
     mkdir("build", 0777);
-    mkdir("build/test_post", 0777);
-    snprintf(path, sizeof path, "build/test_post/%s", name);
+    mkdir("build/post", 0777);
+    snprintf(path, sizeof path, "build/post/%s", name);
     stbi_flip_vertically_on_write(1);
     stbi_write_png(path, W, H, 4, px, W * 4);
 }
