@@ -648,6 +648,57 @@ static void snapshot(snap *s)
     }
 }
 
+/* the engine's state: none of it fogvol's choice */
+static void engine_state_set(const GLuint tex[3], GLuint buf, GLuint vao)
+{
+    int i;
+    for (i = 0; i < 3; ++i) {
+        glActiveTexture((GLenum)(GL_TEXTURE0 + i));
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+    }
+    glActiveTexture(GL_TEXTURE3);
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, buf);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_SRC_COLOR, GL_DST_ALPHA, GL_ZERO);
+    glBlendEquation(GL_MAX);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GEQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_FRONT);
+    glFrontFace(GL_CW);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(3, 4, 20, 21);
+    glViewport(1, 2, 30, 31);
+    glColorMask(1, 0, 1, 1);
+    glDisable(GL_DITHER);
+    glEnable(GL_STENCIL_TEST);
+}
+
+static void engine_state_reset(void)
+{
+    int i;
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ZERO);
+    glDisable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
+    glColorMask(1, 1, 1, 1);
+    glEnable(GL_DITHER);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    for (i = 0; i < 4; ++i) {
+        glActiveTexture((GLenum)(GL_TEXTURE0 + i));
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
+}
+
 static void test_gl_state(void **state)
 {
     fx *x = (fx *)*state;
@@ -670,31 +721,9 @@ static void test_gl_state(void **state)
     memset(&rd, 0, sizeof rd);
     rd.density = 0.1f;
     assert_int_equal(fogvol_create_ramp(x->fv, &rd, &ramp), FOGVOL_SUCCESS);
-    /* the engine's state: none of it fogvol's choice */
     glGenTextures(3, tex);
     glGenBuffers(1, &buf);
-    for (i = 0; i < 3; ++i) {
-        glActiveTexture((GLenum)(GL_TEXTURE0 + i));
-        glBindTexture(GL_TEXTURE_2D, tex[i]);
-    }
-    glActiveTexture(GL_TEXTURE3);
-    glBindVertexArray(x->vao);
-    glBindBuffer(GL_ARRAY_BUFFER, buf);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_SRC_COLOR, GL_DST_ALPHA, GL_ZERO);
-    glBlendEquation(GL_MAX);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GEQUAL);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_FRONT);
-    glFrontFace(GL_CW);
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(3, 4, 20, 21);
-    glViewport(1, 2, 30, 31);
-    glColorMask(1, 0, 1, 1);
-    glDisable(GL_DITHER);
-    glEnable(GL_STENCIL_TEST);
+    engine_state_set(tex, buf, x->vao);
     snapshot(&a);
     for (k = 0; k < 3; ++k) {
         fogvol_result r;
@@ -715,24 +744,7 @@ static void test_gl_state(void **state)
         assert_memory_equal(&a, &b, sizeof a);
         assert_int_equal(glGetError(), GL_NO_ERROR);
     }
-    glDisable(GL_STENCIL_TEST);
-    glDisable(GL_SCISSOR_TEST);
-    glDisable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ZERO);
-    glDisable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glFrontFace(GL_CCW);
-    glColorMask(1, 1, 1, 1);
-    glEnable(GL_DITHER);
-    glBindVertexArray(0);
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
-    for (i = 0; i < 4; ++i) {
-        glActiveTexture((GLenum)(GL_TEXTURE0 + i));
-        glBindTexture(GL_TEXTURE_2D, 0);
-    }
+    engine_state_reset();
     glActiveTexture(GL_TEXTURE0);
     glDeleteTextures(3, tex);
     glDeleteTextures(1, &tdep);
