@@ -150,7 +150,8 @@
 
    SECTIONS (search for the markers)
    ========
-       >>declarations  >>cpu  >>analytic  >>shaders  >>null backend  >>renderer  >>gl backend
+       >>declarations  >>cpu  >>analytic  >>shaders  >>null backend  >>renderer  >>image-space effects
+       >>gl backend
 */
 
 #ifndef FOGVOL_H
@@ -834,7 +835,12 @@ typedef enum fogvol_uniform {
     FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
                             zw: offset of the engine depth texel (ENGINE_DEPTH) */
     FOGVOL_U_LINEAR_W = 8, /* "fv_lin2": the denominator row of fv_lin */
-    FOGVOL_U_COUNT = 9
+    /* image-space effects (fogvol_post_*) */
+    FOGVOL_U_POST_TEXEL = 9,  /* "fv_ptexel":  (1/texture width, 1/texture height, 1 = perspective, 0) */
+    FOGVOL_U_POST_RECT = 10,  /* "fv_prect":   centres of the viewport's first and last pixels (x0, y0, x1, y1) */
+    FOGVOL_U_POST_PARAMS = 11,/* "fv_pparams": per effect (see fogvol__post_* in the implementation) */
+    FOGVOL_U_POST_COLOR = 12, /* "fv_pcolor":  outline colour */
+    FOGVOL_U_COUNT = 13
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
@@ -1329,6 +1335,95 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
    plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
    line and the engine's precision statements. */
 FOGVOL_API const char *fogvol_occluder_snippet(void);
+
+/* ---- image-space effects ---------------------------------------------------
+   Screen-space passes over the engine's depth (and colour, normals), drawn
+   into the framebuffer bound when they are called, GL state restored like a
+   frame. Call them outside a frame (not between fogvol_begin_frame and
+   fogvol_end_frame: FOGVOL_ERROR_INVALID_STATE). Each desc points at a
+   fogvol_frame_desc that supplies the camera (view and projection, or
+   view_projection + eye + forward), znear < zfar (validated as for a frame;
+   not used otherwise), the viewport written, draw_buffer, alpha (outlines,
+   distance fog) and the engine depth texture with its conventions:
+   engine_depth_texture (required: FOGVOL_ERROR_INVALID_ARGUMENT without it),
+   engine_depth_zero_to_one and engine_depth_range (0 = as the backend reports
+   the context's clip control and depth range). View depth e is the distance
+   along the view axis, recovered from window depth exactly as the
+   ENGINE_DEPTH variant does (any projection fogvol_frame_desc accepts:
+   reversed-Z, [0,1] depth, infinite far, orthographic).
+   Engine textures (GL texture names) are read at texel centres, texel =
+   framebuffer pixel (the texture covers the framebuffer from its origin);
+   texture_size 0 = (viewport x + width, viewport y + height). Taps outside
+   the viewport are clamped to its edge pixels. A texture sampled must not be
+   attached to the framebuffer written. Needs FOGVOL_CAP_DEPTH_TEXTURE and
+   FOGVOL_CAP_HIGHP_FRAGMENT (view depth from window depth in mediump is
+   useless): else FOGVOL_ERROR_UNSUPPORTED. Every GLSL dialect fogvol has
+   (110 ... 330 core, ES 100 with highp, ES 300) compiles every effect. */
+typedef enum fogvol_post_effect {
+    FOGVOL_POST_DOF = 0,          /* depth of field */
+    FOGVOL_POST_OUTLINES = 1,     /* edges from depth (and normal) deltas */
+    FOGVOL_POST_DISTANCE_FOG = 2, /* a colour ramp of view depth */
+    FOGVOL_POST_EFFECT_COUNT = 3
+} fogvol_post_effect;
+
+/* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
+   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
+   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
+   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
+   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
+   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
+   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
+   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
+   without blending (in-focus pixels keep their colour exactly). */
+typedef struct fogvol_dof_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
+    float focus_distance;    /* view depth in focus (> 0) */
+    float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
+    float max_radius;        /* pixels, 0 = 4, at most 64 */
+    int taps;                /* 0 = 6; 3, 6 or 12 */
+} fogvol_dof_desc;
+FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
+
+/* Outlines (cel-shading look) by a 3x3 moving kernel. Depth: with g = 1/e
+   (perspective; e for orthographic), which is linear across the screen on any
+   plane, an edge is where a line of three pixels through the centre
+   (horizontal, vertical, both diagonals, both ends inside the viewport) has
+   |g(-o) + g(+o) - 2 g0| > depth_threshold * |g0|: depth discontinuities and
+   creases, never a flat slope. Normals (optional): n = 2 rgb - 1 normalised,
+   an edge where 1 - dot(n0, nk) > normal_threshold for one of the 8
+   neighbours. Edge pixels get color blended like the fog composite
+   (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
+typedef struct fogvol_outline_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
+    float color[4];           /* rgb, a = opacity; all 0 = opaque black */
+    float depth_threshold;    /* relative second difference, 0 = 0.05 */
+    float normal_threshold;   /* 1 - cos(angle), 0 = 0.3 */
+} fogvol_outline_desc;
+FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc);
+
+/* Image-space distance fog: thickness t = max(e - start, 0) looked up in a
+   colour ramp exactly as the volume composite does (texel i holds
+   i / (width - 1) * max_thickness, linear filtering, clamped at the ends) and
+   blended by the ramp's blend (FOG: rgb = mix(rgb, ramp.rgb, ramp.a); LIGHT:
+   rgb += ramp.rgb * ramp.a) over the viewport. Pixels at the far plane (sky)
+   get the fog of e = zfar of the projection (infinite: the ramp's end). */
+typedef struct fogvol_distance_fog_desc {
+    const fogvol_frame_desc *frame;
+    const fogvol_ramp *ramp;  /* required */
+    int texture_size[2];      /* of the depth texture; 0 = from the viewport */
+    float start;              /* view depth where the fog begins (>= 0) */
+} fogvol_distance_fog_desc;
+FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
+
+/* The GLSL of an effect for the engine's own use or validation. variant: DOF the
+   tap count (3, 6, 12), OUTLINES 1 = with normals, DISTANCE_FOG 0. Samplers:
+   fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
+FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
+                                                    fogvol_stage stage, const char **strings, int *count);
 
 #ifndef FOGVOL_NO_GL
 /* The default GL backend on its own (fogvol_create_context makes one when the
@@ -3933,7 +4028,8 @@ FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_s
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
     static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec",
-                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf", "fv_lin2"};
+                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf", "fv_lin2",
+                                                      "fv_ptexel", "fv_prect", "fv_pparams", "fv_pcolor"};
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -4152,6 +4248,10 @@ typedef struct fogvol__occluder {
     float model[16];
 } fogvol__occluder;
 
+/* image-space effect programs: depth of field with 3, 6, 12 taps; outlines from depth, from depth and
+   normals; distance fog */
+#define FOGVOL__POST_PROGRAMS 6
+
 /* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
 #define FOGVOL__QFRAMES 4
 #define FOGVOL__QPER 32
@@ -4200,6 +4300,7 @@ struct fogvol_context {
     int counting, overflow_late, overflow_warned, qcur;
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
+    fogvol_handle post_prog[FOGVOL__POST_PROGRAMS]; /* image-space effects, built on first use */
 };
 
 /* column-major 4x4 helpers in double */
@@ -4363,6 +4464,8 @@ static void fogvol__release(fogvol_context *ctx)
         if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
         if (ctx->prog_alt[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog_alt[i]);
+    for (i = 0; i < FOGVOL__POST_PROGRAMS; ++i)
+        if (ctx->post_prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->post_prog[i]);
     if (ctx->tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_rg);
     if (ctx->tex_blue) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_blue);
     if (ctx->tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_dither);
@@ -5481,14 +5584,17 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     return FOGVOL_SUCCESS;
 }
 
+static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
+                                 fogvol_pass *ps);
+
 /* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
    is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
    window depth -> view depth through the inverse view-projection). */
 static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
 {
     const fogvol_frame_desc *fd = &ctx->frame;
-    double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0, n[4], dn[4], a, b, sy, r0, r1;
-    int i, j, c, z01;
+    double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0;
+    int i, j, c;
     if (ctx->wscale > 0.0) {
         k = 2.0 * ctx->wscale * range; /* k d <= 2 s (e - near) <= 2 w */
     } else {                           /* orthographic: w is constant, bound d over the volumes */
@@ -5509,6 +5615,16 @@ static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_
     ps->uniforms[FOGVOL_U_MISC][0] = (float)(k < 1.0 ? k : 1.0);
     /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
     ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
+    fogvol__lin_uniforms(ctx, fd, info, ps);
+}
+
+/* fv_lin, fv_lin2: the engine depth texture's window depth -> view depth, for the camera in
+   ctx (eyerow, invvp) and the depth conventions of fd (overrides) or info (reported). */
+static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
+                                 fogvol_pass *ps)
+{
+    double n[4], dn[4], a, b, sy, r0, r1;
+    int i, z01;
     /* q = (s, t, window depth, 1) -> NDC (2s - 1, +-(2t - 1), a z + b, 1), folded into the
        rows eyerow * invVP (numerator) and invVP row 3 (denominator) */
     z01 = fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
@@ -6149,6 +6265,347 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
+}
+
+/* >>image-space effects ==================================================== */
+/* Full-screen passes over the engine's depth texture: depth of field, outlines,
+   distance fog. fv_view_depth(o): view depth of the pixel at offset o (whole
+   pixels, clamped to the viewport), from the depth texture's window depth
+   through fv_lin / fv_lin2 as in the ENGINE_DEPTH variant. */
+static const char fogvol__fs_post_common[] =
+    "uniform vec4 fv_screen;\n"
+    "uniform vec4 fv_lin;\n"
+    "uniform vec4 fv_lin2;\n"
+    "uniform vec4 fv_ptexel;\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
+    "uniform vec4 fv_prect;\n"  /* first and last pixel centres of the viewport */
+    "uniform vec4 fv_pparams;\n"
+    "uniform sampler2D fv_pdepth;\n"
+    "vec2 fv_ppix(vec2 o) { return clamp(gl_FragCoord.xy + o, fv_prect.xy, fv_prect.zw); }\n"
+    "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
+    "float fv_view_depth(vec2 o) {\n"
+    "    vec2 p = fv_ppix(o);\n"
+    "    vec4 q = vec4(p * fv_screen.xy + fv_screen.zw, FV_TEXTURE(fv_pdepth, p * fv_ptexel.xy).r, 1.0);\n"
+    "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
+    "}\n";
+
+/* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
+static const char fogvol__fs_post_dof[] =
+    "uniform sampler2D fv_pscene;\n"
+    "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
+    "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
+    "    vec2 o = floor(dir * r + 0.5);\n"
+    "    return mix(c0, fv_ptex(fv_pscene, o), fv_coc(fv_view_depth(o)));\n"
+    "}\n"
+    "void main() {\n"
+    "    vec4 c0 = fv_ptex(fv_pscene, vec2(0.0));\n"
+    "    float r = fv_coc(fv_view_depth(vec2(0.0))) * fv_pparams.z;\n"
+    "    vec4 sum = c0;\n"
+    "    sum += fv_dof_tap(vec2(0.0, 1.0), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(-0.8660254, -0.5), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(0.8660254, -0.5), r, c0);\n"
+    "#if FV_TAPS >= 6\n"
+    "    sum += fv_dof_tap(vec2(0.0, -1.0), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(0.8660254, 0.5), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(-0.8660254, 0.5), r, c0);\n"
+    "#endif\n"
+    "#if FV_TAPS >= 12\n"
+    "    sum += fv_dof_tap(vec2(0.5, 0.0), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(0.25, 0.4330127), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(-0.25, 0.4330127), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(-0.5, 0.0), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(-0.25, -0.4330127), r, c0);\n"
+    "    sum += fv_dof_tap(vec2(0.25, -0.4330127), r, c0);\n"
+    "#endif\n"
+    "    FV_FRAGCOLOR = sum / float(FV_TAPS + 1);\n"
+    "}\n";
+
+/* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
+static const char fogvol__fs_post_outlines[] =
+    "uniform vec4 fv_pcolor;\n"
+    "float fv_pg(vec2 o) { float e = fv_view_depth(o); return fv_ptexel.z > 0.5 ? 1.0 / e : e; }\n"
+    "float fv_pline(vec2 o, float g0) {\n" /* second difference along a line of three, both ends inside */
+    "    vec2 a = gl_FragCoord.xy + o, b = gl_FragCoord.xy - o;\n"
+    "    if (any(lessThan(min(a, b), fv_prect.xy)) || any(greaterThan(max(a, b), fv_prect.zw))) return 0.0;\n"
+    "    return abs(fv_pg(o) + fv_pg(-o) - 2.0 * g0);\n"
+    "}\n"
+    "#ifdef FV_NORMALS\n"
+    "uniform sampler2D fv_pnormal;\n"
+    "vec3 fv_pn(vec2 o) { return normalize(fv_ptex(fv_pnormal, o).rgb * 2.0 - 1.0); }\n"
+    "#endif\n"
+    "void main() {\n"
+    "    float g0 = fv_pg(vec2(0.0));\n"
+    "    float d = max(max(fv_pline(vec2(1.0, 0.0), g0), fv_pline(vec2(0.0, 1.0), g0)),\n"
+    "                  max(fv_pline(vec2(1.0, 1.0), g0), fv_pline(vec2(1.0, -1.0), g0)));\n"
+    "    bool edge = d > fv_pparams.x * abs(g0);\n"
+    "#ifdef FV_NORMALS\n"
+    "    vec3 n0 = fv_pn(vec2(0.0));\n"
+    "    float m = 0.0;\n"
+    "    for (int j = -1; j <= 1; ++j)\n"
+    "        for (int i = -1; i <= 1; ++i) m = max(m, 1.0 - dot(n0, fv_pn(vec2(float(i), float(j)))));\n"
+    "    edge = edge || m > fv_pparams.y;\n"
+    "#endif\n"
+    "    if (!edge) discard;\n"
+    "    FV_FRAGCOLOR = fv_pcolor;\n"
+    "}\n";
+
+/* Distance fog: fv_pparams.x = start, fv_rampmap as in the volume composite. */
+static const char fogvol__fs_post_fog[] =
+    "uniform vec4 fv_rampmap;\n"
+    "uniform sampler2D fv_colors;\n"
+    "void main() {\n"
+    "    float t = max(fv_view_depth(vec2(0.0)) - fv_pparams.x, 0.0);\n"
+    "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
+    "}\n";
+
+FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
+                                                    fogvol_stage stage, const char **strings, int *count)
+{
+    static const char *const taps[3] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n", "#define FV_TAPS 12\n"};
+    int legacy, es, n = 0;
+    if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    *count = 0;
+    if ((int)dialect <= FOGVOL_GLSL_AUTO || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
+    if (!(effect == FOGVOL_POST_DOF && (variant == 3 || variant == 6 || variant == 12)) &&
+        !(effect == FOGVOL_POST_OUTLINES && (variant == 0 || variant == 1)) &&
+        !(effect == FOGVOL_POST_DISTANCE_FOG && variant == 0))
+        return FOGVOL_ERROR_UNSUPPORTED;
+    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
+    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
+    strings[n++] = fogvol__version[dialect];
+    if (stage == FOGVOL_STAGE_VERTEX) {
+        strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
+        if (es) strings[n++] = fogvol__vs_es;
+        strings[n++] = fogvol__vs_fullscreen;
+    } else {
+        strings[n++] = dialect == FOGVOL_GLSL_100     ? fogvol__fs_es100
+                       : dialect == FOGVOL_GLSL_300ES ? fogvol__fs_es300
+                       : legacy                       ? fogvol__fs_legacy
+                                                      : fogvol__fs_modern;
+        strings[n++] = fogvol__fs_post_common;
+        if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
+        if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
+        strings[n++] = effect == FOGVOL_POST_DOF        ? fogvol__fs_post_dof
+                       : effect == FOGVOL_POST_OUTLINES ? fogvol__fs_post_outlines
+                                                        : fogvol__fs_post_fog;
+    }
+    *count = n;
+    return FOGVOL_SUCCESS;
+}
+
+/* The program of an effect variant, built on first use (slot: see FOGVOL__POST_PROGRAMS). */
+static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effect effect, int variant,
+                                          fogvol_handle *out)
+{
+    static const char *const labels[FOGVOL_POST_EFFECT_COUNT] = {"fogvol depth of field", "fogvol outlines",
+                                                                  "fogvol distance fog"};
+    int slot = effect == FOGVOL_POST_DOF ? (variant == 3 ? 0 : variant == 6 ? 1 : 2)
+               : effect == FOGVOL_POST_OUTLINES ? 3 + variant
+                                                : 5;
+    fogvol_program_desc pd;
+    fogvol_result r;
+    if (!ctx->post_prog[slot]) {
+        memset(&pd, 0, sizeof pd);
+        r = fogvol_post_shader_strings(effect, variant, ctx->be.dialect, FOGVOL_STAGE_VERTEX, pd.vs, &pd.vs_count);
+        if (r == FOGVOL_SUCCESS)
+            r = fogvol_post_shader_strings(effect, variant, ctx->be.dialect, FOGVOL_STAGE_FRAGMENT, pd.fs,
+                                           &pd.fs_count);
+        pd.samplers[0] = effect == FOGVOL_POST_DOF ? "fv_pscene" : NULL;
+        pd.samplers[1] = "fv_pdepth";
+        pd.samplers[2] = effect == FOGVOL_POST_DISTANCE_FOG ? "fv_colors"
+                         : effect == FOGVOL_POST_OUTLINES && variant ? "fv_pnormal"
+                                                                     : NULL;
+        pd.label = labels[effect];
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->post_prog[slot]);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
+                        labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
+            ctx->post_prog[slot] = 0;
+            return r;
+        }
+    }
+    *out = ctx->post_prog[slot];
+    return FOGVOL_SUCCESS;
+}
+
+/* What every effect needs: no open frame, a backend that can, a frame desc a frame would accept
+   with a depth texture, textures covering the viewport; then the camera (ctx's camera fields). */
+static fogvol_result fogvol__post_check(fogvol_context *ctx, const fogvol_frame_desc *d, const int size[2],
+                                        const char *what)
+{
+    const char *why = NULL;
+    if (ctx->in_frame) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s inside an open frame (call it after end_frame)", what);
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if (!(ctx->be.caps & FOGVOL_CAP_DEPTH_TEXTURE) || !(ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) ||
+        (int)ctx->be.dialect <= FOGVOL_GLSL_AUTO || (int)ctx->be.dialect >= FOGVOL_GLSL_COUNT) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s needs depth textures and highp fragment shaders in a "
+                    "known GLSL dialect (backend caps 0x%x, GLSL %s)", what, ctx->be.caps,
+                    fogvol_dialect_name(ctx->be.dialect));
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (!d) why = "desc->frame is NULL";
+    else if (!d->engine_depth_texture || d->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE)
+        why = "no depth texture (frame->engine_depth_texture)";
+    else if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear))
+        why = "need 0 < znear < zfar";
+    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || d->viewport[2] <= 0 || d->viewport[3] <= 0 ||
+             d->viewport[2] > 16384 || d->viewport[3] > 16384)
+        why = "viewport outside the framebuffer's 0..16384";
+    else if (size[0] < 0 || size[1] < 0 || (size[0] && size[0] < d->viewport[0] + d->viewport[2]) ||
+             (size[1] && size[1] < d->viewport[1] + d->viewport[3]))
+        why = "texture_size smaller than the viewport's extent";
+    else if (d->engine_depth_zero_to_one < -1 || d->engine_depth_zero_to_one > 1 ||
+             !fogvol__finite_n(d->engine_depth_range, 2))
+        why = "engine_depth_zero_to_one not -1, 0 or 1, or non-finite engine_depth_range";
+    else if (d->draw_buffer < 0 || d->draw_buffer > 15 ||
+             (d->alpha != FOGVOL_ALPHA_KEEP && d->alpha != FOGVOL_ALPHA_COVERAGE))
+        why = "draw_buffer outside 0..15 or unknown alpha mode";
+    if (why) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s: %s", what, why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    return fogvol__camera(ctx, d);
+}
+
+/* One full-screen pass of ps (program, textures, effect uniforms set) into the engine framebuffer. */
+static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_desc *fd, const int size[2],
+                                      fogvol_pass *ps)
+{
+    fogvol_frame_info info;
+    fogvol_result r = FOGVOL_SUCCESS;
+    const int *vp = fd->viewport;
+    int tw = size[0] > 0 ? size[0] : vp[0] + vp[2], th = size[1] > 0 ? size[1] : vp[1] + vp[3];
+    memset(&info, 0, sizeof info);
+    info.draw_buffer = fd->draw_buffer;
+    if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, &info);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+        return r;
+    }
+    fogvol__lin_uniforms(ctx, fd, &info, ps);
+    ps->target = 0;
+    memcpy(ps->viewport, vp, sizeof ps->viewport);
+    ps->draw_buffer = fd->draw_buffer;
+    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)vp[2];
+    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)vp[3];
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)vp[0] / (float)vp[2];
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1] / (float)vp[3];
+    ps->uniforms[FOGVOL_U_POST_TEXEL][0] = 1.0f / (float)tw;
+    ps->uniforms[FOGVOL_U_POST_TEXEL][1] = 1.0f / (float)th;
+    ps->uniforms[FOGVOL_U_POST_TEXEL][2] = ctx->wscale > 0.0 ? 1.0f : 0.0f;
+    ps->uniforms[FOGVOL_U_POST_RECT][0] = (float)vp[0] + 0.5f;
+    ps->uniforms[FOGVOL_U_POST_RECT][1] = (float)vp[1] + 0.5f;
+    ps->uniforms[FOGVOL_U_POST_RECT][2] = (float)(vp[0] + vp[2]) - 0.5f;
+    ps->uniforms[FOGVOL_U_POST_RECT][3] = (float)(vp[1] + vp[3]) - 0.5f;
+    ps->native_textures[1] = fd->engine_depth_texture;
+    ctx->be.begin_pass(ctx->be.user_data, ps);
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    fogvol__end_pass(ctx);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc)
+{
+    fogvol_pass ps;
+    fogvol_result r;
+    fogvol_handle prog;
+    int taps;
+    float radius;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: desc is NULL");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_check(ctx, desc->frame, desc->texture_size, "post_dof");
+    if (r != FOGVOL_SUCCESS) return r;
+    taps = desc->taps ? desc->taps : 6;
+    radius = desc->max_radius != 0.0f ? desc->max_radius : 4.0f;
+    if (!desc->color_texture || (taps != 3 && taps != 6 && taps != 12) || !fogvol__finite(desc->focus_distance) ||
+        !(desc->focus_distance > 0.0f) || !fogvol__finite(desc->focus_range) || !(desc->focus_range > 0.0f) ||
+        !(radius > 0.0f && radius <= 64.0f)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: need color_texture, taps 3, 6 or 12, "
+                    "focus_distance > 0, focus_range > 0, 0 < max_radius <= 64");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_program(ctx, FOGVOL_POST_DOF, taps, &prog);
+    if (r != FOGVOL_SUCCESS) return r;
+    memset(&ps, 0, sizeof ps);
+    ps.program = prog;
+    ps.blend = FOGVOL_PASS_BLEND_NONE;
+    ps.native_textures[0] = desc->color_texture;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][0] = desc->focus_distance;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][1] = 1.0f / desc->focus_range;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][2] = radius;
+    return fogvol__post_run(ctx, desc->frame, desc->texture_size, &ps);
+}
+
+FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc)
+{
+    fogvol_pass ps;
+    fogvol_result r;
+    fogvol_handle prog;
+    float dt, nt;
+    int i, black;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_outlines: desc is NULL");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_check(ctx, desc->frame, desc->texture_size, "post_outlines");
+    if (r != FOGVOL_SUCCESS) return r;
+    dt = desc->depth_threshold != 0.0f ? desc->depth_threshold : 0.05f;
+    nt = desc->normal_threshold != 0.0f ? desc->normal_threshold : 0.3f;
+    if (!fogvol__finite_n(desc->color, 4) || !(dt > 0.0f) || !(nt > 0.0f) || !fogvol__finite(dt) ||
+        !fogvol__finite(nt)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_outlines: non-finite colour or thresholds not > 0");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_program(ctx, FOGVOL_POST_OUTLINES, desc->normal_texture ? 1 : 0, &prog);
+    if (r != FOGVOL_SUCCESS) return r;
+    memset(&ps, 0, sizeof ps);
+    ps.program = prog;
+    ps.blend = FOGVOL_PASS_BLEND_FOG;
+    ps.alpha_coverage = desc->frame->alpha == FOGVOL_ALPHA_COVERAGE;
+    ps.native_textures[2] = desc->normal_texture;
+    black = desc->color[0] == 0.0f && desc->color[1] == 0.0f && desc->color[2] == 0.0f && desc->color[3] == 0.0f;
+    for (i = 0; i < 4; ++i) ps.uniforms[FOGVOL_U_POST_COLOR][i] = black ? (i == 3 ? 1.0f : 0.0f) : desc->color[i];
+    ps.uniforms[FOGVOL_U_POST_PARAMS][0] = dt;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][1] = nt;
+    return fogvol__post_run(ctx, desc->frame, desc->texture_size, &ps);
+}
+
+FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc)
+{
+    fogvol_pass ps;
+    fogvol_result r;
+    fogvol_handle prog;
+    const fogvol_ramp *ramp;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_distance_fog: desc is NULL");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_check(ctx, desc->frame, desc->texture_size, "post_distance_fog");
+    if (r != FOGVOL_SUCCESS) return r;
+    ramp = desc->ramp;
+    if (!ramp || !fogvol__finite(desc->start) || !(desc->start >= 0.0f)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_distance_fog: need a ramp and a finite start >= 0");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    r = fogvol__post_program(ctx, FOGVOL_POST_DISTANCE_FOG, 0, &prog);
+    if (r != FOGVOL_SUCCESS) return r;
+    memset(&ps, 0, sizeof ps);
+    ps.program = prog;
+    ps.blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
+    ps.alpha_coverage = desc->frame->alpha == FOGVOL_ALPHA_COVERAGE;
+    ps.textures[FOGVOL__UNIT_RAMP] = ramp->texture;
+    ps.uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
+    ps.uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][0] = desc->start;
+    return fogvol__post_run(ctx, desc->frame, desc->texture_size, &ps);
 }
 
 /* >>gl backend ============================================================ */

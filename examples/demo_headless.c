@@ -13,6 +13,7 @@
                       dithering off | on (the banding and its cure)
      ramps.png        colour ramps: extinction | linear | artist gradient
      thickness.png    the raw thickness of the fog group as false colour
+     dof.png, outlines.png, distance_fog.png  the overview with the image-space effects
    and prints where they went, the tier, the pass count and the frame time.
 
    usage: demo_headless [output-dir] [--check]    (default dir: build/demo)
@@ -276,6 +277,129 @@ static void row(demo *d, const char *dir, const char *name, const settings *v, i
     }
 }
 
+/* ---- image-space effects on the overview: the scene (opaque + fog volumes) goes into a framebuffer
+   with colour and depth textures, as an engine would keep it, then each effect writes the window */
+/* the overview into the engine's colour and depth textures (fbo): the opaque scene, then its fog */
+static void scene_to_textures(demo *d, fogvol_context *fv, const float v[16], const float p[16], GLuint fbo)
+{
+    fogvol_mesh *fm[DS_MAX_MESHES];
+    fogvol_ramp *ramp[3];
+    fogvol_frame_desc fd;
+    settings s;
+    int i;
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    ds_draw(&d->gl, &d->scene, v, p, DW, DH);
+    memset(&s, 0, sizeof s);
+    s.fog_scale = 1.0f;
+    make_ramps(fv, &s, ramp);
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, v, sizeof fd.view);
+    memcpy(fd.projection, p, sizeof fd.projection);
+    fd.znear = 0.1f;
+    fd.zfar = 40.0f;
+    fd.viewport[2] = DW;
+    fd.viewport[3] = DH;
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    fogvol_begin_frame(fv, &fd);
+    add_scene(fv, &d->scene, fm, ramp);
+    fogvol_end_frame(fv, NULL);
+    for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
+    for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static GLuint demo_texture(GLenum internal, GLenum format, GLenum type)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexImage2D(GL_TEXTURE_2D, 0, (GLint)internal, DW, DH, 0, format, type, NULL);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return t;
+}
+
+/* the window gets the scene back (for the blended effects), then effect k, then a PNG */
+static int post_effect(demo *d, fogvol_context *fv, const fogvol_frame_desc *fd, GLuint fbo, GLuint color, int k,
+                       const char *dir, const fogvol_ramp *ramp)
+{
+    static const char *const names[3] = {"dof.png", "outlines.png", "distance_fog.png"};
+    fogvol_dof_desc dd;
+    fogvol_outline_desc od;
+    fogvol_distance_fog_desc gd;
+    fogvol_result r;
+    unsigned char *img = d->g.pixels;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, DW, DH, 0, 0, DW, DH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    memset(&dd, 0, sizeof dd);
+    memset(&od, 0, sizeof od);
+    memset(&gd, 0, sizeof gd);
+    dd.frame = od.frame = gd.frame = fd;
+    dd.color_texture = color;
+    dd.focus_distance = 9.0f; /* the pillars in the middle sharp, the front and the back blurred */
+    dd.focus_range = 5.0f;
+    dd.max_radius = 5.0f;
+    dd.taps = 12;
+    od.color[0] = 0.05f, od.color[1] = 0.04f, od.color[2] = 0.08f, od.color[3] = 0.9f;
+    gd.ramp = ramp;
+    gd.start = 4.0f;
+    r = k == 0 ? fogvol_post_dof(fv, &dd) : k == 1 ? fogvol_post_outlines(fv, &od) : fogvol_post_distance_fog(fv, &gd);
+    if (r != FOGVOL_SUCCESS) {
+        fprintf(stderr, "%s: %s\n", names[k], fogvol_result_string(r));
+        return 0;
+    }
+    glFinish();
+    save_row(dir, names[k], &img, 1, DW, DH);
+    return 1;
+}
+
+/* dof.png, outlines.png, distance_fog.png: the overview with each image-space effect */
+static int post_effects(demo *d, const char *dir)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd;
+    fogvol_ramp_desc rd;
+    fogvol_ramp *ramp;
+    GLuint fbo, color, depth;
+    int k, ok = 1;
+    if (!glu_create(&d->g, DW, DH, 1)) return 0;
+    ds_gl_init(&d->gl, &d->scene);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = log_cb;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) return 0;
+    color = demo_texture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE);
+    depth = demo_texture(GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth, 0);
+    memset(&fd, 0, sizeof fd);
+    camera(0, DW, DH, fd.view, fd.projection);
+    scene_to_textures(d, fv, fd.view, fd.projection, fbo);
+    fd.znear = 0.1f;
+    fd.zfar = 40.0f;
+    fd.viewport[2] = DW;
+    fd.viewport[3] = DH;
+    fd.engine_depth_texture = depth;
+    memset(&rd, 0, sizeof rd); /* distance fog: a hazy blue that swallows the far end */
+    rd.color[0] = 0.62f, rd.color[1] = 0.70f, rd.color[2] = 0.80f, rd.density = 0.12f;
+    fogvol_create_ramp(fv, &rd, &ramp);
+    for (k = 0; k < 3; ++k) ok &= post_effect(d, fv, &fd, fbo, color, k, dir, ramp);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &color);
+    glDeleteTextures(1, &depth);
+    ds_gl_free(&d->gl);
+    glu_destroy(&d->g);
+    return ok;
+}
+
 static int g_tap;
 static int check(int ok, const char *what)
 {
@@ -380,6 +504,9 @@ int main(int argc, char **argv)
         }
         row(&d, dir, "ramps.png", v, 3, 0);
     }
+    k = post_effects(&d, dir);
+    if (do_check) failures += !check(k, "image-space effects: dof.png, outlines.png, distance_fog.png");
+    else failures += !k;
     ds_scene_free(&d.scene);
     if (do_check) printf("1..%d\n", g_tap);
     return failures ? 1 : 0;

@@ -61,6 +61,39 @@ int main(int argc, char **argv)
                         fclose(f);
                         ++n;
                     }
+    /* image-space effects: every effect variant in every dialect (post_<effect><variant>_<dialect>) */
+    {
+        static const int eff[6] = {FOGVOL_POST_DOF, FOGVOL_POST_DOF, FOGVOL_POST_DOF, FOGVOL_POST_OUTLINES,
+                                   FOGVOL_POST_OUTLINES, FOGVOL_POST_DISTANCE_FOG};
+        static const int var[6] = {3, 6, 12, 0, 1, 0};
+        static const char *const ename[FOGVOL_POST_EFFECT_COUNT] = {"dof", "outlines", "fog"};
+        int e;
+        for (e = 0; e < 6; ++e)
+            for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
+                for (st = 0; st < 2; ++st) {
+                    const char *s[FOGVOL_MAX_SHADER_STRINGS];
+                    int count = -1, i;
+                    char path[512];
+                    FILE *f;
+                    if (fogvol_post_shader_strings((fogvol_post_effect)eff[e], var[e], (fogvol_dialect)d,
+                                                   (fogvol_stage)st, s, &count) != FOGVOL_SUCCESS || count < 3) {
+                        fprintf(stderr, "missing: post %s %d %s\n", ename[eff[e]], var[e], dia[d]);
+                        return 1;
+                    }
+                    snprintf(path, sizeof path, "%s/post_%s%d_%s.%s", dir, ename[eff[e]], var[e], dia[d],
+                             st ? "frag" : "vert");
+                    f = fopen(path, "w");
+                    if (!f) return 1;
+                    for (i = 0; i < count; ++i) fputs(s[i], f);
+                    fclose(f);
+                    ++n;
+                }
+        if (fogvol_post_shader_strings(FOGVOL_POST_DOF, 5, FOGVOL_GLSL_330, FOGVOL_STAGE_FRAGMENT, NULL, NULL) !=
+            FOGVOL_ERROR_INVALID_ARGUMENT) {
+            fprintf(stderr, "post shader strings without an output accepted\n");
+            return 1;
+        }
+    }
     printf("%d shaders written to %s; %d combinations refused with FOGVOL_ERROR_UNSUPPORTED\n", n, dir, refused);
     return 0;
 }
