@@ -5,6 +5,8 @@
 #   make images refresh the README pictures in docs/ from the demo
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
+#   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
+#   make test-web  load it in headless Chromium (software GL) and check the pictures
 CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
@@ -17,10 +19,13 @@ LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests
 TAP      = CMOCKA_MESSAGE_OUTPUT=TAP
 VALGRIND = valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite
 FUZZ_TIME ?= 60
+EMCC     ?= emcc
+CHROMIUM ?= chromium
 
 HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
-.PHONY: all check test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean
+.PHONY: all check test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean \
+        web test-web deps-web
 
 all: test
 
@@ -30,6 +35,8 @@ deps-demo:
 	@tools/deps.sh demo
 deps-run:
 	@tools/deps.sh run
+deps-web:
+	@tools/deps.sh web
 
 $(BUILD):
 	@mkdir -p $(BUILD)
@@ -119,6 +126,12 @@ TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
 TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
 TEST_BINS += $(BUILD)/test_gles $(BUILD)/test_gles_san
 TEST_BINS += $(BUILD)/test_post $(BUILD)/test_post_san
+# the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
+HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
+ifeq ($(HAVE_WEB),1)
+TEST_BINS += $(BUILD)/web/demo_web.html
+WEB_TEST = "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
+endif
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
@@ -168,7 +181,8 @@ test: deps-test deps-run
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
-	  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
+	  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
+	  $(WEB_TEST)
 
 # --- demo --------------------------------------------------------------------------
 $(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h $(HEADERS) | $(BUILD)
@@ -227,6 +241,23 @@ images: demo
 	cp $(BUILD)/demo/scene_low.png docs/demo_low.png
 	cp $(BUILD)/demo/scene_inside_fog_bank.png docs/demo_inside_fog_bank.png
 	cp $(BUILD)/demo/tiers.png $(BUILD)/demo/dither.png $(BUILD)/demo/ramps.png $(BUILD)/demo/thickness.png docs/
+
+# --- browser build: emscripten (Debian's emcc ships its system libraries prebuilt), one page for
+# WebGL1 (?webgl1) and WebGL2 (?webgl2, the default), the wasm embedded so it loads from file://.
+# NODE_PATH: Debian's emscripten finds its node modules (acorn) there even under a node from elsewhere
+WEB_FLAGS = -std=c99 -O2 $(WARN) $(INC) -I/usr/include/stb -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 \
+            -sSINGLE_FILE=1 -sWASM_ASYNC_COMPILATION=0 -sALLOW_MEMORY_GROWTH=1 -sMINIFY_HTML=0
+$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/shell.html fogvol.h tests/raycast.h tests/shapes.h
+	@mkdir -p $(BUILD)/web
+	NODE_PATH=/usr/share/nodejs $(EMCC) $(WEB_FLAGS) $< --shell-file examples/web/shell.html -o $@
+
+web: deps-web
+	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html
+	@echo "open $(BUILD)/web/demo_web.html?webgl1 or ?webgl2 in a browser"
+
+test-web: deps-web
+	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html
+	@LOGDIR=$(BUILD)/logs tests/run.sh "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
 
 clean:
 	rm -rf $(BUILD)

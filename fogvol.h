@@ -5612,7 +5612,9 @@ static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_
             }
         if (dmax > 0.0) k = 1.98 * ctx->wconst / dmax;
     }
-    ps->uniforms[FOGVOL_U_MISC][0] = (float)(k < 1.0 ? k : 1.0);
+    /* the whole [0, 1] depth range: a 16-bit depth buffer (GLES2, WebGL1) orders the occluders'
+       faces as finely as a standard projection would (k = 1 left it 1 / (2 (far - near)) of it) */
+    ps->uniforms[FOGVOL_U_MISC][0] = (float)k;
     /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
     ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
     fogvol__lin_uniforms(ctx, fd, info, ps);
@@ -6977,6 +6979,7 @@ typedef struct fogvol__gl {
     int depth_w, depth_h;
     fogvol__GLenum depth_format;
     int has_query; /* occlusion queries loaded (GL 1.5+, GLES 3.0+) */
+    int webgl;     /* a WebGL context behind GLES (GL_VERSION names WebGL, as emscripten reports it) */
 } fogvol__gl;
 
 static int fogvol__has_ext(const char *list, const char *name)
@@ -8330,7 +8333,7 @@ static void fogvol__gl_raster_caps(fogvol__gl *gl)
         gl->n_clip = n < 0 ? 0 : n > 8 ? 8 : n;
     }
     gl->has_restart = !es && v >= 31;
-    gl->has_restart_fixed = es ? v >= 30 : v >= 43;
+    gl->has_restart_fixed = es ? v >= 30 && !gl->webgl : v >= 43; /* WebGL 2: always on, no enable */
     gl->has_depth_clamp = !es && v >= 32;
     gl->has_sample_shading = (es ? v >= 32 : v >= 40) || gl->has_msaa; /* GL 3.2 + ARB_sample_shading */
     gl->has_sample_mask = es ? v >= 31 : v >= 32;
@@ -8392,6 +8395,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     gl->gles = strncmp(ver, "OpenGL ES", 9) == 0;
+    gl->webgl = gl->gles && strstr(ver, "WebGL") != NULL;
     fogvol__parse_version(ver, &gl->major, &gl->minor);
     if (!gl->gles && (gl->major > 3 || (gl->major == 3 && gl->minor >= 2))) {
         fogvol__GLint mask = 0;

@@ -1,17 +1,20 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the tests and examples need, only when missing.
-# Usage: tools/deps.sh test|demo|run
+# Usage: tools/deps.sh test|demo|run|web
+#   web: emscripten (emcc with its system libraries prebuilt) and chromium for make web / the browser test
 # FOGVOL_NO_INSTALL=1 turns installing off (provide the packages yourself, e.g. on a non-Debian system).
 set -euo pipefail
 what=${1:-test}
 pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
 pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth cmake pkg-config libosmesa6-dev libstb-dev"
+pkgs_web="make emscripten chromium libstb-dev"
 case "$what" in
   test) pkgs="$pkgs_test" ;;
   demo) pkgs="$pkgs_demo" ;;
   run) pkgs="$pkgs_run" ;;
-  *) echo "usage: $0 test|demo|run" >&2; exit 2 ;;
+  web) pkgs="$pkgs_web" ;;
+  *) echo "usage: $0 test|demo|run|web" >&2; exit 2 ;;
 esac
 # FOGVOL_NO_INSTALL=1: never install anything (the dependencies are yours to provide)
 if [ "${FOGVOL_NO_INSTALL:-0}" = 1 ]; then
@@ -21,8 +24,9 @@ if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>
   cat >&2 <<EOF2
 deps: this is not a Debian-like system (no dpkg-query/apt-get), so nothing is installed.
 deps: '$what' needs these Debian packages or their equivalents: $pkgs
-deps:   (OSMesa: mesa's libOSMesa + headers; Mesa's EGL with the surfaceless platform + GLES headers; cmocka; stb_image_write.h under <stb/>; glslangValidator;
-deps:    GLFW 3 and Xvfb for the windowed demo; cmake and pkg-config for the packaging tests)
+deps:   (OSMesa: mesa's libOSMesa + headers; Mesa's EGL with the surfaceless platform + GLES headers; cmocka;
+deps:    stb_image_write.h under <stb/>; glslangValidator; GLFW 3 and Xvfb for the windowed demo; cmake and
+deps:    pkg-config for the packaging tests; emscripten and chromium for the browser build and its test)
 deps: install them, then run again with FOGVOL_NO_INSTALL=1.
 EOF2
   exit 1
