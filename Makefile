@@ -79,6 +79,10 @@ $(BUILD)/test_engine_input: tests/test_engine_input.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_engine_input_san: tests/test_engine_input.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_texlight: tests/test_texlight.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_texlight_san: tests/test_texlight.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
 $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
@@ -107,6 +111,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
 TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
 TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
+TEST_BINS += $(BUILD)/test_texlight $(BUILD)/test_texlight_san
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
@@ -147,6 +152,8 @@ test: deps-test deps-run
 	  "engine_input=$(TAP) $(BUILD)/test_engine_input" \
 	  "engine_input_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_input_san" \
 	  "overflow=$(TAP) $(BUILD)/test_overflow" \
+	  "texlight=$(TAP) $(BUILD)/test_texlight" \
+	  "texlight_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_texlight_san" \
 	  "overflow_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_overflow_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
