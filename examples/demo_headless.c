@@ -398,6 +398,179 @@ static void row(demo *d, const char *dir, const char *name, const settings *v, i
     }
 }
 
+/* ---- textured fog and volume light by compare (fogvol_volume_desc.density / color, fogvol_add_light) ---- */
+
+static fogvol_volume_texture *demo_texture(fogvol_context *fv, int kind, int n)
+{
+    unsigned char *px = (unsigned char *)malloc((size_t)n * n * 4);
+    fogvol_texture_desc td;
+    fogvol_volume_texture *t = NULL;
+    int x, y, k;
+    for (y = 0; y < n; ++y)
+        for (x = 0; x < n; ++x) {
+            unsigned char *q = px + 4 * (y * n + x);
+            float u = 6.2831853f * x / n, v = 6.2831853f * y / n, f = 0.0f;
+            for (k = 1; k <= 4; ++k) /* tileable sum of waves: soft cloudy noise */
+                f += sinf(k * u + 1.7f * k + cosf(k * v * 1.3f)) * sinf(k * v + 0.9f * k + sinf(u * k)) / (float)k;
+            f = 0.5f + 0.45f * f;
+            f = f < 0 ? 0 : f > 1 ? 1 : f;
+            if (kind == 0) { /* density noise */
+                q[0] = q[1] = q[2] = (unsigned char)(255 * f);
+            } else if (kind == 1) { /* shaft gradient (1 texel high): thin at the base */
+                q[0] = q[1] = q[2] = (unsigned char)(255.0f * powf((float)x / (n - 1), 1.5f));
+            } else { /* colour: warm and cold patches */
+                q[0] = (unsigned char)(255 * (0.7f + 0.3f * f));
+                q[1] = (unsigned char)(255 * (0.75f + 0.2f * sinf(u)));
+                q[2] = (unsigned char)(255 * (1.0f - 0.45f * f));
+            }
+            q[3] = 255;
+        }
+    memset(&td, 0, sizeof td);
+    td.width = n;
+    td.height = kind == 1 ? 1 : n;
+    td.pixels = px;
+    td.filter = FOGVOL_FILTER_LINEAR;
+    td.wrap = kind == 1 ? FOGVOL_WRAP_CLAMP : FOGVOL_WRAP_REPEAT;
+    if (fogvol_create_volume_texture(fv, &td, &t) != FOGVOL_SUCCESS) t = NULL;
+    free(px);
+    return t;
+}
+
+/* A frustum-shaped light shaft: a box whose top face is shrunk (convex). */
+static shp_mesh demo_shaft(void)
+{
+    shp_mesh m = shp_box(1.4f, 2.6f, 1.0f);
+    int i;
+    for (i = 0; i < m.vcount; ++i)
+        if (m.pos[3 * i + 1] > 0) m.pos[3 * i] *= 0.35f, m.pos[3 * i + 2] *= 0.35f;
+    return m;
+}
+
+/* the scene's volumes with textures: noise density (scrolled), the shaft's gradient, a colour */
+static void demo_tl_volumes(demo *d, fogvol_context *fv, fogvol_mesh **fm, fogvol_ramp **ramp,
+                            fogvol_volume_texture **tex, int lights)
+{
+    fogvol_volume_texture *noise = tex[0], *grad = tex[1], *colour = tex[2];
+    int i;
+    for (i = 0; i < d->n; ++i) {
+        fogvol_volume_desc vd;
+        if (d->kind[i] == 0) {
+            fogvol_add_occluder(fv, fm[i], d->model[i]);
+            continue;
+        }
+        if (lights) continue;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = fm[i];
+        vd.ramp = ramp[d->kind[i] == 1 ? 0 : d->kind[i] == 4 ? 2 : 1];
+        vd.negative = d->kind[i] == 3;
+        memcpy(vd.model, d->model[i], sizeof vd.model);
+        if (d->kind[i] == 4) { /* shaft: s along its axis (model y in [-3, 3]), thin at the base */
+            vd.density = grad;
+            vd.density_map[1] = 1.0f / 6.0f;
+            vd.density_map[3] = 0.5f;
+            vd.density_map[7] = 0.5f;
+        } else if (!vd.negative) { /* noise in the horizontal plane, scrolled (time 1.5 s, 0.2 units/s) */
+            vd.density = noise;
+            vd.density_map[0] = d->kind[i] == 2 ? 0.12f : 0.35f;
+            vd.density_map[6] = d->kind[i] == 2 ? 0.12f : 0.35f;
+            vd.density_map[3] = 0.2f * 1.5f;
+            if (d->kind[i] == 1) vd.color = colour;
+        }
+        fogvol_add_volume(fv, &vd);
+    }
+}
+
+/* two convex light volumes (frustum-shaped shafts) lighting the scene by compare */
+static fogvol_mesh *demo_tl_lights(fogvol_context *fv)
+{
+    fogvol_mesh *shaft;
+    fogvol_light_desc ld;
+    float r[16], t[16];
+    shp_mesh sm = demo_shaft();
+    shaft = upload(fv, &sm, 0);
+    shp_free(&sm);
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = shaft;
+    shp_mat_rotate(r, 15, 0, 0, 1);
+    shp_mat_translate(t, -1.2f, 1.4f, -0.6f);
+    shp_mat_mul(ld.model, t, r);
+    ld.color[0] = 0.9f, ld.color[1] = 0.65f, ld.color[2] = 0.3f;
+    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+    shp_mat_rotate(r, -25, 0, 1, 0);
+    shp_mat_translate(t, 2.2f, 0.0f, 0.8f);
+    shp_mat_mul(ld.model, t, r);
+    ld.color[0] = 0.2f, ld.color[1] = 0.45f, ld.color[2] = 0.8f;
+    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+    return shaft;
+}
+
+/* textured: fog groups with density noise (the bank scrolled, the shaft thinning towards its
+   base), a colour texture on the floating fog; lights: two convex light volumes lighting the
+   scene by compare, no fog. */
+static void demo_texlight(demo *d, const char *dir, int lights)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *fm[NOBJ], *shaft = NULL;
+    fogvol_ramp *ramp[3];
+    fogvol_ramp_desc rd;
+    fogvol_volume_texture *tex[3];
+    fogvol_frame_desc fd;
+    float v[16], p[16], vp[16];
+    unsigned char *imgs[1];
+    int i;
+    static const float grey[3] = {0.55f, 0.52f, 0.48f}, stone[3] = {0.7f, 0.66f, 0.6f};
+    if (!glu_create(&d->g, DW, DH, 1)) return;
+    engine_init(&d->e);
+    camera(0, DW, DH, v, p);
+    shp_mat_mul(vp, p, v);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = log_cb;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
+        glu_destroy(&d->g);
+        return;
+    }
+    for (i = 0; i < d->n; ++i) fm[i] = upload(fv, &d->mesh[i], d->kind[i] == 0);
+    for (i = 0; i < 3; ++i) tex[i] = demo_texture(fv, i, i == 1 ? 32 : 64);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.9f, rd.color[1] = 0.92f, rd.color[2] = 0.97f, rd.density = 0.9f;
+    fogvol_create_ramp(fv, &rd, &ramp[0]);
+    rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.45f;
+    fogvol_create_ramp(fv, &rd, &ramp[1]);
+    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.6f, rd.blend = FOGVOL_BLEND_LIGHT;
+    fogvol_create_ramp(fv, &rd, &ramp[2]);
+    glViewport(0, 0, DW, DH);
+    glEnable(GL_DEPTH_TEST);
+    glClearColor(0.32f, 0.45f, 0.62f, 1);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    for (i = 0; i < d->n; ++i)
+        if (d->kind[i] == 0) engine_draw(&d->e, &d->mesh[i], d->model[i], vp, i == 0 ? grey : stone);
+    glDisable(GL_DEPTH_TEST);
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, v, sizeof v);
+    memcpy(fd.projection, p, sizeof p);
+    fd.znear = 0.1f;
+    fd.zfar = 40.0f;
+    fd.viewport[2] = DW;
+    fd.viewport[3] = DH;
+    fogvol_begin_frame(fv, &fd);
+    demo_tl_volumes(d, fv, fm, ramp, tex, lights);
+    if (lights) shaft = demo_tl_lights(fv);
+    fogvol_end_frame(fv, NULL);
+    glFinish();
+    imgs[0] = d->g.pixels;
+    save_row(dir, lights ? "light_compare.png" : "textured_fog.png", imgs, 1, DW, DH);
+    printf("  %-34s tier %s\n", lights ? "light_compare.png" : "textured_fog.png",
+           fogvol_tier_name(fogvol_context_tier(fv, NULL)));
+    for (i = 0; i < d->n; ++i) fogvol_destroy_mesh(fv, fm[i]);
+    if (shaft) fogvol_destroy_mesh(fv, shaft);
+    for (i = 0; i < 3; ++i) fogvol_destroy_volume_texture(fv, tex[i]);
+    for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
+    fogvol_destroy_context(fv);
+    glu_destroy(&d->g);
+}
+
 static int g_tap;
 static int check(int ok, const char *what)
 {
@@ -501,6 +674,8 @@ int main(int argc, char **argv)
         }
         row(&d, dir, "ramps.png", v, 3, 0);
     }
+    demo_texlight(&d, dir, 0);
+    demo_texlight(&d, dir, 1);
     for (i = 0; i < d.n; ++i) shp_free(&d.mesh[i]);
     if (do_check) printf("1..%d\n", g_tap);
     return failures ? 1 : 0;
