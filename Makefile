@@ -95,6 +95,9 @@ $(BUILD)/test_gles_san: tests/test_gles.c tests/egl_util.h tests/scenes.h $(HEAD
 $(BUILD)/test_post: tests/test_post.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_post_san: tests/test_post.c $(HEADERS) | $(BUILD)
+$(BUILD)/test_texlight: tests/test_texlight.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_texlight_san: tests/test_texlight.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
@@ -132,6 +135,7 @@ ifeq ($(HAVE_WEB),1)
 TEST_BINS += $(BUILD)/web/demo_web.html
 WEB_TEST = "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
 endif
+TEST_BINS += $(BUILD)/test_texlight $(BUILD)/test_texlight_san
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
@@ -172,6 +176,8 @@ test: deps-test deps-run
 	  "engine_input=$(TAP) $(BUILD)/test_engine_input" \
 	  "engine_input_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_input_san" \
 	  "overflow=$(TAP) $(BUILD)/test_overflow" \
+	  "texlight=$(TAP) $(BUILD)/test_texlight" \
+	  "texlight_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_texlight_san" \
 	  "overflow_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_overflow_san" \
 	  "gles=$(TAP) $(BUILD)/test_gles" \
 	  "gles_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_gles_san" \

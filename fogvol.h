@@ -432,6 +432,12 @@ typedef struct fogvol_mesh_report {
     int valid;                 /* usable as a fog volume */
     int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
                                   vertices counts the rest */
+    /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
+       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
+       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
+       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
+       2^26 triangle x vertex pairs). */
+    int convex;
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
@@ -527,7 +533,10 @@ typedef enum fogvol_program {
     FOGVOL_PROGRAM_CHECK = 5,          /* RGBA8 tiers: full-screen triangle over the sums (as COMPOSITE reads
                                           them) that discards every pixel without a saturated channel and
                                           writes 1 into the overflow mask V; counted by occlusion queries */
-    FOGVOL_PROGRAM_COUNT = 6,
+    FOGVOL_PROGRAM_LIGHT = 6,          /* volume light by compare (fogvol_add_light): front faces write their
+                                          depth into L; back faces light the scene pixels whose opaque
+                                          depth lies between L and their own depth (FLOAT, PS20, MRT) */
+    FOGVOL_PROGRAM_COUNT = 7,
     FOGVOL_PROGRAM_MAX_ENUM = 0x7fffffff
 } fogvol_program;
 
@@ -537,7 +546,7 @@ typedef enum fogvol_stage {
     FOGVOL_STAGE_MAX_ENUM = 0x7fffffff
 } fogvol_stage;
 
-#define FOGVOL_MAX_SHADER_STRINGS 12
+#define FOGVOL_MAX_SHADER_STRINGS 16
 
 typedef struct fogvol_shader_desc {
     fogvol_tier tier;      /* not AUTO */
@@ -840,19 +849,28 @@ typedef enum fogvol_uniform {
     FOGVOL_U_POST_RECT = 10,  /* "fv_prect":   centres of the viewport's first and last pixels (x0, y0, x1, y1) */
     FOGVOL_U_POST_PARAMS = 11,/* "fv_pparams": per effect (see fogvol__post_* in the implementation) */
     FOGVOL_U_POST_COLOR = 12, /* "fv_pcolor":  outline colour */
-    FOGVOL_U_COUNT = 13
+    /* density and colour textures on volumes, volume light by compare */
+    FOGVOL_U_DENSITY_U = 13, /* "fv_dens_u": density texture s = dot(fv_dens_u, (model-space position, 1)) */
+    FOGVOL_U_DENSITY_V = 14, /* "fv_dens_v": density texture t, likewise */
+    FOGVOL_U_DENSITY = 15,   /* "fv_dens":   (reference depth c, 1 = density texture on, 1/(far-near), 0) */
+    FOGVOL_U_COLOR_U = 16,   /* "fv_ctex_u": colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on */
+    FOGVOL_U_COLOR_V = 17,   /* "fv_ctex_v": colour texture t = dot(xyz, (screen s, t, 1)) */
+    FOGVOL_U_LIGHT = 18,     /* "fv_light":  (light rgb, 0 = front-depth pass, 1 = compare pass) */
+    FOGVOL_U_COUNT = 19
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
 /* Sampler units, fixed per program:
    ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
    COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
-   (the "2" samplers: second attachments of WIDE targets). Fragment outputs:
+   (the "2" samplers: second attachments of WIDE targets); FACE: fv_density 6 (density
+   texture); COMPOSITE*: fv_ctex 6 (colour texture); LIGHT: fv_rg 0, fv_blue 1, fv_dither 2,
+   fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
    fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
    "fv_sign" (float, FLOAT tier: -1 for negative volumes).
    Vertex attribute 0: "fv_position" (vec3). */
-#define FOGVOL_MAX_TEXTURE_UNITS 6
+#define FOGVOL_MAX_TEXTURE_UNITS 8
 
 typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
 typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
@@ -1172,6 +1190,7 @@ typedef struct fogvol_frame_stats {
     int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
     int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
     int overflow_passes;     /* check passes issued this frame (not included in passes) */
+    int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -1285,13 +1304,77 @@ typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
 FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
 
+typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
 typedef struct fogvol_volume_desc {
     const fogvol_mesh *mesh;
     float model[16];
     const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
     int negative;             /* 1: subtracts thickness from the volumes of its ramp */
+    /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
+       density factor rho in [0,1] sampled on every face fragment at the surface point, with
+       texture coordinates s = dot(density_map[0..3], (p, 1)), t = dot(density_map[4..7], (p, 1))
+       from the model-space position p (all 8 zero: s = x, t = y). Scroll it for drifting fog by
+       adding velocity * time to density_map[3] and [7] every frame; a 1-texel-high gradient with
+       FOGVOL_WRAP_CLAMP and s along a shaft's axis thins a light shaft towards its base.
+       What is summed: each face adds v = c + rho * (min(d, o) - c) instead of min(d, o) (d the
+       face's depth, o the opaque depth, c = min(o, depth of the centre of the volume's bounds),
+       c = 0 when the bounds reach nearer than znear). A closed hull's faces enter and leave
+       every ray equally often, so the c terms cancel and each chord [a, b] of the volume (b
+       clamped to o) contributes  rho_b (b - c) - rho_a (a - c)  (rho_a, rho_b: the density at
+       the entry and exit faces' surface points, also where the exit face is hidden behind o).
+       Exact (= rho * (b - a)) when the density is the same at both ends of every chord: a
+       density that does not vary along the rays (a 2D texture projected along the view
+       direction, e.g. an orthographic camera looking along the texture's projection axis, or a
+       density varying only across the screen). A chord hidden behind o entirely adds nothing
+       when o <= the centre depth (both faces add o). Otherwise an approximation, a two-point
+       rule: with rho_m the mean density along the chord the error per chord is
+       (rho_b - rho_m) (b - c) - (rho_a - rho_m) (a - c), at most the density contrast along the
+       chord times (|a - c| + |b - c|), i.e. about the contrast times the volume's depth extent.
+       RGBA8 tiers encode v like any depth (1 LSB per face). Tiers FLOAT, PS20 and MRT (with
+       SINGLE_TARGET, ALU, NEAR_CLAMP, ENGINE_DEPTH); PS13 (mediump cannot re-encode), COUNT
+       (the opaque depth it adds per missing back face carries no density) and WIDE:
+       fogvol_add_volume returns FOGVOL_ERROR_UNSUPPORTED, logged. A textured volume costs one
+       more pass per sum pass. */
+    const fogvol_volume_texture *density;
+    float density_map[8];
+    /* Colour texture (NULL = none): the composite multiplies the ramp colour's rgb by the
+       texture's rgb at s = dot(color_map[0..2], (x, y, 1)), t = dot(color_map[3..5], (x, y, 1)),
+       (x, y) the pixel's position across the viewport in [0,1] (all 6 zero = s = x, t = y).
+       The composite draws one colour-ramp group at a time, so the volumes of one ramp share one
+       colour texture: a volume whose colour texture or map differs from an earlier volume of
+       its ramp in this frame is refused (FOGVOL_ERROR_INVALID_ARGUMENT, logged); volumes
+       without one take the group's. Every tier and dialect. */
+    const fogvol_volume_texture *color;
+    float color_map[6];
 } fogvol_volume_desc;
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
+
+/* Textures for volumes (density, colour): RGBA8, rows bottom to top, desc->filter and wrap
+   as given (width, height 1..4096; pixels required). */
+FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
+                                                      fogvol_volume_texture **out);
+/* Inside a frame, the volumes that use it are dropped from the frame (logged). */
+FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture);
+
+/* Volume light by compare: the scene pixels whose opaque depth (fogvol's occluders, the MRT
+   target or the engine's depth texture: whatever the tier's O is) lies between the depth of
+   the light volume's front face and its back face are lit: colour * intensity is added to
+   them (the engine framebuffer's RGB; alpha kept); pixels outside the volume, in front of it
+   or behind it, are untouched. A scene point is inside a convex volume exactly when its depth
+   lies between the one front and the one back face on its ray, so the mesh must be convex
+   (fogvol_mesh_report.convex == 1); a concave mesh is refused with FOGVOL_ERROR_INVALID_MESH
+   and a logged message. A camera inside the light works (no front face: from the near plane).
+   Lights are drawn after the opaque depth and before the fog groups, so fog covers lit pixels.
+   RGBA8 tiers compare depths decoded from the encoding (12 bits by default: a pixel within
+   about one encoding LSB of the volume's surface may fall either way). Tiers FLOAT, PS20 (not
+   WIDE) and MRT; PS13 and WIDE: FOGVOL_ERROR_UNSUPPORTED, logged. Two passes per light. */
+typedef struct fogvol_light_desc {
+    const fogvol_mesh *mesh;  /* closed, convex */
+    float model[16];
+    float color[3];           /* added to lit pixels */
+    float intensity;          /* 0 = 1 */
+} fogvol_light_desc;
+FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
@@ -3569,9 +3652,17 @@ static const char fogvol__vs_mesh[] =
     "uniform vec4 fv_depth;\n"
     "uniform vec4 fv_misc;\n"
     "FV_VARYING_OUT float fv_d;\n"
+    "#ifdef FV_DENSITY\n"                        /* density texture coordinates from the model-space position */
+    "uniform vec4 fv_dens_u;\n"
+    "uniform vec4 fv_dens_v;\n"
+    "FV_VARYING_OUT vec2 fv_dtc;\n"
+    "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
     "    vec4 c = fv_mvp * p;\n"
+    "#ifdef FV_DENSITY\n"
+    "    fv_dtc = vec2(dot(fv_dens_u, p), dot(fv_dens_v, p));\n"
+    "#endif\n"
     "    float d = dot(fv_depth, p);\n"
     "#ifdef FV_NEAR_CLAMP\n"
     "    if (fv_misc.w > 0.5) {\n"
@@ -3686,6 +3777,14 @@ static const char fogvol__fs_encode[] =
 static const char fogvol__fs_face[] =
     "FV_VARYING_IN float fv_d;\n"
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "#ifdef FV_DENSITY\n"                        /* v = c + rho (min(d, o) - c), c = min(o, fv_dens.x) */
+    "uniform sampler2D fv_density;\n"
+    "uniform vec4 fv_dens;\n"
+    "FV_VARYING_IN vec2 fv_dtc;\n"
+    "float fv_density_apply(float d, float o) {\n"
+    "    return mix(min(o, fv_dens.x), d, FV_TEXTURE(fv_density, fv_dtc).r);\n"
+    "}\n"
+    "#endif\n"
     "#ifdef FV_FLOAT\n"
     "uniform float fv_sign;\n"
     "uniform vec4 fv_nf;\n"
@@ -3697,6 +3796,9 @@ static const char fogvol__fs_face[] =
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
     "#endif\n"
     "    float d = min(max(fv_d, 0.0), o);\n"
+    "#ifdef FV_DENSITY\n"
+    "    if (fv_dens.y > 0.5) d = fv_density_apply(d, o);\n"
+    "#endif\n"
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
     "}\n"
     "#elif defined(FV_WIDE)\n"
@@ -3710,6 +3812,13 @@ static const char fogvol__fs_face[] =
     "}\n"
     "#else\n"
     "void main() {\n"
+    "#ifdef FV_DENSITY\n"                        /* decoded opaque depth, then v re-encoded */
+    "    if (fv_dens.y > 0.5) {\n"
+    "        float od = dot(FV_TEXTURE(fv_opaque, fv_st()), fv_dec) * fv_dens.z;\n"
+    "        FV_FRAGCOLOR = fv_encode(fv_density_apply(min(max(fv_d, 0.0), od), od));\n"
+    "        return;\n"
+    "    }\n"
+    "#endif\n"
     "    vec4 e = fv_encode(fv_d);\n"
     "#ifdef FV_NORMALIZE\n"
     "    e = fv_normalize(e);\n"
@@ -3764,6 +3873,9 @@ static const char fogvol__fs_composite[] =
     "uniform FV_TARGET_SAMPLER fv_front;\n"
     "uniform sampler2D fv_colors;\n"
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
+    "uniform vec4 fv_ctex_u;\n"
+    "uniform vec4 fv_ctex_v;\n"
     "#ifdef FV_WIDE\n"
     "uniform sampler2D fv_back2;\n"
     "uniform sampler2D fv_front2;\n"
@@ -3814,9 +3926,65 @@ static const char fogvol__fs_composite[] =
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
     "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "    if (fv_ctex_u.w > 0.5)\n"
+    "        c.rgb *= FV_TEXTURE(fv_ctex, vec2(dot(fv_ctex_u.xyz, vec3(st, 1.0)), dot(fv_ctex_v.xyz, vec3(st, 1.0)))).rgb;\n"
     "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
     "#endif\n"
     "}\n";
+
+/* Volume light by compare. fv_light.w = 0: the light's front faces write their depth d into L
+   (FLOAT: d; RGBA8: encoded). 1: its back faces light the pixels whose opaque depth o lies
+   between L's front depth and their own depth, in the engine framebuffer. */
+static const char fogvol__fs_light[] =
+    "FV_VARYING_IN float fv_d;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "uniform FV_TARGET_SAMPLER fv_lfront;\n"
+    "uniform vec4 fv_light;\n"
+    "uniform vec4 fv_nf;\n"
+    "float fv_light_depth(vec4 v) {\n"
+    "#ifdef FV_FLOAT\n"
+    "    return v.r;\n"
+    "#else\n"
+    "    return dot(v, fv_dec) * fv_nf.x;\n"
+    "#endif\n"
+    "}\n"
+    "float fv_light_opaque() {\n"
+    "#if defined(FV_FLOAT) && defined(FV_ENGINE_DEPTH)\n"
+    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
+    "#else\n"
+    "    return fv_light_depth(FV_TEXTURE(fv_opaque, fv_st()));\n"
+    "#endif\n"
+    "}\n"
+    "void main() {\n"
+    "    float d = max(fv_d, 0.0);\n"
+    "    if (fv_light.w < 0.5) {\n"
+    "#if defined(FV_FLOAT)\n"
+    "        FV_FRAGCOLOR = vec4(d, 0.0, 0.0, 0.0);\n"
+    "#elif defined(FV_NORMALIZE)\n"
+    "        FV_FRAGCOLOR = fv_normalize(fv_encode(d));\n"
+    "#else\n"
+    "        FV_FRAGCOLOR = fv_encode(d);\n"
+    "#endif\n"
+    "    } else {\n"
+    "        float o = fv_light_opaque();\n"
+    "        if (o < fv_light_depth(FV_TEXTURE(fv_lfront, fv_st())) || o > d) discard;\n"
+    "        FV_FRAGCOLOR = vec4(fv_light.rgb, 1.0);\n"
+    "    }\n"
+    "}\n";
+
+/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
+static int fogvol__density_ok(fogvol_tier tier, unsigned v)
+{
+    if (tier == FOGVOL_TIER_FLOAT) return 1;
+    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
+           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
+}
+static int fogvol__light_ok(fogvol_tier tier, unsigned v)
+{
+    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
+                                         !(v & FOGVOL_VARIANT_WIDE));
+}
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
 {
@@ -3884,6 +4052,7 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_pro
     case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
     case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
     case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
+    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
     default: return 0;
     }
 }
@@ -3959,6 +4128,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     for (i = 0; i < 6; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants))
+        strings[n++] = "#define FV_DENSITY\n";
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
                         d->program == FOGVOL_PROGRAM_CHECK ||
@@ -3972,6 +4143,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
         case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
         case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
+        case FOGVOL_PROGRAM_LIGHT: strings[n++] = fogvol__fs_light; break;
         default: strings[n++] = fogvol__fs_composite; break;
         }
     }
@@ -4027,9 +4199,11 @@ FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_s
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
-    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec",
-                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf", "fv_lin2",
-                                                      "fv_ptexel", "fv_prect", "fv_pparams", "fv_pcolor"};
+    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc",    "fv_dith",   "fv_screen", "fv_dec",
+                                                      "fv_rampmap", "fv_misc",  "fv_lin",    "fv_nf",
+                                                      "fv_lin2",   "fv_ptexel", "fv_prect",  "fv_pparams",
+                                                      "fv_pcolor", "fv_dens_u", "fv_dens_v", "fv_dens",
+                                                      "fv_ctex_u", "fv_ctex_v", "fv_light"};
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -4203,6 +4377,7 @@ struct fogvol_mesh {
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
+    int convex; /* fogvol_mesh_report.convex */
     float bmin[3], bmax[3]; /* model-space bounds of the vertices (orthographic clip depth scale,
                                geometry composite's scissor) */
 };
@@ -4234,12 +4409,24 @@ struct fogvol_ramp {
     fogvol_blend blend;
 };
 
+struct fogvol_volume_texture {
+    fogvol_handle texture;
+};
+
 typedef struct fogvol__volume {
     const fogvol_mesh *mesh;
     const fogvol_ramp *ramp;
     float model[16];
     int negative;
+    const fogvol_volume_texture *density, *color; /* NULL: none */
+    float density_map[8], color_map[6];
 } fogvol__volume;
+
+typedef struct fogvol__light {
+    const fogvol_mesh *mesh;
+    float model[16];
+    float rgb[3];
+} fogvol__light;
 
 typedef struct fogvol__occluder {
     const fogvol_mesh *mesh;
@@ -4301,6 +4488,9 @@ struct fogvol_context {
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     fogvol_handle post_prog[FOGVOL__POST_PROGRAMS]; /* image-space effects, built on first use */
+    fogvol__light *lights;  /* fogvol_add_light, this frame */
+    int nlight, caplight;
+    fogvol_handle tgt_l;    /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
 };
 
 /* column-major 4x4 helpers in double */
@@ -4380,7 +4570,8 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_f);
     if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
     if (ctx->tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_v);
-    ctx->tgt_v = 0;
+    if (ctx->tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_l);
+    ctx->tgt_v = ctx->tgt_l = 0;
     if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
     ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
     ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
@@ -4471,6 +4662,7 @@ static void fogvol__release(fogvol_context *ctx)
     if (ctx->tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_dither);
     fogvol__free(&ctx->alloc, ctx->vols);
     fogvol__free(&ctx->alloc, ctx->occ);
+    fogvol__free(&ctx->alloc, ctx->lights);
     if (ctx->owns_backend && ctx->be.destroy) ctx->be.destroy(ctx->be.user_data);
 }
 
@@ -4512,7 +4704,9 @@ enum {
     FOGVOL__UNIT_BLUE = 1,    /* fv_blue: blue ramp (low digits, dithered) */
     FOGVOL__UNIT_DITHER = 2,  /* fv_dither: the dither pattern */
     FOGVOL__UNIT_OPAQUE = 3,  /* fv_opaque: encoded opaque depth O (or the engine's depth texture) */
-    FOGVOL__UNIT_OPAQUE2 = 4  /* fv_opaque2: WIDE, O's second attachment */
+    FOGVOL__UNIT_OPAQUE2 = 4, /* fv_opaque2: WIDE, O's second attachment */
+    FOGVOL__UNIT_DENSITY = 6, /* fv_density: FACE, the volume's density texture */
+    FOGVOL__UNIT_LFRONT = 7   /* fv_lfront: LIGHT, the light's front depth L */
 };
 enum {
     FOGVOL__UNIT_BACK = 0,    /* fv_back: sum of back faces B (PS13: the resolved difference T) */
@@ -4520,18 +4714,20 @@ enum {
     FOGVOL__UNIT_RAMP = 2,    /* fv_colors: the ramp's colour texture */
     FOGVOL__UNIT_COUNTS = 3,  /* fv_opaque: COUNT, the opaque depth O whose alpha holds the counts */
     FOGVOL__UNIT_BACK2 = 4,   /* fv_back2, fv_front2: WIDE, second attachments */
-    FOGVOL__UNIT_FRONT2 = 5
+    FOGVOL__UNIT_FRONT2 = 5,
+    FOGVOL__UNIT_CTEX = 6     /* fv_ctex: the group's colour texture */
 };
 
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
 {
-    static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_rg",     "fv_blue",    "fv_dither",
-                                                                      "fv_opaque", "fv_opaque2", NULL};
+    static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {
+        "fv_rg", "fv_blue", "fv_dither", "fv_opaque", "fv_opaque2", NULL, "fv_density", "fv_lfront"};
     static const char *const samp_comp[FOGVOL_MAX_TEXTURE_UNITS] = {"fv_back",   "fv_front", "fv_colors",
-                                                                    "fv_opaque", "fv_back2", "fv_front2"};
-    static const char *const labels[FOGVOL_PROGRAM_COUNT] = {"fogvol encode", "fogvol face", "fogvol composite",
-                                                             "fogvol composite (geometry)", "fogvol resolve",
-                                                             "fogvol overflow check"};
+                                                                    "fv_opaque", "fv_back2", "fv_front2",
+                                                                    "fv_ctex",   NULL};
+    static const char *const labels[FOGVOL_PROGRAM_COUNT] = {
+        "fogvol encode", "fogvol face", "fogvol composite", "fogvol composite (geometry)", "fogvol resolve",
+        "fogvol overflow check", "fogvol light"};
     fogvol_program_desc pd;
     fogvol_shader_desc sd;
     fogvol_result r;
@@ -4552,7 +4748,9 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
         return r;
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
-        pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE) ? samp_encode[i] : samp_comp[i];
+        pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT)
+                             ? samp_encode[i]
+                             : samp_comp[i];
     if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[FOGVOL__UNIT_OPAQUE2] = NULL;
     if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH))
         pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
@@ -4694,9 +4892,11 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
         }
         if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
     }
+    /* COMPOSITE_MESH: for engines only (the geometry composite is scissored); CHECK: made when a
+       frame first runs a check pass; LIGHT: when a frame first draws a light */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
-            i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK)
+            i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)
             r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
     return r;
 }
@@ -4806,6 +5006,75 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     return r;
 }
 
+/* >>texlight (convexity of light volumes) ================================ */
+
+static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3])
+{
+    float f[3];
+    size_t stride = desc->stride ? (size_t)desc->stride : 12u;
+    memcpy(f, (const unsigned char *)desc->positions + desc->offset + (size_t)i * stride, sizeof f);
+    p[0] = f[0];
+    p[1] = f[1];
+    p[2] = f[2];
+}
+
+/* fogvol_mesh_report.convex of a valid hull: every vertex on the inner side of every face plane
+   (outward normals: counter-clockwise seen from outside), within 1e-5 of the box diagonal. */
+static int fogvol__convexity(const fogvol_mesh_desc *desc)
+{
+    int t, v, k, tris = desc->index_count / 3;
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0.0, tol;
+    if ((double)tris * (double)desc->vertex_count > 67108864.0) return -1;
+    for (v = 0; v < desc->vertex_count; ++v) {
+        double p[3];
+        fogvol__vertex(desc, (uint32_t)v, p);
+        for (k = 0; k < 3; ++k) {
+            if (p[k] < lo[k]) lo[k] = p[k];
+            if (p[k] > hi[k]) hi[k] = p[k];
+        }
+    }
+    for (k = 0; k < 3; ++k) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diag = FOGVOL_SQRT(diag);
+    tol = 1e-5 * diag;
+    for (t = 0; t < tris; ++t) {
+        double a[3], b[3], c[3], n[3], len;
+        uint32_t ix[3];
+        for (k = 0; k < 3; ++k)
+            ix[k] = desc->index_type == FOGVOL_INDEX_UINT16 ? desc->indices16[3 * t + k] : desc->indices[3 * t + k];
+        fogvol__vertex(desc, ix[0], a);
+        fogvol__vertex(desc, ix[1], b);
+        fogvol__vertex(desc, ix[2], c);
+        for (k = 0; k < 3; ++k) {
+            b[k] -= a[k];
+            c[k] -= a[k];
+        }
+        n[0] = b[1] * c[2] - b[2] * c[1];
+        n[1] = b[2] * c[0] - b[0] * c[2];
+        n[2] = b[0] * c[1] - b[1] * c[0];
+        len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
+        for (v = 0; v < desc->vertex_count; ++v) {
+            double p[3];
+            fogvol__vertex(desc, (uint32_t)v, p);
+            if ((n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]) + n[2] * (p[2] - a[2])) / len > tol) return 0;
+        }
+    }
+    return 1;
+}
+
+/* A mesh destroyed inside a frame: the lights that use it leave the frame. */
+static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
+{
+    int i, n = 0;
+    if (!ctx->in_frame) return;
+    for (i = 0; i < ctx->nlight; ++i)
+        if (ctx->lights[i].mesh != mesh) ctx->lights[n++] = ctx->lights[i];
+    if (n != ctx->nlight)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh destroyed inside a frame: %d lights that use it "
+                    "are dropped from the frame", ctx->nlight - n);
+    ctx->nlight = n;
+}
+
 FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
                                             fogvol_mesh_report *report)
 {
@@ -4861,6 +5130,8 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     m->vertex_count = desc->vertex_count;
     m->index_count = desc->index_count;
     m->volume = rep.valid;
+    m->convex = rep.valid ? fogvol__convexity(desc) : -1;
+    if (report) report->convex = m->convex;
     ctx->live_meshes++;
     *out = m;
     return FOGVOL_SUCCESS;
@@ -4890,6 +5161,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
 {
     if (!ctx || !mesh) return;
     fogvol__forget(ctx, mesh, NULL);
+    fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
     ctx->live_meshes--;
     fogvol__free(&ctx->alloc, mesh);
@@ -5133,6 +5405,7 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->frame = *d;
     ctx->nvol = ctx->nocc = 0;
     ctx->in_frame = 1;
+    ctx->nlight = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -5205,6 +5478,96 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     return FOGVOL_SUCCESS;
 }
 
+/* >>texlight (volume textures) ============================================ */
+
+FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
+                                                      fogvol_volume_texture **out)
+{
+    fogvol_volume_texture *t;
+    fogvol_texture_desc td;
+    fogvol_result r;
+    if (out) *out = NULL;
+    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
+                    "(got %dx%d)", desc->width, desc->height);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
+    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    td = *desc;
+    if (!td.label) td.label = "fogvol volume texture";
+    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        fogvol__free(&ctx->alloc, t);
+        return r;
+    }
+    *out = t;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture)
+{
+    int i, n = 0;
+    if (!ctx || !texture) return;
+    for (i = 0; ctx->in_frame && i < ctx->nvol; ++i)
+        if (ctx->vols[i].density != texture && ctx->vols[i].color != texture) ctx->vols[n++] = ctx->vols[i];
+    if (ctx->in_frame && n != ctx->nvol) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: volume texture destroyed inside a frame: %d volumes "
+                    "that use it are dropped from the frame", ctx->nvol - n);
+        ctx->nvol = n;
+    }
+    ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    fogvol__free(&ctx->alloc, texture);
+}
+
+static int fogvol__all_zero(const float *v, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (v[i] != 0.0f) return 0;
+    return 1;
+}
+
+/* fogvol_add_volume: the density texture needs a tier that can weight faces; one colour
+   texture (and map) per colour-ramp group. */
+static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_volume_desc *desc)
+{
+    int i;
+    if (!fogvol__finite_n(desc->density_map, 8) || !fogvol__finite_n(desc->color_map, 6)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite density_map or color_map");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->density && !fogvol__density_ok(ctx->tier, ctx->variants)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: density textures need tier FLOAT, PS20 or MRT without the "
+                    "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    for (i = 0; desc->color && i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        float map[6];
+        memcpy(map, desc->color_map, sizeof map);
+        if (fogvol__all_zero(map, 6)) map[0] = map[4] = 1.0f;
+        if (v->ramp == desc->ramp && v->color && (v->color != desc->color || memcmp(v->color_map, map, sizeof map))) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volumes of one ramp share one colour texture and "
+                        "map (volume %d of this frame has another)", i);
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    return FOGVOL_SUCCESS;
+}
+
+static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *desc)
+{
+    v->density = desc->density;
+    v->color = desc->color;
+    memcpy(v->density_map, desc->density_map, sizeof v->density_map);
+    memcpy(v->color_map, desc->color_map, sizeof v->color_map);
+    if (fogvol__all_zero(v->density_map, 8)) v->density_map[0] = v->density_map[5] = 1.0f; /* s = x, t = y */
+    if (fogvol__all_zero(v->color_map, 6)) v->color_map[0] = v->color_map[4] = 1.0f;
+}
+
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
     fogvol__volume *v;
@@ -5220,6 +5583,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    r = fogvol__check_textures(ctx, desc);
+    if (r != FOGVOL_SUCCESS) return r;
     arr = ctx->vols;
     r = fogvol__grow(ctx, &arr, &ctx->capvol, ctx->nvol + 1, sizeof *v);
     ctx->vols = (fogvol__volume *)arr;
@@ -5229,6 +5594,7 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     v->ramp = desc->ramp;
     memcpy(v->model, desc->model, sizeof v->model);
     v->negative = desc->negative != 0;
+    fogvol__set_textures(v, desc);
     return FOGVOL_SUCCESS;
 }
 
@@ -5275,13 +5641,76 @@ static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int 
     fogvol_draw dr;
     for (i = 0; i < ctx->nvol; ++i) {
         const fogvol__volume *v = &ctx->vols[i];
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative)) continue;
+        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || v->density) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
         ++n;
     }
     return n;
+}
+
+/* The reference depth c of a density-textured volume (normalised): the depth of the centre of its
+   bounds, 0 when the bounds reach nearer than znear (a front face may be clipped away there). */
+static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume *v)
+{
+    double emin = 1e300, sum = 0.0, range = (double)ctx->frame.zfar - ctx->frame.znear, d;
+    int c, j;
+    for (c = 0; c < 8; ++c) {
+        double p[3], e = ctx->eyerow[3];
+        for (j = 0; j < 3; ++j) p[j] = (c >> j & 1) ? v->mesh->bmax[j] : v->mesh->bmin[j];
+        for (j = 0; j < 3; ++j)
+            e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
+        if (e < emin) emin = e;
+        sum += e;
+    }
+    if (emin < ctx->frame.znear) return 0.0f;
+    d = (sum / 8.0 - ctx->frame.znear) / range;
+    return (float)(d > 1.0 ? 1.0 : d);
+}
+
+/* After a sum pass (its state in *base): each density-textured volume of the group in a pass of
+   its own with its texture and texture-coordinate rows (negative as in fogvol__draw_group).
+   Returns the passes issued. */
+static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
+{
+    int i, n = 0;
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        fogvol_pass ps;
+        fogvol_draw dr;
+        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
+        ps = *base;
+        ps.clear = 0;
+        ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
+        memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
+        memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
+        ps.uniforms[FOGVOL_U_DENSITY][0] = fogvol__density_ref(ctx, v);
+        ps.uniforms[FOGVOL_U_DENSITY][1] = 1.0f;
+        ps.uniforms[FOGVOL_U_DENSITY][2] = 1.0f / (ctx->frame.zfar - ctx->frame.znear);
+        ctx->be.begin_pass(ctx->be.user_data, &ps);
+        fogvol__draw_for(ctx, v->model, &dr);
+        if (v->negative) dr.sign = -1.0f;
+        ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
+        fogvol__end_pass(ctx);
+        ++n;
+    }
+    return n;
+}
+
+/* The composite of a group: the colour texture of its first volume that has one. */
+static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ramp, fogvol_pass *ps)
+{
+    int i;
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        if (v->ramp != ramp || !v->color) continue;
+        ps->textures[FOGVOL__UNIT_CTEX] = v->color->texture;
+        memcpy(ps->uniforms[FOGVOL_U_COLOR_U], v->color_map, 3 * sizeof(float));
+        memcpy(ps->uniforms[FOGVOL_U_COLOR_V], v->color_map + 3, 3 * sizeof(float));
+        ps->uniforms[FOGVOL_U_COLOR_U][3] = 1.0f;
+        return;
+    }
 }
 
 /* One sum pass over a group: the faces culled by 'cull' are left out for the
@@ -5297,13 +5726,14 @@ static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, fogvol_handle 
     ctx->be.begin_pass(ctx->be.user_data, ps);
     fogvol__draw_group(ctx, ramp, 0);
     fogvol__end_pass(ctx);
+    passes += fogvol__draw_textured(ctx, ps, ramp, 0);
     if (has_neg) {
         ps->clear = 0;
         ps->cull = cull == FOGVOL_CULL_FRONT ? FOGVOL_CULL_BACK : FOGVOL_CULL_FRONT;
         ctx->be.begin_pass(ctx->be.user_data, ps);
         fogvol__draw_group(ctx, ramp, 1);
         fogvol__end_pass(ctx);
-        ++passes;
+        passes += 1 + fogvol__draw_textured(ctx, ps, ramp, 1);
     }
     return passes;
 }
@@ -5945,6 +6375,120 @@ typedef struct fogvol__run {
     fogvol_result r;            /* the last error that did not stop the frame */
 } fogvol__run;
 
+/* >>texlight (volume light by compare) ====================================== */
+
+FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
+{
+    fogvol__light *l;
+    void *arr;
+    fogvol_result r;
+    float k;
+    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!fogvol__light_ok(ctx->tier, ctx->variants)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
+                    "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (desc->mesh->convex != 1) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: a light volume must be a convex closed hull: %s",
+                    !desc->mesh->volume        ? "the mesh is not a valid closed hull"
+                    : desc->mesh->convex == 0 ? "the mesh is concave (a vertex lies outside a face plane)"
+                                              : "the mesh is too large for the convexity check");
+        return FOGVOL_ERROR_INVALID_MESH;
+    }
+    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
+        !fogvol__finite_n(&desc->intensity, 1)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    arr = ctx->lights;
+    r = fogvol__grow(ctx, &arr, &ctx->caplight, ctx->nlight + 1, sizeof *l);
+    ctx->lights = (fogvol__light *)arr;
+    if (r != FOGVOL_SUCCESS) return r;
+    l = &ctx->lights[ctx->nlight++];
+    l->mesh = desc->mesh;
+    memcpy(l->model, desc->model, sizeof l->model);
+    k = desc->intensity != 0.0f ? desc->intensity : 1.0f;
+    l->rgb[0] = desc->color[0] * k;
+    l->rgb[1] = desc->color[1] * k;
+    l->rgb[2] = desc->color[2] * k;
+    return FOGVOL_SUCCESS;
+}
+
+/* The program and the front-depth target L, made on first use. */
+static fogvol_result fogvol__light_setup(fogvol_context *ctx)
+{
+    fogvol_target_desc td;
+    fogvol_result r = FOGVOL_SUCCESS;
+    if (!ctx->prog[FOGVOL_PROGRAM_LIGHT])
+        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
+    if (r == FOGVOL_SUCCESS && !ctx->tgt_l) {
+        memset(&td, 0, sizeof td);
+        td.width = ctx->target_w;
+        td.height = ctx->target_h;
+        td.samples = ctx->samples;
+        td.format = ctx->tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+        td.label = "fogvol L (light front depth)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_l);
+        if (r != FOGVOL_SUCCESS) ctx->tgt_l = 0;
+    }
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
+                    fogvol_result_string(r));
+    return r;
+}
+
+/* Per light: its front faces' depth into L (cleared to 0: the near plane, for a camera inside),
+   then its back faces over the engine framebuffer, lighting the pixels whose opaque depth lies
+   between L and the back face (convex: one front and one back face per pixel). */
+static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_pass fp = run->base, bp;
+    fogvol_draw dr;
+    fogvol_result r;
+    int i;
+    if (!ctx->nlight) return;
+    if ((r = fogvol__light_setup(ctx)) != FOGVOL_SUCCESS) {
+        run->r = r;
+        return;
+    }
+    fp.program = ctx->prog[FOGVOL_PROGRAM_LIGHT];
+    fp.target = ctx->tgt_l;
+    fp.clear = 1;
+    fp.cull = FOGVOL_CULL_BACK;
+    bp = fp;
+    bp.target = 0;
+    bp.clear = 0;
+    bp.cull = FOGVOL_CULL_FRONT;
+    bp.blend = FOGVOL_PASS_BLEND_LIGHT;
+    memcpy(bp.viewport, fd->viewport, sizeof bp.viewport);
+    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
+    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
+    bp.draw_buffer = fd->draw_buffer;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+        bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    else
+        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
+    bp.textures[FOGVOL__UNIT_LFRONT] = ctx->tgt_l;
+    bp.uniforms[FOGVOL_U_LIGHT][3] = 1.0f;
+    for (i = 0; i < ctx->nlight; ++i) {
+        const fogvol__light *l = &ctx->lights[i];
+        fogvol__draw_for(ctx, l->model, &dr);
+        ctx->be.begin_pass(ctx->be.user_data, &fp);
+        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
+        fogvol__end_pass(ctx);
+        memcpy(bp.uniforms[FOGVOL_U_LIGHT], l->rgb, sizeof l->rgb);
+        ctx->be.begin_pass(ctx->be.user_data, &bp);
+        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
+        fogvol__end_pass(ctx);
+        run->st.passes += 2;
+        run->st.lights++;
+    }
+}
+
 /* Frames fogvol refuses before touching the backend (logged; the caller cancels the frame). */
 static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
 {
@@ -6100,7 +6644,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         fogvol__draw_group(ctx, ramp, -1);
         fogvol__end_pass(ctx);
-        run->st.passes++;
+        run->st.passes += 1 + fogvol__draw_textured(ctx, &ps, ramp, -1);
     } else if (run->single) {
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
         run->st.passes +=
@@ -6168,6 +6712,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
     ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
+    fogvol__group_color(ctx, ramp, ps);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;
     ctx->be.draw_fullscreen(ctx->be.user_data);
@@ -6263,6 +6808,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     if (r == FOGVOL_SUCCESS) {
         fogvol__frame_uniforms(ctx, &run);
         fogvol__opaque_pass(ctx, &run);
+        fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->nvol; ++g) fogvol__group(ctx, &run, g);
         r = fogvol__frame_overflow(ctx, &run);
     }

@@ -400,6 +400,180 @@ static int post_effects(demo *d, const char *dir)
     return ok;
 }
 
+/* ---- textured fog and volume light by compare (fogvol_volume_desc.density / color, fogvol_add_light) ---- */
+
+static fogvol_volume_texture *demo_volume_texture(fogvol_context *fv, int kind, int n)
+{
+    unsigned char *px = (unsigned char *)malloc((size_t)n * n * 4);
+    fogvol_texture_desc td;
+    fogvol_volume_texture *t = NULL;
+    int x, y, k;
+    for (y = 0; y < n; ++y)
+        for (x = 0; x < n; ++x) {
+            unsigned char *q = px + 4 * (y * n + x);
+            float u = 6.2831853f * x / n, v = 6.2831853f * y / n, f = 0.0f;
+            for (k = 1; k <= 4; ++k) /* tileable sum of waves: soft cloudy noise */
+                f += sinf(k * u + 1.7f * k + cosf(k * v * 1.3f)) * sinf(k * v + 0.9f * k + sinf(u * k)) / (float)k;
+            f = 0.5f + 0.45f * f;
+            f = f < 0 ? 0 : f > 1 ? 1 : f;
+            if (kind == 0) { /* density noise */
+                q[0] = q[1] = q[2] = (unsigned char)(255 * f);
+            } else if (kind == 1) { /* shaft gradient (1 texel high): thin at the base */
+                q[0] = q[1] = q[2] = (unsigned char)(255.0f * powf((float)x / (n - 1), 1.5f));
+            } else { /* colour: warm and cold patches */
+                q[0] = (unsigned char)(255 * (0.7f + 0.3f * f));
+                q[1] = (unsigned char)(255 * (0.75f + 0.2f * sinf(u)));
+                q[2] = (unsigned char)(255 * (1.0f - 0.45f * f));
+            }
+            q[3] = 255;
+        }
+    memset(&td, 0, sizeof td);
+    td.width = n;
+    td.height = kind == 1 ? 1 : n;
+    td.pixels = px;
+    td.filter = FOGVOL_FILTER_LINEAR;
+    td.wrap = kind == 1 ? FOGVOL_WRAP_CLAMP : FOGVOL_WRAP_REPEAT;
+    if (fogvol_create_volume_texture(fv, &td, &t) != FOGVOL_SUCCESS) t = NULL;
+    free(px);
+    return t;
+}
+
+/* A frustum-shaped light shaft: a box whose top face is shrunk (convex). */
+static shp_mesh demo_shaft(void)
+{
+    shp_mesh m = shp_box(1.4f, 2.6f, 1.0f);
+    int i;
+    for (i = 0; i < m.vcount; ++i)
+        if (m.pos[3 * i + 1] > 0) m.pos[3 * i] *= 0.35f, m.pos[3 * i + 2] *= 0.35f;
+    return m;
+}
+
+/* the scene's volumes with textures: noise density (scrolled), the shaft's gradient, a colour */
+static fogvol_mesh *demo_tl_lights(fogvol_context *fv)
+{
+    fogvol_mesh *shaft;
+    fogvol_light_desc ld;
+    float r[16], t[16];
+    shp_mesh sm = demo_shaft();
+    shaft = upload(fv, &sm, 0);
+    shp_free(&sm);
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = shaft;
+    shp_mat_rotate(r, 15, 0, 0, 1); /* a warm shaft over the column at (-5.5, -0.8) */
+    shp_mat_translate(t, -5.2f, 1.6f, -0.8f);
+    shp_mat_mul(ld.model, t, r);
+    ld.color[0] = 0.9f, ld.color[1] = 0.65f, ld.color[2] = 0.3f;
+    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+    shp_mat_rotate(r, -25, 0, 1, 0); /* a cold one through the arch gate, lighting its right pier */
+    shp_mat_translate(t, 2.6f, 1.2f, -4.3f);
+    shp_mat_mul(ld.model, t, r);
+    ld.color[0] = 0.2f, ld.color[1] = 0.45f, ld.color[2] = 0.8f;
+    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+    return shaft;
+}
+
+/* textured: fog groups with density noise (the bank scrolled, the shaft thinning towards its
+   base), a colour texture on the floating fog; lights: two convex light volumes lighting the
+   scene by compare, no fog. */
+
+/* the scene's volumes with textures: noise density (scrolled), the light shafts' gradient, a colour */
+static void demo_tl_volumes(demo *d, fogvol_context *fv, fogvol_mesh **fm, fogvol_ramp **ramp,
+                            fogvol_volume_texture **tex, int lights)
+{
+    fogvol_volume_texture *noise = tex[0], *grad = tex[1], *colour = tex[2];
+    int i;
+    for (i = 0; i < d->scene.count; ++i) {
+        const ds_object *o = &d->scene.obj[i];
+        fogvol_volume_desc vd;
+        if (o->kind == DS_OPAQUE) {
+            fogvol_add_occluder(fv, fm[o->mesh], o->model);
+            continue;
+        }
+        if (lights) continue;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = fm[o->mesh];
+        vd.ramp = ramp[ds_group(o->kind)];
+        vd.negative = o->kind == DS_HOLE;
+        memcpy(vd.model, o->model, sizeof vd.model);
+        if (o->kind == DS_LIGHT) { /* s along the axis, thin at the base: the sunbeam's box spans model
+                                      y -1..1, the lamp's cone y 0..2.6 */
+            int cone = d->scene.mesh[o->mesh].vcount > 8;
+            vd.density = grad;
+            vd.density_map[1] = cone ? 1.0f / 2.6f : 0.5f;
+            vd.density_map[3] = cone ? 0.0f : 0.5f;
+            vd.density_map[7] = 0.5f;
+        } else if (!vd.negative) { /* noise in the horizontal plane, scrolled (time 1.5 s, 0.2 units/s) */
+            vd.density = noise;
+            vd.density_map[0] = o->kind == DS_BANK ? 0.12f : 0.35f;
+            vd.density_map[6] = o->kind == DS_BANK ? 0.12f : 0.35f;
+            vd.density_map[3] = 0.2f * 1.5f;
+            if (o->kind == DS_FOG) vd.color = colour;
+        }
+        fogvol_add_volume(fv, &vd);
+    }
+}
+
+/* textured: fog groups with density noise (the bank scrolled, the light shafts thinning towards
+   their base), a colour texture on the fog group; lights: two convex light volumes lighting the
+   scene by compare, no fog. */
+static void demo_texlight(demo *d, const char *dir, int lights)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *fm[DS_MAX_MESHES], *shaft = NULL;
+    fogvol_ramp *ramp[3];
+    fogvol_ramp_desc rd;
+    fogvol_volume_texture *tex[3];
+    fogvol_frame_desc fd;
+    float v[16], p[16];
+    unsigned char *imgs[1];
+    int i;
+    if (!glu_create(&d->g, DW, DH, 1)) return;
+    ds_gl_init(&d->gl, &d->scene);
+    camera(0, DW, DH, v, p);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = log_cb;
+    if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
+        ds_gl_free(&d->gl);
+        glu_destroy(&d->g);
+        return;
+    }
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    for (i = 0; i < 3; ++i) tex[i] = demo_volume_texture(fv, i, i == 1 ? 32 : 64);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.9f, rd.color[1] = 0.92f, rd.color[2] = 0.97f, rd.density = 0.9f;
+    fogvol_create_ramp(fv, &rd, &ramp[0]);
+    rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.45f;
+    fogvol_create_ramp(fv, &rd, &ramp[1]);
+    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.6f, rd.blend = FOGVOL_BLEND_LIGHT;
+    fogvol_create_ramp(fv, &rd, &ramp[2]);
+    ds_draw(&d->gl, &d->scene, v, p, DW, DH);
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, v, sizeof v);
+    memcpy(fd.projection, p, sizeof p);
+    fd.znear = 0.1f;
+    fd.zfar = 40.0f;
+    fd.viewport[2] = DW;
+    fd.viewport[3] = DH;
+    fogvol_begin_frame(fv, &fd);
+    demo_tl_volumes(d, fv, fm, ramp, tex, lights);
+    if (lights) shaft = demo_tl_lights(fv);
+    fogvol_end_frame(fv, NULL);
+    glFinish();
+    imgs[0] = d->g.pixels;
+    save_row(dir, lights ? "light_compare.png" : "textured_fog.png", imgs, 1, DW, DH);
+    printf("  %-34s tier %s\n", lights ? "light_compare.png" : "textured_fog.png",
+           fogvol_tier_name(fogvol_context_tier(fv, NULL)));
+    for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
+    if (shaft) fogvol_destroy_mesh(fv, shaft);
+    for (i = 0; i < 3; ++i) fogvol_destroy_volume_texture(fv, tex[i]);
+    for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
+    fogvol_destroy_context(fv);
+    ds_gl_free(&d->gl);
+    glu_destroy(&d->g);
+}
+
 static int g_tap;
 static int check(int ok, const char *what)
 {
@@ -507,6 +681,8 @@ int main(int argc, char **argv)
     k = post_effects(&d, dir);
     if (do_check) failures += !check(k, "image-space effects: dof.png, outlines.png, distance_fog.png");
     else failures += !k;
+    demo_texlight(&d, dir, 0);
+    demo_texlight(&d, dir, 1);
     ds_scene_free(&d.scene);
     if (do_check) printf("1..%d\n", g_tap);
     return failures ? 1 : 0;
