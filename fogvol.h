@@ -1253,8 +1253,8 @@ typedef struct fogvol_frame_desc {
    the GPU before end_frame. A begin_frame while a frame is open discards the
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
-   restored: the list is in fogvol__gl_save_raster): GL errors the engine left
-   pending are still pending after every fogvol call (out-of-memory and
+   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
+   the engine left pending are still pending after every fogvol call (out-of-memory and
    context-loss codes cannot be raised again: logged as a warning); an active
    transform feedback is paused during the call (GL 4.0 / GLES 3.0; on GL 3.x,
    where it cannot be queried, do not call fogvol inside one); fogvol must not
@@ -6282,37 +6282,110 @@ FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
 #undef FOGVOL__GL_PFN_MSAA
 #define FOGVOL__GL_MAX_DB 8 /* draw buffers saved and restored (GL guarantees at least 8 on GL 3.0+) */
 
+/* ---- the engine state fogvol saves and restores ----
+   One table per kind of state, walked by fogvol__gl_save, fogvol__gl_restore and every pass:
+   - FOGVOL__GL_ENABLES (below): every glEnable capability, with the contexts that have it (W: a
+     FOGVOL__GLW_* test of fogvol__gl_has) and what every fogvol pass does with it (P: OFF turns it off,
+     SET leaves it to the pass, which sets it itself or keeps the engine's value);
+   - fogvol__gl_values (after struct fogvol__gl): plain values read with glGet* and written back by one
+     call each (fogvol__gl_put), pixel-store values with fogvol's own value for its passes;
+   - small functions for the rest: bindings (fogvol__gl_save_bindings), depth clear value, depth range
+     and clip control (fogvol__gl_save_depth), the engine FBO's draw buffers and per-draw-buffer blend
+     state (fogvol__gl_save_draw_buffers), multisample bindings (fogvol__gl_save_msaa).
+   To save one more piece of state: a row here or in fogvol__gl_values (plus its field in
+   fogvol__gl_state, and a FOGVOL__GLV_* setter in fogvol__gl_put if no existing call writes it).
+   Why the state beyond the GL 2.0 list matters to fogvol's draws:
+   - the draw-buffer list of an engine FBO: the composite writes one buffer, the others stay intact;
+   - per-draw-buffer blend functions, equations, colour masks and blend enables: fogvol's non-indexed
+     calls overwrite every buffer's values;
+   - PRIMITIVE_RESTART (+ _FIXED_INDEX): would cut fogvol's index lists at the engine's restart index
+     (the index itself is never changed, so it is not saved);
+   - CLIP_DISTANCE0..7 (CLIP_PLANEi): fogvol's shaders write no gl_ClipDistance, so an enabled one is
+     undefined there;
+   - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
+   - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
+   - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
+   - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
+     GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
+   Judged irrelevant, not touched:
+   - MULTISAMPLE: fogvol's targets are single-sample; on a multisampled engine target the full-screen
+     composite covers every sample whether it is on or off (saved only where fogvol's own multisampled
+     passes turn it on);
+   - FRAMEBUFFER_SRGB: acts only on sRGB attachments, which fogvol's RGBA8/R32F targets are not; on an
+     sRGB engine target it selects the blending space the engine wants (see fogvol_ramp_desc);
+   - MIN_SAMPLE_SHADING_VALUE, PRIMITIVE_RESTART_INDEX: read only while their enables are on (fogvol
+     turns those off);
+   - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
+   - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
+   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
+     function reads them;
+   - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
+   - conditional rendering: it cannot be queried; fogvol must not be called between
+     glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
+#define FOGVOL__GL_ENABLES(X) \
+    X(FOGVOL__GL_BLEND, ALL, SET) \
+    X(FOGVOL__GL_DEPTH_TEST, ALL, SET) \
+    X(FOGVOL__GL_CULL_FACE, ALL, SET) \
+    X(FOGVOL__GL_SCISSOR_TEST, ALL, OFF) \
+    X(FOGVOL__GL_STENCIL_TEST, ALL, SET) \
+    X(FOGVOL__GL_DITHER, ALL, OFF) \
+    X(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, ALL, OFF) \
+    X(FOGVOL__GL_SAMPLE_COVERAGE, ALL, OFF) \
+    X(FOGVOL__GL_POLYGON_OFFSET_FILL, ALL, OFF) \
+    X(FOGVOL__GL_RASTERIZER_DISCARD, DISCARD, OFF) \
+    X(FOGVOL__GL_COLOR_LOGIC_OP, DESKTOP, OFF) \
+    X(FOGVOL__GL_ALPHA_TEST, COMPAT, OFF) \
+    X(FOGVOL__GL_MULTISAMPLE, MSAA, SET) \
+    X(FOGVOL__GL_PRIMITIVE_RESTART, RESTART, OFF) \
+    X(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX, RESTART_FIXED, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 0, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 1, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 2, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 3, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 4, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 5, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 6, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 7, CLIP, OFF) \
+    X(FOGVOL__GL_DEPTH_CLAMP, DEPTH_CLAMP, OFF) \
+    X(FOGVOL__GL_SAMPLE_SHADING, SAMPLE_SHADING, OFF) \
+    X(FOGVOL__GL_SAMPLE_MASK, SAMPLE_MASK, OFF) \
+    X(FOGVOL__GL_POLYGON_SMOOTH, DESKTOP, OFF) \
+    X(FOGVOL__GL_POLYGON_STIPPLE, COMPAT, OFF)
+#define FOGVOL__GL_ONE(cap, when, pass) +1
+enum { FOGVOL__GL_N_ENABLES = 0 FOGVOL__GL_ENABLES(FOGVOL__GL_ONE) };
+#undef FOGVOL__GL_ONE
+
 typedef struct fogvol__gl_state {
-    fogvol__GLint draw_fbo, read_fbo, renderbuffer, viewport[4], scissor_box[4], program, vao, array_buffer,
-        element_buffer, active_texture, tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS];
-    fogvol__GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
-    fogvol__GLint depth_func, cull_mode, front_face, polygon_mode[2];
+    /* bindings (fogvol__gl_save_bindings, fogvol__gl_save_msaa) */
+    fogvol__GLint draw_fbo, read_fbo, renderbuffer, program, vao, array_buffer, element_buffer, active_texture,
+        tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS], unpack_buffer, pack_buffer;
+    fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
+    void *a0_pointer;
+    fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
+    fogvol__GLfloat min_sample_shading;
+    /* the rows of fogvol__gl_values */
+    fogvol__GLint viewport[4], scissor_box[4], blend_func[4], blend_eq[2], depth_func, cull_mode, front_face,
+        polygon_mode[2];
+    fogvol__GLint st_func[3], st_op[3], st_wmask, stb_func[3], stb_op[3], stb_wmask, st_clear; /* stb: back */
+    fogvol__GLint pixel_align[2], unpack_rows[3], pack_rows[3]; /* row length, skip rows, skip pixels */
     fogvol__GLboolean depth_mask, color_mask[4];
-    fogvol__GLfloat clear_color[4], clear_depth;
+    fogvol__GLfloat clear_color[4];
+    /* the rows of FOGVOL__GL_ENABLES, in order */
+    fogvol__GLboolean enabled[FOGVOL__GL_N_ENABLES];
+    /* fogvol__gl_save_depth */
+    fogvol__GLfloat clear_depth;
     fogvol__GLdouble clear_depth_d; /* desktop: kept in double so it comes back exactly */
     fogvol__GLdouble depth_range_d[2]; /* desktop (double, exact); GLES: depth_range */
     fogvol__GLfloat depth_range[2];
     fogvol__GLint clip_origin, clip_depth; /* with clip control */
-    fogvol__GLint st_func, st_ref, st_vmask, st_fail, st_zfail, st_zpass, st_wmask;
-    fogvol__GLint stb_func, stb_ref, stb_vmask, stb_fail, stb_zfail, stb_zpass, stb_wmask, st_clear;
-    fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
-    fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
-    void *a0_pointer;
-    fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
-    fogvol__GLboolean en_multisample;
-    fogvol__GLfloat min_sample_shading;
-    fogvol__GLboolean en_blend, en_depth, en_cull, en_scissor, en_stencil, en_dither, en_a2c, en_samplecov,
-        en_polyoffset, en_discard, en_logicop, en_alphatest;
     /* The engine framebuffer's draw buffers (an FBO's list; not read for the default framebuffer), and
-       per-draw-buffer blend state (GL 3.0 / 4.0, GLES 3.2) that the non-indexed calls overwrite. */
+       per-draw-buffer blend state (GL 3.0 / 4.0, GLES 3.2) that the non-indexed calls overwrite
+       (fogvol__gl_save_draw_buffers). */
     fogvol__GLint n_draw_buffers, draw_buffers[FOGVOL__GL_MAX_DB], draw_buffers_set;
     fogvol__GLint n_indexed, bi_src_rgb[FOGVOL__GL_MAX_DB], bi_dst_rgb[FOGVOL__GL_MAX_DB],
         bi_src_a[FOGVOL__GL_MAX_DB], bi_dst_a[FOGVOL__GL_MAX_DB], bi_eq_rgb[FOGVOL__GL_MAX_DB],
         bi_eq_a[FOGVOL__GL_MAX_DB];
     fogvol__GLboolean bi_mask[FOGVOL__GL_MAX_DB][4], bi_blend[FOGVOL__GL_MAX_DB];
-    /* Rasterisation, vertex fetch and fragment state fogvol's draws depend on (see fogvol__gl_save). */
-    fogvol__GLboolean en_restart, en_restart_fixed, en_clip[8], en_depth_clamp, en_sample_shading, en_sample_mask,
-        en_poly_smooth, en_poly_stipple;
 } fogvol__gl_state;
 
 /* Textures and targets share this header so either can be bound for sampling. */
@@ -6394,6 +6467,172 @@ static void fogvol__gl_enable(fogvol__gl *gl, fogvol__GLenum cap, int on)
     else gl->Disable(cap);
 }
 
+/* Which contexts have a piece of state (the W column of FOGVOL__GL_ENABLES, when of fogvol__gl_values). */
+enum {
+    FOGVOL__GLW_ALL, FOGVOL__GLW_DESKTOP, FOGVOL__GLW_COMPAT, FOGVOL__GLW_ROW_LENGTH, FOGVOL__GLW_DISCARD,
+    FOGVOL__GLW_MSAA, FOGVOL__GLW_RESTART, FOGVOL__GLW_RESTART_FIXED, FOGVOL__GLW_CLIP, FOGVOL__GLW_DEPTH_CLAMP,
+    FOGVOL__GLW_SAMPLE_SHADING, FOGVOL__GLW_SAMPLE_MASK
+};
+enum { FOGVOL__GLP_SET, FOGVOL__GLP_OFF };
+
+static int fogvol__gl_has(const fogvol__gl *gl, int when, fogvol__GLenum name)
+{
+    switch (when) {
+    case FOGVOL__GLW_DESKTOP: return !gl->gles;
+    case FOGVOL__GLW_COMPAT: return !gl->gles && !gl->core;
+    case FOGVOL__GLW_ROW_LENGTH: return gl->has_row_length;
+    case FOGVOL__GLW_DISCARD: return gl->has_discard;
+    case FOGVOL__GLW_MSAA: return gl->has_msaa;
+    case FOGVOL__GLW_RESTART: return gl->has_restart;
+    case FOGVOL__GLW_RESTART_FIXED: return gl->has_restart_fixed;
+    case FOGVOL__GLW_CLIP: return (int)(name - FOGVOL__GL_CLIP_DISTANCE0) < gl->n_clip;
+    case FOGVOL__GLW_DEPTH_CLAMP: return gl->has_depth_clamp;
+    case FOGVOL__GLW_SAMPLE_SHADING: return gl->has_sample_shading;
+    case FOGVOL__GLW_SAMPLE_MASK: return gl->has_sample_mask;
+    default: return 1;
+    }
+}
+
+typedef struct fogvol__gl_enable_row {
+    fogvol__GLenum cap;
+    unsigned char when, pass; /* FOGVOL__GLW_*, FOGVOL__GLP_* */
+} fogvol__gl_enable_row;
+
+static const fogvol__gl_enable_row fogvol__gl_enables[FOGVOL__GL_N_ENABLES] = {
+#define FOGVOL__GL_ENABLE_ROW(cap, when, pass) {(fogvol__GLenum)(cap), FOGVOL__GLW_##when, FOGVOL__GLP_##pass},
+    FOGVOL__GL_ENABLES(FOGVOL__GL_ENABLE_ROW)
+#undef FOGVOL__GL_ENABLE_ROW
+};
+
+/* The call that writes a row of fogvol__gl_values back. */
+enum {
+    FOGVOL__GLV_PIXEL_STORE, FOGVOL__GLV_VIEWPORT, FOGVOL__GLV_SCISSOR, FOGVOL__GLV_BLEND_FUNC, FOGVOL__GLV_BLEND_EQ,
+    FOGVOL__GLV_DEPTH_FUNC, FOGVOL__GLV_CULL_FACE, FOGVOL__GLV_FRONT_FACE, FOGVOL__GLV_POLYGON_MODE,
+    FOGVOL__GLV_DEPTH_MASK, FOGVOL__GLV_COLOR_MASK, FOGVOL__GLV_CLEAR_COLOR, FOGVOL__GLV_STENCIL_FUNC,
+    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL
+};
+
+/* Plain values: each name of a row is read with glGet<type>v into per consecutive values from the row's
+   field on, and the row is written back by one call (fogvol__gl_put). */
+typedef struct fogvol__gl_value_row {
+    unsigned char put, type, when, per; /* FOGVOL__GLV_*; 'i', 'b' or 'f'; FOGVOL__GLW_*; values per name */
+    unsigned short offset;              /* the field in fogvol__gl_state */
+    fogvol__GLenum arg;                 /* stencil: the face; pixel store: fogvol's value in its passes */
+    fogvol__GLenum names[4];            /* 0 ends the list */
+} fogvol__gl_value_row;
+
+#define FOGVOL__GL_AT(field) (unsigned short)offsetof(fogvol__gl_state, field)
+static const fogvol__gl_value_row fogvol__gl_values[] = {
+    {FOGVOL__GLV_VIEWPORT, 'i', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(viewport), 0, {FOGVOL__GL_VIEWPORT}},
+    {FOGVOL__GLV_SCISSOR, 'i', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(scissor_box), 0, {FOGVOL__GL_SCISSOR_BOX}},
+    {FOGVOL__GLV_BLEND_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(blend_func), 0,
+     {FOGVOL__GL_BLEND_SRC_RGB, FOGVOL__GL_BLEND_DST_RGB, FOGVOL__GL_BLEND_SRC_ALPHA, FOGVOL__GL_BLEND_DST_ALPHA}},
+    {FOGVOL__GLV_BLEND_EQ, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(blend_eq), 0,
+     {FOGVOL__GL_BLEND_EQUATION_RGB, FOGVOL__GL_BLEND_EQUATION_ALPHA}},
+    {FOGVOL__GLV_DEPTH_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(depth_func), 0, {FOGVOL__GL_DEPTH_FUNC}},
+    {FOGVOL__GLV_CULL_FACE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(cull_mode), 0, {FOGVOL__GL_CULL_FACE_MODE}},
+    {FOGVOL__GLV_FRONT_FACE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(front_face), 0, {FOGVOL__GL_FRONT_FACE}},
+    {FOGVOL__GLV_POLYGON_MODE, 'i', FOGVOL__GLW_DESKTOP, 2, FOGVOL__GL_AT(polygon_mode), 0, {FOGVOL__GL_POLYGON_MODE}},
+    {FOGVOL__GLV_DEPTH_MASK, 'b', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(depth_mask), 0, {FOGVOL__GL_DEPTH_WRITEMASK}},
+    {FOGVOL__GLV_COLOR_MASK, 'b', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(color_mask), 0, {FOGVOL__GL_COLOR_WRITEMASK}},
+    {FOGVOL__GLV_CLEAR_COLOR, 'f', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(clear_color), 0, {FOGVOL__GL_COLOR_CLEAR_VALUE}},
+    {FOGVOL__GLV_STENCIL_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_func), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_FUNC, FOGVOL__GL_STENCIL_REF, FOGVOL__GL_STENCIL_VALUE_MASK}},
+    {FOGVOL__GLV_STENCIL_OP, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_op), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_FAIL, FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL, FOGVOL__GL_STENCIL_PASS_DEPTH_PASS}},
+    {FOGVOL__GLV_STENCIL_MASK, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_wmask), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_WRITEMASK}},
+    {FOGVOL__GLV_STENCIL_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_func), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_FUNC, FOGVOL__GL_STENCIL_BACK_REF, FOGVOL__GL_STENCIL_BACK_VALUE_MASK}},
+    {FOGVOL__GLV_STENCIL_OP, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_op), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_FAIL, FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL, FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS}},
+    {FOGVOL__GLV_STENCIL_MASK, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_wmask), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_WRITEMASK}},
+    {FOGVOL__GLV_CLEAR_STENCIL, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_clear), 0, {FOGVOL__GL_STENCIL_CLEAR_VALUE}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(pixel_align), 4,
+     {FOGVOL__GL_UNPACK_ALIGNMENT, FOGVOL__GL_PACK_ALIGNMENT}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(unpack_rows), 0,
+     {FOGVOL__GL_UNPACK_ROW_LENGTH, FOGVOL__GL_UNPACK_SKIP_ROWS, FOGVOL__GL_UNPACK_SKIP_PIXELS}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(pack_rows), 0,
+     {FOGVOL__GL_PACK_ROW_LENGTH, FOGVOL__GL_PACK_SKIP_ROWS, FOGVOL__GL_PACK_SKIP_PIXELS}}};
+#undef FOGVOL__GL_AT
+#define FOGVOL__GL_N_VALUES (int)(sizeof fogvol__gl_values / sizeof fogvol__gl_values[0])
+
+static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const void *p)
+{
+    const fogvol__GLint *v = (const fogvol__GLint *)p;
+    const fogvol__GLboolean *b = (const fogvol__GLboolean *)p;
+    const fogvol__GLfloat *f = (const fogvol__GLfloat *)p;
+    int k;
+    switch (r->put) {
+    case FOGVOL__GLV_VIEWPORT: gl->Viewport(v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_SCISSOR: gl->Scissor(v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_BLEND_FUNC:
+        gl->BlendFuncSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2], (fogvol__GLenum)v[3]);
+        break;
+    case FOGVOL__GLV_BLEND_EQ: gl->BlendEquationSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1]); break;
+    case FOGVOL__GLV_DEPTH_FUNC: gl->DepthFunc((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_CULL_FACE: gl->CullFace((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_FRONT_FACE: gl->FrontFace((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_POLYGON_MODE: /* core profiles accept only FRONT_AND_BACK; both entries hold the same mode */
+        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, (fogvol__GLenum)v[0]);
+        if (!gl->core && v[1] != v[0]) gl->PolygonMode(FOGVOL__GL_BACK, (fogvol__GLenum)v[1]);
+        break;
+    case FOGVOL__GLV_DEPTH_MASK: gl->DepthMask(b[0]); break;
+    case FOGVOL__GLV_COLOR_MASK: gl->ColorMask(b[0], b[1], b[2], b[3]); break;
+    case FOGVOL__GLV_CLEAR_COLOR: gl->ClearColor(f[0], f[1], f[2], f[3]); break;
+    case FOGVOL__GLV_STENCIL_FUNC: gl->StencilFuncSeparate(r->arg, (fogvol__GLenum)v[0], v[1], (fogvol__GLuint)v[2]); break;
+    case FOGVOL__GLV_STENCIL_OP:
+        gl->StencilOpSeparate(r->arg, (fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2]);
+        break;
+    case FOGVOL__GLV_STENCIL_MASK: gl->StencilMaskSeparate(r->arg, (fogvol__GLuint)v[0]); break;
+    case FOGVOL__GLV_CLEAR_STENCIL: gl->ClearStencil(v[0]); break;
+    default:
+        for (k = 0; k < 4 && r->names[k]; ++k) gl->PixelStorei(r->names[k], v[k]);
+        break;
+    }
+}
+
+/* Reads every row of both tables that the context has. */
+static void fogvol__gl_save_tables(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    int i, k;
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i) {
+        const fogvol__gl_value_row *r = &fogvol__gl_values[i];
+        void *p = (char *)s + r->offset;
+        if (!fogvol__gl_has(gl, r->when, 0)) continue;
+        for (k = 0; k < 4 && r->names[k]; ++k) {
+            if (r->type == 'b') gl->GetBooleanv(r->names[k], (fogvol__GLboolean *)p + k * r->per);
+            else if (r->type == 'f') gl->GetFloatv(r->names[k], (fogvol__GLfloat *)p + k * r->per);
+            else gl->GetIntegerv(r->names[k], (fogvol__GLint *)p + k * r->per);
+        }
+    }
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            s->enabled[i] = gl->IsEnabled(fogvol__gl_enables[i].cap);
+}
+
+static void fogvol__gl_restore_tables(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_values[i].when, 0))
+            fogvol__gl_put(gl, &fogvol__gl_values[i], (const char *)s + fogvol__gl_values[i].offset);
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            fogvol__gl_enable(gl, fogvol__gl_enables[i].cap, s->enabled[i]);
+}
+
+/* Every pass: the capabilities marked OFF turned off (fogvol__gl_begin_pass sets the others). */
+static void fogvol__gl_pass_enables(fogvol__gl *gl)
+{
+    int i;
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_enables[i].pass == FOGVOL__GLP_OFF &&
+            fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            gl->Disable(fogvol__gl_enables[i].cap);
+}
+
 /* Multisample texture bindings of fogvol's units, multisampling and sample shading. */
 static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
 {
@@ -6406,8 +6645,7 @@ static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegerv(FOGVOL__GL_TEXTURE_BINDING_2D_MULTISAMPLE, &s->tex2dms[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)active);
-    s->en_multisample = gl->IsEnabled(FOGVOL__GL_MULTISAMPLE);
-    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading); /* the enable: save_raster */
+    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading); /* the enables: the table */
 }
 
 static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
@@ -6419,7 +6657,6 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, (fogvol__GLuint)s->tex2dms[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    fogvol__gl_enable(gl, FOGVOL__GL_MULTISAMPLE, s->en_multisample);
     gl->MinSampleShading(s->min_sample_shading);
 }
 
@@ -6443,35 +6680,9 @@ static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
     }
 }
 
-/* State beyond the GL 2.0 list of fogvol__gl_save that changes what fogvol draws; saved here, set to a
-   known value by fogvol__gl_set_raster in every pass, restored by fogvol__gl_restore_raster:
-   - the draw-buffer list of an engine FBO: the composite writes one buffer, the others stay intact;
-   - per-draw-buffer blend functions, equations, colour masks and blend enables: fogvol's non-indexed
-     calls overwrite every buffer's values;
-   - PRIMITIVE_RESTART (+ _FIXED_INDEX): would cut fogvol's index lists at the engine's restart index
-     (the index itself is never changed, so it is not saved);
-   - CLIP_DISTANCE0..7 (CLIP_PLANEi): fogvol's shaders write no gl_ClipDistance, so an enabled one is
-     undefined there;
-   - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
-   - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
-   - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
-   - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
-     GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
-   Judged irrelevant, not touched:
-   - MULTISAMPLE: fogvol's targets are single-sample; on a multisampled engine target the full-screen
-     composite covers every sample whether it is on or off;
-   - FRAMEBUFFER_SRGB: acts only on sRGB attachments, which fogvol's RGBA8/R32F targets are not; on an
-     sRGB engine target it selects the blending space the engine wants (see fogvol_ramp_desc);
-   - MIN_SAMPLE_SHADING_VALUE, PRIMITIVE_RESTART_INDEX: read only while their enables are on (fogvol
-     turns those off);
-   - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
-   - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
-   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
-     function reads them;
-   - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
-   - conditional rendering: it cannot be queried; fogvol must not be called between
-     glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
-static void fogvol__gl_save_raster(fogvol__gl *gl, fogvol__gl_state *s)
+/* The engine FBO's draw-buffer list and the per-draw-buffer colour masks, blend enables, functions
+   and equations (the module comment above FOGVOL__GL_ENABLES says why). */
+static void fogvol__gl_save_draw_buffers(fogvol__gl *gl, fogvol__gl_state *s)
 {
     int i;
     if (gl->max_draw_buffers > 0 && s->draw_fbo != 0)
@@ -6491,33 +6702,11 @@ static void fogvol__gl_save_raster(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_RGB, (fogvol__GLuint)i, &s->bi_eq_rgb[i]);
         gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_ALPHA, (fogvol__GLuint)i, &s->bi_eq_a[i]);
     }
-    if (gl->has_restart) s->en_restart = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART);
-    if (gl->has_restart_fixed) s->en_restart_fixed = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
-    for (i = 0; i < gl->n_clip; ++i) s->en_clip[i] = gl->IsEnabled((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
-    if (gl->has_depth_clamp) s->en_depth_clamp = gl->IsEnabled(FOGVOL__GL_DEPTH_CLAMP);
-    if (gl->has_sample_shading) s->en_sample_shading = gl->IsEnabled(FOGVOL__GL_SAMPLE_SHADING);
-    if (gl->has_sample_mask) s->en_sample_mask = gl->IsEnabled(FOGVOL__GL_SAMPLE_MASK);
-    if (!gl->gles) s->en_poly_smooth = gl->IsEnabled(FOGVOL__GL_POLYGON_SMOOTH);
-    if (!gl->gles && !gl->core) s->en_poly_stipple = gl->IsEnabled(FOGVOL__GL_POLYGON_STIPPLE);
-}
-
-/* Known values for every pass (fogvol__gl_save_raster says why each matters). */
-static void fogvol__gl_set_raster(fogvol__gl *gl)
-{
-    int i;
-    if (gl->has_restart) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART);
-    if (gl->has_restart_fixed) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
-    for (i = 0; i < gl->n_clip; ++i) gl->Disable((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
-    if (gl->has_depth_clamp) gl->Disable(FOGVOL__GL_DEPTH_CLAMP);
-    if (gl->has_sample_shading) gl->Disable(FOGVOL__GL_SAMPLE_SHADING);
-    if (gl->has_sample_mask) gl->Disable(FOGVOL__GL_SAMPLE_MASK);
-    if (!gl->gles) gl->Disable(FOGVOL__GL_POLYGON_SMOOTH);
-    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_POLYGON_STIPPLE);
 }
 
 /* Runs last in fogvol__gl_restore: the engine framebuffer is bound again and the non-indexed blend
    state is back, so the per-buffer values go on top of it. */
-static void fogvol__gl_restore_raster(fogvol__gl *gl, const fogvol__gl_state *s)
+static void fogvol__gl_restore_draw_buffers(fogvol__gl *gl, const fogvol__gl_state *s)
 {
     int i;
     if (s->draw_buffers_set) {
@@ -6536,15 +6725,6 @@ static void fogvol__gl_restore_raster(fogvol__gl *gl, const fogvol__gl_state *s)
         if (s->bi_blend[i]) gl->Enablei(FOGVOL__GL_BLEND, u);
         else gl->Disablei(FOGVOL__GL_BLEND, u);
     }
-    if (gl->has_restart) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART, s->en_restart);
-    if (gl->has_restart_fixed) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX, s->en_restart_fixed);
-    for (i = 0; i < gl->n_clip; ++i)
-        fogvol__gl_enable(gl, (fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i), s->en_clip[i]);
-    if (gl->has_depth_clamp) fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_CLAMP, s->en_depth_clamp);
-    if (gl->has_sample_shading) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, s->en_sample_shading);
-    if (gl->has_sample_mask) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_MASK, s->en_sample_mask);
-    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_SMOOTH, s->en_poly_smooth);
-    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_STIPPLE, s->en_poly_stipple);
 }
 
 /* The engine's pending GL errors. glGetError returns and clears them, so the first fogvol entry of a
@@ -6609,33 +6789,41 @@ static void fogvol__gl_host_leave(fogvol__gl *gl)
     gl->host_n = 0;
 }
 
-static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
+/* Vertex attribute 0 where there is no vertex array object to keep it. */
+static void fogvol__gl_save_attrib0(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->a0_enabled);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE, &s->a0_size);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE, &s->a0_type);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED, &s->a0_normalized);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE, &s->a0_stride);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, &s->a0_buffer);
+    gl->GetVertexAttribPointerv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER, &s->a0_pointer);
+}
+
+static void fogvol__gl_restore_attrib0(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->a0_buffer);
+    gl->VertexAttribPointer(0, s->a0_size, (fogvol__GLenum)s->a0_type, (fogvol__GLboolean)s->a0_normalized,
+                            s->a0_stride, s->a0_pointer);
+    if (s->a0_enabled) gl->EnableVertexAttribArray(0);
+    else gl->DisableVertexAttribArray(0);
+    gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)s->element_buffer);
+}
+
+/* Framebuffers, renderbuffer, program, vertex input, textures and samplers of fogvol's units, pixel
+   buffers. */
+static void fogvol__gl_save_bindings(fogvol__gl *gl, fogvol__gl_state *s)
 {
     int i;
-    memset(s, 0, sizeof *s);
-    fogvol__gl_save_msaa(gl, s);
-    if (gl->has_split_fbo) {
-        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
-        gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
-    } else {
-        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo); /* == FRAMEBUFFER_BINDING */
-    }
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo); /* == FRAMEBUFFER_BINDING */
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
     gl->GetIntegerv(FOGVOL__GL_RENDERBUFFER_BINDING, &s->renderbuffer);
-    gl->GetIntegerv(FOGVOL__GL_VIEWPORT, s->viewport);
-    gl->GetIntegerv(FOGVOL__GL_SCISSOR_BOX, s->scissor_box);
     gl->GetIntegerv(FOGVOL__GL_CURRENT_PROGRAM, &s->program);
     if (gl->has_vao) gl->GetIntegerv(FOGVOL__GL_VERTEX_ARRAY_BINDING, &s->vao);
     gl->GetIntegerv(FOGVOL__GL_ARRAY_BUFFER_BINDING, &s->array_buffer);
     gl->GetIntegerv(FOGVOL__GL_ELEMENT_ARRAY_BUFFER_BINDING, &s->element_buffer);
-    if (!gl->has_vao) {
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->a0_enabled);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE, &s->a0_size);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE, &s->a0_type);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED, &s->a0_normalized);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE, &s->a0_stride);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, &s->a0_buffer);
-        gl->GetVertexAttribPointerv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER, &s->a0_pointer);
-    }
+    if (!gl->has_vao) fogvol__gl_save_attrib0(gl, s);
     gl->GetIntegerv(FOGVOL__GL_ACTIVE_TEXTURE, &s->active_texture);
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
@@ -6643,24 +6831,47 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
         if (gl->has_sampler) gl->GetIntegerv(FOGVOL__GL_SAMPLER_BINDING, &s->sampler[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_RGB, &s->blend_src_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_RGB, &s->blend_dst_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_ALPHA, &s->blend_src_a);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_ALPHA, &s->blend_dst_a);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_RGB, &s->blend_eq_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_ALPHA, &s->blend_eq_a);
-    gl->GetIntegerv(FOGVOL__GL_DEPTH_FUNC, &s->depth_func);
-    gl->GetIntegerv(FOGVOL__GL_CULL_FACE_MODE, &s->cull_mode);
-    gl->GetIntegerv(FOGVOL__GL_FRONT_FACE, &s->front_face);
-    if (!gl->gles) gl->GetIntegerv(FOGVOL__GL_POLYGON_MODE, s->polygon_mode);
-    gl->GetBooleanv(FOGVOL__GL_DEPTH_WRITEMASK, &s->depth_mask);
-    gl->GetBooleanv(FOGVOL__GL_COLOR_WRITEMASK, s->color_mask);
-    gl->GetFloatv(FOGVOL__GL_COLOR_CLEAR_VALUE, s->clear_color);
-    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
-    else gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
-    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_RANGE, s->depth_range);
-    else gl->GetDoublev(FOGVOL__GL_DEPTH_RANGE, s->depth_range_d);
-    if (!gl->gles) {
+    if (gl->has_pixel_buffers) {
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
+    }
+}
+
+static void fogvol__gl_restore_bindings(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    if (gl->has_split_fbo) {
+        gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+        gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
+    } else {
+        gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+    }
+    gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
+    gl->UseProgram((fogvol__GLuint)s->program);
+    if (gl->has_vao) gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
+    else fogvol__gl_restore_attrib0(gl, s);
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, (fogvol__GLuint)s->tex2d[i]);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, (fogvol__GLuint)s->sampler[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
+    if (gl->has_pixel_buffers) {
+        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, (fogvol__GLuint)s->unpack_buffer);
+        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, (fogvol__GLuint)s->pack_buffer);
+    }
+}
+
+/* Depth clear value and depth range (double on desktop GL, so they come back exactly), clip control. */
+static void fogvol__gl_save_depth(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    if (gl->gles) {
+        gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
+        gl->GetFloatv(FOGVOL__GL_DEPTH_RANGE, s->depth_range);
+    } else {
+        gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
+        gl->GetDoublev(FOGVOL__GL_DEPTH_RANGE, s->depth_range_d);
         s->depth_range[0] = (fogvol__GLfloat)s->depth_range_d[0];
         s->depth_range[1] = (fogvol__GLfloat)s->depth_range_d[1];
     }
@@ -6670,156 +6881,53 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegerv(FOGVOL__GL_CLIP_ORIGIN, &s->clip_origin);
         gl->GetIntegerv(FOGVOL__GL_CLIP_DEPTH_MODE, &s->clip_depth);
     }
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_FUNC, &s->st_func);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_REF, &s->st_ref);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_VALUE_MASK, &s->st_vmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_FAIL, &s->st_fail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL, &s->st_zfail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_PASS, &s->st_zpass);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_WRITEMASK, &s->st_wmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FUNC, &s->stb_func);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_REF, &s->stb_ref);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_VALUE_MASK, &s->stb_vmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FAIL, &s->stb_fail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL, &s->stb_zfail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS, &s->stb_zpass);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_WRITEMASK, &s->stb_wmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_CLEAR_VALUE, &s->st_clear);
-    gl->GetIntegerv(FOGVOL__GL_UNPACK_ALIGNMENT, &s->unpack[0]);
-    gl->GetIntegerv(FOGVOL__GL_PACK_ALIGNMENT, &s->pack[0]);
-    if (gl->has_row_length) {
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_ROW_LENGTH, &s->unpack[1]);
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_ROWS, &s->unpack[2]);
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_PIXELS, &s->unpack[3]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_ROW_LENGTH, &s->pack[1]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_ROWS, &s->pack[2]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_PIXELS, &s->pack[3]);
+}
+
+static void fogvol__gl_restore_depth(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    if (gl->gles) {
+        gl->ClearDepthf(s->clear_depth);
+        gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
+    } else {
+        gl->ClearDepth(s->clear_depth_d);
+        gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
     }
-    if (gl->has_pixel_buffers) {
-        gl->GetIntegerv(FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
-        gl->GetIntegerv(FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
-    }
-    s->en_blend = gl->IsEnabled(FOGVOL__GL_BLEND);
-    s->en_depth = gl->IsEnabled(FOGVOL__GL_DEPTH_TEST);
-    s->en_cull = gl->IsEnabled(FOGVOL__GL_CULL_FACE);
-    s->en_scissor = gl->IsEnabled(FOGVOL__GL_SCISSOR_TEST);
-    s->en_stencil = gl->IsEnabled(FOGVOL__GL_STENCIL_TEST);
-    s->en_dither = gl->IsEnabled(FOGVOL__GL_DITHER);
-    s->en_a2c = gl->IsEnabled(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
-    s->en_samplecov = gl->IsEnabled(FOGVOL__GL_SAMPLE_COVERAGE);
-    s->en_polyoffset = gl->IsEnabled(FOGVOL__GL_POLYGON_OFFSET_FILL);
-    if (gl->has_discard) s->en_discard = gl->IsEnabled(FOGVOL__GL_RASTERIZER_DISCARD);
-    if (!gl->gles) s->en_logicop = gl->IsEnabled(FOGVOL__GL_COLOR_LOGIC_OP);
-    if (!gl->gles && !gl->core) s->en_alphatest = gl->IsEnabled(FOGVOL__GL_ALPHA_TEST);
-    fogvol__gl_save_raster(gl, s);
+    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
+}
+
+static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    memset(s, 0, sizeof *s);
+    fogvol__gl_save_msaa(gl, s);
+    fogvol__gl_save_bindings(gl, s);
+    fogvol__gl_save_tables(gl, s);
+    fogvol__gl_save_depth(gl, s);
+    fogvol__gl_save_draw_buffers(gl, s); /* after the bindings: reads the engine FBO's list */
 }
 
 static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
 {
-    int i;
     fogvol__gl_restore_msaa(gl, s);
-    if (gl->has_split_fbo) {
-        gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
-        gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
-    } else {
-        gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
-    }
-    gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
-    gl->Viewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
-    gl->Scissor(s->scissor_box[0], s->scissor_box[1], s->scissor_box[2], s->scissor_box[3]);
-    gl->UseProgram((fogvol__GLuint)s->program);
-    if (gl->has_vao) {
-        gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
-    } else {
-        gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->a0_buffer);
-        gl->VertexAttribPointer(0, s->a0_size, (fogvol__GLenum)s->a0_type, (fogvol__GLboolean)s->a0_normalized,
-                                s->a0_stride, s->a0_pointer);
-        if (s->a0_enabled) gl->EnableVertexAttribArray(0);
-        else gl->DisableVertexAttribArray(0);
-        gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)s->element_buffer);
-    }
-    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);
-    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
-        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, (fogvol__GLuint)s->tex2d[i]);
-        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, (fogvol__GLuint)s->sampler[i]);
-    }
-    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    gl->BlendFuncSeparate((fogvol__GLenum)s->blend_src_rgb, (fogvol__GLenum)s->blend_dst_rgb,
-                          (fogvol__GLenum)s->blend_src_a, (fogvol__GLenum)s->blend_dst_a);
-    gl->BlendEquationSeparate((fogvol__GLenum)s->blend_eq_rgb, (fogvol__GLenum)s->blend_eq_a);
-    gl->DepthFunc((fogvol__GLenum)s->depth_func);
-    gl->CullFace((fogvol__GLenum)s->cull_mode);
-    gl->FrontFace((fogvol__GLenum)s->front_face);
-    if (!gl->gles) {
-        /* core profiles accept only FRONT_AND_BACK; both entries hold the same mode there */
-        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, (fogvol__GLenum)s->polygon_mode[0]);
-        if (!gl->core && s->polygon_mode[1] != s->polygon_mode[0])
-            gl->PolygonMode(FOGVOL__GL_BACK, (fogvol__GLenum)s->polygon_mode[1]);
-    }
-    gl->DepthMask(s->depth_mask);
-    gl->ColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
-    gl->ClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
-    if (gl->gles) gl->ClearDepthf(s->clear_depth);
-    else gl->ClearDepth(s->clear_depth_d);
-    if (gl->gles) gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
-    else gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
-    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
-    gl->StencilFuncSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_func, s->st_ref, (fogvol__GLuint)s->st_vmask);
-    gl->StencilOpSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_fail, (fogvol__GLenum)s->st_zfail,
-                          (fogvol__GLenum)s->st_zpass);
-    gl->StencilMaskSeparate(FOGVOL__GL_FRONT, (fogvol__GLuint)s->st_wmask);
-    gl->StencilFuncSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_func, s->stb_ref, (fogvol__GLuint)s->stb_vmask);
-    gl->StencilOpSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_fail, (fogvol__GLenum)s->stb_zfail,
-                          (fogvol__GLenum)s->stb_zpass);
-    gl->StencilMaskSeparate(FOGVOL__GL_BACK, (fogvol__GLuint)s->stb_wmask);
-    gl->ClearStencil(s->st_clear);
-    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, s->unpack[0]);
-    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, s->pack[0]);
-    if (gl->has_row_length) {
-        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, s->unpack[1]);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, s->unpack[2]);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, s->unpack[3]);
-        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, s->pack[1]);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, s->pack[2]);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, s->pack[3]);
-    }
-    if (gl->has_pixel_buffers) {
-        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, (fogvol__GLuint)s->unpack_buffer);
-        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, (fogvol__GLuint)s->pack_buffer);
-    }
-    fogvol__gl_enable(gl, FOGVOL__GL_BLEND, s->en_blend);
-    fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, s->en_depth);
-    fogvol__gl_enable(gl, FOGVOL__GL_CULL_FACE, s->en_cull);
-    fogvol__gl_enable(gl, FOGVOL__GL_SCISSOR_TEST, s->en_scissor);
-    fogvol__gl_enable(gl, FOGVOL__GL_STENCIL_TEST, s->en_stencil);
-    fogvol__gl_enable(gl, FOGVOL__GL_DITHER, s->en_dither);
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, s->en_a2c);
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_COVERAGE, s->en_samplecov);
-    fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_OFFSET_FILL, s->en_polyoffset);
-    if (gl->has_discard) fogvol__gl_enable(gl, FOGVOL__GL_RASTERIZER_DISCARD, s->en_discard);
-    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_COLOR_LOGIC_OP, s->en_logicop);
-    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_ALPHA_TEST, s->en_alphatest);
-    fogvol__gl_restore_raster(gl, s);
+    fogvol__gl_restore_bindings(gl, s);
+    fogvol__gl_restore_tables(gl, s);
+    fogvol__gl_restore_depth(gl, s);
+    fogvol__gl_restore_draw_buffers(gl, s);
 }
 
-/* Pixel-transfer state fogvol's uploads and read-backs assume. */
+/* Pixel-transfer state fogvol's uploads and read-backs assume: no pixel buffers, and the pixel-store
+   rows of fogvol__gl_values at their arg values. */
 static void fogvol__gl_pixel_defaults(fogvol__gl *gl)
 {
+    int i, k;
     if (gl->has_pixel_buffers) {
         gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, 0);
         gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, 0);
     }
-    if (gl->has_row_length) {
-        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, 0);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, 0);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, 0);
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i) {
+        const fogvol__gl_value_row *r = &fogvol__gl_values[i];
+        if (r->put != FOGVOL__GLV_PIXEL_STORE || !fogvol__gl_has(gl, r->when, 0)) continue;
+        for (k = 0; k < 4 && r->names[k]; ++k) gl->PixelStorei(r->names[k], (fogvol__GLint)r->arg);
     }
-    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, 4);
-    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, 4);
 }
 
 /* Resource entries called outside a frame save and restore the state they touch. */
@@ -7319,25 +7427,81 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__free(&gl->alloc, m);
 }
 
+/* Blending of a pass: off, sums (add, or dst - src), or the composite over the engine's colour. */
+static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
+{
+    switch (p->blend) {
+    case FOGVOL_PASS_BLEND_ADD:
+    case FOGVOL_PASS_BLEND_SUBTRACT:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
+        break;
+    case FOGVOL_PASS_BLEND_FOG:
+    case FOGVOL_PASS_BLEND_LIGHT:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
+                              p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
+                              p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
+                              p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
+        break;
+    default: gl->Disable(FOGVOL__GL_BLEND); break;
+    }
+    if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_REVERSE_SUBTRACT, FOGVOL__GL_FUNC_REVERSE_SUBTRACT);
+    else
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+}
+
+/* The stencil guard of a pass: its bit cleared over the viewport, then each pixel blended once. */
+static void fogvol__gl_pass_guard(fogvol__gl *gl, const fogvol_pass *p)
+{
+    gl->guard = p->stencil_guard;
+    if (!p->stencil_guard) {
+        gl->Disable(FOGVOL__GL_STENCIL_TEST);
+        return;
+    }
+    gl->guard_bit = p->stencil_bit;
+    memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
+    gl->Enable(FOGVOL__GL_STENCIL_TEST);
+    gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
+    gl->ClearStencil(0);
+    gl->Enable(FOGVOL__GL_SCISSOR_TEST);
+    gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
+    gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
+                            p->stencil_bit);
+    gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
+}
+
+/* The program of a pass with its uniforms, and its textures on fogvol's units. */
+static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
+{
+    int i;
+    gl->program = (fogvol__gl_program *)p->program;
+    gl->UseProgram(gl->program ? gl->program->id : 0);
+    if (gl->program)
+        for (i = 0; i < FOGVOL_U_COUNT; ++i)
+            if (gl->program->u_vec[i] >= 0) gl->Uniform4fv(gl->program->u_vec[i], 1, p->uniforms[i]);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        /* texture and target handles both start with the texture name */
+        fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
+        if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
+        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
+    }
+}
+
 static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_target *t = (const fogvol__gl_target *)p->target;
-    int i;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
-    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-    gl->Disable(FOGVOL__GL_DITHER);
-    gl->Disable(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
-    gl->Disable(FOGVOL__GL_SAMPLE_COVERAGE);
-    gl->Disable(FOGVOL__GL_POLYGON_OFFSET_FILL);
-    if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
-    if (!gl->gles) {
-        gl->Disable(FOGVOL__GL_COLOR_LOGIC_OP);
-        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
-    }
-    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_ALPHA_TEST);
-    fogvol__gl_set_raster(gl);
+    fogvol__gl_pass_enables(gl);
+    if (!gl->gles) gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
     if (!t && (gl->saved.n_draw_buffers > 1 || p->draw_buffer > 0)) { /* only the named engine buffer */
         fogvol__GLenum buf = (fogvol__GLenum)gl->saved.draw_buffers[p->draw_buffer];
         gl->DrawBuffers(1, &buf);
@@ -7359,26 +7523,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         }
         gl->Clear(bits);
     }
-    switch (p->blend) {
-    case FOGVOL_PASS_BLEND_ADD:
-    case FOGVOL_PASS_BLEND_SUBTRACT:
-        gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
-        break;
-    case FOGVOL_PASS_BLEND_FOG:
-    case FOGVOL_PASS_BLEND_LIGHT:
-        gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
-                              p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
-                              p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
-                              p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
-        break;
-    default: gl->Disable(FOGVOL__GL_BLEND); break;
-    }
-    if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
-        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_REVERSE_SUBTRACT, FOGVOL__GL_FUNC_REVERSE_SUBTRACT);
-    else
-        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+    fogvol__gl_pass_blend(gl, p);
     if (p->cull == FOGVOL_CULL_NONE) {
         gl->Disable(FOGVOL__GL_CULL_FACE);
     } else {
@@ -7389,37 +7534,8 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
     gl->DepthFunc(FOGVOL__GL_LESS);
     gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
-    gl->guard = p->stencil_guard;
-    if (p->stencil_guard) {
-        gl->guard_bit = p->stencil_bit;
-        memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
-        gl->Enable(FOGVOL__GL_STENCIL_TEST);
-        gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
-        gl->ClearStencil(0);
-        gl->Enable(FOGVOL__GL_SCISSOR_TEST);
-        gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
-        gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
-        gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-        gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
-                                p->stencil_bit);
-        gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
-    } else {
-        gl->Disable(FOGVOL__GL_STENCIL_TEST);
-    }
-    gl->program = (fogvol__gl_program *)p->program;
-    gl->UseProgram(gl->program ? gl->program->id : 0);
-    if (gl->program)
-        for (i = 0; i < FOGVOL_U_COUNT; ++i)
-            if (gl->program->u_vec[i] >= 0) gl->Uniform4fv(gl->program->u_vec[i], 1, p->uniforms[i]);
-    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
-        /* texture and target handles both start with the texture name */
-        fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
-        if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
-        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
-        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
-    }
+    fogvol__gl_pass_guard(gl, p);
+    fogvol__gl_pass_program(gl, p);
     fogvol__gl_sample_pass(gl, p);
 }
 
@@ -7712,7 +7828,7 @@ static int fogvol__gl_load_msaa(fogvol__gl *gl, const fogvol_gl_desc *desc)
     return gl->has_msaa;
 }
 
-/* Which of the state that fogvol__gl_save_raster handles the context has. */
+/* Which of the state of FOGVOL__GL_ENABLES and fogvol__gl_save_draw_buffers the context has. */
 static void fogvol__gl_raster_caps(fogvol__gl *gl)
 {
     fogvol__GLint n = 0;
@@ -7744,52 +7860,27 @@ static void fogvol__parse_version(const char *s, int *major, int *minor)
     while (*s >= '0' && *s <= '9') *minor = *minor * 10 + (*s++ - '0');
 }
 
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
-                                                  const fogvol_logger *logger, fogvol_backend *out)
-{
-    static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
-    fogvol_mesh_data tri_data;
-    fogvol__gl *gl;
-    fogvol_logger silent;
-    const char *ver, *ext = NULL;
-    const char *fbo_suffix = "";
-    fogvol_result r;
-    int need_vao;
-    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    memset(&silent, 0, sizeof silent);
-    if (!logger) logger = &silent;
-    if (!desc || !desc->get_proc_address) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
-    if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    memset(gl, 0, sizeof *gl);
-    if (alloc) gl->alloc = *alloc;
-    gl->log = *logger;
-
 #define FOGVOL__GL_LOAD(ret, name, params) \
     gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
-    FOGVOL__GL_BASE(FOGVOL__GL_LOAD)
-#undef FOGVOL__GL_LOAD
 #define FOGVOL__GL_REQUIRE(ret, name, params) \
     if (!gl->name) { \
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function gl%s is missing", #name); \
-        fogvol__free(alloc, gl); \
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function gl%s is missing", #name); \
         return FOGVOL_ERROR_MISSING_FUNCTION; \
     }
-    FOGVOL__GL_BASE(FOGVOL__GL_REQUIRE)
 
-    ver = (const char *)gl->GetString(FOGVOL__GL_VERSION);
-    if (!ver) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: glGetString(GL_VERSION) returned NULL: no current context?");
-        fogvol__free(alloc, gl);
+/* The GL 1.x/2.0 functions, then the context's version and profile (or the older one desc asks for):
+   GL 2.0 / GLES 2.0 at least. */
+static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *desc, const char **ver)
+{
+    FOGVOL__GL_BASE(FOGVOL__GL_LOAD)
+    FOGVOL__GL_BASE(FOGVOL__GL_REQUIRE)
+    *ver = (const char *)gl->GetString(FOGVOL__GL_VERSION);
+    if (!*ver) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: glGetString(GL_VERSION) returned NULL: no current context?");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    gl->gles = strncmp(ver, "OpenGL ES", 9) == 0;
-    fogvol__parse_version(ver, &gl->major, &gl->minor);
+    gl->gles = strncmp(*ver, "OpenGL ES", 9) == 0;
+    fogvol__parse_version(*ver, &gl->major, &gl->minor);
     if (!gl->gles && (gl->major > 3 || (gl->major == 3 && gl->minor >= 2))) {
         fogvol__GLint mask = 0;
         gl->GetIntegerv(FOGVOL__GL_CONTEXT_PROFILE_MASK, &mask);
@@ -7802,11 +7893,19 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
                     gl->gles ? "OpenGL ES" : "OpenGL", gl->major, gl->minor);
-        fogvol__free(alloc, gl);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
+    return FOGVOL_SUCCESS;
+}
+
+/* Framebuffer objects (core, ARB_framebuffer_object or EXT_framebuffer_object: fbo_suffix "EXT") and
+   what else the version has; ext: the GL 2 / GLES 2 extension string (NULL on 3.x and later). */
+static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *desc, const char **ext)
+{
+    const char *fbo_suffix = "";
+    char name[64];
     gl->has_split_fbo = gl->major >= 3;
     gl->has_vao = gl->major >= 3;
     gl->has_sampler = gl->gles ? gl->major >= 3 : (gl->major > 3 || (gl->major == 3 && gl->minor >= 3));
@@ -7814,36 +7913,35 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     gl->has_row_length = !gl->gles || gl->major >= 3;
     gl->has_discard = gl->major >= 3;
     gl->has_uint_index = !gl->gles || gl->major >= 3;
-    if (gl->major < 3) ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
-    if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(ext, "GL_OES_element_index_uint");
-    if (!gl->gles && gl->major < 3 && !fogvol__has_ext(ext, "GL_ARB_framebuffer_object")) {
-        if (!fogvol__has_ext(ext, "GL_EXT_framebuffer_object")) {
-            fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: GL %d.%d without framebuffer objects", gl->major, gl->minor);
-            fogvol__free(alloc, gl);
+    if (gl->major < 3) *ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
+    if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(*ext, "GL_OES_element_index_uint");
+    if (!gl->gles && gl->major < 3 && !fogvol__has_ext(*ext, "GL_ARB_framebuffer_object")) {
+        if (!fogvol__has_ext(*ext, "GL_EXT_framebuffer_object")) {
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL %d.%d without framebuffer objects", gl->major,
+                        gl->minor);
             return FOGVOL_ERROR_UNSUPPORTED;
         }
         fbo_suffix = "EXT";
     }
     if (!gl->gles && gl->major < 3) /* ARB_framebuffer_object / EXT_framebuffer_blit: separate read and draw */
-        gl->has_split_fbo = fogvol__has_ext(ext, "GL_ARB_framebuffer_object") ||
-                            fogvol__has_ext(ext, "GL_EXT_framebuffer_blit");
-    {
-        char name[64];
+        gl->has_split_fbo = fogvol__has_ext(*ext, "GL_ARB_framebuffer_object") ||
+                            fogvol__has_ext(*ext, "GL_EXT_framebuffer_blit");
 #define FOGVOL__GL_LOAD_FBO(ret, nm, params) \
     snprintf(name, sizeof name, "gl%s%s", #nm, fbo_suffix); \
     gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
     if (!gl->nm) { \
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
-        fogvol__free(alloc, gl); \
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
         return FOGVOL_ERROR_MISSING_FUNCTION; \
     }
-        FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
+    FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
 #undef FOGVOL__GL_LOAD_FBO
-    }
-#define FOGVOL__GL_LOAD(ret, name, params) \
-    gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
-    need_vao = gl->has_vao;
-    if (need_vao) {
+    return FOGVOL_SUCCESS;
+}
+
+/* The functions of the later versions that the context has. */
+static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
+    if (gl->has_vao) {
         FOGVOL__GL_VAO(FOGVOL__GL_LOAD)
         FOGVOL__GL_VAO(FOGVOL__GL_REQUIRE)
     }
@@ -7894,20 +7992,14 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_DESKTOP(FOGVOL__GL_LOAD)
         FOGVOL__GL_DESKTOP(FOGVOL__GL_REQUIRE)
     }
+    return FOGVOL_SUCCESS;
+}
 #undef FOGVOL__GL_LOAD
 #undef FOGVOL__GL_REQUIRE
 
-    gl->dialect = desc->dialect;
-    if (gl->dialect == FOGVOL_GLSL_AUTO) {
-        if (gl->gles) gl->dialect = gl->major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
-        else if (gl->major > 3 || (gl->major == 3 && gl->minor >= 3)) gl->dialect = FOGVOL_GLSL_330;
-        else if (gl->major == 3 && gl->minor == 2) gl->dialect = FOGVOL_GLSL_150;
-        else if (gl->major == 3) gl->dialect = FOGVOL_GLSL_130;
-        else gl->dialect = gl->minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
-    }
-    gl->stencil_override = desc->stencil_bits;
-    gl->caps = fogvol__gl_caps(gl, ext);
-    if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+/* GL 4.5 / ARB_clip_control, or GLES EXT_clip_control (glClipControlEXT). */
+static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
     if (!gl->gles && (gl->major > 4 || (gl->major == 4 && gl->minor >= 5) ||
                       (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_ARB_clip_control")
                                       : fogvol__has_ext(ext, "GL_ARB_clip_control"))))
@@ -7915,6 +8007,30 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     else if (gl->gles && (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_clip_control")
                                          : fogvol__has_ext(ext, "GL_EXT_clip_control")))
         gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControlEXT", desc->user_data);
+}
+
+/* The newest dialect a context has. */
+static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
+{
+    if (gles) return major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
+    if (major > 3 || (major == 3 && minor >= 3)) return FOGVOL_GLSL_330;
+    if (major == 3 && minor == 2) return FOGVOL_GLSL_150;
+    if (major == 3) return FOGVOL_GLSL_130;
+    return minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
+}
+
+/* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
+    static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
+    fogvol_mesh_data tri_data;
+    fogvol_result r;
+    gl->dialect = desc->dialect;
+    if (gl->dialect == FOGVOL_GLSL_AUTO) gl->dialect = fogvol__dialect_for_gl(gl->gles, gl->major, gl->minor);
+    gl->stencil_override = desc->stencil_bits;
+    gl->caps = fogvol__gl_caps(gl, ext);
+    if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+    fogvol__gl_load_clip_control(gl, desc, ext);
     fogvol__gl_raster_caps(gl);
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
         gl->GenSamplers(1, &gl->native_sampler);
@@ -7928,14 +8044,12 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
-    if (r != FOGVOL_SUCCESS) {
-        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-        fogvol__free(alloc, gl);
-        return r;
-    }
-    fogvol__log(logger, FOGVOL_LOG_INFO, "fogvol: GL backend on %s (%s%d.%d%s), GLSL %s", ver,
-                gl->gles ? "ES " : "", gl->major, gl->minor, gl->core ? " core" : "", fogvol_dialect_name(gl->dialect));
+    if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+    return r;
+}
 
+static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
+{
     out->user_data = gl;
     out->dialect = gl->dialect;
     out->caps = gl->caps | FOGVOL_CAP_MESH_LAYOUT;
@@ -7966,6 +8080,40 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         out->end_query = fogvol__gl_end_query;
         out->query_result = fogvol__gl_query_result;
     }
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out)
+{
+    fogvol__gl *gl;
+    fogvol_logger silent;
+    const char *ver = NULL, *ext = NULL;
+    fogvol_result r;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    memset(&silent, 0, sizeof silent);
+    if (!logger) logger = &silent;
+    if (!desc || !desc->get_proc_address) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
+    if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(gl, 0, sizeof *gl);
+    if (alloc) gl->alloc = *alloc;
+    gl->log = *logger;
+    r = fogvol__gl_version(gl, desc, &ver);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(alloc, gl);
+        return r;
+    }
+    fogvol__log(logger, FOGVOL_LOG_INFO, "fogvol: GL backend on %s (%s%d.%d%s), GLSL %s", ver,
+                gl->gles ? "ES " : "", gl->major, gl->minor, gl->core ? " core" : "", fogvol_dialect_name(gl->dialect));
+    fogvol__gl_fill_table(gl, out);
     return FOGVOL_SUCCESS;
 }
 
