@@ -811,20 +811,37 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
    NULL optional entries (marked) are skipped. */
 typedef uintptr_t fogvol_handle;
 
+/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
+   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
+   end. fogvol_uniform_name gives the name.
+   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   DECODE   fv_dec:     decode weights (world units)
+   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
+   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
+   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
+                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
+                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
+   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
+                        zw: offset of the engine depth texel (ENGINE_DEPTH)
+   LINEAR_W fv_lin2:    the denominator row of fv_lin */
+#define FOGVOL_UNIFORMS(X) \
+    X(ENC, fv_enc) \
+    X(DITHER, fv_dith) \
+    X(SCREEN, fv_screen) \
+    X(DECODE, fv_dec) \
+    X(RAMP, fv_rampmap) \
+    X(MISC, fv_misc) \
+    X(LINEAR, fv_lin) \
+    X(NEARFAR, fv_nf) \
+    X(LINEAR_W, fv_lin2)
+
 typedef enum fogvol_uniform {
-    FOGVOL_U_ENC = 0,    /* "fv_enc":    (N, N^2, depth_offset, depth_max) */
-    FOGVOL_U_DITHER = 1, /* "fv_dith":   (255 or 0 = dither off, 1/D, D, 0) */
-    FOGVOL_U_SCREEN = 2, /* "fv_screen": (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1] */
-    FOGVOL_U_DECODE = 3, /* "fv_dec":    decode weights (world units) */
-    FOGVOL_U_RAMP = 4,   /* "fv_rampmap": (slope, offset, overflow flag, 0): thickness -> ramp s */
-    FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, near-clamp w, 0) */
-    FOGVOL_U_LINEAR = 6, /* "fv_lin":    engine depth texture -> view depth, numerator row:
-                            view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
-                            (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders) */
-    FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
-                            zw: offset of the engine depth texel (ENGINE_DEPTH) */
-    FOGVOL_U_LINEAR_W = 8, /* "fv_lin2": the denominator row of fv_lin */
-    FOGVOL_U_COUNT = 9
+#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
+    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
+#undef FOGVOL__UNIFORM_ENUM
+    FOGVOL_U_COUNT
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
@@ -2414,6 +2431,121 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
 }
 
+/* >>dialects ============================================================== */
+/* One row per GLSL dialect in fogvol__dialects: its #version lines, whether it is
+   GLSL ES, whether it is a legacy dialect (attribute/varying, texture2D,
+   gl_FragColor: no float targets, engine MRT output or texelFetch), how many
+   colour outputs a fragment shader writes, which GL version it belongs to
+   (FOGVOL_GLSL_AUTO), and its preludes for the volume programs
+   (fogvol_shader_strings) and the analytic fog (fogvol_analytic_shader_strings).
+   fogvol_dialect_name, fogvol_combination_supported and fogvol_msaa_supported
+   read the same rows.
+   To add a dialect: its value at the end of fogvol_dialect (before
+   FOGVOL_GLSL_COUNT) and its row here.
+   To add a variant: its bit in fogvol_variant (FOGVOL_VARIANT_ALL covers the
+   bits in use) and its #define line in fogvol__variant_define; the tiers and
+   dialects it combines with go to fogvol_combination_supported. */
+
+static const char fogvol__highp_float[] = "precision highp float;\n";
+static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
+static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
+static const char fogvol__fs_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* GLES: highp where the GPU has it (samplers too: their default is lowp, which
+   would fetch depths at low precision); the PS13 tier is written for mediump */
+static const char fogvol__fs_es100[] =
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
+    "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_es300[] =
+    "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
+    "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* WIDE ENCODE/FACE write two targets: gl_FragData or an output array at location 0 */
+static const char fogvol__fs_two_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_OUT0 gl_FragData[0]\n"
+    "#define FV_OUT1 gl_FragData[1]\n";
+static const char fogvol__fs_two_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_frag[2];\n#define FV_OUT0 fv_frag[0]\n"
+    "#define FV_OUT1 fv_frag[1]\n";
+static const char fogvol__fs_two_layout[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_frag[2];\n"
+    "#define FV_OUT0 fv_frag[0]\n#define FV_OUT1 fv_frag[1]\n";
+static const char fogvol__fs_two_es300[] = "precision highp float;\nprecision highp sampler2D;\n";
+/* the analytic fog samples no texture */
+static const char fogvol__an_fs_es100[] =
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump float;\n#endif\n";
+static const char fogvol__an_fs_legacy[] = "#define FV_VARYING_IN varying\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__an_fs_modern[] =
+    "#define FV_VARYING_IN in\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* Per-sample fragment shaders (fogvol_shader_desc.samples > 1): gl_SampleID needs
+   GLSL 400 or ARB_sample_shading, declared before any other token. */
+#define FOGVOL__SAMPLE_SHADING "#extension GL_ARB_sample_shading : require\n"
+
+typedef struct fogvol__dialect_info {
+    const char *name;                 /* fogvol_dialect_name */
+    const char *version;              /* the #version line */
+    const char *version_msaa;         /* per-sample fragment shaders; NULL: not in this dialect */
+    unsigned char es, legacy;         /* GLSL ES; legacy (see above) */
+    unsigned char outputs;            /* colour outputs of a fragment shader */
+    unsigned char gl_major, gl_minor; /* the oldest GL (GLES if es) whose newest dialect this is */
+    const char *vs[2];                /* vertex prelude (NULL: no string) */
+    const char *fs;                   /* fragment prelude, one output */
+    const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
+    const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
+} fogvol__dialect_info;
+
+static const fogvol__dialect_info fogvol__dialects[FOGVOL_GLSL_COUNT] = {
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}},
+    {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+    {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+    {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+    {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
+     fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+    {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
+     {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
+     {NULL, fogvol__an_fs_modern}},
+    {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}},
+    {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
+     {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
+     {fogvol__highp_float, fogvol__an_fs_modern}}};
+#undef FOGVOL__SAMPLE_SHADING
+
+/* The row of a dialect; NULL for FOGVOL_GLSL_AUTO and values out of range. */
+static const fogvol__dialect_info *fogvol__dialect(fogvol_dialect dialect)
+{
+    if ((int)dialect <= (int)FOGVOL_GLSL_AUTO || (int)dialect >= (int)FOGVOL_GLSL_COUNT) return NULL;
+    return &fogvol__dialects[dialect];
+}
+
+/* Appends the (up to two) strings of a prelude. */
+static int fogvol__prelude(const char **strings, int n, const char *const prelude[2])
+{
+    if (prelude[0]) strings[n++] = prelude[0];
+    if (prelude[1]) strings[n++] = prelude[1];
+    return n;
+}
+
+#ifndef FOGVOL_NO_GL
+/* The newest dialect of a GL (gles = 0) or GLES context of this version. */
+static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
+{
+    int d, best = FOGVOL_GLSL_AUTO;
+    for (d = 1; d < FOGVOL_GLSL_COUNT; ++d) { /* the rows of each family go from old to new */
+        const fogvol__dialect_info *di = &fogvol__dialects[d];
+        if ((di->es != 0) != (gles != 0)) continue;
+        if (best == FOGVOL_GLSL_AUTO || major > di->gl_major || (major == di->gl_major && minor >= di->gl_minor))
+            best = d;
+    }
+    return (fogvol_dialect)best;
+}
+#endif
+
 /* >>analytic ============================================================== */
 /* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
    ways of combining volumes, the batch over vertex arrays, and the same maths
@@ -3264,10 +3396,6 @@ static const char fogvol__an_glsl_main[] =
     "}\n";
 static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
 
-static const char *const fogvol__an_version[FOGVOL_GLSL_COUNT] = {
-    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
-    "#version 100\n", "#version 300 es\n"};
-
 static const char fogvol__an_vs_body[] =
     "FV_ATTRIB vec3 fv_position;\n"
     "uniform mat4 fv_mvp;\n"
@@ -3311,28 +3439,14 @@ static const char fogvol__an_fs_body[] =
 FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, fogvol_stage stage, int per_pixel,
                                                         const char **strings, int *count)
 {
-    int legacy, es, n = 0;
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int n = 0;
     if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
-    if ((int)dialect <= (int)FOGVOL_GLSL_AUTO || (int)dialect >= (int)FOGVOL_GLSL_COUNT)
-        return FOGVOL_ERROR_UNSUPPORTED;
+    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
-    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = fogvol__an_version[dialect];
-    if (stage == FOGVOL_STAGE_VERTEX) {
-        if (es) strings[n++] = "precision highp float;\n";
-        strings[n++] = legacy ? "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n"
-                              : "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
-    } else {
-        if (dialect == FOGVOL_GLSL_100)
-            strings[n++] = "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\n"
-                           "precision mediump float;\n#endif\n";
-        else if (dialect == FOGVOL_GLSL_300ES)
-            strings[n++] = "precision highp float;\n";
-        strings[n++] = legacy ? "#define FV_VARYING_IN varying\n#define FV_FRAGCOLOR gl_FragColor\n"
-                              : "#define FV_VARYING_IN in\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-    }
+    strings[n++] = di->version;
+    n = fogvol__prelude(strings, n, stage == FOGVOL_STAGE_VERTEX ? di->an_vs : di->an_fs);
     if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
     if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
         strings[n++] = fogvol__an_glsl[0];
@@ -3359,15 +3473,6 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
    #defines: FV_PS13, FV_FLOAT, FV_SINGLE, FV_COUNT, FV_ALU, FV_NEAR_CLAMP,
    FV_ENGINE_DEPTH (FV_NORMALIZE follows from PS13 and COUNT). */
 
-static const char *const fogvol__version[FOGVOL_GLSL_COUNT] = {
-    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
-    "#version 100\n", "#version 300 es\n"};
-
-/* Multisampled targets (fogvol_shader_desc.samples > 1): gl_SampleID needs
-   GLSL 400 or ARB_sample_shading, declared before any other token. */
-static const char *const fogvol__version_msaa[FOGVOL_GLSL_COUNT] = {
-    "", "", "", "", "#version 150\n#extension GL_ARB_sample_shading : require\n",
-    "#version 330 core\n#extension GL_ARB_sample_shading : require\n", "", ""};
 /* FV_MSAA: fogvol's targets are sampler2DMS (FV_TARGET_SAMPLER); FV_TEXTURE
    overloads on the sampler type, so a target read fetches this fragment's
    own sample and the ramps keep their filtered lookups. */
@@ -3381,39 +3486,14 @@ static const char fogvol__fs_msaa[] =
     "#undef FV_TEXTURE\n"
     "#define FV_TEXTURE fv_tex\n";
 
-static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
-static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
-static const char fogvol__vs_es[] = "precision highp float;\n";
-static const char fogvol__fs_legacy[] =
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
-static const char fogvol__fs_modern[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-/* GLES: highp where the GPU has it (samplers too: their default is lowp, which
-   would fetch depths at low precision); the PS13 tier is written for mediump */
-static const char fogvol__fs_es100[] =
-    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
-    "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
-static const char fogvol__fs_es300[] =
-    "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
-    "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-
 static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
                                                                    "#define FV_FLOAT\n"};
-static const char *const fogvol__variant_define[6] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
+static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
                                                       "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n"};
-/* WIDE ENCODE/FACE write two targets: gl_FragData or an output array at location 0 */
-static const char fogvol__fs_two_legacy[] =
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_OUT0 gl_FragData[0]\n"
-    "#define FV_OUT1 gl_FragData[1]\n";
-static const char fogvol__fs_two_modern[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_frag[2];\n#define FV_OUT0 fv_frag[0]\n"
-    "#define FV_OUT1 fv_frag[1]\n";
-static const char fogvol__fs_two_layout[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_frag[2];\n"
-    "#define FV_OUT0 fv_frag[0]\n#define FV_OUT1 fv_frag[1]\n";
-
+#define FOGVOL__VARIANT_COUNT (int)(sizeof fogvol__variant_define / sizeof fogvol__variant_define[0])
+/* one #define per bit of FOGVOL_VARIANT_ALL */
+typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__VARIANT_COUNT) - 1u ? 1 : -1];
 /* Mesh vertex shader: clip position and normalised depth d = (w - near) /
    (far - near). With fv_misc.y = 1 clip z is replaced by k*d - w: the near
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
@@ -3675,10 +3755,8 @@ static const char fogvol__fs_composite[] =
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
 {
-    static const char *const names[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330 core", "100",
-                                                         "300 es"};
     if ((int)dialect < 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return "invalid";
-    return names[dialect];
+    return fogvol__dialects[dialect].name;
 }
 
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
@@ -3690,12 +3768,13 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
-    int modern; /* GLSL 130+ / 300 es: float targets, multiple outputs */
-    if ((int)dialect <= 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int modern; /* float targets, multiple outputs */
+    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
     if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_100;
+    modern = !di->legacy;
     if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || dialect == FOGVOL_GLSL_100 ||
+    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
                                       (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
         return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
     switch (tier) {
@@ -3721,7 +3800,7 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
 
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
-    if (dialect != FOGVOL_GLSL_150 && dialect != FOGVOL_GLSL_330) return FOGVOL_ERROR_UNSUPPORTED;
+    if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
     if (v & FOGVOL_VARIANT_WIDE) return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
     if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
@@ -3775,9 +3854,32 @@ FOGVOL_API fogvol_result fogvol_get_tier_info(fogvol_tier tier, unsigned v, fogv
     return FOGVOL_SUCCESS;
 }
 
+/* The fragment or vertex shader's program body and its program's #defines. */
+static int fogvol__program_strings(const fogvol_shader_desc *d, const char **strings, int n)
+{
+    if (d->stage == FOGVOL_STAGE_VERTEX) {
+        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
+                        d->program == FOGVOL_PROGRAM_CHECK ||
+                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
+                           ? fogvol__vs_fullscreen
+                           : fogvol__vs_mesh;
+        return n;
+    }
+    if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
+    strings[n++] = fogvol__fs_common;
+    switch (d->program) {
+    case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
+    case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
+    case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
+    default: strings[n++] = fogvol__fs_composite; break;
+    }
+    return n;
+}
+
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
 {
-    int legacy, es, n = 0, i;
+    const fogvol__dialect_info *di;
+    int n = 0, i, per_sample;
     if (!strings || !count || !d) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if (d->tier <= FOGVOL_TIER_AUTO || d->tier >= FOGVOL_TIER_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
@@ -3789,47 +3891,21 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->stage != FOGVOL_STAGE_VERTEX && d->stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     if (d->samples > 1 && fogvol_msaa_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
         return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = d->dialect == FOGVOL_GLSL_110 || d->dialect == FOGVOL_GLSL_120 || d->dialect == FOGVOL_GLSL_100;
-    es = d->dialect == FOGVOL_GLSL_100 || d->dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT ? fogvol__version_msaa[d->dialect]
-                                                                         : fogvol__version[d->dialect];
-    if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
-        if (es) strings[n++] = fogvol__vs_es;
-    } else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
-               (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE)) {
-        if (d->dialect == FOGVOL_GLSL_300ES) strings[n++] = "precision highp float;\nprecision highp sampler2D;\n";
-        strings[n++] = legacy                              ? fogvol__fs_two_legacy
-                       : d->dialect == FOGVOL_GLSL_330 ||
-                               d->dialect == FOGVOL_GLSL_300ES ? fogvol__fs_two_layout
-                                                               : fogvol__fs_two_modern;
-    } else if (d->dialect == FOGVOL_GLSL_100) {
-        strings[n++] = fogvol__fs_es100;
-    } else if (d->dialect == FOGVOL_GLSL_300ES) {
-        strings[n++] = fogvol__fs_es300;
-    } else {
-        strings[n++] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
-    }
+    di = fogvol__dialect(d->dialect);
+    per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
+    strings[n++] = per_sample ? di->version_msaa : di->version;
+    if (d->stage == FOGVOL_STAGE_VERTEX)
+        n = fogvol__prelude(strings, n, di->vs);
+    else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
+             (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE))
+        n = fogvol__prelude(strings, n, di->fs_two);
+    else
+        strings[n++] = di->fs;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
-    for (i = 0; i < 6; ++i)
+    for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
-    if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
-    if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
-                        d->program == FOGVOL_PROGRAM_CHECK ||
-                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
-                           ? fogvol__vs_fullscreen
-                           : fogvol__vs_mesh;
-    } else {
-        if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
-        strings[n++] = fogvol__fs_common;
-        switch (d->program) {
-        case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
-        case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
-        case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
-        default: strings[n++] = fogvol__fs_composite; break;
-        }
-    }
+    if (per_sample) strings[n++] = fogvol__fs_msaa;
+    n = fogvol__program_strings(d, strings, n);
     FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
     *count = n;
     return FOGVOL_SUCCESS;
@@ -3882,8 +3958,11 @@ FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_s
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
-    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc", "fv_dith", "fv_screen", "fv_dec",
-                                                      "fv_rampmap", "fv_misc", "fv_lin", "fv_nf", "fv_lin2"};
+    static const char *const names[FOGVOL_U_COUNT] = {
+#define FOGVOL__UNIFORM_NAME(id, name) #name,
+        FOGVOL_UNIFORMS(FOGVOL__UNIFORM_NAME)
+#undef FOGVOL__UNIFORM_NAME
+    };
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -8007,16 +8086,6 @@ static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *d
     else if (gl->gles && (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_clip_control")
                                          : fogvol__has_ext(ext, "GL_EXT_clip_control")))
         gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControlEXT", desc->user_data);
-}
-
-/* The newest dialect a context has. */
-static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
-{
-    if (gles) return major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
-    if (major > 3 || (major == 3 && minor >= 3)) return FOGVOL_GLSL_330;
-    if (major == 3 && minor == 2) return FOGVOL_GLSL_150;
-    if (major == 3) return FOGVOL_GLSL_130;
-    return minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
 }
 
 /* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
