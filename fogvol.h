@@ -7186,6 +7186,53 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
     fogvol__free(&gl->alloc, t);
 }
 
+/* WIDE: a second RGBA8 texture at attachment 1 of t's bound FBO, also a target of its own (own FBO,
+   for reading it back); t->second stays NULL when out of memory. */
+static void fogvol__gl_target_second(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_target_desc *d)
+{
+    static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
+    fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
+    if (!t2) return;
+    memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
+    t2->width = d->width;
+    t2->height = d->height;
+    t2->format = FOGVOL_FORMAT_RGBA8;
+    t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
+                                          FOGVOL__GL_CLAMP_TO_EDGE, NULL);
+    gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
+                             t2->base.tex, 0);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D,
+                             t2->base.tex, 0);
+    gl->DrawBuffers(2, bufs); /* framebuffer state of our FBO */
+    t->second = t2;
+}
+
+/* The depth renderbuffer of t's bound FBO: another target's (share_depth) or a new one. */
+static void fogvol__gl_target_depth(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_target_desc *d)
+{
+    if (d->share_depth) {
+        t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    } else if (d->depth) {
+        t->owns_depth = 1;
+        gl->GenRenderbuffers(1, &t->depth);
+        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
+        if (t->base.samples)
+            gl->RenderbufferStorageMultisample(FOGVOL__GL_RENDERBUFFER, d->samples, FOGVOL__GL_DEPTH_COMPONENT24,
+                                               d->width, d->height);
+        else
+            gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
+                                    gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
+                                    d->width, d->height);
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    }
+}
+
 static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -7220,45 +7267,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
                              t->base.samples ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
                                              : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D,
                              t->base.tex, 0);
-    if (d->color_count == 2 && gl->DrawBuffers) { /* WIDE: a second RGBA8 texture at attachment 1 */
-        static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
-        fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
-        if (t2) {
-            memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
-            t2->width = d->width;
-            t2->height = d->height;
-            t2->format = FOGVOL_FORMAT_RGBA8;
-            t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
-                                                  FOGVOL__GL_CLAMP_TO_EDGE, NULL);
-            gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
-            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
-            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
-                                     t2->base.tex, 0);
-            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
-            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D,
-                                     t2->base.tex, 0);
-            gl->DrawBuffers(2, bufs); /* framebuffer state of our FBO */
-            t->second = t2;
-        }
-    }
-    if (d->share_depth) {
-        t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
-        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
-                                    t->depth);
-    } else if (d->depth) {
-        t->owns_depth = 1;
-        gl->GenRenderbuffers(1, &t->depth);
-        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
-        if (t->base.samples)
-            gl->RenderbufferStorageMultisample(FOGVOL__GL_RENDERBUFFER, d->samples, FOGVOL__GL_DEPTH_COMPONENT24,
-                                               d->width, d->height);
-        else
-            gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
-                                    gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
-                                    d->width, d->height);
-        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
-                                    t->depth);
-    }
+    if (d->color_count == 2 && gl->DrawBuffers) fogvol__gl_target_second(gl, t, d);
+    fogvol__gl_target_depth(gl, t, d);
     status = gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_target");
     if (r == FOGVOL_SUCCESS && d->color_count == 2 && !t->second) r = FOGVOL_ERROR_OUT_OF_MEMORY;
