@@ -438,6 +438,8 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
                                               fogvol_mesh_report *report);
 
 /* ---- shaders ------------------------------------------------------------- */
+/* A new dialect: its value here before FOGVOL_GLSL_COUNT and its row in
+   fogvol__dialects (the >>dialects section says what a row holds). */
 typedef enum fogvol_dialect {
     FOGVOL_GLSL_AUTO = 0,
     FOGVOL_GLSL_110 = 1,
@@ -475,7 +477,9 @@ typedef enum fogvol_tier {
 } fogvol_tier;
 
 /* Variants (bit flags) that combine with tiers; fogvol_combination_supported()
-   says which combinations exist. */
+   says which combinations exist. A new variant: its bit at the end here,
+   FOGVOL_VARIANT_ALL, and its #define line in fogvol__variant_define (the
+   >>shaders section). */
 enum {
     /* RGBA8 tiers: one sum target starting from mid-range (128), back faces
        added, front faces subtracted by reverse-subtract blending; half the
@@ -1271,12 +1275,12 @@ typedef struct fogvol_frame_desc {
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
    restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call (out-of-memory and
-   context-loss codes cannot be raised again: logged as a warning); an active
-   transform feedback is paused during the call (GL 4.0 / GLES 3.0; on GL 3.x,
-   where it cannot be queried, do not call fogvol inside one); fogvol must not
-   be called between glBeginConditionalRender and glEndConditionalRender (not
-   queryable: its passes could be skipped). */
+   the engine left pending are still pending after every fogvol call
+   (out-of-memory and context-loss codes cannot be raised again: logged as a
+   warning); an active transform feedback is paused during the call (GL 4.0 /
+   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
+   one); fogvol must not be called between glBeginConditionalRender and
+   glEndConditionalRender (not queryable: its passes could be skipped). */
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
 /* The callback runs inside the O pass with the depth-encode program bound:
@@ -2496,7 +2500,7 @@ typedef struct fogvol__dialect_info {
     const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
 } fogvol__dialect_info;
 
-static const fogvol__dialect_info fogvol__dialects[FOGVOL_GLSL_COUNT] = {
+static const fogvol__dialect_info fogvol__dialects[] = {
     {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
      {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
@@ -2515,6 +2519,9 @@ static const fogvol__dialect_info fogvol__dialects[FOGVOL_GLSL_COUNT] = {
      {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
      {fogvol__highp_float, fogvol__an_fs_modern}}};
 #undef FOGVOL__SAMPLE_SHADING
+/* one row per value of fogvol_dialect */
+typedef char
+    fogvol__dialect_rows_match[sizeof fogvol__dialects / sizeof fogvol__dialects[0] == FOGVOL_GLSL_COUNT ? 1 : -1];
 
 /* The row of a dialect; NULL for FOGVOL_GLSL_AUTO and values out of range. */
 static const fogvol__dialect_info *fogvol__dialect(fogvol_dialect dialect)
@@ -6660,7 +6667,9 @@ static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const 
     case FOGVOL__GLV_DEPTH_MASK: gl->DepthMask(b[0]); break;
     case FOGVOL__GLV_COLOR_MASK: gl->ColorMask(b[0], b[1], b[2], b[3]); break;
     case FOGVOL__GLV_CLEAR_COLOR: gl->ClearColor(f[0], f[1], f[2], f[3]); break;
-    case FOGVOL__GLV_STENCIL_FUNC: gl->StencilFuncSeparate(r->arg, (fogvol__GLenum)v[0], v[1], (fogvol__GLuint)v[2]); break;
+    case FOGVOL__GLV_STENCIL_FUNC:
+        gl->StencilFuncSeparate(r->arg, (fogvol__GLenum)v[0], v[1], (fogvol__GLuint)v[2]);
+        break;
     case FOGVOL__GLV_STENCIL_OP:
         gl->StencilOpSeparate(r->arg, (fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2]);
         break;
