@@ -451,6 +451,8 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
                                               fogvol_mesh_report *report);
 
 /* ---- shaders ------------------------------------------------------------- */
+/* A new dialect: its value here before FOGVOL_GLSL_COUNT and its row in
+   fogvol__dialects (the >>dialects section says what a row holds). */
 typedef enum fogvol_dialect {
     FOGVOL_GLSL_AUTO = 0,
     FOGVOL_GLSL_110 = 1,
@@ -489,7 +491,9 @@ typedef enum fogvol_tier {
 } fogvol_tier;
 
 /* Variants (bit flags) that combine with tiers; fogvol_combination_supported()
-   says which combinations exist. */
+   says which combinations exist. A new variant: its bit at the end here,
+   FOGVOL_VARIANT_ALL, and its #define line in fogvol__variant_define (the
+   >>shaders section). */
 enum {
     /* RGBA8 tiers: one sum target starting from mid-range (128), back faces
        added, front faces subtracted by reverse-subtract blending; half the
@@ -831,32 +835,59 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
    NULL optional entries (marked) are skipped. */
 typedef uintptr_t fogvol_handle;
 
+/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
+   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
+   end. fogvol_uniform_name gives the name.
+   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   DECODE   fv_dec:     decode weights (world units)
+   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
+   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
+   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
+                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
+                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
+   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
+                        zw: offset of the engine depth texel (ENGINE_DEPTH)
+   LINEAR_W fv_lin2:    the denominator row of fv_lin
+   image-space effects (fogvol_post_*):
+   POST_TEXEL  fv_ptexel:  (1/texture width, 1/texture height, 1 = perspective, 0)
+   POST_RECT   fv_prect:   centres of the viewport's first and last pixels (x0, y0, x1, y1)
+   POST_PARAMS fv_pparams: per effect (see fogvol__post_* in the implementation)
+   POST_COLOR  fv_pcolor:  outline colour
+   density and colour textures on volumes, volume light by compare:
+   DENSITY_U fv_dens_u: density texture s = dot(fv_dens_u, (model-space position, 1))
+   DENSITY_V fv_dens_v: density texture t, likewise
+   DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
+   COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
+   COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
+   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass) */
+#define FOGVOL_UNIFORMS(X) \
+    X(ENC, fv_enc) \
+    X(DITHER, fv_dith) \
+    X(SCREEN, fv_screen) \
+    X(DECODE, fv_dec) \
+    X(RAMP, fv_rampmap) \
+    X(MISC, fv_misc) \
+    X(LINEAR, fv_lin) \
+    X(NEARFAR, fv_nf) \
+    X(LINEAR_W, fv_lin2) \
+    X(POST_TEXEL, fv_ptexel) \
+    X(POST_RECT, fv_prect) \
+    X(POST_PARAMS, fv_pparams) \
+    X(POST_COLOR, fv_pcolor) \
+    X(DENSITY_U, fv_dens_u) \
+    X(DENSITY_V, fv_dens_v) \
+    X(DENSITY, fv_dens) \
+    X(COLOR_U, fv_ctex_u) \
+    X(COLOR_V, fv_ctex_v) \
+    X(LIGHT, fv_light)
+
 typedef enum fogvol_uniform {
-    FOGVOL_U_ENC = 0,    /* "fv_enc":    (N, N^2, depth_offset, depth_max) */
-    FOGVOL_U_DITHER = 1, /* "fv_dith":   (255 or 0 = dither off, 1/D, D, 0) */
-    FOGVOL_U_SCREEN = 2, /* "fv_screen": (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1] */
-    FOGVOL_U_DECODE = 3, /* "fv_dec":    decode weights (world units) */
-    FOGVOL_U_RAMP = 4,   /* "fv_rampmap": (slope, offset, overflow flag, 0): thickness -> ramp s */
-    FOGVOL_U_MISC = 5,   /* "fv_misc":   (z scale k, 1 = replace clip z, near-clamp w, 0) */
-    FOGVOL_U_LINEAR = 6, /* "fv_lin":    engine depth texture -> view depth, numerator row:
-                            view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
-                            (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders) */
-    FOGVOL_U_NEARFAR = 7,/* "fv_nf":     (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
-                            zw: offset of the engine depth texel (ENGINE_DEPTH) */
-    FOGVOL_U_LINEAR_W = 8, /* "fv_lin2": the denominator row of fv_lin */
-    /* image-space effects (fogvol_post_*) */
-    FOGVOL_U_POST_TEXEL = 9,  /* "fv_ptexel":  (1/texture width, 1/texture height, 1 = perspective, 0) */
-    FOGVOL_U_POST_RECT = 10,  /* "fv_prect":   centres of the viewport's first and last pixels (x0, y0, x1, y1) */
-    FOGVOL_U_POST_PARAMS = 11,/* "fv_pparams": per effect (see fogvol__post_* in the implementation) */
-    FOGVOL_U_POST_COLOR = 12, /* "fv_pcolor":  outline colour */
-    /* density and colour textures on volumes, volume light by compare */
-    FOGVOL_U_DENSITY_U = 13, /* "fv_dens_u": density texture s = dot(fv_dens_u, (model-space position, 1)) */
-    FOGVOL_U_DENSITY_V = 14, /* "fv_dens_v": density texture t, likewise */
-    FOGVOL_U_DENSITY = 15,   /* "fv_dens":   (reference depth c, 1 = density texture on, 1/(far-near), 0) */
-    FOGVOL_U_COLOR_U = 16,   /* "fv_ctex_u": colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on */
-    FOGVOL_U_COLOR_V = 17,   /* "fv_ctex_v": colour texture t = dot(xyz, (screen s, t, 1)) */
-    FOGVOL_U_LIGHT = 18,     /* "fv_light":  (light rgb, 0 = front-depth pass, 1 = compare pass) */
-    FOGVOL_U_COUNT = 19
+#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
+    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
+#undef FOGVOL__UNIFORM_ENUM
+    FOGVOL_U_COUNT
 } fogvol_uniform;
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 
@@ -1288,13 +1319,13 @@ typedef struct fogvol_frame_desc {
    the GPU before end_frame. A begin_frame while a frame is open discards the
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
-   restored: the list is in fogvol__gl_save_raster): GL errors the engine left
-   pending are still pending after every fogvol call (out-of-memory and
-   context-loss codes cannot be raised again: logged as a warning); an active
-   transform feedback is paused during the call (GL 4.0 / GLES 3.0; on GL 3.x,
-   where it cannot be queried, do not call fogvol inside one); fogvol must not
-   be called between glBeginConditionalRender and glEndConditionalRender (not
-   queryable: its passes could be skipped). */
+   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
+   the engine left pending are still pending after every fogvol call
+   (out-of-memory and context-loss codes cannot be raised again: logged as a
+   warning); an active transform feedback is paused during the call (GL 4.0 /
+   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
+   one); fogvol must not be called between glBeginConditionalRender and
+   glEndConditionalRender (not queryable: its passes could be skipped). */
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
 /* The callback runs inside the O pass with the depth-encode program bound:
@@ -2639,6 +2670,124 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     return rep->valid ? FOGVOL_SUCCESS : FOGVOL_ERROR_INVALID_MESH;
 }
 
+/* >>dialects ============================================================== */
+/* One row per GLSL dialect in fogvol__dialects: its #version lines, whether it is
+   GLSL ES, whether it is a legacy dialect (attribute/varying, texture2D,
+   gl_FragColor: no float targets, engine MRT output or texelFetch), how many
+   colour outputs a fragment shader writes, which GL version it belongs to
+   (FOGVOL_GLSL_AUTO), and its preludes for the volume programs
+   (fogvol_shader_strings) and the analytic fog (fogvol_analytic_shader_strings).
+   fogvol_dialect_name, fogvol_combination_supported and fogvol_msaa_supported
+   read the same rows.
+   To add a dialect: its value at the end of fogvol_dialect (before
+   FOGVOL_GLSL_COUNT) and its row here.
+   To add a variant: its bit in fogvol_variant (FOGVOL_VARIANT_ALL covers the
+   bits in use) and its #define line in fogvol__variant_define; the tiers and
+   dialects it combines with go to fogvol_combination_supported. */
+
+static const char fogvol__highp_float[] = "precision highp float;\n";
+static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
+static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
+static const char fogvol__fs_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* GLES: highp where the GPU has it (samplers too: their default is lowp, which
+   would fetch depths at low precision); the PS13 tier is written for mediump */
+static const char fogvol__fs_es100[] =
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
+    "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__fs_es300[] =
+    "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
+    "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* WIDE ENCODE/FACE write two targets: gl_FragData or an output array at location 0 */
+static const char fogvol__fs_two_legacy[] =
+    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_OUT0 gl_FragData[0]\n"
+    "#define FV_OUT1 gl_FragData[1]\n";
+static const char fogvol__fs_two_modern[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_frag[2];\n#define FV_OUT0 fv_frag[0]\n"
+    "#define FV_OUT1 fv_frag[1]\n";
+static const char fogvol__fs_two_layout[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_frag[2];\n"
+    "#define FV_OUT0 fv_frag[0]\n#define FV_OUT1 fv_frag[1]\n";
+static const char fogvol__fs_two_es300[] = "precision highp float;\nprecision highp sampler2D;\n";
+/* the analytic fog samples no texture */
+static const char fogvol__an_fs_es100[] =
+    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump float;\n#endif\n";
+static const char fogvol__an_fs_legacy[] = "#define FV_VARYING_IN varying\n#define FV_FRAGCOLOR gl_FragColor\n";
+static const char fogvol__an_fs_modern[] =
+    "#define FV_VARYING_IN in\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+/* Per-sample fragment shaders (fogvol_shader_desc.samples > 1): gl_SampleID needs
+   GLSL 400 or ARB_sample_shading, declared before any other token. */
+#define FOGVOL__SAMPLE_SHADING "#extension GL_ARB_sample_shading : require\n"
+
+typedef struct fogvol__dialect_info {
+    const char *name;                 /* fogvol_dialect_name */
+    const char *version;              /* the #version line */
+    const char *version_msaa;         /* per-sample fragment shaders; NULL: not in this dialect */
+    unsigned char es, legacy;         /* GLSL ES; legacy (see above) */
+    unsigned char outputs;            /* colour outputs of a fragment shader */
+    unsigned char gl_major, gl_minor; /* the oldest GL (GLES if es) whose newest dialect this is */
+    const char *vs[2];                /* vertex prelude (NULL: no string) */
+    const char *fs;                   /* fragment prelude, one output */
+    const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
+    const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
+} fogvol__dialect_info;
+
+static const fogvol__dialect_info fogvol__dialects[] = {
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}},
+    {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+    {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+    {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+    {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
+     fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+    {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
+     {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
+     {NULL, fogvol__an_fs_modern}},
+    {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}},
+    {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
+     {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
+     {fogvol__highp_float, fogvol__an_fs_modern}}};
+#undef FOGVOL__SAMPLE_SHADING
+/* one row per value of fogvol_dialect */
+typedef char
+    fogvol__dialect_rows_match[sizeof fogvol__dialects / sizeof fogvol__dialects[0] == FOGVOL_GLSL_COUNT ? 1 : -1];
+
+/* The row of a dialect; NULL for FOGVOL_GLSL_AUTO and values out of range. */
+static const fogvol__dialect_info *fogvol__dialect(fogvol_dialect dialect)
+{
+    if ((int)dialect <= (int)FOGVOL_GLSL_AUTO || (int)dialect >= (int)FOGVOL_GLSL_COUNT) return NULL;
+    return &fogvol__dialects[dialect];
+}
+
+/* Appends the (up to two) strings of a prelude. */
+static int fogvol__prelude(const char **strings, int n, const char *const prelude[2])
+{
+    if (prelude[0]) strings[n++] = prelude[0];
+    if (prelude[1]) strings[n++] = prelude[1];
+    return n;
+}
+
+#ifndef FOGVOL_NO_GL
+/* The newest dialect of a GL (gles = 0) or GLES context of this version. */
+static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
+{
+    int d, best = FOGVOL_GLSL_AUTO;
+    for (d = 1; d < FOGVOL_GLSL_COUNT; ++d) { /* the rows of each family go from old to new */
+        const fogvol__dialect_info *di = &fogvol__dialects[d];
+        if ((di->es != 0) != (gles != 0)) continue;
+        if (best == FOGVOL_GLSL_AUTO || major > di->gl_major || (major == di->gl_major && minor >= di->gl_minor))
+            best = d;
+    }
+    return (fogvol_dialect)best;
+}
+#endif
+
 #ifndef FOGVOL_NO_ANALYTIC
 /* >>analytic ============================================================== */
 /* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
@@ -3490,10 +3639,6 @@ static const char fogvol__an_glsl_main[] =
     "}\n";
 static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
 
-static const char *const fogvol__an_version[FOGVOL_GLSL_COUNT] = {
-    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
-    "#version 100\n", "#version 300 es\n"};
-
 static const char fogvol__an_vs_body[] =
     "FV_ATTRIB vec3 fv_position;\n"
     "uniform mat4 fv_mvp;\n"
@@ -3537,28 +3682,14 @@ static const char fogvol__an_fs_body[] =
 FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, fogvol_stage stage, int per_pixel,
                                                         const char **strings, int *count)
 {
-    int legacy, es, n = 0;
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int n = 0;
     if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
-    if ((int)dialect <= (int)FOGVOL_GLSL_AUTO || (int)dialect >= (int)FOGVOL_GLSL_COUNT)
-        return FOGVOL_ERROR_UNSUPPORTED;
+    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
-    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = fogvol__an_version[dialect];
-    if (stage == FOGVOL_STAGE_VERTEX) {
-        if (es) strings[n++] = "precision highp float;\n";
-        strings[n++] = legacy ? "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n"
-                              : "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
-    } else {
-        if (dialect == FOGVOL_GLSL_100)
-            strings[n++] = "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\n"
-                           "precision mediump float;\n#endif\n";
-        else if (dialect == FOGVOL_GLSL_300ES)
-            strings[n++] = "precision highp float;\n";
-        strings[n++] = legacy ? "#define FV_VARYING_IN varying\n#define FV_FRAGCOLOR gl_FragColor\n"
-                              : "#define FV_VARYING_IN in\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-    }
+    strings[n++] = di->version;
+    n = fogvol__prelude(strings, n, stage == FOGVOL_STAGE_VERTEX ? di->an_vs : di->an_fs);
     if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
     if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
         strings[n++] = fogvol__an_glsl[0];
@@ -3587,15 +3718,6 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
    #defines: FV_PS13, FV_FLOAT, FV_SINGLE, FV_COUNT, FV_ALU, FV_NEAR_CLAMP,
    FV_ENGINE_DEPTH (FV_NORMALIZE follows from PS13 and COUNT). */
 
-static const char *const fogvol__version[FOGVOL_GLSL_COUNT] = {
-    "", "#version 110\n", "#version 120\n", "#version 130\n", "#version 150\n", "#version 330 core\n",
-    "#version 100\n", "#version 300 es\n"};
-
-/* Multisampled targets (fogvol_shader_desc.samples > 1): gl_SampleID needs
-   GLSL 400 or ARB_sample_shading, declared before any other token. */
-static const char *const fogvol__version_msaa[FOGVOL_GLSL_COUNT] = {
-    "", "", "", "", "#version 150\n#extension GL_ARB_sample_shading : require\n",
-    "#version 330 core\n#extension GL_ARB_sample_shading : require\n", "", ""};
 /* FV_MSAA: fogvol's targets are sampler2DMS (FV_TARGET_SAMPLER); FV_TEXTURE
    overloads on the sampler type, so a target read fetches this fragment's
    own sample and the ramps keep their filtered lookups. */
@@ -3609,39 +3731,14 @@ static const char fogvol__fs_msaa[] =
     "#undef FV_TEXTURE\n"
     "#define FV_TEXTURE fv_tex\n";
 
-static const char fogvol__vs_legacy[] = "#define FV_ATTRIB attribute\n#define FV_VARYING_OUT varying\n";
-static const char fogvol__vs_modern[] = "#define FV_ATTRIB in\n#define FV_VARYING_OUT out\n";
-static const char fogvol__vs_es[] = "precision highp float;\n";
-static const char fogvol__fs_legacy[] =
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
-static const char fogvol__fs_modern[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-/* GLES: highp where the GPU has it (samplers too: their default is lowp, which
-   would fetch depths at low precision); the PS13 tier is written for mediump */
-static const char fogvol__fs_es100[] =
-    "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
-    "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
-static const char fogvol__fs_es300[] =
-    "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
-    "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
-
 static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
                                                                    "#define FV_FLOAT\n"};
-static const char *const fogvol__variant_define[6] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
+static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
                                                       "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n"};
-/* WIDE ENCODE/FACE write two targets: gl_FragData or an output array at location 0 */
-static const char fogvol__fs_two_legacy[] =
-    "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_OUT0 gl_FragData[0]\n"
-    "#define FV_OUT1 gl_FragData[1]\n";
-static const char fogvol__fs_two_modern[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nout vec4 fv_frag[2];\n#define FV_OUT0 fv_frag[0]\n"
-    "#define FV_OUT1 fv_frag[1]\n";
-static const char fogvol__fs_two_layout[] =
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_frag[2];\n"
-    "#define FV_OUT0 fv_frag[0]\n#define FV_OUT1 fv_frag[1]\n";
-
+#define FOGVOL__VARIANT_COUNT (int)(sizeof fogvol__variant_define / sizeof fogvol__variant_define[0])
+/* one #define per bit of FOGVOL_VARIANT_ALL */
+typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__VARIANT_COUNT) - 1u ? 1 : -1];
 /* Mesh vertex shader: clip position and normalised depth d = (w - near) /
    (far - near). With fv_misc.y = 1 clip z is replaced by k*d - w: the near
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
@@ -3988,10 +4085,8 @@ static int fogvol__light_ok(fogvol_tier tier, unsigned v)
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
 {
-    static const char *const names[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330 core", "100",
-                                                         "300 es"};
     if ((int)dialect < 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return "invalid";
-    return names[dialect];
+    return fogvol__dialects[dialect].name;
 }
 
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
@@ -4003,12 +4098,13 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
-    int modern; /* GLSL 130+ / 300 es: float targets, multiple outputs */
-    if ((int)dialect <= 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int modern; /* float targets, multiple outputs */
+    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
     if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_100;
+    modern = !di->legacy;
     if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || dialect == FOGVOL_GLSL_100 ||
+    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
                                       (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
         return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
     switch (tier) {
@@ -4034,7 +4130,7 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
 
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
-    if (dialect != FOGVOL_GLSL_150 && dialect != FOGVOL_GLSL_330) return FOGVOL_ERROR_UNSUPPORTED;
+    if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
     if (v & FOGVOL_VARIANT_WIDE) return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
     if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
@@ -4089,9 +4185,33 @@ FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_
     return FOGVOL_SUCCESS;
 }
 
+/* The fragment or vertex shader's program body and its program's #defines. */
+static int fogvol__program_strings(const fogvol_shader_desc *d, const char **strings, int n)
+{
+    if (d->stage == FOGVOL_STAGE_VERTEX) {
+        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
+                        d->program == FOGVOL_PROGRAM_CHECK ||
+                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
+                           ? fogvol__vs_fullscreen
+                           : fogvol__vs_mesh;
+        return n;
+    }
+    if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
+    strings[n++] = fogvol__fs_common;
+    switch (d->program) {
+    case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
+    case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
+    case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
+    case FOGVOL_PROGRAM_LIGHT: strings[n++] = fogvol__fs_light; break;
+    default: strings[n++] = fogvol__fs_composite; break;
+    }
+    return n;
+}
+
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
 {
-    int legacy, es, n = 0, i;
+    const fogvol__dialect_info *di;
+    int n = 0, i, per_sample;
     if (!strings || !count || !d) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if (d->tier <= FOGVOL_TIER_AUTO || d->tier >= FOGVOL_TIER_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
@@ -4103,50 +4223,23 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->stage != FOGVOL_STAGE_VERTEX && d->stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     if (d->samples > 1 && fogvol_msaa_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
         return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = d->dialect == FOGVOL_GLSL_110 || d->dialect == FOGVOL_GLSL_120 || d->dialect == FOGVOL_GLSL_100;
-    es = d->dialect == FOGVOL_GLSL_100 || d->dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT ? fogvol__version_msaa[d->dialect]
-                                                                         : fogvol__version[d->dialect];
-    if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
-        if (es) strings[n++] = fogvol__vs_es;
-    } else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
-               (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE)) {
-        if (d->dialect == FOGVOL_GLSL_300ES) strings[n++] = "precision highp float;\nprecision highp sampler2D;\n";
-        strings[n++] = legacy                              ? fogvol__fs_two_legacy
-                       : d->dialect == FOGVOL_GLSL_330 ||
-                               d->dialect == FOGVOL_GLSL_300ES ? fogvol__fs_two_layout
-                                                               : fogvol__fs_two_modern;
-    } else if (d->dialect == FOGVOL_GLSL_100) {
-        strings[n++] = fogvol__fs_es100;
-    } else if (d->dialect == FOGVOL_GLSL_300ES) {
-        strings[n++] = fogvol__fs_es300;
-    } else {
-        strings[n++] = legacy ? fogvol__fs_legacy : fogvol__fs_modern;
-    }
+    di = fogvol__dialect(d->dialect);
+    per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
+    strings[n++] = per_sample ? di->version_msaa : di->version;
+    if (d->stage == FOGVOL_STAGE_VERTEX)
+        n = fogvol__prelude(strings, n, di->vs);
+    else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
+             (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE))
+        n = fogvol__prelude(strings, n, di->fs_two);
+    else
+        strings[n++] = di->fs;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
-    for (i = 0; i < 6; ++i)
+    for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
-    if (d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT) strings[n++] = fogvol__fs_msaa;
+    if (per_sample) strings[n++] = fogvol__fs_msaa;
     if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants))
         strings[n++] = "#define FV_DENSITY\n";
-    if (d->stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
-                        d->program == FOGVOL_PROGRAM_CHECK ||
-                        (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
-                           ? fogvol__vs_fullscreen
-                           : fogvol__vs_mesh;
-    } else {
-        if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
-        strings[n++] = fogvol__fs_common;
-        switch (d->program) {
-        case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
-        case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
-        case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
-        case FOGVOL_PROGRAM_LIGHT: strings[n++] = fogvol__fs_light; break;
-        default: strings[n++] = fogvol__fs_composite; break;
-        }
-    }
+    n = fogvol__program_strings(d, strings, n);
     FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
     *count = n;
     return FOGVOL_SUCCESS;
@@ -4199,11 +4292,11 @@ FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_s
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 {
-    static const char *const names[FOGVOL_U_COUNT] = {"fv_enc",    "fv_dith",   "fv_screen", "fv_dec",
-                                                      "fv_rampmap", "fv_misc",  "fv_lin",    "fv_nf",
-                                                      "fv_lin2",   "fv_ptexel", "fv_prect",  "fv_pparams",
-                                                      "fv_pcolor", "fv_dens_u", "fv_dens_v", "fv_dens",
-                                                      "fv_ctex_u", "fv_ctex_v", "fv_light"};
+    static const char *const names[FOGVOL_U_COUNT] = {
+#define FOGVOL__UNIFORM_NAME(id, name) #name,
+        FOGVOL_UNIFORMS(FOGVOL__UNIFORM_NAME)
+#undef FOGVOL__UNIFORM_NAME
+    };
     if ((int)u < 0 || (int)u >= FOGVOL_U_COUNT) return "";
     return names[u];
 }
@@ -6909,7 +7002,8 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                                                     fogvol_stage stage, const char **strings, int *count)
 {
     static const char *const taps[3] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n", "#define FV_TAPS 12\n"};
-    int legacy, es, n = 0;
+    const fogvol__dialect_info *di;
+    int n = 0;
     if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if ((int)dialect <= FOGVOL_GLSL_AUTO || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
@@ -6918,18 +7012,13 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
         !(effect == FOGVOL_POST_OUTLINES && (variant == 0 || variant == 1)) &&
         !(effect == FOGVOL_POST_DISTANCE_FOG && variant == 0))
         return FOGVOL_ERROR_UNSUPPORTED;
-    legacy = dialect == FOGVOL_GLSL_110 || dialect == FOGVOL_GLSL_120 || dialect == FOGVOL_GLSL_100;
-    es = dialect == FOGVOL_GLSL_100 || dialect == FOGVOL_GLSL_300ES;
-    strings[n++] = fogvol__version[dialect];
+    di = fogvol__dialect(dialect);
+    strings[n++] = di->version;
     if (stage == FOGVOL_STAGE_VERTEX) {
-        strings[n++] = legacy ? fogvol__vs_legacy : fogvol__vs_modern;
-        if (es) strings[n++] = fogvol__vs_es;
+        n = fogvol__prelude(strings, n, di->vs);
         strings[n++] = fogvol__vs_fullscreen;
     } else {
-        strings[n++] = dialect == FOGVOL_GLSL_100     ? fogvol__fs_es100
-                       : dialect == FOGVOL_GLSL_300ES ? fogvol__fs_es300
-                       : legacy                       ? fogvol__fs_legacy
-                                                      : fogvol__fs_modern;
+        strings[n++] = di->fs;
         strings[n++] = fogvol__fs_post_common;
         if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
@@ -7433,37 +7522,110 @@ FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
 #undef FOGVOL__GL_PFN_MSAA
 #define FOGVOL__GL_MAX_DB 8 /* draw buffers saved and restored (GL guarantees at least 8 on GL 3.0+) */
 
+/* ---- the engine state fogvol saves and restores ----
+   One table per kind of state, walked by fogvol__gl_save, fogvol__gl_restore and every pass:
+   - FOGVOL__GL_ENABLES (below): every glEnable capability, with the contexts that have it (W: a
+     FOGVOL__GLW_* test of fogvol__gl_has) and what every fogvol pass does with it (P: OFF turns it off,
+     SET leaves it to the pass, which sets it itself or keeps the engine's value);
+   - fogvol__gl_values (after struct fogvol__gl): plain values read with glGet* and written back by one
+     call each (fogvol__gl_put), pixel-store values with fogvol's own value for its passes;
+   - small functions for the rest: bindings (fogvol__gl_save_bindings), depth clear value, depth range
+     and clip control (fogvol__gl_save_depth), the engine FBO's draw buffers and per-draw-buffer blend
+     state (fogvol__gl_save_draw_buffers), multisample bindings (fogvol__gl_save_msaa).
+   To save one more piece of state: a row here or in fogvol__gl_values (plus its field in
+   fogvol__gl_state, and a FOGVOL__GLV_* setter in fogvol__gl_put if no existing call writes it).
+   Why the state beyond the GL 2.0 list matters to fogvol's draws:
+   - the draw-buffer list of an engine FBO: the composite writes one buffer, the others stay intact;
+   - per-draw-buffer blend functions, equations, colour masks and blend enables: fogvol's non-indexed
+     calls overwrite every buffer's values;
+   - PRIMITIVE_RESTART (+ _FIXED_INDEX): would cut fogvol's index lists at the engine's restart index
+     (the index itself is never changed, so it is not saved);
+   - CLIP_DISTANCE0..7 (CLIP_PLANEi): fogvol's shaders write no gl_ClipDistance, so an enabled one is
+     undefined there;
+   - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
+   - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
+   - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
+   - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
+     GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
+   Judged irrelevant, not touched:
+   - MULTISAMPLE: fogvol's targets are single-sample; on a multisampled engine target the full-screen
+     composite covers every sample whether it is on or off (saved only where fogvol's own multisampled
+     passes turn it on);
+   - FRAMEBUFFER_SRGB: acts only on sRGB attachments, which fogvol's RGBA8/R32F targets are not; on an
+     sRGB engine target it selects the blending space the engine wants (see fogvol_ramp_desc);
+   - MIN_SAMPLE_SHADING_VALUE, PRIMITIVE_RESTART_INDEX: read only while their enables are on (fogvol
+     turns those off);
+   - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
+   - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
+   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
+     function reads them;
+   - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
+   - conditional rendering: it cannot be queried; fogvol must not be called between
+     glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
+#define FOGVOL__GL_ENABLES(X) \
+    X(FOGVOL__GL_BLEND, ALL, SET) \
+    X(FOGVOL__GL_DEPTH_TEST, ALL, SET) \
+    X(FOGVOL__GL_CULL_FACE, ALL, SET) \
+    X(FOGVOL__GL_SCISSOR_TEST, ALL, OFF) \
+    X(FOGVOL__GL_STENCIL_TEST, ALL, SET) \
+    X(FOGVOL__GL_DITHER, ALL, OFF) \
+    X(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, ALL, OFF) \
+    X(FOGVOL__GL_SAMPLE_COVERAGE, ALL, OFF) \
+    X(FOGVOL__GL_POLYGON_OFFSET_FILL, ALL, OFF) \
+    X(FOGVOL__GL_RASTERIZER_DISCARD, DISCARD, OFF) \
+    X(FOGVOL__GL_COLOR_LOGIC_OP, DESKTOP, OFF) \
+    X(FOGVOL__GL_ALPHA_TEST, COMPAT, OFF) \
+    X(FOGVOL__GL_MULTISAMPLE, MSAA, SET) \
+    X(FOGVOL__GL_PRIMITIVE_RESTART, RESTART, OFF) \
+    X(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX, RESTART_FIXED, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 0, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 1, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 2, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 3, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 4, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 5, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 6, CLIP, OFF) \
+    X(FOGVOL__GL_CLIP_DISTANCE0 + 7, CLIP, OFF) \
+    X(FOGVOL__GL_DEPTH_CLAMP, DEPTH_CLAMP, OFF) \
+    X(FOGVOL__GL_SAMPLE_SHADING, SAMPLE_SHADING, OFF) \
+    X(FOGVOL__GL_SAMPLE_MASK, SAMPLE_MASK, OFF) \
+    X(FOGVOL__GL_POLYGON_SMOOTH, DESKTOP, OFF) \
+    X(FOGVOL__GL_POLYGON_STIPPLE, COMPAT, OFF)
+#define FOGVOL__GL_ONE(cap, when, pass) +1
+enum { FOGVOL__GL_N_ENABLES = 0 FOGVOL__GL_ENABLES(FOGVOL__GL_ONE) };
+#undef FOGVOL__GL_ONE
+
 typedef struct fogvol__gl_state {
-    fogvol__GLint draw_fbo, read_fbo, renderbuffer, viewport[4], scissor_box[4], program, vao, array_buffer,
-        element_buffer, active_texture, tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS];
-    fogvol__GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
-    fogvol__GLint depth_func, cull_mode, front_face, polygon_mode[2];
+    /* bindings (fogvol__gl_save_bindings, fogvol__gl_save_msaa) */
+    fogvol__GLint draw_fbo, read_fbo, renderbuffer, program, vao, array_buffer, element_buffer, active_texture,
+        tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS], unpack_buffer, pack_buffer;
+    fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
+    void *a0_pointer;
+    fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
+    fogvol__GLfloat min_sample_shading;
+    /* the rows of fogvol__gl_values */
+    fogvol__GLint viewport[4], scissor_box[4], blend_func[4], blend_eq[2], depth_func, cull_mode, front_face,
+        polygon_mode[2];
+    fogvol__GLint st_func[3], st_op[3], st_wmask, stb_func[3], stb_op[3], stb_wmask, st_clear; /* stb: back */
+    fogvol__GLint pixel_align[2], unpack_rows[3], pack_rows[3]; /* row length, skip rows, skip pixels */
     fogvol__GLboolean depth_mask, color_mask[4];
-    fogvol__GLfloat clear_color[4], clear_depth;
+    fogvol__GLfloat clear_color[4];
+    /* the rows of FOGVOL__GL_ENABLES, in order */
+    fogvol__GLboolean enabled[FOGVOL__GL_N_ENABLES];
+    /* fogvol__gl_save_depth */
+    fogvol__GLfloat clear_depth;
     fogvol__GLdouble clear_depth_d; /* desktop: kept in double so it comes back exactly */
     fogvol__GLdouble depth_range_d[2]; /* desktop (double, exact); GLES: depth_range */
     fogvol__GLfloat depth_range[2];
     fogvol__GLint clip_origin, clip_depth; /* with clip control */
-    fogvol__GLint st_func, st_ref, st_vmask, st_fail, st_zfail, st_zpass, st_wmask;
-    fogvol__GLint stb_func, stb_ref, stb_vmask, stb_fail, stb_zfail, stb_zpass, stb_wmask, st_clear;
-    fogvol__GLint unpack[4], pack[4], unpack_buffer, pack_buffer; /* alignment, row length, skip rows, skip pixels */
-    fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
-    void *a0_pointer;
-    fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
-    fogvol__GLboolean en_multisample;
-    fogvol__GLfloat min_sample_shading;
-    fogvol__GLboolean en_blend, en_depth, en_cull, en_scissor, en_stencil, en_dither, en_a2c, en_samplecov,
-        en_polyoffset, en_discard, en_logicop, en_alphatest;
     /* The engine framebuffer's draw buffers (an FBO's list; not read for the default framebuffer), and
-       per-draw-buffer blend state (GL 3.0 / 4.0, GLES 3.2) that the non-indexed calls overwrite. */
+       per-draw-buffer blend state (GL 3.0 / 4.0, GLES 3.2) that the non-indexed calls overwrite
+       (fogvol__gl_save_draw_buffers). */
     fogvol__GLint n_draw_buffers, draw_buffers[FOGVOL__GL_MAX_DB], draw_buffers_set;
     fogvol__GLint n_indexed, bi_src_rgb[FOGVOL__GL_MAX_DB], bi_dst_rgb[FOGVOL__GL_MAX_DB],
         bi_src_a[FOGVOL__GL_MAX_DB], bi_dst_a[FOGVOL__GL_MAX_DB], bi_eq_rgb[FOGVOL__GL_MAX_DB],
         bi_eq_a[FOGVOL__GL_MAX_DB];
     fogvol__GLboolean bi_mask[FOGVOL__GL_MAX_DB][4], bi_blend[FOGVOL__GL_MAX_DB];
-    /* Rasterisation, vertex fetch and fragment state fogvol's draws depend on (see fogvol__gl_save). */
-    fogvol__GLboolean en_restart, en_restart_fixed, en_clip[8], en_depth_clamp, en_sample_shading, en_sample_mask,
-        en_poly_smooth, en_poly_stipple;
 } fogvol__gl_state;
 
 /* Textures and targets share this header so either can be bound for sampling. */
@@ -7546,6 +7708,174 @@ static void fogvol__gl_enable(fogvol__gl *gl, fogvol__GLenum cap, int on)
     else gl->Disable(cap);
 }
 
+/* Which contexts have a piece of state (the W column of FOGVOL__GL_ENABLES, when of fogvol__gl_values). */
+enum {
+    FOGVOL__GLW_ALL, FOGVOL__GLW_DESKTOP, FOGVOL__GLW_COMPAT, FOGVOL__GLW_ROW_LENGTH, FOGVOL__GLW_DISCARD,
+    FOGVOL__GLW_MSAA, FOGVOL__GLW_RESTART, FOGVOL__GLW_RESTART_FIXED, FOGVOL__GLW_CLIP, FOGVOL__GLW_DEPTH_CLAMP,
+    FOGVOL__GLW_SAMPLE_SHADING, FOGVOL__GLW_SAMPLE_MASK
+};
+enum { FOGVOL__GLP_SET, FOGVOL__GLP_OFF };
+
+static int fogvol__gl_has(const fogvol__gl *gl, int when, fogvol__GLenum name)
+{
+    switch (when) {
+    case FOGVOL__GLW_DESKTOP: return !gl->gles;
+    case FOGVOL__GLW_COMPAT: return !gl->gles && !gl->core;
+    case FOGVOL__GLW_ROW_LENGTH: return gl->has_row_length;
+    case FOGVOL__GLW_DISCARD: return gl->has_discard;
+    case FOGVOL__GLW_MSAA: return gl->has_msaa;
+    case FOGVOL__GLW_RESTART: return gl->has_restart;
+    case FOGVOL__GLW_RESTART_FIXED: return gl->has_restart_fixed;
+    case FOGVOL__GLW_CLIP: return (int)(name - FOGVOL__GL_CLIP_DISTANCE0) < gl->n_clip;
+    case FOGVOL__GLW_DEPTH_CLAMP: return gl->has_depth_clamp;
+    case FOGVOL__GLW_SAMPLE_SHADING: return gl->has_sample_shading;
+    case FOGVOL__GLW_SAMPLE_MASK: return gl->has_sample_mask;
+    default: return 1;
+    }
+}
+
+typedef struct fogvol__gl_enable_row {
+    fogvol__GLenum cap;
+    unsigned char when, pass; /* FOGVOL__GLW_*, FOGVOL__GLP_* */
+} fogvol__gl_enable_row;
+
+static const fogvol__gl_enable_row fogvol__gl_enables[FOGVOL__GL_N_ENABLES] = {
+#define FOGVOL__GL_ENABLE_ROW(cap, when, pass) {(fogvol__GLenum)(cap), FOGVOL__GLW_##when, FOGVOL__GLP_##pass},
+    FOGVOL__GL_ENABLES(FOGVOL__GL_ENABLE_ROW)
+#undef FOGVOL__GL_ENABLE_ROW
+};
+
+/* The call that writes a row of fogvol__gl_values back. */
+enum {
+    FOGVOL__GLV_PIXEL_STORE, FOGVOL__GLV_VIEWPORT, FOGVOL__GLV_SCISSOR, FOGVOL__GLV_BLEND_FUNC, FOGVOL__GLV_BLEND_EQ,
+    FOGVOL__GLV_DEPTH_FUNC, FOGVOL__GLV_CULL_FACE, FOGVOL__GLV_FRONT_FACE, FOGVOL__GLV_POLYGON_MODE,
+    FOGVOL__GLV_DEPTH_MASK, FOGVOL__GLV_COLOR_MASK, FOGVOL__GLV_CLEAR_COLOR, FOGVOL__GLV_STENCIL_FUNC,
+    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL
+};
+
+/* Plain values: each name of a row is read with glGet<type>v into per consecutive values from the row's
+   field on, and the row is written back by one call (fogvol__gl_put). */
+typedef struct fogvol__gl_value_row {
+    unsigned char put, type, when, per; /* FOGVOL__GLV_*; 'i', 'b' or 'f'; FOGVOL__GLW_*; values per name */
+    unsigned short offset;              /* the field in fogvol__gl_state */
+    fogvol__GLenum arg;                 /* stencil: the face; pixel store: fogvol's value in its passes */
+    fogvol__GLenum names[4];            /* 0 ends the list */
+} fogvol__gl_value_row;
+
+#define FOGVOL__GL_AT(field) (unsigned short)offsetof(fogvol__gl_state, field)
+static const fogvol__gl_value_row fogvol__gl_values[] = {
+    {FOGVOL__GLV_VIEWPORT, 'i', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(viewport), 0, {FOGVOL__GL_VIEWPORT}},
+    {FOGVOL__GLV_SCISSOR, 'i', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(scissor_box), 0, {FOGVOL__GL_SCISSOR_BOX}},
+    {FOGVOL__GLV_BLEND_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(blend_func), 0,
+     {FOGVOL__GL_BLEND_SRC_RGB, FOGVOL__GL_BLEND_DST_RGB, FOGVOL__GL_BLEND_SRC_ALPHA, FOGVOL__GL_BLEND_DST_ALPHA}},
+    {FOGVOL__GLV_BLEND_EQ, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(blend_eq), 0,
+     {FOGVOL__GL_BLEND_EQUATION_RGB, FOGVOL__GL_BLEND_EQUATION_ALPHA}},
+    {FOGVOL__GLV_DEPTH_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(depth_func), 0, {FOGVOL__GL_DEPTH_FUNC}},
+    {FOGVOL__GLV_CULL_FACE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(cull_mode), 0, {FOGVOL__GL_CULL_FACE_MODE}},
+    {FOGVOL__GLV_FRONT_FACE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(front_face), 0, {FOGVOL__GL_FRONT_FACE}},
+    {FOGVOL__GLV_POLYGON_MODE, 'i', FOGVOL__GLW_DESKTOP, 2, FOGVOL__GL_AT(polygon_mode), 0, {FOGVOL__GL_POLYGON_MODE}},
+    {FOGVOL__GLV_DEPTH_MASK, 'b', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(depth_mask), 0, {FOGVOL__GL_DEPTH_WRITEMASK}},
+    {FOGVOL__GLV_COLOR_MASK, 'b', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(color_mask), 0, {FOGVOL__GL_COLOR_WRITEMASK}},
+    {FOGVOL__GLV_CLEAR_COLOR, 'f', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(clear_color), 0, {FOGVOL__GL_COLOR_CLEAR_VALUE}},
+    {FOGVOL__GLV_STENCIL_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_func), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_FUNC, FOGVOL__GL_STENCIL_REF, FOGVOL__GL_STENCIL_VALUE_MASK}},
+    {FOGVOL__GLV_STENCIL_OP, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_op), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_FAIL, FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL, FOGVOL__GL_STENCIL_PASS_DEPTH_PASS}},
+    {FOGVOL__GLV_STENCIL_MASK, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_wmask), FOGVOL__GL_FRONT,
+     {FOGVOL__GL_STENCIL_WRITEMASK}},
+    {FOGVOL__GLV_STENCIL_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_func), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_FUNC, FOGVOL__GL_STENCIL_BACK_REF, FOGVOL__GL_STENCIL_BACK_VALUE_MASK}},
+    {FOGVOL__GLV_STENCIL_OP, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_op), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_FAIL, FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL, FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS}},
+    {FOGVOL__GLV_STENCIL_MASK, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_wmask), FOGVOL__GL_BACK,
+     {FOGVOL__GL_STENCIL_BACK_WRITEMASK}},
+    {FOGVOL__GLV_CLEAR_STENCIL, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_clear), 0, {FOGVOL__GL_STENCIL_CLEAR_VALUE}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(pixel_align), 4,
+     {FOGVOL__GL_UNPACK_ALIGNMENT, FOGVOL__GL_PACK_ALIGNMENT}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(unpack_rows), 0,
+     {FOGVOL__GL_UNPACK_ROW_LENGTH, FOGVOL__GL_UNPACK_SKIP_ROWS, FOGVOL__GL_UNPACK_SKIP_PIXELS}},
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(pack_rows), 0,
+     {FOGVOL__GL_PACK_ROW_LENGTH, FOGVOL__GL_PACK_SKIP_ROWS, FOGVOL__GL_PACK_SKIP_PIXELS}}};
+#undef FOGVOL__GL_AT
+#define FOGVOL__GL_N_VALUES (int)(sizeof fogvol__gl_values / sizeof fogvol__gl_values[0])
+
+static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const void *p)
+{
+    const fogvol__GLint *v = (const fogvol__GLint *)p;
+    const fogvol__GLboolean *b = (const fogvol__GLboolean *)p;
+    const fogvol__GLfloat *f = (const fogvol__GLfloat *)p;
+    int k;
+    switch (r->put) {
+    case FOGVOL__GLV_VIEWPORT: gl->Viewport(v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_SCISSOR: gl->Scissor(v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_BLEND_FUNC:
+        gl->BlendFuncSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2], (fogvol__GLenum)v[3]);
+        break;
+    case FOGVOL__GLV_BLEND_EQ: gl->BlendEquationSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1]); break;
+    case FOGVOL__GLV_DEPTH_FUNC: gl->DepthFunc((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_CULL_FACE: gl->CullFace((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_FRONT_FACE: gl->FrontFace((fogvol__GLenum)v[0]); break;
+    case FOGVOL__GLV_POLYGON_MODE: /* core profiles accept only FRONT_AND_BACK; both entries hold the same mode */
+        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, (fogvol__GLenum)v[0]);
+        if (!gl->core && v[1] != v[0]) gl->PolygonMode(FOGVOL__GL_BACK, (fogvol__GLenum)v[1]);
+        break;
+    case FOGVOL__GLV_DEPTH_MASK: gl->DepthMask(b[0]); break;
+    case FOGVOL__GLV_COLOR_MASK: gl->ColorMask(b[0], b[1], b[2], b[3]); break;
+    case FOGVOL__GLV_CLEAR_COLOR: gl->ClearColor(f[0], f[1], f[2], f[3]); break;
+    case FOGVOL__GLV_STENCIL_FUNC:
+        gl->StencilFuncSeparate(r->arg, (fogvol__GLenum)v[0], v[1], (fogvol__GLuint)v[2]);
+        break;
+    case FOGVOL__GLV_STENCIL_OP:
+        gl->StencilOpSeparate(r->arg, (fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2]);
+        break;
+    case FOGVOL__GLV_STENCIL_MASK: gl->StencilMaskSeparate(r->arg, (fogvol__GLuint)v[0]); break;
+    case FOGVOL__GLV_CLEAR_STENCIL: gl->ClearStencil(v[0]); break;
+    default:
+        for (k = 0; k < 4 && r->names[k]; ++k) gl->PixelStorei(r->names[k], v[k]);
+        break;
+    }
+}
+
+/* Reads every row of both tables that the context has. */
+static void fogvol__gl_save_tables(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    int i, k;
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i) {
+        const fogvol__gl_value_row *r = &fogvol__gl_values[i];
+        void *p = (char *)s + r->offset;
+        if (!fogvol__gl_has(gl, r->when, 0)) continue;
+        for (k = 0; k < 4 && r->names[k]; ++k) {
+            if (r->type == 'b') gl->GetBooleanv(r->names[k], (fogvol__GLboolean *)p + k * r->per);
+            else if (r->type == 'f') gl->GetFloatv(r->names[k], (fogvol__GLfloat *)p + k * r->per);
+            else gl->GetIntegerv(r->names[k], (fogvol__GLint *)p + k * r->per);
+        }
+    }
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            s->enabled[i] = gl->IsEnabled(fogvol__gl_enables[i].cap);
+}
+
+static void fogvol__gl_restore_tables(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_values[i].when, 0))
+            fogvol__gl_put(gl, &fogvol__gl_values[i], (const char *)s + fogvol__gl_values[i].offset);
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            fogvol__gl_enable(gl, fogvol__gl_enables[i].cap, s->enabled[i]);
+}
+
+/* Every pass: the capabilities marked OFF turned off (fogvol__gl_begin_pass sets the others). */
+static void fogvol__gl_pass_enables(fogvol__gl *gl)
+{
+    int i;
+    for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
+        if (fogvol__gl_enables[i].pass == FOGVOL__GLP_OFF &&
+            fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
+            gl->Disable(fogvol__gl_enables[i].cap);
+}
+
 /* Multisample texture bindings of fogvol's units, multisampling and sample shading. */
 static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
 {
@@ -7558,8 +7888,7 @@ static void fogvol__gl_save_msaa(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegerv(FOGVOL__GL_TEXTURE_BINDING_2D_MULTISAMPLE, &s->tex2dms[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)active);
-    s->en_multisample = gl->IsEnabled(FOGVOL__GL_MULTISAMPLE);
-    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading); /* the enable: save_raster */
+    gl->GetFloatv(FOGVOL__GL_MIN_SAMPLE_SHADING_VALUE, &s->min_sample_shading); /* the enables: the table */
 }
 
 static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
@@ -7571,7 +7900,6 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, (fogvol__GLuint)s->tex2dms[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    fogvol__gl_enable(gl, FOGVOL__GL_MULTISAMPLE, s->en_multisample);
     gl->MinSampleShading(s->min_sample_shading);
 }
 
@@ -7595,35 +7923,9 @@ static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
     }
 }
 
-/* State beyond the GL 2.0 list of fogvol__gl_save that changes what fogvol draws; saved here, set to a
-   known value by fogvol__gl_set_raster in every pass, restored by fogvol__gl_restore_raster:
-   - the draw-buffer list of an engine FBO: the composite writes one buffer, the others stay intact;
-   - per-draw-buffer blend functions, equations, colour masks and blend enables: fogvol's non-indexed
-     calls overwrite every buffer's values;
-   - PRIMITIVE_RESTART (+ _FIXED_INDEX): would cut fogvol's index lists at the engine's restart index
-     (the index itself is never changed, so it is not saved);
-   - CLIP_DISTANCE0..7 (CLIP_PLANEi): fogvol's shaders write no gl_ClipDistance, so an enabled one is
-     undefined there;
-   - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
-   - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
-   - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
-   - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
-     GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
-   Judged irrelevant, not touched:
-   - MULTISAMPLE: fogvol's targets are single-sample; on a multisampled engine target the full-screen
-     composite covers every sample whether it is on or off;
-   - FRAMEBUFFER_SRGB: acts only on sRGB attachments, which fogvol's RGBA8/R32F targets are not; on an
-     sRGB engine target it selects the blending space the engine wants (see fogvol_ramp_desc);
-   - MIN_SAMPLE_SHADING_VALUE, PRIMITIVE_RESTART_INDEX: read only while their enables are on (fogvol
-     turns those off);
-   - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
-   - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
-   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
-     function reads them;
-   - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
-   - conditional rendering: it cannot be queried; fogvol must not be called between
-     glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
-static void fogvol__gl_save_raster(fogvol__gl *gl, fogvol__gl_state *s)
+/* The engine FBO's draw-buffer list and the per-draw-buffer colour masks, blend enables, functions
+   and equations (the module comment above FOGVOL__GL_ENABLES says why). */
+static void fogvol__gl_save_draw_buffers(fogvol__gl *gl, fogvol__gl_state *s)
 {
     int i;
     if (gl->max_draw_buffers > 0 && s->draw_fbo != 0)
@@ -7643,33 +7945,11 @@ static void fogvol__gl_save_raster(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_RGB, (fogvol__GLuint)i, &s->bi_eq_rgb[i]);
         gl->GetIntegeri_v(FOGVOL__GL_BLEND_EQUATION_ALPHA, (fogvol__GLuint)i, &s->bi_eq_a[i]);
     }
-    if (gl->has_restart) s->en_restart = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART);
-    if (gl->has_restart_fixed) s->en_restart_fixed = gl->IsEnabled(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
-    for (i = 0; i < gl->n_clip; ++i) s->en_clip[i] = gl->IsEnabled((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
-    if (gl->has_depth_clamp) s->en_depth_clamp = gl->IsEnabled(FOGVOL__GL_DEPTH_CLAMP);
-    if (gl->has_sample_shading) s->en_sample_shading = gl->IsEnabled(FOGVOL__GL_SAMPLE_SHADING);
-    if (gl->has_sample_mask) s->en_sample_mask = gl->IsEnabled(FOGVOL__GL_SAMPLE_MASK);
-    if (!gl->gles) s->en_poly_smooth = gl->IsEnabled(FOGVOL__GL_POLYGON_SMOOTH);
-    if (!gl->gles && !gl->core) s->en_poly_stipple = gl->IsEnabled(FOGVOL__GL_POLYGON_STIPPLE);
-}
-
-/* Known values for every pass (fogvol__gl_save_raster says why each matters). */
-static void fogvol__gl_set_raster(fogvol__gl *gl)
-{
-    int i;
-    if (gl->has_restart) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART);
-    if (gl->has_restart_fixed) gl->Disable(FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX);
-    for (i = 0; i < gl->n_clip; ++i) gl->Disable((fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i));
-    if (gl->has_depth_clamp) gl->Disable(FOGVOL__GL_DEPTH_CLAMP);
-    if (gl->has_sample_shading) gl->Disable(FOGVOL__GL_SAMPLE_SHADING);
-    if (gl->has_sample_mask) gl->Disable(FOGVOL__GL_SAMPLE_MASK);
-    if (!gl->gles) gl->Disable(FOGVOL__GL_POLYGON_SMOOTH);
-    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_POLYGON_STIPPLE);
 }
 
 /* Runs last in fogvol__gl_restore: the engine framebuffer is bound again and the non-indexed blend
    state is back, so the per-buffer values go on top of it. */
-static void fogvol__gl_restore_raster(fogvol__gl *gl, const fogvol__gl_state *s)
+static void fogvol__gl_restore_draw_buffers(fogvol__gl *gl, const fogvol__gl_state *s)
 {
     int i;
     if (s->draw_buffers_set) {
@@ -7688,15 +7968,6 @@ static void fogvol__gl_restore_raster(fogvol__gl *gl, const fogvol__gl_state *s)
         if (s->bi_blend[i]) gl->Enablei(FOGVOL__GL_BLEND, u);
         else gl->Disablei(FOGVOL__GL_BLEND, u);
     }
-    if (gl->has_restart) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART, s->en_restart);
-    if (gl->has_restart_fixed) fogvol__gl_enable(gl, FOGVOL__GL_PRIMITIVE_RESTART_FIXED_INDEX, s->en_restart_fixed);
-    for (i = 0; i < gl->n_clip; ++i)
-        fogvol__gl_enable(gl, (fogvol__GLenum)(FOGVOL__GL_CLIP_DISTANCE0 + i), s->en_clip[i]);
-    if (gl->has_depth_clamp) fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_CLAMP, s->en_depth_clamp);
-    if (gl->has_sample_shading) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, s->en_sample_shading);
-    if (gl->has_sample_mask) fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_MASK, s->en_sample_mask);
-    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_SMOOTH, s->en_poly_smooth);
-    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_STIPPLE, s->en_poly_stipple);
 }
 
 /* The engine's pending GL errors. glGetError returns and clears them, so the first fogvol entry of a
@@ -7761,33 +8032,41 @@ static void fogvol__gl_host_leave(fogvol__gl *gl)
     gl->host_n = 0;
 }
 
-static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
+/* Vertex attribute 0 where there is no vertex array object to keep it. */
+static void fogvol__gl_save_attrib0(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->a0_enabled);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE, &s->a0_size);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE, &s->a0_type);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED, &s->a0_normalized);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE, &s->a0_stride);
+    gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, &s->a0_buffer);
+    gl->GetVertexAttribPointerv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER, &s->a0_pointer);
+}
+
+static void fogvol__gl_restore_attrib0(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->a0_buffer);
+    gl->VertexAttribPointer(0, s->a0_size, (fogvol__GLenum)s->a0_type, (fogvol__GLboolean)s->a0_normalized,
+                            s->a0_stride, s->a0_pointer);
+    if (s->a0_enabled) gl->EnableVertexAttribArray(0);
+    else gl->DisableVertexAttribArray(0);
+    gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)s->element_buffer);
+}
+
+/* Framebuffers, renderbuffer, program, vertex input, textures and samplers of fogvol's units, pixel
+   buffers. */
+static void fogvol__gl_save_bindings(fogvol__gl *gl, fogvol__gl_state *s)
 {
     int i;
-    memset(s, 0, sizeof *s);
-    fogvol__gl_save_msaa(gl, s);
-    if (gl->has_split_fbo) {
-        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
-        gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
-    } else {
-        gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo); /* == FRAMEBUFFER_BINDING */
-    }
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo); /* == FRAMEBUFFER_BINDING */
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
     gl->GetIntegerv(FOGVOL__GL_RENDERBUFFER_BINDING, &s->renderbuffer);
-    gl->GetIntegerv(FOGVOL__GL_VIEWPORT, s->viewport);
-    gl->GetIntegerv(FOGVOL__GL_SCISSOR_BOX, s->scissor_box);
     gl->GetIntegerv(FOGVOL__GL_CURRENT_PROGRAM, &s->program);
     if (gl->has_vao) gl->GetIntegerv(FOGVOL__GL_VERTEX_ARRAY_BINDING, &s->vao);
     gl->GetIntegerv(FOGVOL__GL_ARRAY_BUFFER_BINDING, &s->array_buffer);
     gl->GetIntegerv(FOGVOL__GL_ELEMENT_ARRAY_BUFFER_BINDING, &s->element_buffer);
-    if (!gl->has_vao) {
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_ENABLED, &s->a0_enabled);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_SIZE, &s->a0_size);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_TYPE, &s->a0_type);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_NORMALIZED, &s->a0_normalized);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_STRIDE, &s->a0_stride);
-        gl->GetVertexAttribiv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, &s->a0_buffer);
-        gl->GetVertexAttribPointerv(0, FOGVOL__GL_VERTEX_ATTRIB_ARRAY_POINTER, &s->a0_pointer);
-    }
+    if (!gl->has_vao) fogvol__gl_save_attrib0(gl, s);
     gl->GetIntegerv(FOGVOL__GL_ACTIVE_TEXTURE, &s->active_texture);
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
@@ -7795,24 +8074,47 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
         if (gl->has_sampler) gl->GetIntegerv(FOGVOL__GL_SAMPLER_BINDING, &s->sampler[i]);
     }
     gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_RGB, &s->blend_src_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_RGB, &s->blend_dst_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_SRC_ALPHA, &s->blend_src_a);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_DST_ALPHA, &s->blend_dst_a);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_RGB, &s->blend_eq_rgb);
-    gl->GetIntegerv(FOGVOL__GL_BLEND_EQUATION_ALPHA, &s->blend_eq_a);
-    gl->GetIntegerv(FOGVOL__GL_DEPTH_FUNC, &s->depth_func);
-    gl->GetIntegerv(FOGVOL__GL_CULL_FACE_MODE, &s->cull_mode);
-    gl->GetIntegerv(FOGVOL__GL_FRONT_FACE, &s->front_face);
-    if (!gl->gles) gl->GetIntegerv(FOGVOL__GL_POLYGON_MODE, s->polygon_mode);
-    gl->GetBooleanv(FOGVOL__GL_DEPTH_WRITEMASK, &s->depth_mask);
-    gl->GetBooleanv(FOGVOL__GL_COLOR_WRITEMASK, s->color_mask);
-    gl->GetFloatv(FOGVOL__GL_COLOR_CLEAR_VALUE, s->clear_color);
-    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
-    else gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
-    if (gl->gles) gl->GetFloatv(FOGVOL__GL_DEPTH_RANGE, s->depth_range);
-    else gl->GetDoublev(FOGVOL__GL_DEPTH_RANGE, s->depth_range_d);
-    if (!gl->gles) {
+    if (gl->has_pixel_buffers) {
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
+        gl->GetIntegerv(FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
+    }
+}
+
+static void fogvol__gl_restore_bindings(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    int i;
+    if (gl->has_split_fbo) {
+        gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+        gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
+    } else {
+        gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
+    }
+    gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
+    gl->UseProgram((fogvol__GLuint)s->program);
+    if (gl->has_vao) gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
+    else fogvol__gl_restore_attrib0(gl, s);
+    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, (fogvol__GLuint)s->tex2d[i]);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, (fogvol__GLuint)s->sampler[i]);
+    }
+    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
+    if (gl->has_pixel_buffers) {
+        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, (fogvol__GLuint)s->unpack_buffer);
+        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, (fogvol__GLuint)s->pack_buffer);
+    }
+}
+
+/* Depth clear value and depth range (double on desktop GL, so they come back exactly), clip control. */
+static void fogvol__gl_save_depth(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    if (gl->gles) {
+        gl->GetFloatv(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
+        gl->GetFloatv(FOGVOL__GL_DEPTH_RANGE, s->depth_range);
+    } else {
+        gl->GetDoublev(FOGVOL__GL_DEPTH_CLEAR_VALUE, &s->clear_depth_d);
+        gl->GetDoublev(FOGVOL__GL_DEPTH_RANGE, s->depth_range_d);
         s->depth_range[0] = (fogvol__GLfloat)s->depth_range_d[0];
         s->depth_range[1] = (fogvol__GLfloat)s->depth_range_d[1];
     }
@@ -7822,156 +8124,53 @@ static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
         gl->GetIntegerv(FOGVOL__GL_CLIP_ORIGIN, &s->clip_origin);
         gl->GetIntegerv(FOGVOL__GL_CLIP_DEPTH_MODE, &s->clip_depth);
     }
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_FUNC, &s->st_func);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_REF, &s->st_ref);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_VALUE_MASK, &s->st_vmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_FAIL, &s->st_fail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_FAIL, &s->st_zfail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_PASS_DEPTH_PASS, &s->st_zpass);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_WRITEMASK, &s->st_wmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FUNC, &s->stb_func);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_REF, &s->stb_ref);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_VALUE_MASK, &s->stb_vmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_FAIL, &s->stb_fail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_FAIL, &s->stb_zfail);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_PASS_DEPTH_PASS, &s->stb_zpass);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_BACK_WRITEMASK, &s->stb_wmask);
-    gl->GetIntegerv(FOGVOL__GL_STENCIL_CLEAR_VALUE, &s->st_clear);
-    gl->GetIntegerv(FOGVOL__GL_UNPACK_ALIGNMENT, &s->unpack[0]);
-    gl->GetIntegerv(FOGVOL__GL_PACK_ALIGNMENT, &s->pack[0]);
-    if (gl->has_row_length) {
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_ROW_LENGTH, &s->unpack[1]);
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_ROWS, &s->unpack[2]);
-        gl->GetIntegerv(FOGVOL__GL_UNPACK_SKIP_PIXELS, &s->unpack[3]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_ROW_LENGTH, &s->pack[1]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_ROWS, &s->pack[2]);
-        gl->GetIntegerv(FOGVOL__GL_PACK_SKIP_PIXELS, &s->pack[3]);
+}
+
+static void fogvol__gl_restore_depth(fogvol__gl *gl, const fogvol__gl_state *s)
+{
+    if (gl->gles) {
+        gl->ClearDepthf(s->clear_depth);
+        gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
+    } else {
+        gl->ClearDepth(s->clear_depth_d);
+        gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
     }
-    if (gl->has_pixel_buffers) {
-        gl->GetIntegerv(FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
-        gl->GetIntegerv(FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
-    }
-    s->en_blend = gl->IsEnabled(FOGVOL__GL_BLEND);
-    s->en_depth = gl->IsEnabled(FOGVOL__GL_DEPTH_TEST);
-    s->en_cull = gl->IsEnabled(FOGVOL__GL_CULL_FACE);
-    s->en_scissor = gl->IsEnabled(FOGVOL__GL_SCISSOR_TEST);
-    s->en_stencil = gl->IsEnabled(FOGVOL__GL_STENCIL_TEST);
-    s->en_dither = gl->IsEnabled(FOGVOL__GL_DITHER);
-    s->en_a2c = gl->IsEnabled(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
-    s->en_samplecov = gl->IsEnabled(FOGVOL__GL_SAMPLE_COVERAGE);
-    s->en_polyoffset = gl->IsEnabled(FOGVOL__GL_POLYGON_OFFSET_FILL);
-    if (gl->has_discard) s->en_discard = gl->IsEnabled(FOGVOL__GL_RASTERIZER_DISCARD);
-    if (!gl->gles) s->en_logicop = gl->IsEnabled(FOGVOL__GL_COLOR_LOGIC_OP);
-    if (!gl->gles && !gl->core) s->en_alphatest = gl->IsEnabled(FOGVOL__GL_ALPHA_TEST);
-    fogvol__gl_save_raster(gl, s);
+    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
+}
+
+static void fogvol__gl_save(fogvol__gl *gl, fogvol__gl_state *s)
+{
+    memset(s, 0, sizeof *s);
+    fogvol__gl_save_msaa(gl, s);
+    fogvol__gl_save_bindings(gl, s);
+    fogvol__gl_save_tables(gl, s);
+    fogvol__gl_save_depth(gl, s);
+    fogvol__gl_save_draw_buffers(gl, s); /* after the bindings: reads the engine FBO's list */
 }
 
 static void fogvol__gl_restore(fogvol__gl *gl, const fogvol__gl_state *s)
 {
-    int i;
     fogvol__gl_restore_msaa(gl, s);
-    if (gl->has_split_fbo) {
-        gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
-        gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)s->read_fbo);
-    } else {
-        gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
-    }
-    gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
-    gl->Viewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
-    gl->Scissor(s->scissor_box[0], s->scissor_box[1], s->scissor_box[2], s->scissor_box[3]);
-    gl->UseProgram((fogvol__GLuint)s->program);
-    if (gl->has_vao) {
-        gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
-    } else {
-        gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->a0_buffer);
-        gl->VertexAttribPointer(0, s->a0_size, (fogvol__GLenum)s->a0_type, (fogvol__GLboolean)s->a0_normalized,
-                                s->a0_stride, s->a0_pointer);
-        if (s->a0_enabled) gl->EnableVertexAttribArray(0);
-        else gl->DisableVertexAttribArray(0);
-        gl->BindBuffer(FOGVOL__GL_ELEMENT_ARRAY_BUFFER, (fogvol__GLuint)s->element_buffer);
-    }
-    gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);
-    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
-        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, (fogvol__GLuint)s->tex2d[i]);
-        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, (fogvol__GLuint)s->sampler[i]);
-    }
-    gl->ActiveTexture((fogvol__GLenum)s->active_texture);
-    gl->BlendFuncSeparate((fogvol__GLenum)s->blend_src_rgb, (fogvol__GLenum)s->blend_dst_rgb,
-                          (fogvol__GLenum)s->blend_src_a, (fogvol__GLenum)s->blend_dst_a);
-    gl->BlendEquationSeparate((fogvol__GLenum)s->blend_eq_rgb, (fogvol__GLenum)s->blend_eq_a);
-    gl->DepthFunc((fogvol__GLenum)s->depth_func);
-    gl->CullFace((fogvol__GLenum)s->cull_mode);
-    gl->FrontFace((fogvol__GLenum)s->front_face);
-    if (!gl->gles) {
-        /* core profiles accept only FRONT_AND_BACK; both entries hold the same mode there */
-        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, (fogvol__GLenum)s->polygon_mode[0]);
-        if (!gl->core && s->polygon_mode[1] != s->polygon_mode[0])
-            gl->PolygonMode(FOGVOL__GL_BACK, (fogvol__GLenum)s->polygon_mode[1]);
-    }
-    gl->DepthMask(s->depth_mask);
-    gl->ColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
-    gl->ClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
-    if (gl->gles) gl->ClearDepthf(s->clear_depth);
-    else gl->ClearDepth(s->clear_depth_d);
-    if (gl->gles) gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
-    else gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
-    if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
-    gl->StencilFuncSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_func, s->st_ref, (fogvol__GLuint)s->st_vmask);
-    gl->StencilOpSeparate(FOGVOL__GL_FRONT, (fogvol__GLenum)s->st_fail, (fogvol__GLenum)s->st_zfail,
-                          (fogvol__GLenum)s->st_zpass);
-    gl->StencilMaskSeparate(FOGVOL__GL_FRONT, (fogvol__GLuint)s->st_wmask);
-    gl->StencilFuncSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_func, s->stb_ref, (fogvol__GLuint)s->stb_vmask);
-    gl->StencilOpSeparate(FOGVOL__GL_BACK, (fogvol__GLenum)s->stb_fail, (fogvol__GLenum)s->stb_zfail,
-                          (fogvol__GLenum)s->stb_zpass);
-    gl->StencilMaskSeparate(FOGVOL__GL_BACK, (fogvol__GLuint)s->stb_wmask);
-    gl->ClearStencil(s->st_clear);
-    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, s->unpack[0]);
-    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, s->pack[0]);
-    if (gl->has_row_length) {
-        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, s->unpack[1]);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, s->unpack[2]);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, s->unpack[3]);
-        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, s->pack[1]);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, s->pack[2]);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, s->pack[3]);
-    }
-    if (gl->has_pixel_buffers) {
-        gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, (fogvol__GLuint)s->unpack_buffer);
-        gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, (fogvol__GLuint)s->pack_buffer);
-    }
-    fogvol__gl_enable(gl, FOGVOL__GL_BLEND, s->en_blend);
-    fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, s->en_depth);
-    fogvol__gl_enable(gl, FOGVOL__GL_CULL_FACE, s->en_cull);
-    fogvol__gl_enable(gl, FOGVOL__GL_SCISSOR_TEST, s->en_scissor);
-    fogvol__gl_enable(gl, FOGVOL__GL_STENCIL_TEST, s->en_stencil);
-    fogvol__gl_enable(gl, FOGVOL__GL_DITHER, s->en_dither);
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, s->en_a2c);
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_COVERAGE, s->en_samplecov);
-    fogvol__gl_enable(gl, FOGVOL__GL_POLYGON_OFFSET_FILL, s->en_polyoffset);
-    if (gl->has_discard) fogvol__gl_enable(gl, FOGVOL__GL_RASTERIZER_DISCARD, s->en_discard);
-    if (!gl->gles) fogvol__gl_enable(gl, FOGVOL__GL_COLOR_LOGIC_OP, s->en_logicop);
-    if (!gl->gles && !gl->core) fogvol__gl_enable(gl, FOGVOL__GL_ALPHA_TEST, s->en_alphatest);
-    fogvol__gl_restore_raster(gl, s);
+    fogvol__gl_restore_bindings(gl, s);
+    fogvol__gl_restore_tables(gl, s);
+    fogvol__gl_restore_depth(gl, s);
+    fogvol__gl_restore_draw_buffers(gl, s);
 }
 
-/* Pixel-transfer state fogvol's uploads and read-backs assume. */
+/* Pixel-transfer state fogvol's uploads and read-backs assume: no pixel buffers, and the pixel-store
+   rows of fogvol__gl_values at their arg values. */
 static void fogvol__gl_pixel_defaults(fogvol__gl *gl)
 {
+    int i, k;
     if (gl->has_pixel_buffers) {
         gl->BindBuffer(FOGVOL__GL_PIXEL_UNPACK_BUFFER, 0);
         gl->BindBuffer(FOGVOL__GL_PIXEL_PACK_BUFFER, 0);
     }
-    if (gl->has_row_length) {
-        gl->PixelStorei(FOGVOL__GL_UNPACK_ROW_LENGTH, 0);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_ROWS, 0);
-        gl->PixelStorei(FOGVOL__GL_UNPACK_SKIP_PIXELS, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_ROW_LENGTH, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_ROWS, 0);
-        gl->PixelStorei(FOGVOL__GL_PACK_SKIP_PIXELS, 0);
+    for (i = 0; i < FOGVOL__GL_N_VALUES; ++i) {
+        const fogvol__gl_value_row *r = &fogvol__gl_values[i];
+        if (r->put != FOGVOL__GLV_PIXEL_STORE || !fogvol__gl_has(gl, r->when, 0)) continue;
+        for (k = 0; k < 4 && r->names[k]; ++k) gl->PixelStorei(r->names[k], (fogvol__GLint)r->arg);
     }
-    gl->PixelStorei(FOGVOL__GL_UNPACK_ALIGNMENT, 4);
-    gl->PixelStorei(FOGVOL__GL_PACK_ALIGNMENT, 4);
 }
 
 /* Resource entries called outside a frame save and restore the state they touch. */
@@ -8151,6 +8350,53 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
     fogvol__free(&gl->alloc, t);
 }
 
+/* WIDE: a second RGBA8 texture at attachment 1 of t's bound FBO, also a target of its own (own FBO,
+   for reading it back); t->second stays NULL when out of memory. */
+static void fogvol__gl_target_second(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_target_desc *d)
+{
+    static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
+    fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
+    if (!t2) return;
+    memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
+    t2->width = d->width;
+    t2->height = d->height;
+    t2->format = FOGVOL_FORMAT_RGBA8;
+    t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
+                                          FOGVOL__GL_CLAMP_TO_EDGE, NULL);
+    gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
+                             t2->base.tex, 0);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D,
+                             t2->base.tex, 0);
+    gl->DrawBuffers(2, bufs); /* framebuffer state of our FBO */
+    t->second = t2;
+}
+
+/* The depth renderbuffer of t's bound FBO: another target's (share_depth) or a new one. */
+static void fogvol__gl_target_depth(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_target_desc *d)
+{
+    if (d->share_depth) {
+        t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    } else if (d->depth) {
+        t->owns_depth = 1;
+        gl->GenRenderbuffers(1, &t->depth);
+        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
+        if (t->base.samples)
+            gl->RenderbufferStorageMultisample(FOGVOL__GL_RENDERBUFFER, d->samples, FOGVOL__GL_DEPTH_COMPONENT24,
+                                               d->width, d->height);
+        else
+            gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
+                                    gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
+                                    d->width, d->height);
+        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
+                                    t->depth);
+    }
+}
+
 static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -8185,45 +8431,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
                              t->base.samples ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
                                              : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D,
                              t->base.tex, 0);
-    if (d->color_count == 2 && gl->DrawBuffers) { /* WIDE: a second RGBA8 texture at attachment 1 */
-        static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
-        fogvol__gl_target *t2 = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t2);
-        if (t2) {
-            memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
-            t2->width = d->width;
-            t2->height = d->height;
-            t2->format = FOGVOL_FORMAT_RGBA8;
-            t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
-                                                  FOGVOL__GL_CLAMP_TO_EDGE, NULL);
-            gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
-            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
-            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_TEXTURE_2D,
-                                     t2->base.tex, 0);
-            gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
-            gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D,
-                                     t2->base.tex, 0);
-            gl->DrawBuffers(2, bufs); /* framebuffer state of our FBO */
-            t->second = t2;
-        }
-    }
-    if (d->share_depth) {
-        t->depth = ((const fogvol__gl_target *)d->share_depth)->depth;
-        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
-                                    t->depth);
-    } else if (d->depth) {
-        t->owns_depth = 1;
-        gl->GenRenderbuffers(1, &t->depth);
-        gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, t->depth);
-        if (t->base.samples)
-            gl->RenderbufferStorageMultisample(FOGVOL__GL_RENDERBUFFER, d->samples, FOGVOL__GL_DEPTH_COMPONENT24,
-                                               d->width, d->height);
-        else
-            gl->RenderbufferStorage(FOGVOL__GL_RENDERBUFFER,
-                                    gl->gles && gl->major < 3 ? FOGVOL__GL_DEPTH_COMPONENT16 : FOGVOL__GL_DEPTH_COMPONENT24,
-                                    d->width, d->height);
-        gl->FramebufferRenderbuffer(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_RENDERBUFFER,
-                                    t->depth);
-    }
+    if (d->color_count == 2 && gl->DrawBuffers) fogvol__gl_target_second(gl, t, d);
+    fogvol__gl_target_depth(gl, t, d);
     status = gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_target");
     if (r == FOGVOL_SUCCESS && d->color_count == 2 && !t->second) r = FOGVOL_ERROR_OUT_OF_MEMORY;
@@ -8471,25 +8680,81 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__free(&gl->alloc, m);
 }
 
+/* Blending of a pass: off, sums (add, or dst - src), or the composite over the engine's colour. */
+static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
+{
+    switch (p->blend) {
+    case FOGVOL_PASS_BLEND_ADD:
+    case FOGVOL_PASS_BLEND_SUBTRACT:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
+        break;
+    case FOGVOL_PASS_BLEND_FOG:
+    case FOGVOL_PASS_BLEND_LIGHT:
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
+                              p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
+                              p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
+                              p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
+        break;
+    default: gl->Disable(FOGVOL__GL_BLEND); break;
+    }
+    if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_REVERSE_SUBTRACT, FOGVOL__GL_FUNC_REVERSE_SUBTRACT);
+    else
+        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+}
+
+/* The stencil guard of a pass: its bit cleared over the viewport, then each pixel blended once. */
+static void fogvol__gl_pass_guard(fogvol__gl *gl, const fogvol_pass *p)
+{
+    gl->guard = p->stencil_guard;
+    if (!p->stencil_guard) {
+        gl->Disable(FOGVOL__GL_STENCIL_TEST);
+        return;
+    }
+    gl->guard_bit = p->stencil_bit;
+    memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
+    gl->Enable(FOGVOL__GL_STENCIL_TEST);
+    gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
+    gl->ClearStencil(0);
+    gl->Enable(FOGVOL__GL_SCISSOR_TEST);
+    gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
+    gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
+    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
+                            p->stencil_bit);
+    gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
+}
+
+/* The program of a pass with its uniforms, and its textures on fogvol's units. */
+static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
+{
+    int i;
+    gl->program = (fogvol__gl_program *)p->program;
+    gl->UseProgram(gl->program ? gl->program->id : 0);
+    if (gl->program)
+        for (i = 0; i < FOGVOL_U_COUNT; ++i)
+            if (gl->program->u_vec[i] >= 0) gl->Uniform4fv(gl->program->u_vec[i], 1, p->uniforms[i]);
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
+        /* texture and target handles both start with the texture name */
+        fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
+        if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
+        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
+        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
+        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
+    }
+}
+
 static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_target *t = (const fogvol__gl_target *)p->target;
-    int i;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
-    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-    gl->Disable(FOGVOL__GL_DITHER);
-    gl->Disable(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE);
-    gl->Disable(FOGVOL__GL_SAMPLE_COVERAGE);
-    gl->Disable(FOGVOL__GL_POLYGON_OFFSET_FILL);
-    if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
-    if (!gl->gles) {
-        gl->Disable(FOGVOL__GL_COLOR_LOGIC_OP);
-        gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
-    }
-    if (!gl->gles && !gl->core) gl->Disable(FOGVOL__GL_ALPHA_TEST);
-    fogvol__gl_set_raster(gl);
+    fogvol__gl_pass_enables(gl);
+    if (!gl->gles) gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
     if (!t && (gl->saved.n_draw_buffers > 1 || p->draw_buffer > 0)) { /* only the named engine buffer */
         fogvol__GLenum buf = (fogvol__GLenum)gl->saved.draw_buffers[p->draw_buffer];
         gl->DrawBuffers(1, &buf);
@@ -8511,26 +8776,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         }
         gl->Clear(bits);
     }
-    switch (p->blend) {
-    case FOGVOL_PASS_BLEND_ADD:
-    case FOGVOL_PASS_BLEND_SUBTRACT:
-        gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE, FOGVOL__GL_ONE);
-        break;
-    case FOGVOL_PASS_BLEND_FOG:
-    case FOGVOL_PASS_BLEND_LIGHT:
-        gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
-                              p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
-                              p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
-                              p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
-        break;
-    default: gl->Disable(FOGVOL__GL_BLEND); break;
-    }
-    if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
-        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_REVERSE_SUBTRACT, FOGVOL__GL_FUNC_REVERSE_SUBTRACT);
-    else
-        gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
+    fogvol__gl_pass_blend(gl, p);
     if (p->cull == FOGVOL_CULL_NONE) {
         gl->Disable(FOGVOL__GL_CULL_FACE);
     } else {
@@ -8541,37 +8787,8 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
     gl->DepthFunc(FOGVOL__GL_LESS);
     gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
-    gl->guard = p->stencil_guard;
-    if (p->stencil_guard) {
-        gl->guard_bit = p->stencil_bit;
-        memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
-        gl->Enable(FOGVOL__GL_STENCIL_TEST);
-        gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
-        gl->ClearStencil(0);
-        gl->Enable(FOGVOL__GL_SCISSOR_TEST);
-        gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
-        gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
-        gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-        gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
-                                p->stencil_bit);
-        gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
-    } else {
-        gl->Disable(FOGVOL__GL_STENCIL_TEST);
-    }
-    gl->program = (fogvol__gl_program *)p->program;
-    gl->UseProgram(gl->program ? gl->program->id : 0);
-    if (gl->program)
-        for (i = 0; i < FOGVOL_U_COUNT; ++i)
-            if (gl->program->u_vec[i] >= 0) gl->Uniform4fv(gl->program->u_vec[i], 1, p->uniforms[i]);
-    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
-        /* texture and target handles both start with the texture name */
-        fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
-        if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
-        gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
-        if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
-    }
+    fogvol__gl_pass_guard(gl, p);
+    fogvol__gl_pass_program(gl, p);
     fogvol__gl_sample_pass(gl, p);
 }
 
@@ -8864,7 +9081,7 @@ static int fogvol__gl_load_msaa(fogvol__gl *gl, const fogvol_gl_desc *desc)
     return gl->has_msaa;
 }
 
-/* Which of the state that fogvol__gl_save_raster handles the context has. */
+/* Which of the state of FOGVOL__GL_ENABLES and fogvol__gl_save_draw_buffers the context has. */
 static void fogvol__gl_raster_caps(fogvol__gl *gl)
 {
     fogvol__GLint n = 0;
@@ -8896,53 +9113,28 @@ static void fogvol__parse_version(const char *s, int *major, int *minor)
     while (*s >= '0' && *s <= '9') *minor = *minor * 10 + (*s++ - '0');
 }
 
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
-                                                  const fogvol_logger *logger, fogvol_backend *out)
-{
-    static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
-    fogvol_mesh_data tri_data;
-    fogvol__gl *gl;
-    fogvol_logger silent;
-    const char *ver, *ext = NULL;
-    const char *fbo_suffix = "";
-    fogvol_result r;
-    int need_vao;
-    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    memset(&silent, 0, sizeof silent);
-    if (!logger) logger = &silent;
-    if (!desc || !desc->get_proc_address) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
-    if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    memset(gl, 0, sizeof *gl);
-    if (alloc) gl->alloc = *alloc;
-    gl->log = *logger;
-
 #define FOGVOL__GL_LOAD(ret, name, params) \
     gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
-    FOGVOL__GL_BASE(FOGVOL__GL_LOAD)
-#undef FOGVOL__GL_LOAD
 #define FOGVOL__GL_REQUIRE(ret, name, params) \
     if (!gl->name) { \
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function gl%s is missing", #name); \
-        fogvol__free(alloc, gl); \
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function gl%s is missing", #name); \
         return FOGVOL_ERROR_MISSING_FUNCTION; \
     }
-    FOGVOL__GL_BASE(FOGVOL__GL_REQUIRE)
 
-    ver = (const char *)gl->GetString(FOGVOL__GL_VERSION);
-    if (!ver) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: glGetString(GL_VERSION) returned NULL: no current context?");
-        fogvol__free(alloc, gl);
+/* The GL 1.x/2.0 functions, then the context's version and profile (or the older one desc asks for):
+   GL 2.0 / GLES 2.0 at least. */
+static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *desc, const char **ver)
+{
+    FOGVOL__GL_BASE(FOGVOL__GL_LOAD)
+    FOGVOL__GL_BASE(FOGVOL__GL_REQUIRE)
+    *ver = (const char *)gl->GetString(FOGVOL__GL_VERSION);
+    if (!*ver) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: glGetString(GL_VERSION) returned NULL: no current context?");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    gl->gles = strncmp(ver, "OpenGL ES", 9) == 0;
-    gl->webgl = gl->gles && strstr(ver, "WebGL") != NULL;
-    fogvol__parse_version(ver, &gl->major, &gl->minor);
+    gl->gles = strncmp(*ver, "OpenGL ES", 9) == 0;
+    gl->webgl = gl->gles && strstr(*ver, "WebGL") != NULL;
+    fogvol__parse_version(*ver, &gl->major, &gl->minor);
     if (!gl->gles && (gl->major > 3 || (gl->major == 3 && gl->minor >= 2))) {
         fogvol__GLint mask = 0;
         gl->GetIntegerv(FOGVOL__GL_CONTEXT_PROFILE_MASK, &mask);
@@ -8955,11 +9147,19 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
                     gl->gles ? "OpenGL ES" : "OpenGL", gl->major, gl->minor);
-        fogvol__free(alloc, gl);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
+    return FOGVOL_SUCCESS;
+}
+
+/* Framebuffer objects (core, ARB_framebuffer_object or EXT_framebuffer_object: fbo_suffix "EXT") and
+   what else the version has; ext: the GL 2 / GLES 2 extension string (NULL on 3.x and later). */
+static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *desc, const char **ext)
+{
+    const char *fbo_suffix = "";
+    char name[64];
     gl->has_split_fbo = gl->major >= 3;
     gl->has_vao = gl->major >= 3;
     gl->has_sampler = gl->gles ? gl->major >= 3 : (gl->major > 3 || (gl->major == 3 && gl->minor >= 3));
@@ -8967,36 +9167,35 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     gl->has_row_length = !gl->gles || gl->major >= 3;
     gl->has_discard = gl->major >= 3;
     gl->has_uint_index = !gl->gles || gl->major >= 3;
-    if (gl->major < 3) ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
-    if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(ext, "GL_OES_element_index_uint");
-    if (!gl->gles && gl->major < 3 && !fogvol__has_ext(ext, "GL_ARB_framebuffer_object")) {
-        if (!fogvol__has_ext(ext, "GL_EXT_framebuffer_object")) {
-            fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: GL %d.%d without framebuffer objects", gl->major, gl->minor);
-            fogvol__free(alloc, gl);
+    if (gl->major < 3) *ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
+    if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(*ext, "GL_OES_element_index_uint");
+    if (!gl->gles && gl->major < 3 && !fogvol__has_ext(*ext, "GL_ARB_framebuffer_object")) {
+        if (!fogvol__has_ext(*ext, "GL_EXT_framebuffer_object")) {
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL %d.%d without framebuffer objects", gl->major,
+                        gl->minor);
             return FOGVOL_ERROR_UNSUPPORTED;
         }
         fbo_suffix = "EXT";
     }
     if (!gl->gles && gl->major < 3) /* ARB_framebuffer_object / EXT_framebuffer_blit: separate read and draw */
-        gl->has_split_fbo = fogvol__has_ext(ext, "GL_ARB_framebuffer_object") ||
-                            fogvol__has_ext(ext, "GL_EXT_framebuffer_blit");
-    {
-        char name[64];
+        gl->has_split_fbo = fogvol__has_ext(*ext, "GL_ARB_framebuffer_object") ||
+                            fogvol__has_ext(*ext, "GL_EXT_framebuffer_blit");
 #define FOGVOL__GL_LOAD_FBO(ret, nm, params) \
     snprintf(name, sizeof name, "gl%s%s", #nm, fbo_suffix); \
     gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
     if (!gl->nm) { \
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
-        fogvol__free(alloc, gl); \
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
         return FOGVOL_ERROR_MISSING_FUNCTION; \
     }
-        FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
+    FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
 #undef FOGVOL__GL_LOAD_FBO
-    }
-#define FOGVOL__GL_LOAD(ret, name, params) \
-    gl->name = (fogvol__PFN_##name)desc->get_proc_address("gl" #name, desc->user_data);
-    need_vao = gl->has_vao;
-    if (need_vao) {
+    return FOGVOL_SUCCESS;
+}
+
+/* The functions of the later versions that the context has. */
+static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
+    if (gl->has_vao) {
         FOGVOL__GL_VAO(FOGVOL__GL_LOAD)
         FOGVOL__GL_VAO(FOGVOL__GL_REQUIRE)
     }
@@ -9047,20 +9246,14 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         FOGVOL__GL_DESKTOP(FOGVOL__GL_LOAD)
         FOGVOL__GL_DESKTOP(FOGVOL__GL_REQUIRE)
     }
+    return FOGVOL_SUCCESS;
+}
 #undef FOGVOL__GL_LOAD
 #undef FOGVOL__GL_REQUIRE
 
-    gl->dialect = desc->dialect;
-    if (gl->dialect == FOGVOL_GLSL_AUTO) {
-        if (gl->gles) gl->dialect = gl->major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
-        else if (gl->major > 3 || (gl->major == 3 && gl->minor >= 3)) gl->dialect = FOGVOL_GLSL_330;
-        else if (gl->major == 3 && gl->minor == 2) gl->dialect = FOGVOL_GLSL_150;
-        else if (gl->major == 3) gl->dialect = FOGVOL_GLSL_130;
-        else gl->dialect = gl->minor >= 1 ? FOGVOL_GLSL_120 : FOGVOL_GLSL_110;
-    }
-    gl->stencil_override = desc->stencil_bits;
-    gl->caps = fogvol__gl_caps(gl, ext);
-    if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+/* GL 4.5 / ARB_clip_control, or GLES EXT_clip_control (glClipControlEXT). */
+static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
     if (!gl->gles && (gl->major > 4 || (gl->major == 4 && gl->minor >= 5) ||
                       (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_ARB_clip_control")
                                       : fogvol__has_ext(ext, "GL_ARB_clip_control"))))
@@ -9068,6 +9261,20 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     else if (gl->gles && (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_clip_control")
                                          : fogvol__has_ext(ext, "GL_EXT_clip_control")))
         gl->ClipControl = (fogvol__PFN_ClipControl)desc->get_proc_address("glClipControlEXT", desc->user_data);
+}
+
+/* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
+{
+    static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
+    fogvol_mesh_data tri_data;
+    fogvol_result r;
+    gl->dialect = desc->dialect;
+    if (gl->dialect == FOGVOL_GLSL_AUTO) gl->dialect = fogvol__dialect_for_gl(gl->gles, gl->major, gl->minor);
+    gl->stencil_override = desc->stencil_bits;
+    gl->caps = fogvol__gl_caps(gl, ext);
+    if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+    fogvol__gl_load_clip_control(gl, desc, ext);
     fogvol__gl_raster_caps(gl);
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
         gl->GenSamplers(1, &gl->native_sampler);
@@ -9081,14 +9288,12 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
-    if (r != FOGVOL_SUCCESS) {
-        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-        fogvol__free(alloc, gl);
-        return r;
-    }
-    fogvol__log(logger, FOGVOL_LOG_INFO, "fogvol: GL backend on %s (%s%d.%d%s), GLSL %s", ver,
-                gl->gles ? "ES " : "", gl->major, gl->minor, gl->core ? " core" : "", fogvol_dialect_name(gl->dialect));
+    if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+    return r;
+}
 
+static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
+{
     out->user_data = gl;
     out->dialect = gl->dialect;
     out->caps = gl->caps | FOGVOL_CAP_MESH_LAYOUT;
@@ -9119,6 +9324,40 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         out->end_query = fogvol__gl_end_query;
         out->query_result = fogvol__gl_query_result;
     }
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out)
+{
+    fogvol__gl *gl;
+    fogvol_logger silent;
+    const char *ver = NULL, *ext = NULL;
+    fogvol_result r;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    memset(&silent, 0, sizeof silent);
+    if (!logger) logger = &silent;
+    if (!desc || !desc->get_proc_address) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
+    if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    memset(gl, 0, sizeof *gl);
+    if (alloc) gl->alloc = *alloc;
+    gl->log = *logger;
+    r = fogvol__gl_version(gl, desc, &ver);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__free(alloc, gl);
+        return r;
+    }
+    fogvol__log(logger, FOGVOL_LOG_INFO, "fogvol: GL backend on %s (%s%d.%d%s), GLSL %s", ver,
+                gl->gles ? "ES " : "", gl->major, gl->minor, gl->core ? " core" : "", fogvol_dialect_name(gl->dialect));
+    fogvol__gl_fill_table(gl, out);
     return FOGVOL_SUCCESS;
 }
 
