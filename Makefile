@@ -247,6 +247,8 @@ images: demo
 	cp $(BUILD)/demo/scene_low.png docs/demo_low.png
 	cp $(BUILD)/demo/scene_inside_fog_bank.png docs/demo_inside_fog_bank.png
 	cp $(BUILD)/demo/tiers.png $(BUILD)/demo/dither.png $(BUILD)/demo/ramps.png $(BUILD)/demo/thickness.png docs/
+	cp $(BUILD)/demo/textured_fog.png $(BUILD)/demo/light_compare.png $(BUILD)/demo/dof.png \
+	   $(BUILD)/demo/outlines.png $(BUILD)/demo/distance_fog.png docs/
 
 # --- browser build: emscripten (Debian's emcc ships its system libraries prebuilt), one page for
 # WebGL1 (?webgl1) and WebGL2 (?webgl2, the default), the wasm embedded so it loads from file://.
