@@ -711,6 +711,25 @@ typedef enum fogvol_fog_mix {
     FOGVOL_FOG_MIX_MAX_ENUM = 0x7fffffff
 } fogvol_fog_mix;
 
+/* How fogvol_analytic_batch evaluates its vertices (fogvol_analytic_set.kernel).
+   The float kernels work on blocks of vertices in structure-of-arrays float
+   loops (8 lanes with AVX2, 4 with SSE2), redo grazing rays of spheres,
+   ellipsoids and cylinders (and every ray of such a volume seen from further
+   than 64 radii) in double, and sort only the events of the volumes a ray
+   hits; they stay within 1.2e-5 of the double kernel in fog and in colour x
+   (1 - fog). AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
+   CPU is asked with __builtin_cpu_supports); a level the compiler or the CPU
+   lacks falls back to the next one down (fogvol_analytic_kernel_resolve). */
+typedef enum fogvol_analytic_kernel {
+    FOGVOL_ANALYTIC_KERNEL_AUTO = 0,   /* the best float kernel this CPU runs */
+    FOGVOL_ANALYTIC_KERNEL_DOUBLE = 1, /* everything in double (the reference; the batch before 2026-11) */
+    FOGVOL_ANALYTIC_KERNEL_FLOAT = 2,  /* the float kernel in plain C (every compiler and architecture) */
+    FOGVOL_ANALYTIC_KERNEL_SSE2 = 3,   /* the float kernel, SSE2 square roots, 4 lanes */
+    FOGVOL_ANALYTIC_KERNEL_AVX2 = 4,   /* the float kernel compiled for AVX2, 8 lanes */
+    FOGVOL_ANALYTIC_KERNEL_COUNT = 5,
+    FOGVOL_ANALYTIC_KERNEL_MAX_ENUM = 0x7fffffff
+} fogvol_analytic_kernel;
+
 /* Prepared volumes (inverse transforms etc.), caller-owned, about 5 KB; a
    zeroed set holds no volume. Fields are filled by fogvol_analytic_prepare. */
 typedef struct fogvol_analytic_set {
@@ -723,6 +742,8 @@ typedef struct fogvol_analytic_set {
     double map[FOGVOL_ANALYTIC_CAPACITY][12]; /* rows of the world -> unit-shape map (see the uniforms) */
     double density[FOGVOL_ANALYTIC_CAPACITY];
     double color[FOGVOL_ANALYTIC_CAPACITY][3];
+    int kernel;           /* fogvol_analytic_kernel for fogvol_analytic_batch; prepare sets 0 (AUTO):
+                             change it after prepare */
 } fogvol_analytic_set;
 
 /* The insertion sorts' starting orders, carried between vertices and calls
@@ -768,8 +789,8 @@ FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, co
    every fog_stride bytes (0 = 4), color_out (3 floats) every color_stride bytes
    (0 = 12); either output may be NULL. Outputs may sit in the same vertex
    structs as the positions. No allocation; blocks of vertices are evaluated
-   in structure-of-arrays loops the compiler vectorises (compile with
-   -fno-math-errno to vectorise the square roots too). order may be NULL.
+   in structure-of-arrays loops (set->kernel: float with run-time SIMD
+   dispatch by default, or double; see fogvol_analytic_kernel). order may be NULL.
    Vertices with a non-finite coordinate get fog 1, colour 0; *invalid (may be
    NULL) counts them and the call returns FOGVOL_ERROR_INVALID_ARGUMENT when
    there are any (every output is still written). */
@@ -777,6 +798,12 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
                                                int color_stride, fogvol_analytic_order *order, int *invalid);
+/* The kernel fogvol_analytic_batch runs for a set whose kernel field is
+   `requested`: AUTO gives the best this build and CPU have, a level they lack
+   the next one down (AVX2 -> SSE2 -> FLOAT); DOUBLE and FLOAT are always
+   there. Values outside the enum give FOGVOL_ANALYTIC_KERNEL_COUNT (the batch
+   refuses them with FOGVOL_ERROR_INVALID_ARGUMENT). */
+FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic_kernel requested);
 /* The seed's register trick: new_diffuse = diffuse * fog, new_specular =
    specular * fog + fog_color * (1 - fog), on rgb (alpha unchanged); then
    texture * new_diffuse + new_specular = fogged (texture * diffuse + specular).
@@ -2786,31 +2813,13 @@ static void fogvol__an_identity(unsigned char *p, int m)
     for (i = 0; i < m; ++i) p[i] = (unsigned char)i;
 }
 
-/* The seed's sorted evaluation of one vertex from its entry/exit pairs (those
-   of volume v at t1[v * ts], t2[v * ts]). Misses sort last and end the walk. */
-static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
-                              const float *t2, int ts, unsigned char *perm, int64_t *moves, fogvol__an_state *st)
+/* Walks the events perm[0..m) (sorted by key, indexed by event; misses keyed
+   2 and last) front to back into st: SEPARATE takes each volume whole at its
+   entry, INTERPENETRATING the seed's event list. */
+static void fogvol__an_walk(const fogvol_analytic_set *s, int law, int mix, double len, const float *key,
+                            const unsigned char *perm, int m, fogvol__an_state *st)
 {
-    float key[2 * FOGVOL_ANALYTIC_CAPACITY];
-    int n = s->count, m = 2 * s->count, k, j, v, c;
-    int64_t mv = 0;
-    for (v = 0; v < n; ++v) {
-        float a = t1[v * ts], b = t2[v * ts];
-        int hit = b > a && s->density[v] > 0.0;
-        key[2 * v] = hit ? a : 2.0f;
-        key[2 * v + 1] = hit ? b : 2.0f;
-    }
-    /* insertion sort from the carried order: O(m) when it is still right */
-    for (k = 1; k < m; ++k) {
-        unsigned char x = perm[k];
-        float kx = key[x];
-        for (j = k; j > 0 && (key[perm[j - 1]] > kx || (key[perm[j - 1]] == kx && perm[j - 1] > x)); --j) {
-            perm[j] = perm[j - 1];
-            ++mv;
-        }
-        perm[j] = x;
-    }
-    if (moves) *moves += mv;
+    int k, v, c;
     if (mix == FOGVOL_MIX_SEPARATE) {
         /* the entries in order of t1; each volume whole */
         for (k = 0; k < m && !st->done; ++k) {
@@ -2843,6 +2852,34 @@ static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, do
             last = t;
         }
     }
+}
+
+/* The seed's sorted evaluation of one vertex from its entry/exit pairs (those
+   of volume v at t1[v * ts], t2[v * ts]). Misses sort last and end the walk. */
+static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
+                              const float *t2, int ts, unsigned char *perm, int64_t *moves, fogvol__an_state *st)
+{
+    float key[2 * FOGVOL_ANALYTIC_CAPACITY];
+    int n = s->count, m = 2 * s->count, k, j, v;
+    int64_t mv = 0;
+    for (v = 0; v < n; ++v) {
+        float a = t1[v * ts], b = t2[v * ts];
+        int hit = b > a && s->density[v] > 0.0;
+        key[2 * v] = hit ? a : 2.0f;
+        key[2 * v + 1] = hit ? b : 2.0f;
+    }
+    /* insertion sort from the carried order: O(m) when it is still right */
+    for (k = 1; k < m; ++k) {
+        unsigned char x = perm[k];
+        float kx = key[x];
+        for (j = k; j > 0 && (key[perm[j - 1]] > kx || (key[perm[j - 1]] == kx && perm[j - 1] > x)); --j) {
+            perm[j] = perm[j - 1];
+            ++mv;
+        }
+        perm[j] = x;
+    }
+    if (moves) *moves += mv;
+    fogvol__an_walk(s, law, mix, len, key, perm, m, st);
 }
 
 static void fogvol__an_sorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
@@ -2879,41 +2916,51 @@ static int fogvol__an_args_ok(const fogvol_analytic_set *set, fogvol_fog_law law
            (mix == FOGVOL_MIX_SEPARATE || mix == FOGVOL_MIX_INTERPENETRATING);
 }
 
+/* One vertex in double from the eye in the volumes' spaces (eval, and the
+   float kernels' vertices too far away for float). */
+static void fogvol__an_vertex(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                              const float p[3], int law, int mix, float *fog, float col[3])
+{
+    float t1[FOGVOL_ANALYTIC_CAPACITY], t2[FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char perm[2 * FOGVOL_ANALYTIC_CAPACITY];
+    double dx, dy, dz, len, tau = 0.0, rgb[3] = {0.0, 0.0, 0.0}, hits = 0.0;
+    int v, c;
+    dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
+    len = FOGVOL_SQRT(dx * dx + dy * dy + dz * dz);
+    for (v = 0; v < set->count; ++v) {
+        double lo, hi, tv;
+        fogvol__an_ray(set, pe, v, dx, dy, dz, len, &lo, &hi);
+        t1[v] = (float)lo;
+        t2[v] = (float)hi;
+        tv = set->density[v] * (len * (hi - lo));
+        tau += tv;
+        for (c = 0; c < 3; ++c) rgb[c] += set->color[v][c] * tv;
+        hits += (double)(tv > 0.0);
+    }
+    if (hits > 1.0 && tau > fogvol__an_sort_limit(set, law)) {
+        fogvol__an_identity(perm, 2 * set->count);
+        fogvol__an_sorted_vertex(set, law, mix, len, t1, t2, 1, perm, NULL, fog, col);
+    } else { /* the same expressions as the batch's order-free loop */
+        double inv = 1.0 / (tau + (double)(tau == 0.0));
+        *fog = (float)(law == FOGVOL_FOG_EXP ? (tau > 0.0 ? FOGVOL_EXP(-tau) : 1.0) : fogvol__an_max(1.0 - tau, 0.0));
+        for (c = 0; c < 3; ++c) col[c] = (float)(rgb[c] * inv);
+    }
+}
+
 FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, const float eye[3], const float p[3],
                                               fogvol_fog_law law, fogvol_fog_mix mix, float *fog, float color[3])
 {
     fogvol__an_eye pe;
-    float t1[FOGVOL_ANALYTIC_CAPACITY], t2[FOGVOL_ANALYTIC_CAPACITY], f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
-    unsigned char perm[2 * FOGVOL_ANALYTIC_CAPACITY];
-    double e[3], dx, dy, dz, len, tau = 0.0, rgb[3] = {0.0, 0.0, 0.0}, hits = 0.0;
+    float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+    double e[3];
     fogvol_result res = FOGVOL_SUCCESS;
-    int v, c;
     if (!fogvol__an_args_ok(set, law, mix) || !fog) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!eye || !p || !fogvol__finite_n(eye, 3) || !fogvol__finite_n(p, 3)) {
         res = FOGVOL_ERROR_INVALID_ARGUMENT;
     } else {
         e[0] = eye[0], e[1] = eye[1], e[2] = eye[2];
         fogvol__an_eye_init(set, e, &pe);
-        dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
-        len = FOGVOL_SQRT(dx * dx + dy * dy + dz * dz);
-        for (v = 0; v < set->count; ++v) {
-            double lo, hi, tv;
-            fogvol__an_ray(set, &pe, v, dx, dy, dz, len, &lo, &hi);
-            t1[v] = (float)lo;
-            t2[v] = (float)hi;
-            tv = set->density[v] * (len * (hi - lo));
-            tau += tv;
-            for (c = 0; c < 3; ++c) rgb[c] += set->color[v][c] * tv;
-            hits += (double)(tv > 0.0);
-        }
-        if (hits > 1.0 && tau > fogvol__an_sort_limit(set, law)) {
-            fogvol__an_identity(perm, 2 * set->count);
-            fogvol__an_sorted_vertex(set, law, mix, len, t1, t2, 1, perm, NULL, &f, col);
-        } else { /* the same expressions as the batch's order-free loop */
-            double inv = 1.0 / (tau + (double)(tau == 0.0));
-            f = (float)(law == FOGVOL_FOG_EXP ? (tau > 0.0 ? FOGVOL_EXP(-tau) : 1.0) : fogvol__an_max(1.0 - tau, 0.0));
-            for (c = 0; c < 3; ++c) col[c] = (float)(rgb[c] * inv);
-        }
+        fogvol__an_vertex(set, &pe, e, p, (int)law, (int)mix, &f, col);
     }
     *fog = f;
     if (color) color[0] = col[0], color[1] = col[1], color[2] = col[2];
@@ -3001,6 +3048,430 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
     }
 }
 
+/* ---- the float kernels ----
+   The same entry/exit maths in float over blocks of vertices (one volume at a
+   time, structure of arrays), compiled once per SIMD level: the block body is
+   inlined into one function per level, so the compiler vectorises it for that
+   level's registers; the square roots go through a per-level helper (the C
+   library's sqrt keeps errno and so stays scalar). Float loses the chord of a
+   grazing ray (it depends on the square root of a small discriminant), so the
+   lanes whose discriminant is below FOGVOL__AN_GRAZE of a are redone in
+   double, and so is every ray of a quadric whose unit space puts the eye
+   further than FOGVOL__AN_FAR_EYE from its centre (the cross product o x v
+   loses digits there). */
+
+#define FOGVOL__AN_GRAZE 0.0625f
+#define FOGVOL__AN_FAR_EYE 64.0
+
+#if (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 5)) && (defined(__x86_64__) || defined(__i386__))
+#define FOGVOL__AN_X86 1
+#include <immintrin.h>
+#else
+#define FOGVOL__AN_X86 0
+#endif
+
+FOGVOL__AN_INLINE float fogvol__an_fmin(float a, float b) { return a < b ? a : b; }
+FOGVOL__AN_INLINE float fogvol__an_fmax(float a, float b) { return a > b ? a : b; }
+
+/* one volume as the float kernels read it, the eye already in its unit space */
+typedef struct fogvol__an_fvol {
+    float m[12], o[3], c0, dens, col[3];
+    int shape, dbl; /* dbl: every ray of this volume in double */
+} fogvol__an_fvol;
+
+typedef struct fogvol__an_fblock {
+    float px[FOGVOL__AN_BLOCK], py[FOGVOL__AN_BLOCK], pz[FOGVOL__AN_BLOCK]; /* the vertices (redos) */
+    float dx[FOGVOL__AN_BLOCK], dy[FOGVOL__AN_BLOCK], dz[FOGVOL__AN_BLOCK], len[FOGVOL__AN_BLOCK];
+    float a[FOGVOL__AN_BLOCK], b[FOGVOL__AN_BLOCK], disc[FOGVOL__AN_BLOCK], s[FOGVOL__AN_BLOCK];
+    float vz[FOGVOL__AN_BLOCK], lo[FOGVOL__AN_BLOCK], hi[FOGVOL__AN_BLOCK];
+    float tau[FOGVOL__AN_BLOCK], r[FOGVOL__AN_BLOCK], g[FOGVOL__AN_BLOCK], bl[FOGVOL__AN_BLOCK];
+    float hits[FOGVOL__AN_BLOCK], fog[FOGVOL__AN_BLOCK], need[FOGVOL__AN_BLOCK];
+    int redo[FOGVOL__AN_BLOCK];
+    float t1[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK], t2[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK];
+} fogvol__an_fblock;
+
+typedef void (*fogvol__an_sqrt_fn)(float *out, const float *in); /* FOGVOL__AN_BLOCK values, in >= 0 */
+
+static void fogvol__an_sqrt_c(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) out[i] = (float)FOGVOL_SQRT((double)in[i]);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fdistance(const float *m, float len, float *lo, float *hi)
+{
+    float ls = len + (float)(len == 0.0f);
+    float f = fogvol__an_fmin(m[1] / ls, 1.0f);
+    float h = m[1] > 0.0f ? f : 1.0f;
+    *lo = m[0] / ls;
+    *hi = len > 0.0f ? h : -1.0f;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fhalf(const float *m, float s0, float dx, float dy, float dz, float *lo, float *hi)
+{
+    float s1 = m[0] * dx + m[1] * dy + m[2] * dz;
+    float ss = s1 + (float)(s1 == 0.0f), tx = -s0 / ss;
+    float txl = fogvol__an_fmax(tx, 0.0f), txh = fogvol__an_fmin(tx, 1.0f);
+    float par = s0 >= 0.0f ? 1.0f : -1.0f;
+    float h = s1 > 0.0f ? 1.0f : par;
+    *lo = s1 > 0.0f ? txl : 0.0f;
+    *hi = s1 < 0.0f ? txh : h;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fslab(float o, float v, float *lo, float *hi)
+{
+    float vs = v + (float)(v == 0.0f);
+    float ta = (-1.0f - o) / vs, tb = (1.0f - o) / vs;
+    float mn = fogvol__an_fmin(ta, tb), mx = fogvol__an_fmax(ta, tb);
+    float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
+    float l = v == 0.0f ? 0.0f : mn, h = v == 0.0f ? par : mx;
+    *lo = fogvol__an_fmax(*lo, l);
+    *hi = fogvol__an_fmin(*hi, h);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fbox(const float *m, const float *o, float dx, float dy, float dz, float *lo,
+                                       float *hi)
+{
+    float l = 0.0f, h = 1.0f;
+    fogvol__an_fslab(o[0], m[0] * dx + m[1] * dy + m[2] * dz, &l, &h);
+    fogvol__an_fslab(o[1], m[4] * dx + m[5] * dy + m[6] * dz, &l, &h);
+    fogvol__an_fslab(o[2], m[8] * dx + m[9] * dy + m[10] * dz, &l, &h);
+    *lo = l;
+    *hi = h;
+}
+
+/* fogvol__an_quad1 in float (kind 0 ellipsoid, 1 cylinder side, 2 sphere) */
+FOGVOL__AN_INLINE void fogvol__an_fquad1(const float *m, const float *o, int kind, float dx, float dy, float dz,
+                                         float *a, float *b, float *disc, float *vz)
+{
+    int cyl = kind == 1;
+    float v0 = kind == 2 ? m[0] * dx : m[0] * dx + m[1] * dy + m[2] * dz;
+    float v1 = kind == 2 ? m[0] * dy : m[4] * dx + m[5] * dy + m[6] * dz;
+    float v2 = kind == 2 ? m[0] * dz : m[8] * dx + m[9] * dy + m[10] * dz;
+    float w2 = cyl ? 0.0f : v2, o2 = cyl ? 0.0f : o[2];
+    float cx = o[1] * w2 - o2 * v1, cy = o2 * v0 - o[0] * w2, cz = o[0] * v1 - o[1] * v0;
+    *a = v0 * v0 + v1 * v1 + w2 * w2;
+    *b = o[0] * v0 + o[1] * v1 + o2 * w2;
+    *disc = *a - (cx * cx + cy * cy + cz * cz);
+    *vz = v2;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fquad2(float a, float b, float disc, float s, float c0, float *lo, float *hi)
+{
+    float ns = -s, sg = b >= 0.0f ? s : ns;
+    float q = -(b + sg);
+    float qs = q + (float)(q == 0.0f), as = a + (float)(a == 0.0f);
+    float r1 = q / as, r2 = c0 / qs;
+    float l = fogvol__an_fmax(fogvol__an_fmin(r1, r2), 0.0f), h = fogvol__an_fmin(fogvol__an_fmax(r1, r2), 1.0f);
+    float par = c0 <= 0.0f ? 1.0f : -1.0f;
+    float hd = disc > 0.0f ? h : -1.0f;
+    *lo = a > 0.0f ? l : 0.0f;
+    *hi = a > 0.0f ? hd : par;
+}
+
+/* The lanes of volume v marked in redo (all of them: all != 0) through the
+   double kernels, from the vertices themselves. */
+static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3], int v,
+                            int all, fogvol__an_fblock *k)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        double dx, dy, dz, lo, hi;
+        if (!all && !k->redo[i]) continue;
+        dx = (double)k->px[i] - e[0], dy = (double)k->py[i] - e[1], dz = (double)k->pz[i] - e[2];
+        fogvol__an_ray(set, pe, v, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
+        k->lo[i] = (float)lo;
+        k->hi[i] = (float)hi;
+    }
+}
+
+/* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block; the
+   grazing lanes are redone in double. */
+FOGVOL__AN_INLINE void fogvol__an_fquadric(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                           const double e[3], const fogvol__an_fvol *f, int v, fogvol__an_sqrt_fn sq,
+                                           fogvol__an_fblock *k)
+{
+    const float *m = f->m, *o = f->o, c0 = f->c0;
+    int i, any = 0, kind = f->shape == FOGVOL_SHAPE_SPHERE ? 2 : f->shape == FOGVOL_SHAPE_CYLINDER ? 1 : 0;
+    if (kind == 2)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 2, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    else if (kind == 1)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 1, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    else
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 0, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        int g = (k->a[i] > 0.0f) & (k->disc[i] < FOGVOL__AN_GRAZE * k->a[i]) & (k->disc[i] > -FOGVOL__AN_GRAZE * k->a[i]);
+        k->redo[i] = g;
+        any |= g;
+        k->s[i] = fogvol__an_fmax(k->disc[i], 0.0f);
+    }
+    sq(k->s, k->s);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+        fogvol__an_fquad2(k->a[i], k->b[i], k->disc[i], k->s[i], c0, &k->lo[i], &k->hi[i]);
+    if (kind == 1)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fslab(o[2], k->vz[i], &k->lo[i], &k->hi[i]);
+    if (any) fogvol__an_redo(set, pe, e, v, 0, k);
+}
+
+/* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
+   and which vertices need the sorted walk. Inlined into one function per level. */
+FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                              const double e[3], const fogvol__an_fvol *fv, float limit,
+                                              fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
+{
+    int v, i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
+    sq(k->len, k->len);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0f;
+    for (v = 0; v < set->count; ++v) {
+        const fogvol__an_fvol *f = &fv[v];
+        const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
+        if (f->dbl) fogvol__an_redo(set, pe, e, v, 1, k);
+        else if (f->shape == FOGVOL_SHAPE_DISTANCE)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fdistance(m, k->len[i], &k->lo[i], &k->hi[i]);
+        else if (f->shape == FOGVOL_SHAPE_HALF_SPACE)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_fhalf(m, o[0], k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+        else if (f->shape == FOGVOL_SHAPE_BOX)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_fbox(m, o, k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+        else
+            fogvol__an_fquadric(set, pe, e, f, v, sq, k);
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+            float l0 = k->lo[i], h0 = k->hi[i];
+            float d = fogvol__an_fmax(h0 - l0, 0.0f), lo = fogvol__an_fmin(l0, h0);
+            float tv = dens * (k->len[i] * d);
+            k->tau[i] += tv;
+            k->r[i] += cr * tv;
+            k->g[i] += cg * tv;
+            k->bl[i] += cb * tv;
+            k->hits[i] += (float)(tv > 0.0f);
+            k->t1[v][i] = lo;
+            k->t2[v][i] = lo + d;
+        }
+    }
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        float tau = k->tau[i], inv = 1.0f / (tau + (float)(tau == 0.0f));
+        k->fog[i] = fogvol__an_fmax(1.0f - tau, 0.0f);
+        k->r[i] *= inv;
+        k->g[i] *= inv;
+        k->bl[i] *= inv;
+        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
+    }
+}
+
+typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                     const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k);
+
+static void fogvol__an_fblock_c(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_c, k);
+}
+
+#if FOGVOL__AN_X86
+__attribute__((target("sse2"))) static void fogvol__an_sqrt_sse2(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 4) _mm_storeu_ps(out + i, _mm_sqrt_ps(_mm_loadu_ps(in + i)));
+}
+__attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_analytic_set *set,
+                                                                    const fogvol__an_eye *pe, const double e[3],
+                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_sse2, k);
+}
+__attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) _mm256_storeu_ps(out + i, _mm256_sqrt_ps(_mm256_loadu_ps(in + i)));
+}
+__attribute__((target("avx2"))) static void fogvol__an_fblock_avx2(const fogvol_analytic_set *set,
+                                                                    const fogvol__an_eye *pe, const double e[3],
+                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_avx2, k);
+}
+#endif
+
+FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic_kernel requested)
+{
+    int r = (int)requested;
+    if (r < 0 || r >= (int)FOGVOL_ANALYTIC_KERNEL_COUNT) return FOGVOL_ANALYTIC_KERNEL_COUNT;
+    if (r == FOGVOL_ANALYTIC_KERNEL_DOUBLE || r == FOGVOL_ANALYTIC_KERNEL_FLOAT) return requested;
+#if FOGVOL__AN_X86
+    __builtin_cpu_init();
+    if ((r == FOGVOL_ANALYTIC_KERNEL_AUTO || r == FOGVOL_ANALYTIC_KERNEL_AVX2) && __builtin_cpu_supports("avx2"))
+        return FOGVOL_ANALYTIC_KERNEL_AVX2;
+    if (__builtin_cpu_supports("sse2")) return FOGVOL_ANALYTIC_KERNEL_SSE2;
+#endif
+    return FOGVOL_ANALYTIC_KERNEL_FLOAT;
+}
+
+/* The float kernels' per-call volume table: the eye in each unit space
+   (from the double one), and which volumes go to double whole. */
+static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
+{
+    int v, j;
+    for (v = 0; v < set->count; ++v) {
+        const double *o = pe->o[v];
+        double oo = o[0] * o[0] + o[1] * o[1] + (set->shape[v] == FOGVOL_SHAPE_CYLINDER ? 0.0 : o[2] * o[2]);
+        for (j = 0; j < 12; ++j) fv[v].m[j] = (float)set->map[v][j];
+        for (j = 0; j < 3; ++j) fv[v].o[j] = (float)o[j], fv[v].col[j] = (float)set->color[v][j];
+        fv[v].c0 = (float)pe->c0[v];
+        fv[v].dens = (float)set->density[v];
+        fv[v].shape = set->shape[v];
+        fv[v].dbl = (set->shape[v] == FOGVOL_SHAPE_SPHERE || set->shape[v] == FOGVOL_SHAPE_ELLIPSOID ||
+                     set->shape[v] == FOGVOL_SHAPE_CYLINDER) &&
+                    !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
+    }
+}
+
+/* The sorted walk of the float kernels: only the events of the volumes the
+   ray hits are sorted (insertion sort from the carried order perm, whose
+   hit events come first afterwards, the misses after them in their old
+   order). */
+static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
+                                      const float *t2, unsigned char *perm, int64_t *moves, float *fog, float col[3])
+{
+    float key[2 * FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY], rest[2 * FOGVOL_ANALYTIC_CAPACITY];
+    fogvol__an_state st;
+    int m = 2 * s->count, h = 0, r = 0, k, j, c;
+    int64_t mv = 0;
+    double inv;
+    for (k = 0; k < m; ++k) {
+        int e = perm[k], v = e >> 1;
+        float a = t1[v * FOGVOL__AN_BLOCK], b = t2[v * FOGVOL__AN_BLOCK];
+        if (b > a && s->density[v] > 0.0) {
+            key[e] = (e & 1) ? b : a;
+            ev[h++] = (unsigned char)e;
+        } else {
+            rest[r++] = (unsigned char)e;
+        }
+    }
+    for (k = 1; k < h; ++k) {
+        unsigned char x = ev[k];
+        float kx = key[x];
+        for (j = k; j > 0 && (key[ev[j - 1]] > kx || (key[ev[j - 1]] == kx && ev[j - 1] > x)); --j) {
+            ev[j] = ev[j - 1];
+            ++mv;
+        }
+        ev[j] = x;
+    }
+    memcpy(perm, ev, (size_t)h);
+    memcpy(perm + h, rest, (size_t)r);
+    if (moves) *moves += mv;
+    memset(&st, 0, sizeof st);
+    st.f = 1.0;
+    fogvol__an_walk(s, law, mix, len, key, ev, h, &st);
+    inv = st.w > 0.0 ? 1.0 / st.w : 0.0;
+    *fog = (float)st.f;
+    for (c = 0; c < 3; ++c) col[c] = (float)(law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv);
+}
+
+/* What a batch call works on, for the float kernels' loop. */
+typedef struct fogvol__an_call {
+    const fogvol_analytic_set *set;
+    const fogvol__an_eye *pe;
+    const double *e;
+    const unsigned char *src;
+    float *fog_out, *color_out;
+    fogvol_analytic_order *order;
+    unsigned char *carry;
+    double limit;
+    int eye_ok, law, mix, count, stride, fog_stride, color_stride, bad, sorted;
+    int64_t moves;
+} fogvol__an_call;
+
+/* Gathers block `base` (checked: x - x is 0 for finite x only), padded with
+   zero-length rays; valid: 0 non-finite, 1 float, 2 double (too far). */
+static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned char *valid, fogvol__an_fblock *k)
+{
+    float ex = (float)c->e[0], ey = (float)c->e[1], ez = (float)c->e[2];
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        float x = ex, y = ey, z = ez;
+        int ok = 0;
+        if (i < nb) {
+            const float *p = (const float *)(const void *)(c->src + (size_t)(base + i) * (size_t)c->stride);
+            ok = c->eye_ok & (p[0] - p[0] == 0.0f) & (p[1] - p[1] == 0.0f) & (p[2] - p[2] == 0.0f);
+            c->bad += !ok;
+            /* |D|^2 would overflow float: the vertex goes to double whole */
+            if (ok && !(p[0] - ex <= 1e15f && p[0] - ex >= -1e15f && p[1] - ey <= 1e15f && p[1] - ey >= -1e15f &&
+                        p[2] - ez <= 1e15f && p[2] - ez >= -1e15f))
+                ok = 2;
+            if (ok == 1) x = p[0], y = p[1], z = p[2];
+        }
+        valid[i] = (unsigned char)ok;
+        k->px[i] = x, k->py[i] = y, k->pz[i] = z;
+        k->dx[i] = x - ex, k->dy[i] = y - ey, k->dz[i] = z - ez;
+    }
+}
+
+static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
+{
+    fogvol__an_fblock blk;
+    fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char valid[FOGVOL__AN_BLOCK];
+    int base, i, m = 2 * c->set->count;
+    float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
+    fogvol__an_fvols(c->set, c->pe, fv);
+    for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
+        int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
+        fogvol__an_fgather(c, base, nb, valid, &blk);
+        fn(c->set, c->pe, c->e, fv, limit, &blk);
+        for (i = 0; i < nb; ++i) {
+            size_t idx = (size_t)(base + i);
+            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+            if (!valid[i]) {
+                /* fog 1, colour 0 */
+            } else if (valid[i] == 2) {
+                const float *p = (const float *)(const void *)(c->src + idx * (size_t)c->stride);
+                fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, &f, col);
+            } else if (blk.need[i] != 0.0f) {
+                unsigned char *perm = c->carry;
+                fogvol_analytic_order *o = c->order;
+                if (o && o->vertex_orders && (idx + 1) * (size_t)m <= o->vertex_orders_size) {
+                    perm = o->vertex_orders + idx * (size_t)m;
+                    if (!fogvol__an_perm_ok(perm, m)) memcpy(perm, c->carry, (size_t)m);
+                }
+                fogvol__an_fsorted_vertex(c->set, c->law, c->mix, (double)blk.len[i],
+                                          (const float *)(const void *)blk.t1 + i,
+                                          (const float *)(const void *)blk.t2 + i, perm, &c->moves, &f, col);
+                ++c->sorted;
+                if (perm != c->carry) memcpy(c->carry, perm, (size_t)m);
+            } else {
+                f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
+                    : blk.tau[i] > 0.0f ? (float)FOGVOL_EXP(-(double)blk.tau[i]) : 1.0f;
+                col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
+            }
+            if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;
+            if (c->color_out) {
+                float *out = (float *)(void *)((unsigned char *)c->color_out + idx * (size_t)c->color_stride);
+                out[0] = col[0], out[1] = col[1], out[2] = col[2];
+            }
+        }
+    }
+}
+
+/* The float kernel a resolved level runs. */
+static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
+{
+#if FOGVOL__AN_X86
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fblock_avx2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fblock_sse2;
+#else
+    (void)k;
+#endif
+    return fogvol__an_fblock_c;
+}
+
 FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, const float eye[3],
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
@@ -3014,8 +3485,11 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     double e[3], limit;
     int base, i, m, bad = 0, eye_ok, sorted = 0;
     int64_t moves = 0;
+    fogvol_analytic_kernel kern;
     if (invalid) *invalid = 0;
-    if (!fogvol__an_args_ok(set, law, mix) || !eye || count < 0 || (count > 0 && !positions) || stride < 0 ||
+    if (!fogvol__an_args_ok(set, law, mix)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    kern = fogvol_analytic_kernel_resolve((fogvol_analytic_kernel)set->kernel);
+    if (kern == FOGVOL_ANALYTIC_KERNEL_COUNT || !eye || count < 0 || (count > 0 && !positions) || stride < 0 ||
         (stride > 0 && stride < 12) || fog_stride < 0 || (fog_stride > 0 && fog_stride < 4) || color_stride < 0 ||
         (color_stride > 0 && color_stride < 12))
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -3036,6 +3510,16 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     } else {
         carry = local;
         fogvol__an_identity(carry, m);
+    }
+    if (kern != FOGVOL_ANALYTIC_KERNEL_DOUBLE) {
+        fogvol__an_call c;
+        memset(&c, 0, sizeof c);
+        c.set = set, c.pe = &pe, c.e = e, c.src = src, c.order = order, c.carry = carry, c.limit = limit;
+        c.eye_ok = eye_ok, c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride;
+        c.fog_out = fog_out, c.fog_stride = fog_stride, c.color_out = color_out, c.color_stride = color_stride;
+        fogvol__an_fbatch(&c, fogvol__an_fkernel(kern));
+        bad = c.bad, sorted = c.sorted, moves = c.moves;
+        count = 0; /* done: the double loop below is skipped */
     }
     for (base = 0; base < count; base += FOGVOL__AN_BLOCK) {
         int nb = count - base < FOGVOL__AN_BLOCK ? count - base : FOGVOL__AN_BLOCK;
