@@ -753,7 +753,10 @@ typedef struct fogvol_analytic_set {
    set count) bytes, vertex i of a batch keeps its own order there (use one
    struct per vertex array). The contents never change results (ties are
    broken by volume order), only the time the sorts take; any bytes are safe
-   (orders that are not permutations are replaced). */
+   (orders that are not permutations are replaced). Only the DOUBLE kernel
+   (fogvol_analytic_kernel) reads and writes the orders: the float kernels
+   sort the few events of the volumes on each ray from volume order; they
+   still fill sorted_vertices and moves. */
 typedef struct fogvol_analytic_order {
     unsigned char *vertex_orders; /* optional */
     size_t vertex_orders_size;    /* bytes */
@@ -3062,6 +3065,7 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
 
 #define FOGVOL__AN_GRAZE 0.0625f
 #define FOGVOL__AN_FAR_EYE 64.0
+#define FOGVOL__AN_MASKS ((FOGVOL_ANALYTIC_CAPACITY + 31) / 32)
 
 #if (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 5)) && (defined(__x86_64__) || defined(__i386__))
 #define FOGVOL__AN_X86 1
@@ -3072,6 +3076,17 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
 
 FOGVOL__AN_INLINE float fogvol__an_fmin(float a, float b) { return a < b ? a : b; }
 FOGVOL__AN_INLINE float fogvol__an_fmax(float a, float b) { return a > b ? a : b; }
+/* index of the lowest set bit of x != 0 */
+FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctz(x);
+#else
+    int n = 0;
+    while (!(x & 1u)) x >>= 1, ++n;
+    return n;
+#endif
+}
 
 /* one volume as the float kernels read it, the eye already in its unit space */
 typedef struct fogvol__an_fvol {
@@ -3087,6 +3102,7 @@ typedef struct fogvol__an_fblock {
     float tau[FOGVOL__AN_BLOCK], r[FOGVOL__AN_BLOCK], g[FOGVOL__AN_BLOCK], bl[FOGVOL__AN_BLOCK];
     float hits[FOGVOL__AN_BLOCK], fog[FOGVOL__AN_BLOCK], need[FOGVOL__AN_BLOCK];
     int redo[FOGVOL__AN_BLOCK];
+    unsigned int hit[FOGVOL__AN_MASKS][FOGVOL__AN_BLOCK]; /* bit v & 31 of word v >> 5: volume v is on the ray */
     float t1[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK], t2[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK];
 } fogvol__an_fblock;
 
@@ -3226,8 +3242,11 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
     sq(k->len, k->len);
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0f;
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
     for (v = 0; v < set->count; ++v) {
-        const fogvol__an_fvol *f = &fv[v];
+        const int w = v >> 5, bit = v & 31;
+        const fogvol__an_fvol fl = fv[v], *f = &fl; /* a local copy: the block's stores cannot alias it */
         const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
         if (f->dbl) fogvol__an_redo(set, pe, e, v, 1, k);
         else if (f->shape == FOGVOL_SHAPE_DISTANCE)
@@ -3249,6 +3268,7 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
             k->g[i] += cg * tv;
             k->bl[i] += cb * tv;
             k->hits[i] += (float)(tv > 0.0f);
+            k->hit[w][i] |= (unsigned int)(tv > 0.0f) << bit;
             k->t1[v][i] = lo;
             k->t2[v][i] = lo + d;
         }
@@ -3332,27 +3352,28 @@ static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_ey
     }
 }
 
-/* The sorted walk of the float kernels: only the events of the volumes the
-   ray hits are sorted (insertion sort from the carried order perm, whose
-   hit events come first afterwards, the misses after them in their old
-   order). */
+/* The sorted walk of the float kernels: only the events of the volumes on
+   the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
+   are sorted, by insertion from volume order. */
 static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
-                                      const float *t2, unsigned char *perm, int64_t *moves, float *fog, float col[3])
+                                      const float *t2, const unsigned int *hit, int64_t *moves, float *fog,
+                                      float col[3])
 {
     float key[2 * FOGVOL_ANALYTIC_CAPACITY];
-    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY], rest[2 * FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY];
     fogvol__an_state st;
-    int m = 2 * s->count, h = 0, r = 0, k, j, c;
+    int h = 0, w, k, j, c;
     int64_t mv = 0;
     double inv;
-    for (k = 0; k < m; ++k) {
-        int e = perm[k], v = e >> 1;
-        float a = t1[v * FOGVOL__AN_BLOCK], b = t2[v * FOGVOL__AN_BLOCK];
-        if (b > a && s->density[v] > 0.0) {
-            key[e] = (e & 1) ? b : a;
-            ev[h++] = (unsigned char)e;
-        } else {
-            rest[r++] = (unsigned char)e;
+    for (w = 0; w < (s->count + 31) / 32; ++w) {
+        unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
+        while (bits) {
+            int v = 32 * w + fogvol__an_ctz(bits);
+            bits &= bits - 1u;
+            key[2 * v] = t1[v * FOGVOL__AN_BLOCK];
+            key[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK];
+            ev[h++] = (unsigned char)(2 * v);
+            ev[h++] = (unsigned char)(2 * v + 1);
         }
     }
     for (k = 1; k < h; ++k) {
@@ -3364,9 +3385,7 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, int law, int
         }
         ev[j] = x;
     }
-    memcpy(perm, ev, (size_t)h);
-    memcpy(perm + h, rest, (size_t)r);
-    if (moves) *moves += mv;
+    *moves += mv;
     memset(&st, 0, sizeof st);
     st.f = 1.0;
     fogvol__an_walk(s, law, mix, len, key, ev, h, &st);
@@ -3419,7 +3438,7 @@ static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK];
-    int base, i, m = 2 * c->set->count;
+    int base, i;
     float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
     fogvol__an_fvols(c->set, c->pe, fv);
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
@@ -3435,17 +3454,11 @@ static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
                 const float *p = (const float *)(const void *)(c->src + idx * (size_t)c->stride);
                 fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, &f, col);
             } else if (blk.need[i] != 0.0f) {
-                unsigned char *perm = c->carry;
-                fogvol_analytic_order *o = c->order;
-                if (o && o->vertex_orders && (idx + 1) * (size_t)m <= o->vertex_orders_size) {
-                    perm = o->vertex_orders + idx * (size_t)m;
-                    if (!fogvol__an_perm_ok(perm, m)) memcpy(perm, c->carry, (size_t)m);
-                }
                 fogvol__an_fsorted_vertex(c->set, c->law, c->mix, (double)blk.len[i],
                                           (const float *)(const void *)blk.t1 + i,
-                                          (const float *)(const void *)blk.t2 + i, perm, &c->moves, &f, col);
+                                          (const float *)(const void *)blk.t2 + i,
+                                          (const unsigned int *)(const void *)blk.hit + i, &c->moves, &f, col);
                 ++c->sorted;
-                if (perm != c->carry) memcpy(c->carry, perm, (size_t)m);
             } else {
                 f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
                     : blk.tau[i] > 0.0f ? (float)FOGVOL_EXP(-(double)blk.tau[i]) : 1.0f;

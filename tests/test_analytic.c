@@ -910,6 +910,7 @@ static void test_order_coherence(void **state)
         raw[i].color[0] = (float)i / 16;
     }
     assert_int_equal(fogvol_analytic_prepare(&set, raw, 16), FOGVOL_SUCCESS);
+    set.kernel = FOGVOL_ANALYTIC_KERNEL_DOUBLE; /* the kernel that carries orders (the float ones sort hits only) */
     for (i = 0; i < N; ++i) {
         pos[3 * i] = -4.0f + 8.0f * (float)(i % 64) / 63, pos[3 * i + 1] = -4.0f + 8.0f * (float)(i / 64) / 63;
         pos[3 * i + 2] = -5.0f;
