@@ -3352,19 +3352,112 @@ static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_ey
     }
 }
 
+/* exp(-x) for x >= 0 in float without the C library (the walk calls it once
+   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) by its Taylor series to
+   r^7 (relative error below 1e-8 before rounding), times 2^-n. */
+FOGVOL__AN_INLINE float fogvol__an_fexpn(float x)
+{
+    float t, r, p, scale;
+    unsigned int bits;
+    int n;
+    if (!(x < 87.0f)) return x >= 87.0f ? 0.0f : 1.0f; /* NaN: 1 */
+    t = x * 1.44269504f;
+    n = (int)(t + 0.5f);
+    r = (float)n * 0.693145751953125f - x + (float)n * 1.42860677e-6f; /* ln2 in two parts */
+    p = 1.0f / 5040.0f;
+    p = p * r + 1.0f / 720.0f;
+    p = p * r + 1.0f / 120.0f;
+    p = p * r + 1.0f / 24.0f;
+    p = p * r + 1.0f / 6.0f;
+    p = p * r + 0.5f;
+    p = p * r + 1.0f;
+    p = p * r + 1.0f;
+    bits = (unsigned int)(127 - n) << 23;
+    memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
+}
+
+/* fogvol__an_state and fogvol__an_add in float, for the float kernels' walk */
+typedef struct fogvol__an_fstate {
+    float f, w, num[3];
+    int done;
+} fogvol__an_fstate;
+
+FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const float cs[3], float sig, float l)
+{
+    float tau = sig * l, k;
+    int c;
+    if (!(tau > 0.0f) || st->done) return;
+    if (law == FOGVOL_FOG_EXP) {
+        float e = fogvol__an_fexpn(tau);
+        /* (1 - e) / tau, by its series where 1 - e would cancel (error < tau^6 / 5040) */
+        float ps = 1.0f - tau * (0.5f - tau * (1.0f / 6.0f - tau * (1.0f / 24.0f - tau * (1.0f / 120.0f - tau / 720.0f))));
+        float phi = tau < 0.25f ? ps : (1.0f - e) / tau;
+        k = l * phi * st->f;
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * k;
+        st->w += sig * k;
+        st->f *= e;
+        if (st->f < (float)FOGVOL__AN_CUTOFF) st->done = 1;
+    } else if (law == FOGVOL_FOG_LINEAR) {
+        k = tau >= st->f ? st->f / tau : 1.0f;
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * (l * k);
+        st->w += tau * k;
+        st->f = tau >= st->f ? 0.0f : st->f - tau;
+        st->done = st->f == 0.0f;
+    } else {
+        for (c = 0; c < 3; ++c) st->num[c] = cs[c] / sig * st->f + st->num[c] * (1.0f - st->f);
+        st->f -= tau < 1.0f ? tau : 1.0f;
+        if (st->f <= 0.0f) {
+            st->f = 0.0f;
+            st->done = 1;
+        }
+    }
+}
+
+/* fogvol__an_walk in float over the hit events ev[0..h) (sorted by key) */
+static void fogvol__an_fwalk(const fogvol__an_fvol *fv, int law, int mix, float len, const float *key,
+                             const unsigned char *ev, int h, fogvol__an_fstate *st)
+{
+    int k, c;
+    if (mix == FOGVOL_MIX_SEPARATE) {
+        for (k = 0; k < h && !st->done; ++k) {
+            int e = ev[k];
+            const fogvol__an_fvol *f = &fv[e >> 1];
+            float cs[3];
+            if (e & 1) continue;
+            for (c = 0; c < 3; ++c) cs[c] = f->col[c] * f->dens;
+            fogvol__an_fadd(st, law, cs, f->dens, len * (key[e + 1] - key[e]));
+        }
+    } else {
+        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, last = 0.0f;
+        int open = 0;
+        for (k = 0; k < h && !st->done; ++k) {
+            int e = ev[k];
+            const fogvol__an_fvol *f = &fv[e >> 1];
+            float t = key[e], sd = (e & 1) ? -f->dens : f->dens;
+            if (open > 0 && t > last) fogvol__an_fadd(st, law, acc, acc[3], (t - last) * len);
+            for (c = 0; c < 3; ++c) acc[c] += sd * f->col[c];
+            acc[3] += sd;
+            open += (e & 1) ? -1 : 1;
+            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0f;
+            last = t;
+        }
+    }
+}
+
 /* The sorted walk of the float kernels: only the events of the volumes on
    the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
-   are sorted, by insertion from volume order. */
-static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
-                                      const float *t2, const unsigned int *hit, int64_t *moves, float *fog,
-                                      float col[3])
+   are sorted, by insertion from volume order (cheaper than filtering a
+   carried order of all the events). */
+static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol__an_fvol *fv, int law, int mix,
+                                      float len, const float *t1, const float *t2, const unsigned int *hit,
+                                      int64_t *moves, float *fog, float col[3])
 {
-    float key[2 * FOGVOL_ANALYTIC_CAPACITY];
+    float key[2 * FOGVOL_ANALYTIC_CAPACITY], inv;
     unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY];
-    fogvol__an_state st;
+    fogvol__an_fstate st;
     int h = 0, w, k, j, c;
     int64_t mv = 0;
-    double inv;
     for (w = 0; w < (s->count + 31) / 32; ++w) {
         unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
         while (bits) {
@@ -3387,11 +3480,11 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, int law, int
     }
     *moves += mv;
     memset(&st, 0, sizeof st);
-    st.f = 1.0;
-    fogvol__an_walk(s, law, mix, len, key, ev, h, &st);
-    inv = st.w > 0.0 ? 1.0 / st.w : 0.0;
-    *fog = (float)st.f;
-    for (c = 0; c < 3; ++c) col[c] = (float)(law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv);
+    st.f = 1.0f;
+    fogvol__an_fwalk(fv, law, mix, len, key, ev, h, &st);
+    inv = st.w > 0.0f ? 1.0f / st.w : 0.0f;
+    *fog = st.f;
+    for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
 }
 
 /* What a batch call works on, for the float kernels' loop. */
@@ -3454,7 +3547,7 @@ static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
                 const float *p = (const float *)(const void *)(c->src + idx * (size_t)c->stride);
                 fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, &f, col);
             } else if (blk.need[i] != 0.0f) {
-                fogvol__an_fsorted_vertex(c->set, c->law, c->mix, (double)blk.len[i],
+                fogvol__an_fsorted_vertex(c->set, fv, c->law, c->mix, blk.len[i],
                                           (const float *)(const void *)blk.t1 + i,
                                           (const float *)(const void *)blk.t2 + i,
                                           (const unsigned int *)(const void *)blk.hit + i, &c->moves, &f, col);
