@@ -3098,7 +3098,7 @@ typedef struct fogvol__an_fblock {
     float px[FOGVOL__AN_BLOCK], py[FOGVOL__AN_BLOCK], pz[FOGVOL__AN_BLOCK]; /* the vertices (redos) */
     float dx[FOGVOL__AN_BLOCK], dy[FOGVOL__AN_BLOCK], dz[FOGVOL__AN_BLOCK], len[FOGVOL__AN_BLOCK];
     float a[FOGVOL__AN_BLOCK], b[FOGVOL__AN_BLOCK], disc[FOGVOL__AN_BLOCK], s[FOGVOL__AN_BLOCK];
-    float vz[FOGVOL__AN_BLOCK], lo[FOGVOL__AN_BLOCK], hi[FOGVOL__AN_BLOCK];
+    float vz[FOGVOL__AN_BLOCK], lo[FOGVOL__AN_BLOCK], hi[FOGVOL__AN_BLOCK], ch[FOGVOL__AN_BLOCK];
     float tau[FOGVOL__AN_BLOCK], r[FOGVOL__AN_BLOCK], g[FOGVOL__AN_BLOCK], bl[FOGVOL__AN_BLOCK];
     float hits[FOGVOL__AN_BLOCK], fog[FOGVOL__AN_BLOCK], need[FOGVOL__AN_BLOCK];
     int redo[FOGVOL__AN_BLOCK];
@@ -3198,14 +3198,13 @@ static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye
         fogvol__an_ray(set, pe, v, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
         k->lo[i] = (float)lo;
         k->hi[i] = (float)hi;
+        k->ch[i] = (float)(hi > lo ? hi - lo : 0.0); /* the chord in double: t near 1 loses digits in float */
     }
 }
 
-/* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block; the
-   grazing lanes are redone in double. */
-FOGVOL__AN_INLINE void fogvol__an_fquadric(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
-                                           const double e[3], const fogvol__an_fvol *f, int v, fogvol__an_sqrt_fn sq,
-                                           fogvol__an_fblock *k)
+/* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block;
+   returns whether some lanes graze it (marked in redo, for fogvol__an_redo). */
+FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
 {
     const float *m = f->m, *o = f->o, c0 = f->c0;
     int i, any = 0, kind = f->shape == FOGVOL_SHAPE_SPHERE ? 2 : f->shape == FOGVOL_SHAPE_CYLINDER ? 1 : 0;
@@ -3229,7 +3228,7 @@ FOGVOL__AN_INLINE void fogvol__an_fquadric(const fogvol_analytic_set *set, const
         fogvol__an_fquad2(k->a[i], k->b[i], k->disc[i], k->s[i], c0, &k->lo[i], &k->hi[i]);
     if (kind == 1)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fslab(o[2], k->vz[i], &k->lo[i], &k->hi[i]);
-    if (any) fogvol__an_redo(set, pe, e, v, 0, k);
+    return any;
 }
 
 /* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
@@ -3248,7 +3247,9 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
         const int w = v >> 5, bit = v & 31;
         const fogvol__an_fvol fl = fv[v], *f = &fl; /* a local copy: the block's stores cannot alias it */
         const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
-        if (f->dbl) fogvol__an_redo(set, pe, e, v, 1, k);
+        int redo = f->dbl ? -1 : 0;
+        if (f->dbl)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->lo[i] = k->hi[i] = 0.0f;
         else if (f->shape == FOGVOL_SHAPE_DISTANCE)
             for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fdistance(m, k->len[i], &k->lo[i], &k->hi[i]);
         else if (f->shape == FOGVOL_SHAPE_HALF_SPACE)
@@ -3258,10 +3259,12 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
             for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
                 fogvol__an_fbox(m, o, k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
         else
-            fogvol__an_fquadric(set, pe, e, f, v, sq, k);
+            redo = fogvol__an_fquadric(f, sq, k);
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->ch[i] = fogvol__an_fmax(k->hi[i] - k->lo[i], 0.0f);
+        if (redo) fogvol__an_redo(set, pe, e, v, redo < 0, k);
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
             float l0 = k->lo[i], h0 = k->hi[i];
-            float d = fogvol__an_fmax(h0 - l0, 0.0f), lo = fogvol__an_fmin(l0, h0);
+            float d = k->ch[i], lo = fogvol__an_fmin(l0, h0);
             float tv = dens * (k->len[i] * d);
             k->tau[i] += tv;
             k->r[i] += cr * tv;
@@ -3340,15 +3343,13 @@ static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_ey
     int v, j;
     for (v = 0; v < set->count; ++v) {
         const double *o = pe->o[v];
-        double oo = o[0] * o[0] + o[1] * o[1] + (set->shape[v] == FOGVOL_SHAPE_CYLINDER ? 0.0 : o[2] * o[2]);
+        double oo = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
         for (j = 0; j < 12; ++j) fv[v].m[j] = (float)set->map[v][j];
         for (j = 0; j < 3; ++j) fv[v].o[j] = (float)o[j], fv[v].col[j] = (float)set->color[v][j];
         fv[v].c0 = (float)pe->c0[v];
         fv[v].dens = (float)set->density[v];
         fv[v].shape = set->shape[v];
-        fv[v].dbl = (set->shape[v] == FOGVOL_SHAPE_SPHERE || set->shape[v] == FOGVOL_SHAPE_ELLIPSOID ||
-                     set->shape[v] == FOGVOL_SHAPE_CYLINDER) &&
-                    !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
+        fv[v].dbl = set->shape[v] >= FOGVOL_SHAPE_SPHERE && !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
     }
 }
 
