@@ -3354,25 +3354,22 @@ static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_ey
 }
 
 /* exp(-x) for x >= 0 in float without the C library (the walk calls it once
-   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) by its Taylor series to
-   r^7 (relative error below 1e-8 before rounding), times 2^-n. */
+   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) = 1 + r + r^2 P(r) with
+   the minimax P of Cephes' expf (about 1 ulp), evaluated in Estrin's order
+   (short dependency chains), times 2^-n. */
 FOGVOL__AN_INLINE float fogvol__an_fexpn(float x)
 {
-    float t, r, p, scale;
+    float t, r, r2, p, scale;
     unsigned int bits;
     int n;
     if (!(x < 87.0f)) return x >= 87.0f ? 0.0f : 1.0f; /* NaN: 1 */
     t = x * 1.44269504f;
     n = (int)(t + 0.5f);
     r = (float)n * 0.693145751953125f - x + (float)n * 1.42860677e-6f; /* ln2 in two parts */
-    p = 1.0f / 5040.0f;
-    p = p * r + 1.0f / 720.0f;
-    p = p * r + 1.0f / 120.0f;
-    p = p * r + 1.0f / 24.0f;
-    p = p * r + 1.0f / 6.0f;
-    p = p * r + 0.5f;
-    p = p * r + 1.0f;
-    p = p * r + 1.0f;
+    r2 = r * r;
+    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
+        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
+    p = 1.0f + r + r2 * p;
     bits = (unsigned int)(127 - n) << 23;
     memcpy(&scale, &bits, sizeof scale);
     return p * scale;
