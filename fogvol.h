@@ -2447,9 +2447,12 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
 /* >>analytic ============================================================== */
 /* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
    ways of combining volumes, the batch over vertex arrays, and the same maths
-   as GLSL. Everything is computed in double on the CPU: the chord of a grazing
-   ray depends on the square root of a small discriminant, which float would
-   get wrong by up to sqrt(2^-24) = 2.4e-4 of the chord. */
+   as GLSL. The reference path (eval, segment, the DOUBLE kernel of the batch)
+   computes in double: the chord of a grazing ray depends on the square root
+   of a small discriminant, which float would get wrong by up to
+   sqrt(2^-24) = 2.4e-4 of the chord. The batch's float kernels (below) redo
+   those rays in double. The section depends on nothing after it: the
+   renderer does not use it. */
 
 #define FOGVOL__AN_BLOCK 32      /* vertices per structure-of-arrays block */
 #define FOGVOL__AN_CUTOFF 1e-7   /* EXP: a ray whose transmittance fell below this is done */
