@@ -3280,7 +3280,8 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
         }
     }
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
-        float tau = k->tau[i], inv = 1.0f / (tau + (float)(tau == 0.0f));
+        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
+        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f;
         k->fog[i] = fogvol__an_fmax(1.0f - tau, 0.0f);
         k->r[i] *= inv;
         k->g[i] *= inv;
@@ -3340,20 +3341,34 @@ FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic
 }
 
 /* The float kernels' per-call volume table: the eye in each unit space
-   (from the double one), and which volumes go to double whole. */
-static void fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
+   (from the double one), and which volumes go to double whole. Returns the
+   largest |vertex - eye| coordinate the float loops take (further vertices
+   go to double one by one), or 0 when a volume's numbers could overflow
+   float sums (density or colour beyond 1e6, an eye 1e12 units away in a
+   unit space, a map entry beyond 1e12): the call then runs the DOUBLE kernel. */
+static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
 {
+    double mmax = 1.0;
     int v, j;
     for (v = 0; v < set->count; ++v) {
-        const double *o = pe->o[v];
+        const double *o = pe->o[v], *m = set->map[v];
         double oo = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
-        for (j = 0; j < 12; ++j) fv[v].m[j] = (float)set->map[v][j];
+        if (!(set->density[v] <= 1e6) || !(FOGVOL_FABS(set->color[v][0]) <= 1e6) ||
+            !(FOGVOL_FABS(set->color[v][1]) <= 1e6) || !(FOGVOL_FABS(set->color[v][2]) <= 1e6))
+            return 0.0f;
+        if (set->shape[v] != FOGVOL_SHAPE_DISTANCE) {
+            if (!(oo <= 1e24)) return 0.0f;
+            for (j = 0; j < 12; ++j)
+                if ((j & 3) != 3) mmax = fogvol__an_max(mmax, FOGVOL_FABS(m[j]));
+        }
+        for (j = 0; j < 12; ++j) fv[v].m[j] = (float)m[j];
         for (j = 0; j < 3; ++j) fv[v].o[j] = (float)o[j], fv[v].col[j] = (float)set->color[v][j];
         fv[v].c0 = (float)pe->c0[v];
         fv[v].dens = (float)set->density[v];
         fv[v].shape = set->shape[v];
         fv[v].dbl = set->shape[v] >= FOGVOL_SHAPE_SPHERE && !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
     }
+    return mmax > 1e12 ? 0.0f : (float)(1e15 / mmax);
 }
 
 /* exp(-x) for x >= 0 in float without the C library (the walk calls it once
@@ -3483,7 +3498,7 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
     memset(&st, 0, sizeof st);
     st.f = 1.0f;
     fogvol__an_fwalk(fv, law, mix, len, key, ev, h, &st);
-    inv = st.w > 0.0f ? 1.0f / st.w : 0.0f;
+    inv = st.w > 1e-30f ? 1.0f / st.w : 0.0f;
     *fog = st.f;
     for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
 }
@@ -3498,6 +3513,7 @@ typedef struct fogvol__an_call {
     fogvol_analytic_order *order;
     unsigned char *carry;
     double limit;
+    float dlim; /* |vertex - eye| coordinates beyond this go to double (fogvol__an_fvols) */
     int eye_ok, law, mix, count, stride, fog_stride, color_stride, bad, sorted;
     int64_t moves;
 } fogvol__an_call;
@@ -3515,9 +3531,9 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
             const float *p = (const float *)(const void *)(c->src + (size_t)(base + i) * (size_t)c->stride);
             ok = c->eye_ok & (p[0] - p[0] == 0.0f) & (p[1] - p[1] == 0.0f) & (p[2] - p[2] == 0.0f);
             c->bad += !ok;
-            /* |D|^2 would overflow float: the vertex goes to double whole */
-            if (ok && !(p[0] - ex <= 1e15f && p[0] - ex >= -1e15f && p[1] - ey <= 1e15f && p[1] - ey >= -1e15f &&
-                        p[2] - ez <= 1e15f && p[2] - ez >= -1e15f))
+            /* float could overflow: the vertex goes to double whole */
+            if (ok && !(p[0] - ex <= c->dlim && p[0] - ex >= -c->dlim && p[1] - ey <= c->dlim &&
+                        p[1] - ey >= -c->dlim && p[2] - ez <= c->dlim && p[2] - ez >= -c->dlim))
                 ok = 2;
             if (ok == 1) x = p[0], y = p[1], z = p[2];
         }
@@ -3527,14 +3543,16 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
     }
 }
 
-static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
+/* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
+static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK];
     int base, i;
     float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
-    fogvol__an_fvols(c->set, c->pe, fv);
+    c->dlim = fogvol__an_fvols(c->set, c->pe, fv);
+    if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         fogvol__an_fgather(c, base, nb, valid, &blk);
@@ -3565,6 +3583,7 @@ static void fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
             }
         }
     }
+    return 1;
 }
 
 /* The float kernel a resolved level runs. */
@@ -3624,9 +3643,10 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
         c.set = set, c.pe = &pe, c.e = e, c.src = src, c.order = order, c.carry = carry, c.limit = limit;
         c.eye_ok = eye_ok, c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride;
         c.fog_out = fog_out, c.fog_stride = fog_stride, c.color_out = color_out, c.color_stride = color_stride;
-        fogvol__an_fbatch(&c, fogvol__an_fkernel(kern));
-        bad = c.bad, sorted = c.sorted, moves = c.moves;
-        count = 0; /* done: the double loop below is skipped */
+        if (fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
+            bad = c.bad, sorted = c.sorted, moves = c.moves;
+            count = 0; /* done: the double loop below is skipped */
+        }
     }
     for (base = 0; base < count; base += FOGVOL__AN_BLOCK) {
         int nb = count - base < FOGVOL__AN_BLOCK ? count - base : FOGVOL__AN_BLOCK;
