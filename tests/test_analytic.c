@@ -17,7 +17,9 @@
  *     the volumes containing it, steps refined by bisection where the set of volumes
  *     changes), random sets of 1..8 overlapping volumes of every shape, both laws
  *     (LINEAR: f = 1 - clamp01(sum density * d), EXP: f = exp(-sum density * d)),
- *     eval and batch: |dfog| <= 1e-4 and |d(colour * (1 - fog))| <= 1e-4; SEPARATE
+ *     eval and batch (every batch kernel forced: double within 1e-6 of eval, the float
+ *     ones within 1.2e-5 of eval and 1e-4 of the integration, maxima printed):
+ *     |dfog| <= 1e-4 and |d(colour * (1 - fog))| <= 1e-4; SEPARATE
  *     mode against the same integration on disjoint volumes, and on overlapping ones
  *     against the seed's separate algorithm applied to ground-truth chords.
  *   4 the seed's colour formula (FOGVOL_FOG_LINEAR_SEED) against its closed form for
@@ -26,6 +28,8 @@
  *   6 coherence: per-vertex orders from garbage bytes give bit-identical results, a
  *     repeated frame needs 0 insertion-sort moves, a slightly moved eye fewer moves
  *     than sorting from scratch; the carried per-batch order likewise.
+ *  6b the batch kernels (double, float C, SSE2, AVX2; each forced) on edge cases
+ *     against hand-computed chords (test_kernel_edges, see there); <= 1.2e-5.
  *   7 degenerate input: zero-size volumes, singular / non-affine matrices, NaN and
  *     infinite fields, zero normal, too many volumes, NaN / infinite vertices and eye,
  *     vertex at the eye, huge coordinates; result codes, never NaN.
@@ -986,7 +990,8 @@ static void test_order_coherence(void **state)
    0.5 (the lanes the float kernels redo in double), an eye 500 radii away (the
    volumes they evaluate in double whole), FOGVOL_ANALYTIC_CAPACITY disjoint spheres
    on one ray (hit masks up to the last bit; EXP colour by hand), no volumes, zero
-   density, NaN and huge vertices; |dfog| and |d(colour * (1 - fog))| <= 1.2e-5. */
+   density, NaN and huge vertices, a density float sums could overflow (the double
+   kernel runs) and a denormal one; |dfog| and |d(colour * (1 - fog))| <= 1.2e-5. */
 
 #define KN 64 /* vertices per edge-case batch: two blocks, every lane used */
 
@@ -1182,6 +1187,26 @@ static void test_kernel_edges(void **state)
             if (!kernel_there(j)) continue;
             assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_LINEAR, fog, col), 2);
             for (i = 0; i < KN; ++i) assert_true(fog[i] == 1 && col[3 * i] == 0 && col[3 * i + 1] == 0);
+        }
+        /* numbers a float sum could overflow (density 1e7): the call runs the double kernel, bit for bit;
+           a denormal density: no NaN */
+        memset(v, 0, sizeof v);
+        v[0].shape = FOGVOL_SHAPE_SPHERE, v[0].radius = 2, v[0].density = 1e7f, v[0].color[1] = 1;
+        v[1].shape = FOGVOL_SHAPE_SPHERE, v[1].radius = 1, v[1].density = 1e-40f, v[1].color[0] = 1;
+        v[1].center[0] = 0.5f;
+        for (k = 0; k < 2; ++k) {
+            assert_int_equal(fogvol_analytic_prepare(&set, v + k, 1), FOGVOL_SUCCESS);
+            assert_int_equal(kern_batch(&set, 0, eye, pos, FOGVOL_FOG_EXP, fd, cd), 2);
+            for (j = 1; j < 4; ++j) {
+                if (!kernel_there(j)) continue;
+                assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 2);
+                for (i = 0; i < KN; ++i) {
+                    assert_true(fog[i] >= 0 && fog[i] <= 1);
+                    assert_true(isfinite(col[3 * i]) && isfinite(col[3 * i + 1]) && isfinite(col[3 * i + 2]));
+                    if (!k) assert_true(fog[i] == fd[i] && col[3 * i + 1] == cd[3 * i + 1]);
+                    else assert_true(fabs(fog[i] - fd[i]) <= 1.2e-5);
+                }
+            }
         }
         set.kernel = 99; /* not a kernel */
         assert_int_equal(fogvol_analytic_batch(&set, eye, pos, KN, 0, FOGVOL_FOG_EXP, FOGVOL_MIX_SEPARATE, fog, 0, NULL,
