@@ -733,6 +733,25 @@ typedef enum fogvol_fog_mix {
     FOGVOL_FOG_MIX_MAX_ENUM = 0x7fffffff
 } fogvol_fog_mix;
 
+/* How fogvol_analytic_batch evaluates its vertices (fogvol_analytic_set.kernel).
+   The float kernels work on blocks of vertices in structure-of-arrays float
+   loops (8 lanes with AVX2, 4 with SSE2), redo grazing rays of spheres,
+   ellipsoids and cylinders (and every ray of such a volume seen from further
+   than 64 radii) in double, and sort only the events of the volumes a ray
+   hits; they stay within 1.2e-5 of the double kernel in fog and in colour x
+   (1 - fog). AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
+   CPU is asked with __builtin_cpu_supports); a level the compiler or the CPU
+   lacks falls back to the next one down (fogvol_analytic_kernel_resolve). */
+typedef enum fogvol_analytic_kernel {
+    FOGVOL_ANALYTIC_KERNEL_AUTO = 0,   /* the best float kernel this CPU runs */
+    FOGVOL_ANALYTIC_KERNEL_DOUBLE = 1, /* everything in double (the reference; the batch before 2026-11) */
+    FOGVOL_ANALYTIC_KERNEL_FLOAT = 2,  /* the float kernel in plain C (every compiler and architecture) */
+    FOGVOL_ANALYTIC_KERNEL_SSE2 = 3,   /* the float kernel, SSE2 square roots, 4 lanes */
+    FOGVOL_ANALYTIC_KERNEL_AVX2 = 4,   /* the float kernel compiled for AVX2, 8 lanes */
+    FOGVOL_ANALYTIC_KERNEL_COUNT = 5,
+    FOGVOL_ANALYTIC_KERNEL_MAX_ENUM = 0x7fffffff
+} fogvol_analytic_kernel;
+
 /* Prepared volumes (inverse transforms etc.), caller-owned, about 5 KB; a
    zeroed set holds no volume. Fields are filled by fogvol_analytic_prepare. */
 typedef struct fogvol_analytic_set {
@@ -745,6 +764,8 @@ typedef struct fogvol_analytic_set {
     double map[FOGVOL_ANALYTIC_CAPACITY][12]; /* rows of the world -> unit-shape map (see the uniforms) */
     double density[FOGVOL_ANALYTIC_CAPACITY];
     double color[FOGVOL_ANALYTIC_CAPACITY][3];
+    int kernel;           /* fogvol_analytic_kernel for fogvol_analytic_batch; prepare sets 0 (AUTO):
+                             change it after prepare */
 } fogvol_analytic_set;
 
 /* The insertion sorts' starting orders, carried between vertices and calls
@@ -754,7 +775,10 @@ typedef struct fogvol_analytic_set {
    set count) bytes, vertex i of a batch keeps its own order there (use one
    struct per vertex array). The contents never change results (ties are
    broken by volume order), only the time the sorts take; any bytes are safe
-   (orders that are not permutations are replaced). */
+   (orders that are not permutations are replaced). Only the DOUBLE kernel
+   (fogvol_analytic_kernel) reads and writes the orders: the float kernels
+   sort the few events of the volumes on each ray from volume order; they
+   still fill sorted_vertices and moves. */
 typedef struct fogvol_analytic_order {
     unsigned char *vertex_orders; /* optional */
     size_t vertex_orders_size;    /* bytes */
@@ -790,8 +814,8 @@ FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, co
    every fog_stride bytes (0 = 4), color_out (3 floats) every color_stride bytes
    (0 = 12); either output may be NULL. Outputs may sit in the same vertex
    structs as the positions. No allocation; blocks of vertices are evaluated
-   in structure-of-arrays loops the compiler vectorises (compile with
-   -fno-math-errno to vectorise the square roots too). order may be NULL.
+   in structure-of-arrays loops (set->kernel: float with run-time SIMD
+   dispatch by default, or double; see fogvol_analytic_kernel). order may be NULL.
    Vertices with a non-finite coordinate get fog 1, colour 0; *invalid (may be
    NULL) counts them and the call returns FOGVOL_ERROR_INVALID_ARGUMENT when
    there are any (every output is still written). */
@@ -799,6 +823,12 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
                                                int color_stride, fogvol_analytic_order *order, int *invalid);
+/* The kernel fogvol_analytic_batch runs for a set whose kernel field is
+   `requested`: AUTO gives the best this build and CPU have, a level they lack
+   the next one down (AVX2 -> SSE2 -> FLOAT); DOUBLE and FLOAT are always
+   there. Values outside the enum give FOGVOL_ANALYTIC_KERNEL_COUNT (the batch
+   refuses them with FOGVOL_ERROR_INVALID_ARGUMENT). */
+FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic_kernel requested);
 /* The paper's register trick: new_diffuse = diffuse * fog, new_specular =
    specular * fog + fog_color * (1 - fog), on rgb (alpha unchanged); then
    texture * new_diffuse + new_specular = fogged (texture * diffuse + specular).
@@ -2790,11 +2820,15 @@ static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
 
 #ifndef FOGVOL_NO_ANALYTIC
 /* >>analytic ============================================================== */
-/* Analytic fog volumes (seeds/002): prepare, entry/exit per shape, the two
-   ways of combining volumes, the batch over vertex arrays, and the same maths
-   as GLSL. Everything is computed in double on the CPU: the chord of a grazing
-   ray depends on the square root of a small discriminant, which float would
-   get wrong by up to sqrt(2^-24) = 2.4e-4 of the chord. */
+/* Analytic fog volumes (JCAB, "Implementing Volumetric Fog Without Using
+   Texture Stages", GDC 2001): prepare, entry/exit per shape, the two ways of
+   combining volumes, the batch over vertex arrays, and the same maths
+   as GLSL. The reference path (eval, segment, the DOUBLE kernel of the batch)
+   computes in double: the chord of a grazing ray depends on the square root
+   of a small discriminant, which float would get wrong by up to
+   sqrt(2^-24) = 2.4e-4 of the chord. The batch's float kernels (below) redo
+   those rays in double. The section depends on nothing after it: the
+   renderer does not use it. */
 
 #define FOGVOL__AN_BLOCK 32      /* vertices per structure-of-arrays block */
 #define FOGVOL__AN_CUTOFF 1e-7   /* EXP: a ray whose transmittance fell below this is done */
@@ -2941,7 +2975,7 @@ FOGVOL__AN_INLINE void fogvol__an_distance(const double *m, double len, double *
     *hi = len > 0.0 ? h : -1.0;
 }
 
-/* the seed's half-space: fog where s0 + t s1 >= 0 */
+/* the paper's half-space: fog where s0 + t s1 >= 0 */
 FOGVOL__AN_INLINE void fogvol__an_half(const double *m, double s0, double dx, double dy, double dz, double *lo,
                                        double *hi)
 {
@@ -3083,7 +3117,7 @@ FOGVOL_API fogvol_result fogvol_analytic_segment(const fogvol_analytic_volume *v
 
 /* ---- combining volumes ---- */
 
-/* Running state along one ray, front to back: f = fog factor (LINEAR, the seed's
+/* Running state along one ray, front to back: f = fog factor (LINEAR, the paper's
    "fog") or transmittance (EXP); w = how much of the pixel the fog covers so
    far; num = colour * cover (LINEAR_SEED: the fog colour itself). */
 typedef struct fogvol__an_state {
@@ -3094,7 +3128,7 @@ typedef struct fogvol__an_state {
 /* One stretch of fog of length l (world units) with density sig and
    premultiplied colour cs = colour * sig (for a mix: the sums over the volumes
    it is in, so cs / sig is the density-weighted mean colour).
-   LINEAR: the seed's law, fog -= sig * l until 0. The stretch covers sig * l of
+   LINEAR: the paper's law, fog -= sig * l until 0. The stretch covers sig * l of
      the pixel (less when it ends the fog), so it adds its colour times that:
      num += cs * l.
    EXP: the physically consistent compositing of transmittances. Behind
@@ -3102,11 +3136,11 @@ typedef struct fogvol__an_state {
      exp(-sig l); the colour weight is written cs * l * T * phi with
      phi = (1 - exp(-x)) / x (x = sig l) so that no division by a density that
      may be tiny is needed. Then 1 - f = sum of the covers exactly, and the
-     result does not depend on how a volume is cut into stretches (the seed's
+     result does not depend on how a volume is cut into stretches (the paper's
      colour formula applied to EXP would). Done once T < FOGVOL__AN_CUTOFF.
-   LINEAR_SEED: the seed verbatim, C = colour * fog + C * (1 - fog) (the fog
+   LINEAR_SEED: the paper verbatim, C = colour * fog + C * (1 - fog) (the fog
      before the stretch), fog = fog + volFog - 1. Stretches of zero length are
-     skipped (the seed would blend their colour in, depending on sort ties). */
+     skipped (the paper would blend their colour in, depending on sort ties). */
 FOGVOL__AN_INLINE void fogvol__an_add(fogvol__an_state *st, int law, const double cs[3], double sig, double l)
 {
     double tau = sig * l, k;
@@ -3161,13 +3195,54 @@ static void fogvol__an_identity(unsigned char *p, int m)
     for (i = 0; i < m; ++i) p[i] = (unsigned char)i;
 }
 
-/* The seed's sorted evaluation of one vertex from its entry/exit pairs (those
+/* Walks the events perm[0..m) (sorted by key, indexed by event; misses keyed
+   2 and last) front to back into st: SEPARATE takes each volume whole at its
+   entry, INTERPENETRATING the paper's event list. */
+static void fogvol__an_walk(const fogvol_analytic_set *s, int law, int mix, double len, const float *key,
+                            const unsigned char *perm, int m, fogvol__an_state *st)
+{
+    int k, v, c;
+    if (mix == FOGVOL_MIX_SEPARATE) {
+        /* the entries in order of t1; each volume whole */
+        for (k = 0; k < m && !st->done; ++k) {
+            int e = perm[k];
+            double cs[3];
+            if (key[e] > 1.5f) break;
+            if (e & 1) continue;
+            v = e >> 1;
+            for (c = 0; c < 3; ++c) cs[c] = s->color[v][c] * s->density[v];
+            fogvol__an_add(st, law, cs, s->density[v], len * ((double)key[e + 1] - (double)key[e]));
+        }
+    } else {
+        /* the event list: sums of (colour * density, density) of the volumes a
+           stretch is in; the sums restart from exact zeros whenever no volume
+           is open, so that rounding never leaves a ghost density behind. A
+           stretch is (t - lastT) * |D| long (the paper's listing divides by
+           |D| there, a slip: its one-volume algorithm multiplies) */
+        double acc[4] = {0.0, 0.0, 0.0, 0.0}, last = 0.0;
+        int open = 0;
+        for (k = 0; k < m && !st->done; ++k) {
+            int e = perm[k];
+            double t = key[e], sgn = (e & 1) ? -1.0 : 1.0;
+            if (t > 1.5) break;
+            v = e >> 1;
+            if (open > 0 && t > last) fogvol__an_add(st, law, acc, acc[3], (t - last) * len);
+            for (c = 0; c < 3; ++c) acc[c] += sgn * s->color[v][c] * s->density[v];
+            acc[3] += sgn * s->density[v];
+            open += (e & 1) ? -1 : 1;
+            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
+            last = t;
+        }
+    }
+}
+
+/* The paper's sorted evaluation of one vertex from its entry/exit pairs (those
    of volume v at t1[v * ts], t2[v * ts]). Misses sort last and end the walk. */
 static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
                               const float *t2, int ts, unsigned char *perm, int64_t *moves, fogvol__an_state *st)
 {
     float key[2 * FOGVOL_ANALYTIC_CAPACITY];
-    int n = s->count, m = 2 * s->count, k, j, v, c;
+    int n = s->count, m = 2 * s->count, k, j, v;
     int64_t mv = 0;
     for (v = 0; v < n; ++v) {
         float a = t1[v * ts], b = t2[v * ts];
@@ -3186,38 +3261,7 @@ static void fogvol__an_sorted(const fogvol_analytic_set *s, int law, int mix, do
         perm[j] = x;
     }
     if (moves) *moves += mv;
-    if (mix == FOGVOL_MIX_SEPARATE) {
-        /* the entries in order of t1; each volume whole */
-        for (k = 0; k < m && !st->done; ++k) {
-            int e = perm[k];
-            double cs[3];
-            if (key[e] > 1.5f) break;
-            if (e & 1) continue;
-            v = e >> 1;
-            for (c = 0; c < 3; ++c) cs[c] = s->color[v][c] * s->density[v];
-            fogvol__an_add(st, law, cs, s->density[v], len * ((double)key[e + 1] - (double)key[e]));
-        }
-    } else {
-        /* the event list: sums of (colour * density, density) of the volumes a
-           stretch is in; the sums restart from exact zeros whenever no volume
-           is open, so that rounding never leaves a ghost density behind. A
-           stretch is (t - lastT) * |D| long (the seed's listing divides by
-           |D| there, a slip: its one-volume algorithm multiplies) */
-        double acc[4] = {0.0, 0.0, 0.0, 0.0}, last = 0.0;
-        int open = 0;
-        for (k = 0; k < m && !st->done; ++k) {
-            int e = perm[k];
-            double t = key[e], sgn = (e & 1) ? -1.0 : 1.0;
-            if (t > 1.5) break;
-            v = e >> 1;
-            if (open > 0 && t > last) fogvol__an_add(st, law, acc, acc[3], (t - last) * len);
-            for (c = 0; c < 3; ++c) acc[c] += sgn * s->color[v][c] * s->density[v];
-            acc[3] += sgn * s->density[v];
-            open += (e & 1) ? -1 : 1;
-            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
-            last = t;
-        }
-    }
+    fogvol__an_walk(s, law, mix, len, key, perm, m, st);
 }
 
 static void fogvol__an_sorted_vertex(const fogvol_analytic_set *s, int law, int mix, double len, const float *t1,
@@ -3254,41 +3298,51 @@ static int fogvol__an_args_ok(const fogvol_analytic_set *set, fogvol_fog_law law
            (mix == FOGVOL_MIX_SEPARATE || mix == FOGVOL_MIX_INTERPENETRATING);
 }
 
+/* One vertex in double from the eye in the volumes' spaces (eval, and the
+   float kernels' vertices too far away for float). */
+static void fogvol__an_vertex(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                              const float p[3], int law, int mix, float *fog, float col[3])
+{
+    float t1[FOGVOL_ANALYTIC_CAPACITY], t2[FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char perm[2 * FOGVOL_ANALYTIC_CAPACITY];
+    double dx, dy, dz, len, tau = 0.0, rgb[3] = {0.0, 0.0, 0.0}, hits = 0.0;
+    int v, c;
+    dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
+    len = FOGVOL_SQRT(dx * dx + dy * dy + dz * dz);
+    for (v = 0; v < set->count; ++v) {
+        double lo, hi, tv;
+        fogvol__an_ray(set, pe, v, dx, dy, dz, len, &lo, &hi);
+        t1[v] = (float)lo;
+        t2[v] = (float)hi;
+        tv = set->density[v] * (len * (hi - lo));
+        tau += tv;
+        for (c = 0; c < 3; ++c) rgb[c] += set->color[v][c] * tv;
+        hits += (double)(tv > 0.0);
+    }
+    if (hits > 1.0 && tau > fogvol__an_sort_limit(set, law)) {
+        fogvol__an_identity(perm, 2 * set->count);
+        fogvol__an_sorted_vertex(set, law, mix, len, t1, t2, 1, perm, NULL, fog, col);
+    } else { /* the same expressions as the batch's order-free loop */
+        double inv = 1.0 / (tau + (double)(tau == 0.0));
+        *fog = (float)(law == FOGVOL_FOG_EXP ? (tau > 0.0 ? FOGVOL_EXP(-tau) : 1.0) : fogvol__an_max(1.0 - tau, 0.0));
+        for (c = 0; c < 3; ++c) col[c] = (float)(rgb[c] * inv);
+    }
+}
+
 FOGVOL_API fogvol_result fogvol_analytic_eval(const fogvol_analytic_set *set, const float eye[3], const float p[3],
                                               fogvol_fog_law law, fogvol_fog_mix mix, float *fog, float color[3])
 {
     fogvol__an_eye pe;
-    float t1[FOGVOL_ANALYTIC_CAPACITY], t2[FOGVOL_ANALYTIC_CAPACITY], f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
-    unsigned char perm[2 * FOGVOL_ANALYTIC_CAPACITY];
-    double e[3], dx, dy, dz, len, tau = 0.0, rgb[3] = {0.0, 0.0, 0.0}, hits = 0.0;
+    float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+    double e[3];
     fogvol_result res = FOGVOL_SUCCESS;
-    int v, c;
     if (!fogvol__an_args_ok(set, law, mix) || !fog) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!eye || !p || !fogvol__finite_n(eye, 3) || !fogvol__finite_n(p, 3)) {
         res = FOGVOL_ERROR_INVALID_ARGUMENT;
     } else {
         e[0] = eye[0], e[1] = eye[1], e[2] = eye[2];
         fogvol__an_eye_init(set, e, &pe);
-        dx = (double)p[0] - e[0], dy = (double)p[1] - e[1], dz = (double)p[2] - e[2];
-        len = FOGVOL_SQRT(dx * dx + dy * dy + dz * dz);
-        for (v = 0; v < set->count; ++v) {
-            double lo, hi, tv;
-            fogvol__an_ray(set, &pe, v, dx, dy, dz, len, &lo, &hi);
-            t1[v] = (float)lo;
-            t2[v] = (float)hi;
-            tv = set->density[v] * (len * (hi - lo));
-            tau += tv;
-            for (c = 0; c < 3; ++c) rgb[c] += set->color[v][c] * tv;
-            hits += (double)(tv > 0.0);
-        }
-        if (hits > 1.0 && tau > fogvol__an_sort_limit(set, law)) {
-            fogvol__an_identity(perm, 2 * set->count);
-            fogvol__an_sorted_vertex(set, law, mix, len, t1, t2, 1, perm, NULL, &f, col);
-        } else { /* the same expressions as the batch's order-free loop */
-            double inv = 1.0 / (tau + (double)(tau == 0.0));
-            f = (float)(law == FOGVOL_FOG_EXP ? (tau > 0.0 ? FOGVOL_EXP(-tau) : 1.0) : fogvol__an_max(1.0 - tau, 0.0));
-            for (c = 0; c < 3; ++c) col[c] = (float)(rgb[c] * inv);
-        }
+        fogvol__an_vertex(set, &pe, e, p, (int)law, (int)mix, &f, col);
     }
     *fog = f;
     if (color) color[0] = col[0], color[1] = col[1], color[2] = col[2];
@@ -3376,6 +3430,550 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
     }
 }
 
+/* ---- the float kernels ----
+   The same entry/exit maths in float over blocks of vertices (one volume at a
+   time, structure of arrays), compiled once per SIMD level: the block body is
+   inlined into one function per level, so the compiler vectorises it for that
+   level's registers; the square roots go through a per-level helper (the C
+   library's sqrt keeps errno and so stays scalar). Float loses the chord of a
+   grazing ray (it depends on the square root of a small discriminant), so the
+   lanes whose discriminant is below FOGVOL__AN_GRAZE of a are redone in
+   double, and so is every ray of a quadric whose unit space puts the eye
+   further than FOGVOL__AN_FAR_EYE from its centre (the cross product o x v
+   loses digits there). */
+
+#define FOGVOL__AN_GRAZE 0.0625f
+#define FOGVOL__AN_FAR_EYE 64.0
+#define FOGVOL__AN_MASKS ((FOGVOL_ANALYTIC_CAPACITY + 31) / 32)
+
+#if (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 5)) && (defined(__x86_64__) || defined(__i386__))
+#define FOGVOL__AN_X86 1
+#include <immintrin.h>
+#else
+#define FOGVOL__AN_X86 0
+#endif
+
+FOGVOL__AN_INLINE float fogvol__an_fmin(float a, float b) { return a < b ? a : b; }
+FOGVOL__AN_INLINE float fogvol__an_fmax(float a, float b) { return a > b ? a : b; }
+/* index of the lowest set bit of x != 0 */
+FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctz(x);
+#else
+    int n = 0;
+    while (!(x & 1u)) x >>= 1, ++n;
+    return n;
+#endif
+}
+
+/* one volume as the float kernels read it, the eye already in its unit space */
+typedef struct fogvol__an_fvol {
+    float m[12], o[3], c0, dens, col[3];
+    int shape, dbl; /* dbl: every ray of this volume in double */
+} fogvol__an_fvol;
+
+typedef struct fogvol__an_fblock {
+    float px[FOGVOL__AN_BLOCK], py[FOGVOL__AN_BLOCK], pz[FOGVOL__AN_BLOCK]; /* the vertices (redos) */
+    float dx[FOGVOL__AN_BLOCK], dy[FOGVOL__AN_BLOCK], dz[FOGVOL__AN_BLOCK], len[FOGVOL__AN_BLOCK];
+    float a[FOGVOL__AN_BLOCK], b[FOGVOL__AN_BLOCK], disc[FOGVOL__AN_BLOCK], s[FOGVOL__AN_BLOCK];
+    float vz[FOGVOL__AN_BLOCK], lo[FOGVOL__AN_BLOCK], hi[FOGVOL__AN_BLOCK], ch[FOGVOL__AN_BLOCK];
+    float tau[FOGVOL__AN_BLOCK], r[FOGVOL__AN_BLOCK], g[FOGVOL__AN_BLOCK], bl[FOGVOL__AN_BLOCK];
+    float hits[FOGVOL__AN_BLOCK], fog[FOGVOL__AN_BLOCK], need[FOGVOL__AN_BLOCK];
+    int redo[FOGVOL__AN_BLOCK];
+    unsigned int hit[FOGVOL__AN_MASKS][FOGVOL__AN_BLOCK]; /* bit v & 31 of word v >> 5: volume v is on the ray */
+    float t1[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK], t2[FOGVOL_ANALYTIC_CAPACITY][FOGVOL__AN_BLOCK];
+} fogvol__an_fblock;
+
+typedef void (*fogvol__an_sqrt_fn)(float *out, const float *in); /* FOGVOL__AN_BLOCK values, in >= 0 */
+
+static void fogvol__an_sqrt_c(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) out[i] = (float)FOGVOL_SQRT((double)in[i]);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fdistance(const float *m, float len, float *lo, float *hi)
+{
+    float ls = len + (float)(len == 0.0f);
+    float f = fogvol__an_fmin(m[1] / ls, 1.0f);
+    float h = m[1] > 0.0f ? f : 1.0f;
+    *lo = m[0] / ls;
+    *hi = len > 0.0f ? h : -1.0f;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fhalf(const float *m, float s0, float dx, float dy, float dz, float *lo, float *hi)
+{
+    float s1 = m[0] * dx + m[1] * dy + m[2] * dz;
+    float ss = s1 + (float)(s1 == 0.0f), tx = -s0 / ss;
+    float txl = fogvol__an_fmax(tx, 0.0f), txh = fogvol__an_fmin(tx, 1.0f);
+    float par = s0 >= 0.0f ? 1.0f : -1.0f;
+    float h = s1 > 0.0f ? 1.0f : par;
+    *lo = s1 > 0.0f ? txl : 0.0f;
+    *hi = s1 < 0.0f ? txh : h;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fslab(float o, float v, float *lo, float *hi)
+{
+    float vs = v + (float)(v == 0.0f);
+    float ta = (-1.0f - o) / vs, tb = (1.0f - o) / vs;
+    float mn = fogvol__an_fmin(ta, tb), mx = fogvol__an_fmax(ta, tb);
+    float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
+    float l = v == 0.0f ? 0.0f : mn, h = v == 0.0f ? par : mx;
+    *lo = fogvol__an_fmax(*lo, l);
+    *hi = fogvol__an_fmin(*hi, h);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fbox(const float *m, const float *o, float dx, float dy, float dz, float *lo,
+                                       float *hi)
+{
+    float l = 0.0f, h = 1.0f;
+    fogvol__an_fslab(o[0], m[0] * dx + m[1] * dy + m[2] * dz, &l, &h);
+    fogvol__an_fslab(o[1], m[4] * dx + m[5] * dy + m[6] * dz, &l, &h);
+    fogvol__an_fslab(o[2], m[8] * dx + m[9] * dy + m[10] * dz, &l, &h);
+    *lo = l;
+    *hi = h;
+}
+
+/* fogvol__an_quad1 in float (kind 0 ellipsoid, 1 cylinder side, 2 sphere) */
+FOGVOL__AN_INLINE void fogvol__an_fquad1(const float *m, const float *o, int kind, float dx, float dy, float dz,
+                                         float *a, float *b, float *disc, float *vz)
+{
+    int cyl = kind == 1;
+    float v0 = kind == 2 ? m[0] * dx : m[0] * dx + m[1] * dy + m[2] * dz;
+    float v1 = kind == 2 ? m[0] * dy : m[4] * dx + m[5] * dy + m[6] * dz;
+    float v2 = kind == 2 ? m[0] * dz : m[8] * dx + m[9] * dy + m[10] * dz;
+    float w2 = cyl ? 0.0f : v2, o2 = cyl ? 0.0f : o[2];
+    float cx = o[1] * w2 - o2 * v1, cy = o2 * v0 - o[0] * w2, cz = o[0] * v1 - o[1] * v0;
+    *a = v0 * v0 + v1 * v1 + w2 * w2;
+    *b = o[0] * v0 + o[1] * v1 + o2 * w2;
+    *disc = *a - (cx * cx + cy * cy + cz * cz);
+    *vz = v2;
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fquad2(float a, float b, float disc, float s, float c0, float *lo, float *hi)
+{
+    float ns = -s, sg = b >= 0.0f ? s : ns;
+    float q = -(b + sg);
+    float qs = q + (float)(q == 0.0f), as = a + (float)(a == 0.0f);
+    float r1 = q / as, r2 = c0 / qs;
+    float l = fogvol__an_fmax(fogvol__an_fmin(r1, r2), 0.0f), h = fogvol__an_fmin(fogvol__an_fmax(r1, r2), 1.0f);
+    float par = c0 <= 0.0f ? 1.0f : -1.0f;
+    float hd = disc > 0.0f ? h : -1.0f;
+    *lo = a > 0.0f ? l : 0.0f;
+    *hi = a > 0.0f ? hd : par;
+}
+
+/* The lanes of volume v marked in redo (all of them: all != 0) through the
+   double kernels, from the vertices themselves. */
+static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3], int v,
+                            int all, fogvol__an_fblock *k)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        double dx, dy, dz, lo, hi;
+        if (!all && !k->redo[i]) continue;
+        dx = (double)k->px[i] - e[0], dy = (double)k->py[i] - e[1], dz = (double)k->pz[i] - e[2];
+        fogvol__an_ray(set, pe, v, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
+        k->lo[i] = (float)lo;
+        k->hi[i] = (float)hi;
+        k->ch[i] = (float)(hi > lo ? hi - lo : 0.0); /* the chord in double: t near 1 loses digits in float */
+    }
+}
+
+/* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block;
+   returns whether some lanes graze it (marked in redo, for fogvol__an_redo). */
+FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
+{
+    const float *m = f->m, *o = f->o, c0 = f->c0;
+    int i, any = 0, kind = f->shape == FOGVOL_SHAPE_SPHERE ? 2 : f->shape == FOGVOL_SHAPE_CYLINDER ? 1 : 0;
+    if (kind == 2)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 2, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    else if (kind == 1)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 1, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    else
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            fogvol__an_fquad1(m, o, 0, k->dx[i], k->dy[i], k->dz[i], &k->a[i], &k->b[i], &k->disc[i], &k->vz[i]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        int g = (k->a[i] > 0.0f) & (k->disc[i] < FOGVOL__AN_GRAZE * k->a[i]) & (k->disc[i] > -FOGVOL__AN_GRAZE * k->a[i]);
+        k->redo[i] = g;
+        any |= g;
+        k->s[i] = fogvol__an_fmax(k->disc[i], 0.0f);
+    }
+    sq(k->s, k->s);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+        fogvol__an_fquad2(k->a[i], k->b[i], k->disc[i], k->s[i], c0, &k->lo[i], &k->hi[i]);
+    if (kind == 1)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fslab(o[2], k->vz[i], &k->lo[i], &k->hi[i]);
+    return any;
+}
+
+/* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
+   and which vertices need the sorted walk. Inlined into one function per level. */
+FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                              const double e[3], const fogvol__an_fvol *fv, float limit,
+                                              fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
+{
+    int v, i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
+    sq(k->len, k->len);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0f;
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
+    for (v = 0; v < set->count; ++v) {
+        const int w = v >> 5, bit = v & 31;
+        const fogvol__an_fvol fl = fv[v], *f = &fl; /* a local copy: the block's stores cannot alias it */
+        const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
+        int redo = f->dbl ? -1 : 0;
+        if (f->dbl)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->lo[i] = k->hi[i] = 0.0f;
+        else if (f->shape == FOGVOL_SHAPE_DISTANCE)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fdistance(m, k->len[i], &k->lo[i], &k->hi[i]);
+        else if (f->shape == FOGVOL_SHAPE_HALF_SPACE)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_fhalf(m, o[0], k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+        else if (f->shape == FOGVOL_SHAPE_BOX)
+            for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+                fogvol__an_fbox(m, o, k->dx[i], k->dy[i], k->dz[i], &k->lo[i], &k->hi[i]);
+        else
+            redo = fogvol__an_fquadric(f, sq, k);
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->ch[i] = fogvol__an_fmax(k->hi[i] - k->lo[i], 0.0f);
+        if (redo) fogvol__an_redo(set, pe, e, v, redo < 0, k);
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+            float l0 = k->lo[i], h0 = k->hi[i];
+            float d = k->ch[i], lo = fogvol__an_fmin(l0, h0);
+            float tv = dens * (k->len[i] * d);
+            k->tau[i] += tv;
+            k->r[i] += cr * tv;
+            k->g[i] += cg * tv;
+            k->bl[i] += cb * tv;
+            k->hits[i] += (float)(tv > 0.0f);
+            k->hit[w][i] |= (unsigned int)(tv > 0.0f) << bit;
+            k->t1[v][i] = lo;
+            k->t2[v][i] = lo + d;
+        }
+    }
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
+        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f;
+        k->fog[i] = fogvol__an_fmax(1.0f - tau, 0.0f);
+        k->r[i] *= inv;
+        k->g[i] *= inv;
+        k->bl[i] *= inv;
+        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
+    }
+}
+
+typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                     const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k);
+
+static void fogvol__an_fblock_c(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_c, k);
+}
+
+#if FOGVOL__AN_X86
+__attribute__((target("sse2"))) static void fogvol__an_sqrt_sse2(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 4) _mm_storeu_ps(out + i, _mm_sqrt_ps(_mm_loadu_ps(in + i)));
+}
+__attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_analytic_set *set,
+                                                                    const fogvol__an_eye *pe, const double e[3],
+                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_sse2, k);
+}
+__attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, const float *in)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) _mm256_storeu_ps(out + i, _mm256_sqrt_ps(_mm256_loadu_ps(in + i)));
+}
+__attribute__((target("avx2"))) static void fogvol__an_fblock_avx2(const fogvol_analytic_set *set,
+                                                                    const fogvol__an_eye *pe, const double e[3],
+                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    fogvol__an_fblock *k)
+{
+    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_avx2, k);
+}
+#endif
+
+FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic_kernel requested)
+{
+    int r = (int)requested;
+    if (r < 0 || r >= (int)FOGVOL_ANALYTIC_KERNEL_COUNT) return FOGVOL_ANALYTIC_KERNEL_COUNT;
+    if (r == FOGVOL_ANALYTIC_KERNEL_DOUBLE || r == FOGVOL_ANALYTIC_KERNEL_FLOAT) return requested;
+#if FOGVOL__AN_X86
+    __builtin_cpu_init();
+    if ((r == FOGVOL_ANALYTIC_KERNEL_AUTO || r == FOGVOL_ANALYTIC_KERNEL_AVX2) && __builtin_cpu_supports("avx2"))
+        return FOGVOL_ANALYTIC_KERNEL_AVX2;
+    if (__builtin_cpu_supports("sse2")) return FOGVOL_ANALYTIC_KERNEL_SSE2;
+#endif
+    return FOGVOL_ANALYTIC_KERNEL_FLOAT;
+}
+
+/* The float kernels' per-call volume table: the eye in each unit space
+   (from the double one), and which volumes go to double whole. Returns the
+   largest |vertex - eye| coordinate the float loops take (further vertices
+   go to double one by one), or 0 when a volume's numbers could overflow
+   float sums (density or colour beyond 1e6, an eye 1e12 units away in a
+   unit space, a map entry beyond 1e12): the call then runs the DOUBLE kernel. */
+static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
+{
+    double mmax = 1.0;
+    int v, j;
+    for (v = 0; v < set->count; ++v) {
+        const double *o = pe->o[v], *m = set->map[v];
+        double oo = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+        if (!(set->density[v] <= 1e6) || !(FOGVOL_FABS(set->color[v][0]) <= 1e6) ||
+            !(FOGVOL_FABS(set->color[v][1]) <= 1e6) || !(FOGVOL_FABS(set->color[v][2]) <= 1e6))
+            return 0.0f;
+        if (set->shape[v] != FOGVOL_SHAPE_DISTANCE) {
+            if (!(oo <= 1e24)) return 0.0f;
+            for (j = 0; j < 12; ++j)
+                if ((j & 3) != 3) mmax = fogvol__an_max(mmax, FOGVOL_FABS(m[j]));
+        }
+        for (j = 0; j < 12; ++j) fv[v].m[j] = (float)m[j];
+        for (j = 0; j < 3; ++j) fv[v].o[j] = (float)o[j], fv[v].col[j] = (float)set->color[v][j];
+        fv[v].c0 = (float)pe->c0[v];
+        fv[v].dens = (float)set->density[v];
+        fv[v].shape = set->shape[v];
+        fv[v].dbl = set->shape[v] >= FOGVOL_SHAPE_SPHERE && !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
+    }
+    return mmax > 1e12 ? 0.0f : (float)(1e15 / mmax);
+}
+
+/* exp(-x) for x >= 0 in float without the C library (the walk calls it once
+   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) = 1 + r + r^2 P(r) with
+   the minimax P of Cephes' expf (about 1 ulp), evaluated in Estrin's order
+   (short dependency chains), times 2^-n. */
+FOGVOL__AN_INLINE float fogvol__an_fexpn(float x)
+{
+    float t, r, r2, p, scale;
+    unsigned int bits;
+    int n;
+    if (!(x < 87.0f)) return x >= 87.0f ? 0.0f : 1.0f; /* NaN: 1 */
+    t = x * 1.44269504f;
+    n = (int)(t + 0.5f);
+    r = (float)n * 0.693145751953125f - x + (float)n * 1.42860677e-6f; /* ln2 in two parts */
+    r2 = r * r;
+    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
+        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
+    p = 1.0f + r + r2 * p;
+    bits = (unsigned int)(127 - n) << 23;
+    memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
+}
+
+/* fogvol__an_state and fogvol__an_add in float, for the float kernels' walk */
+typedef struct fogvol__an_fstate {
+    float f, w, num[3];
+    int done;
+} fogvol__an_fstate;
+
+FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const float cs[3], float sig, float l)
+{
+    float tau = sig * l, k;
+    int c;
+    if (!(tau > 0.0f) || st->done) return;
+    if (law == FOGVOL_FOG_EXP) {
+        float e = fogvol__an_fexpn(tau);
+        /* (1 - e) / tau, by its series where 1 - e would cancel (error < tau^6 / 5040) */
+        float ps = 1.0f - tau * (0.5f - tau * (1.0f / 6.0f - tau * (1.0f / 24.0f - tau * (1.0f / 120.0f - tau / 720.0f))));
+        float phi = tau < 0.25f ? ps : (1.0f - e) / tau;
+        k = l * phi * st->f;
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * k;
+        st->w += sig * k;
+        st->f *= e;
+        if (st->f < (float)FOGVOL__AN_CUTOFF) st->done = 1;
+    } else if (law == FOGVOL_FOG_LINEAR) {
+        k = tau >= st->f ? st->f / tau : 1.0f;
+        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * (l * k);
+        st->w += tau * k;
+        st->f = tau >= st->f ? 0.0f : st->f - tau;
+        st->done = st->f == 0.0f;
+    } else {
+        for (c = 0; c < 3; ++c) st->num[c] = cs[c] / sig * st->f + st->num[c] * (1.0f - st->f);
+        st->f -= tau < 1.0f ? tau : 1.0f;
+        if (st->f <= 0.0f) {
+            st->f = 0.0f;
+            st->done = 1;
+        }
+    }
+}
+
+/* fogvol__an_walk in float over the hit events ev[0..h) (sorted by key) */
+static void fogvol__an_fwalk(const fogvol__an_fvol *fv, int law, int mix, float len, const float *key,
+                             const unsigned char *ev, int h, fogvol__an_fstate *st)
+{
+    int k, c;
+    if (mix == FOGVOL_MIX_SEPARATE) {
+        for (k = 0; k < h && !st->done; ++k) {
+            int e = ev[k];
+            const fogvol__an_fvol *f = &fv[e >> 1];
+            float cs[3];
+            if (e & 1) continue;
+            for (c = 0; c < 3; ++c) cs[c] = f->col[c] * f->dens;
+            fogvol__an_fadd(st, law, cs, f->dens, len * (key[e + 1] - key[e]));
+        }
+    } else {
+        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, last = 0.0f;
+        int open = 0;
+        for (k = 0; k < h && !st->done; ++k) {
+            int e = ev[k];
+            const fogvol__an_fvol *f = &fv[e >> 1];
+            float t = key[e], sd = (e & 1) ? -f->dens : f->dens;
+            if (open > 0 && t > last) fogvol__an_fadd(st, law, acc, acc[3], (t - last) * len);
+            for (c = 0; c < 3; ++c) acc[c] += sd * f->col[c];
+            acc[3] += sd;
+            open += (e & 1) ? -1 : 1;
+            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0f;
+            last = t;
+        }
+    }
+}
+
+/* The sorted walk of the float kernels: only the events of the volumes on
+   the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
+   are sorted, by insertion from volume order (cheaper than filtering a
+   carried order of all the events). */
+static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol__an_fvol *fv, int law, int mix,
+                                      float len, const float *t1, const float *t2, const unsigned int *hit,
+                                      int64_t *moves, float *fog, float col[3])
+{
+    float key[2 * FOGVOL_ANALYTIC_CAPACITY], inv;
+    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY];
+    fogvol__an_fstate st;
+    int h = 0, w, k, j, c;
+    int64_t mv = 0;
+    for (w = 0; w < (s->count + 31) / 32; ++w) {
+        unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
+        while (bits) {
+            int v = 32 * w + fogvol__an_ctz(bits);
+            bits &= bits - 1u;
+            key[2 * v] = t1[v * FOGVOL__AN_BLOCK];
+            key[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK];
+            ev[h++] = (unsigned char)(2 * v);
+            ev[h++] = (unsigned char)(2 * v + 1);
+        }
+    }
+    for (k = 1; k < h; ++k) {
+        unsigned char x = ev[k];
+        float kx = key[x];
+        for (j = k; j > 0 && (key[ev[j - 1]] > kx || (key[ev[j - 1]] == kx && ev[j - 1] > x)); --j) {
+            ev[j] = ev[j - 1];
+            ++mv;
+        }
+        ev[j] = x;
+    }
+    *moves += mv;
+    memset(&st, 0, sizeof st);
+    st.f = 1.0f;
+    fogvol__an_fwalk(fv, law, mix, len, key, ev, h, &st);
+    inv = st.w > 1e-30f ? 1.0f / st.w : 0.0f;
+    *fog = st.f;
+    for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
+}
+
+/* What a batch call works on, for the float kernels' loop. */
+typedef struct fogvol__an_call {
+    const fogvol_analytic_set *set;
+    const fogvol__an_eye *pe;
+    const double *e;
+    const unsigned char *src;
+    float *fog_out, *color_out;
+    fogvol_analytic_order *order;
+    unsigned char *carry;
+    double limit;
+    float dlim; /* |vertex - eye| coordinates beyond this go to double (fogvol__an_fvols) */
+    int eye_ok, law, mix, count, stride, fog_stride, color_stride, bad, sorted;
+    int64_t moves;
+} fogvol__an_call;
+
+/* Gathers block `base` (checked: x - x is 0 for finite x only), padded with
+   zero-length rays; valid: 0 non-finite, 1 float, 2 double (too far). */
+static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned char *valid, fogvol__an_fblock *k)
+{
+    float ex = (float)c->e[0], ey = (float)c->e[1], ez = (float)c->e[2];
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        float x = ex, y = ey, z = ez;
+        int ok = 0;
+        if (i < nb) {
+            const float *p = (const float *)(const void *)(c->src + (size_t)(base + i) * (size_t)c->stride);
+            ok = c->eye_ok & (p[0] - p[0] == 0.0f) & (p[1] - p[1] == 0.0f) & (p[2] - p[2] == 0.0f);
+            c->bad += !ok;
+            /* float could overflow: the vertex goes to double whole */
+            if (ok && !(p[0] - ex <= c->dlim && p[0] - ex >= -c->dlim && p[1] - ey <= c->dlim &&
+                        p[1] - ey >= -c->dlim && p[2] - ez <= c->dlim && p[2] - ez >= -c->dlim))
+                ok = 2;
+            if (ok == 1) x = p[0], y = p[1], z = p[2];
+        }
+        valid[i] = (unsigned char)ok;
+        k->px[i] = x, k->py[i] = y, k->pz[i] = z;
+        k->dx[i] = x - ex, k->dy[i] = y - ey, k->dz[i] = z - ez;
+    }
+}
+
+/* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
+static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
+{
+    fogvol__an_fblock blk;
+    fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
+    unsigned char valid[FOGVOL__AN_BLOCK];
+    int base, i;
+    float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
+    c->dlim = fogvol__an_fvols(c->set, c->pe, fv);
+    if (c->dlim == 0.0f) return 0;
+    for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
+        int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
+        fogvol__an_fgather(c, base, nb, valid, &blk);
+        fn(c->set, c->pe, c->e, fv, limit, &blk);
+        for (i = 0; i < nb; ++i) {
+            size_t idx = (size_t)(base + i);
+            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+            if (!valid[i]) {
+                /* fog 1, colour 0 */
+            } else if (valid[i] == 2) {
+                const float *p = (const float *)(const void *)(c->src + idx * (size_t)c->stride);
+                fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, &f, col);
+            } else if (blk.need[i] != 0.0f) {
+                fogvol__an_fsorted_vertex(c->set, fv, c->law, c->mix, blk.len[i],
+                                          (const float *)(const void *)blk.t1 + i,
+                                          (const float *)(const void *)blk.t2 + i,
+                                          (const unsigned int *)(const void *)blk.hit + i, &c->moves, &f, col);
+                ++c->sorted;
+            } else {
+                f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
+                    : blk.tau[i] > 0.0f ? (float)FOGVOL_EXP(-(double)blk.tau[i]) : 1.0f;
+                col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
+            }
+            if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;
+            if (c->color_out) {
+                float *out = (float *)(void *)((unsigned char *)c->color_out + idx * (size_t)c->color_stride);
+                out[0] = col[0], out[1] = col[1], out[2] = col[2];
+            }
+        }
+    }
+    return 1;
+}
+
+/* The float kernel a resolved level runs. */
+static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
+{
+#if FOGVOL__AN_X86
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fblock_avx2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fblock_sse2;
+#else
+    (void)k;
+#endif
+    return fogvol__an_fblock_c;
+}
+
 FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, const float eye[3],
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
@@ -3389,8 +3987,11 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     double e[3], limit;
     int base, i, m, bad = 0, eye_ok, sorted = 0;
     int64_t moves = 0;
+    fogvol_analytic_kernel kern;
     if (invalid) *invalid = 0;
-    if (!fogvol__an_args_ok(set, law, mix) || !eye || count < 0 || (count > 0 && !positions) || stride < 0 ||
+    if (!fogvol__an_args_ok(set, law, mix)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    kern = fogvol_analytic_kernel_resolve((fogvol_analytic_kernel)set->kernel);
+    if (kern == FOGVOL_ANALYTIC_KERNEL_COUNT || !eye || count < 0 || (count > 0 && !positions) || stride < 0 ||
         (stride > 0 && stride < 12) || fog_stride < 0 || (fog_stride > 0 && fog_stride < 4) || color_stride < 0 ||
         (color_stride > 0 && color_stride < 12))
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -3411,6 +4012,17 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     } else {
         carry = local;
         fogvol__an_identity(carry, m);
+    }
+    if (kern != FOGVOL_ANALYTIC_KERNEL_DOUBLE) {
+        fogvol__an_call c;
+        memset(&c, 0, sizeof c);
+        c.set = set, c.pe = &pe, c.e = e, c.src = src, c.order = order, c.carry = carry, c.limit = limit;
+        c.eye_ok = eye_ok, c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride;
+        c.fog_out = fog_out, c.fog_stride = fog_stride, c.color_out = color_out, c.color_stride = color_stride;
+        if (fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
+            bad = c.bad, sorted = c.sorted, moves = c.moves;
+            count = 0; /* done: the double loop below is skipped */
+        }
     }
     for (base = 0; base < count; base += FOGVOL__AN_BLOCK) {
         int nb = count - base < FOGVOL__AN_BLOCK ? count - base : FOGVOL__AN_BLOCK;

@@ -17,7 +17,9 @@
  *     the volumes containing it, steps refined by bisection where the set of volumes
  *     changes), random sets of 1..8 overlapping volumes of every shape, both laws
  *     (LINEAR: f = 1 - clamp01(sum density * d), EXP: f = exp(-sum density * d)),
- *     eval and batch: |dfog| <= 1e-4 and |d(colour * (1 - fog))| <= 1e-4; SEPARATE
+ *     eval and batch (every batch kernel forced: double within 1e-6 of eval, the float
+ *     ones within 1.2e-5 of eval and 1e-4 of the integration, maxima printed):
+ *     |dfog| <= 1e-4 and |d(colour * (1 - fog))| <= 1e-4; SEPARATE
  *     mode against the same integration on disjoint volumes, and on overlapping ones
  *     against the seed's separate algorithm applied to ground-truth chords.
  *   4 the seed's colour formula (FOGVOL_FOG_LINEAR_SEED) against its closed form for
@@ -26,6 +28,8 @@
  *   6 coherence: per-vertex orders from garbage bytes give bit-identical results, a
  *     repeated frame needs 0 insertion-sort moves, a slightly moved eye fewer moves
  *     than sorting from scratch; the carried per-batch order likewise.
+ *  6b the batch kernels (double, float C, SSE2, AVX2; each forced) on edge cases
+ *     against hand-computed chords (test_kernel_edges, see there); <= 1.2e-5.
  *   7 degenerate input: zero-size volumes, singular / non-affine matrices, NaN and
  *     infinite fields, zero normal, too many volumes, NaN / infinite vertices and eye,
  *     vertex at the eye, huge coordinates; result codes, never NaN.
@@ -555,27 +559,78 @@ static void gt_fog(const tvol *vs, int n, const float eye[3], const float p[3], 
     for (k = 0; k < 3; ++k) pc[k] = st.num[k]; /* colour * (1 - fog) */
 }
 
-static void lib_fog(const fogvol_analytic_set *set, const float eye[3], const float p[3], int law, int mix,
-                    double *fog, double pc[3], double col[3])
+/* the batch's kernels (fogvol_analytic_kernel), each forced in turn; a level this
+   build or CPU lacks resolves to another one and is left out */
+static const int kernels[4] = {FOGVOL_ANALYTIC_KERNEL_DOUBLE, FOGVOL_ANALYTIC_KERNEL_FLOAT, FOGVOL_ANALYTIC_KERNEL_SSE2,
+                               FOGVOL_ANALYTIC_KERNEL_AVX2};
+static const char *const kernel_name[4] = {"double", "float C", "SSE2", "AVX2"};
+static int kernel_there(int k) { return (int)fogvol_analytic_kernel_resolve((fogvol_analytic_kernel)kernels[k]) == kernels[k]; }
+/* worst difference of each kernel's batch from eval (double), and from the ground
+   truth, over the lib_fog calls since the last reset */
+static double kern_eval_worst[4], kern_gt_worst[4];
+
+static void lib_fog_gt(const fogvol_analytic_set *set, const float eye[3], const float p[3], int law, int mix,
+                       double *fog, double pc[3], double col[3], const double *gf, const double *gc)
 {
+    fogvol_analytic_set ks = *set;
     float f, c[3], fb, cb[3];
-    int k, inv = -1;
+    int k, j, inv = -1;
     assert_int_equal(fogvol_analytic_eval(set, eye, p, (fogvol_fog_law)law, (fogvol_fog_mix)mix, &f, c), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_analytic_batch(set, eye, p, 1, 0, (fogvol_fog_law)law, (fogvol_fog_mix)mix, &fb, 0, cb, 0,
-                                           NULL, &inv),
-                     FOGVOL_SUCCESS);
-    assert_int_equal(inv, 0);
-    assert_true(fabs(f - fb) <= 1e-6);
-    for (k = 0; k < 3; ++k) assert_true(fabs(c[k] - cb[k]) * (1 - f) <= 1e-6);
+    for (j = 0; j < 4; ++j) {
+        if (!kernel_there(j)) continue;
+        ks.kernel = kernels[j];
+        assert_int_equal(fogvol_analytic_batch(&ks, eye, p, 1, 0, (fogvol_fog_law)law, (fogvol_fog_mix)mix, &fb, 0,
+                                               cb, 0, NULL, &inv),
+                         FOGVOL_SUCCESS);
+        assert_int_equal(inv, 0);
+        kern_eval_worst[j] = fmax(kern_eval_worst[j], fabs(f - fb));
+        for (k = 0; k < 3; ++k) kern_eval_worst[j] = fmax(kern_eval_worst[j], fabs(c[k] - cb[k]) * (1 - f));
+        if (gf) {
+            kern_gt_worst[j] = fmax(kern_gt_worst[j], fabs(*gf - fb));
+            for (k = 0; k < 3; ++k) kern_gt_worst[j] = fmax(kern_gt_worst[j], fabs(gc[k] - (double)cb[k] * (1 - fb)));
+        }
+        /* the double kernel is eval's arithmetic; the float ones stay within 1.2e-5 */
+        assert_true(fabs(f - fb) <= (j == 0 ? 1e-6 : 1.2e-5));
+        for (k = 0; k < 3; ++k) assert_true(fabs(c[k] - cb[k]) * (1 - f) <= (j == 0 ? 1e-6 : 1.2e-5));
+    }
     assert_true(f >= 0 && f <= 1);
     *fog = f;
     for (k = 0; k < 3; ++k) pc[k] = (double)c[k] * (1 - f), col[k] = c[k];
+}
+
+static void lib_fog(const fogvol_analytic_set *set, const float eye[3], const float p[3], int law, int mix,
+                    double *fog, double pc[3], double col[3])
+{
+    lib_fog_gt(set, eye, p, law, mix, fog, pc, col, NULL, NULL);
+}
+
+static void kern_reset(void)
+{
+    memset(kern_eval_worst, 0, sizeof kern_eval_worst);
+    memset(kern_gt_worst, 0, sizeof kern_gt_worst);
+}
+
+/* prints (and asserts) the worst differences of every kernel since kern_reset */
+static void kern_report(const char *what, double gt_bound)
+{
+    int j;
+    for (j = 0; j < 4; ++j) {
+        if (!kernel_there(j)) {
+            print_message("# %s: %s kernel not available here, skipped\n", what, kernel_name[j]);
+            continue;
+        }
+        print_message("# %s: %-7s batch max |d| vs eval %.2e, vs integration %.2e\n", what, kernel_name[j],
+                      kern_eval_worst[j], kern_gt_worst[j]);
+        assert_true(kern_eval_worst[j] <= (j == 0 ? 1e-6 : 1.2e-5));
+        assert_true(kern_gt_worst[j] <= gt_bound);
+    }
 }
 
 static void test_fog_integration(void **state)
 {
     int law, k;
     (void)state;
+    kern_reset();
     for (law = FOGVOL_FOG_LINEAR; law <= FOGVOL_FOG_EXP; ++law) {
         double worst_f = 0, worst_c = 0;
         int partial = 0, full = 0;
@@ -595,7 +650,7 @@ static void test_fog_integration(void **state)
             rand_point(eye, 4);
             rand_point(p, 4);
             gt_fog(vs, n, eye, p, law, &gf, gc);
-            lib_fog(&set, eye, p, law, FOGVOL_MIX_INTERPENETRATING, &lf, lc, col);
+            lib_fog_gt(&set, eye, p, law, FOGVOL_MIX_INTERPENETRATING, &lf, lc, col, &gf, gc);
             worst_f = fmax(worst_f, fabs(gf - lf));
             for (c = 0; c < 3; ++c) worst_c = fmax(worst_c, fabs(gc[c] - lc[c]));
             if (fabs(gf - lf) > 1e-4) print_message("# set %d (%d volumes): fog %.6f, integrated %.6f\n", k, n, lf, gf);
@@ -609,6 +664,7 @@ static void test_fog_integration(void **state)
         assert_true(worst_c <= 1e-4);
         assert_true(partial > 50);
     }
+    kern_report("interpenetrating, 600 random sets", 1e-4);
     /* SEPARATE on volumes that do not overlap: the same integral */
     for (law = FOGVOL_FOG_LINEAR; law <= FOGVOL_FOG_EXP; ++law) {
         double worst = 0;
@@ -858,6 +914,7 @@ static void test_order_coherence(void **state)
         raw[i].color[0] = (float)i / 16;
     }
     assert_int_equal(fogvol_analytic_prepare(&set, raw, 16), FOGVOL_SUCCESS);
+    set.kernel = FOGVOL_ANALYTIC_KERNEL_DOUBLE; /* the kernel that carries orders (the float ones sort hits only) */
     for (i = 0; i < N; ++i) {
         pos[3 * i] = -4.0f + 8.0f * (float)(i % 64) / 63, pos[3 * i + 1] = -4.0f + 8.0f * (float)(i / 64) / 63;
         pos[3 * i + 2] = -5.0f;
@@ -924,6 +981,238 @@ static void test_order_coherence(void **state)
     free(f1);
     free(c0);
     free(c1);
+}
+
+/* ==== 6b: the batch's kernels on edge cases ========================================
+   Every kernel (double, float in plain C, SSE2, AVX2; each forced through
+   fogvol_analytic_set.kernel) against hand-computed chords: vertices exactly on
+   sphere and box boundaries, rays tangent to a sphere and grazing it by 1e-7 ..
+   0.5 (the lanes the float kernels redo in double), an eye 500 radii away (the
+   volumes they evaluate in double whole), FOGVOL_ANALYTIC_CAPACITY disjoint spheres
+   on one ray (hit masks up to the last bit; EXP colour by hand), no volumes, zero
+   density, NaN and huge vertices, a density float sums could overflow (the double
+   kernel runs) and a denormal one; |dfog| and |d(colour * (1 - fog))| <= 1.2e-5. */
+
+#define KN 64 /* vertices per edge-case batch: two blocks, every lane used */
+
+/* runs kernel j on the KN vertices in pos; returns the invalid count */
+static int kern_batch(const fogvol_analytic_set *set, int j, const float eye[3], const float *pos, int law,
+                      float *fog, float *col)
+{
+    fogvol_analytic_set ks = *set;
+    int inv = -1;
+    ks.kernel = kernels[j];
+    fogvol_analytic_batch(&ks, eye, pos, KN, 0, (fogvol_fog_law)law, FOGVOL_MIX_INTERPENETRATING, fog, 0, col, 0,
+                          NULL, &inv);
+    return inv;
+}
+
+static double sphere_chord(const double e[3], const double p[3], const double c[3], double r)
+{
+    /* the part of segment e -> p inside the sphere, in world units, by the closed form */
+    double d[3], oc[3], a = 0, b = 0, cc = -r * r, disc, s, t1, t2;
+    int k;
+    for (k = 0; k < 3; ++k) d[k] = p[k] - e[k], oc[k] = e[k] - c[k];
+    for (k = 0; k < 3; ++k) a += d[k] * d[k], b += oc[k] * d[k], cc += oc[k] * oc[k];
+    disc = b * b - a * cc;
+    if (disc <= 0) return 0;
+    s = sqrt(disc);
+    t1 = fmax((-b - s) / a, 0), t2 = fmin((-b + s) / a, 1);
+    return t2 > t1 ? (t2 - t1) * sqrt(a) : 0;
+}
+
+static void test_kernel_edges(void **state)
+{
+    static float pos[KN * 3], fog[KN], col[KN * 3];
+    fogvol_analytic_volume v[FOGVOL_ANALYTIC_CAPACITY];
+    fogvol_analytic_set set;
+    double want[KN], worst[4] = {0, 0, 0, 0};
+    const double dens = 0.7;
+    int j, i, k;
+    (void)state;
+    /* resolve: AUTO is a float kernel, DOUBLE and FLOAT always there, bad values refused */
+    assert_true(fogvol_analytic_kernel_resolve(FOGVOL_ANALYTIC_KERNEL_AUTO) >= FOGVOL_ANALYTIC_KERNEL_FLOAT);
+    assert_int_equal(fogvol_analytic_kernel_resolve(FOGVOL_ANALYTIC_KERNEL_DOUBLE), FOGVOL_ANALYTIC_KERNEL_DOUBLE);
+    assert_int_equal(fogvol_analytic_kernel_resolve(FOGVOL_ANALYTIC_KERNEL_FLOAT), FOGVOL_ANALYTIC_KERNEL_FLOAT);
+    assert_int_equal(fogvol_analytic_kernel_resolve((fogvol_analytic_kernel)7), FOGVOL_ANALYTIC_KERNEL_COUNT);
+    for (j = 0; j < 4; ++j) print_message("# kernel %-7s %s\n", kernel_name[j], kernel_there(j) ? "runs here" : "not available here");
+    memset(v, 0, sizeof v);
+    v[0].shape = FOGVOL_SHAPE_SPHERE, v[0].radius = 1, v[0].density = (float)dens, v[0].color[0] = 1;
+    assert_int_equal(fogvol_analytic_prepare(&set, v, 1), FOGVOL_SUCCESS);
+    {
+        /* rays from (0, 0, 5) to (0, y, -5) tangent to the unit sphere (scaled by 1 - delta: grazing it
+           inside, or just missing it), and vertices on its boundary: (0, 0, 1) (chord 0), (0, 0, -1) (chord 2), (0.6, 0, -0.8) */
+        const float eye[3] = {0, 0, 5};
+        for (i = 0; i < KN; ++i) {
+            double delta = i < 40 ? (i % 2 ? 1 : -1) * pow(10.0, -7.0 + 0.18 * (i / 2)) : 0.5 * (i - 40) / 24;
+            /* the ray from the eye to (0, yt, -5) touches the sphere: 5 yt = sqrt(yt^2 + 100) */
+            double y = sqrt(100.0 / 24.0) * (1 - delta), e[3] = {0, 0, 5}, p[3] = {0, 0, -5}, c[3] = {0, 0, 0};
+            pos[3 * i] = 0, pos[3 * i + 1] = (float)y, pos[3 * i + 2] = -5;
+            p[1] = pos[3 * i + 1];
+            want[i] = exp(-dens * sphere_chord(e, p, c, 1));
+        }
+        pos[0] = 0, pos[1] = 0, pos[2] = 1, want[0] = 1;
+        pos[3] = 0, pos[4] = 0, pos[5] = -1, want[1] = exp(-dens * 2);
+        pos[6] = 0.6f, pos[7] = 0, pos[8] = -0.8f;
+        {
+            double e[3] = {0, 0, 5}, p[3] = {0.6f, 0, -0.8f}, c[3] = {0, 0, 0};
+            want[2] = exp(-dens * sphere_chord(e, p, c, 1));
+        }
+        for (j = 0; j < 4; ++j) {
+            if (!kernel_there(j)) continue;
+            assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 0);
+            for (i = 0; i < KN; ++i) worst[j] = fmax(worst[j], fabs(fog[i] - want[i]));
+        }
+    }
+    for (j = 0; j < 4; ++j)
+        if (kernel_there(j)) {
+            print_message("# %-7s sphere boundaries and rays grazing it by 0 .. 0.5: max |dfog| %.2e\n", kernel_name[j],
+                          worst[j]);
+            assert_true(worst[j] <= 1.2e-5);
+        }
+    {
+        /* the eye 500 radii from the sphere, vertices behind it: every ray of this volume in double */
+        const float eye[3] = {0, 0, 500};
+        memset(worst, 0, sizeof worst);
+        for (i = 0; i < KN; ++i) {
+            double e[3] = {0, 0, 500}, p[3], c[3] = {0, 0, 0};
+            pos[3 * i] = (float)(-1.2 + 2.4 * i / (KN - 1)), pos[3 * i + 1] = 0.3f, pos[3 * i + 2] = -3;
+            for (k = 0; k < 3; ++k) p[k] = pos[3 * i + k];
+            want[i] = exp(-dens * sphere_chord(e, p, c, 1));
+        }
+        for (j = 0; j < 4; ++j) {
+            if (!kernel_there(j)) continue;
+            assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 0);
+            for (i = 0; i < KN; ++i) worst[j] = fmax(worst[j], fabs(fog[i] - want[i]));
+            print_message("# %-7s eye 500 radii away: max |dfog| %.2e\n", kernel_name[j], worst[j]);
+            assert_true(worst[j] <= 1.2e-5);
+        }
+    }
+    {
+        /* a box [-1,1]^3 scaled by 2: vertices on its faces and edges, the eye outside */
+        const float eye[3] = {0.5f, 0.25f, 7};
+        fogvol_analytic_volume b;
+        memset(&b, 0, sizeof b);
+        b.shape = FOGVOL_SHAPE_BOX, b.density = (float)dens;
+        glu_translate_scale(b.transform, 0, 0, 0, 2);
+        assert_int_equal(fogvol_analytic_prepare(&set, &b, 1), FOGVOL_SUCCESS);
+        for (i = 0; i < KN; ++i) {
+            /* vertex on the back face z = -2 (chord 4 when it enters through the front face) or the front one */
+            double x = -2 + 4.0 * (i % 8) / 7, y = -2 + 4.0 * (i / 8) / 7, zf = i % 3 ? -2 : 2, tin;
+            pos[3 * i] = (float)x, pos[3 * i + 1] = (float)y, pos[3 * i + 2] = (float)zf;
+            /* the segment enters at z = 2 (t = (7 - 2) / (7 - zf)); x, y stay inside: linear in t between
+               eye and vertex, both within [-2, 2] at the entry */
+            tin = zf < 0 ? 5.0 / 9.0 : 1;
+            {
+                double ex = 0.5 + tin * (x - 0.5), ey = 0.25 + tin * (y - 0.25), len = sqrt((x - 0.5) * (x - 0.5) + (y - 0.25) * (y - 0.25) + (zf - 7) * (zf - 7));
+                assert_true(fabs(ex) <= 2 && fabs(ey) <= 2);
+                want[i] = exp(-dens * (1 - tin) * len);
+            }
+        }
+        memset(worst, 0, sizeof worst);
+        for (j = 0; j < 4; ++j) {
+            if (!kernel_there(j)) continue;
+            assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 0);
+            for (i = 0; i < KN; ++i) worst[j] = fmax(worst[j], fabs(fog[i] - want[i]));
+            print_message("# %-7s box, vertices on its faces and edges: max |dfog| %.2e\n", kernel_name[j], worst[j]);
+            assert_true(worst[j] <= 1.2e-5);
+        }
+    }
+    {
+        /* FOGVOL_ANALYTIC_CAPACITY disjoint spheres of radius 0.04 on the z axis, each its own colour; the vertex
+           at z = -1 behind them all (every hit bit set) or between them; EXP by hand: sphere s (front to back)
+           covers T_s (1 - exp(-0.08 dens)) */
+        const float eye[3] = {0, 0, 1};
+        const int n = FOGVOL_ANALYTIC_CAPACITY;
+        const double dz = 4.0 / n;
+        for (i = 0; i < n; ++i) {
+            memset(&v[i], 0, sizeof v[i]);
+            v[i].shape = FOGVOL_SHAPE_SPHERE, v[i].radius = 0.04f, v[i].density = 0.3f;
+            v[i].center[2] = (float)(0.5 - dz * i);
+            v[i].color[0] = (float)i / n, v[i].color[1] = 1 - (float)i / n, v[i].color[2] = (float)(i % 3) / 2;
+        }
+        assert_int_equal(fogvol_analytic_prepare(&set, v, n), FOGVOL_SUCCESS);
+        for (i = 0; i < KN; ++i) {
+            int last = i % (n + 1); /* spheres passed whole */
+            pos[3 * i] = 0, pos[3 * i + 1] = 0;
+            pos[3 * i + 2] = (float)(0.5 - dz * last + 0.5 * dz);
+        }
+        memset(worst, 0, sizeof worst);
+        for (j = 0; j < 4; ++j) {
+            if (!kernel_there(j)) continue;
+            assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 0);
+            for (i = 0; i < KN; ++i) {
+                int last = i % (n + 1), s2;
+                double t = 1, num[3] = {0, 0, 0}, a = exp(-0.3 * 2 * (double)0.04f);
+                for (s2 = 0; s2 < last; ++s2) {
+                    for (k = 0; k < 3; ++k) num[k] += v[s2].color[k] * t * (1 - a);
+                    t *= a;
+                }
+                worst[j] = fmax(worst[j], fabs(fog[i] - t));
+                for (k = 0; k < 3; ++k) worst[j] = fmax(worst[j], fabs(col[3 * i + k] * (1 - fog[i]) - num[k]));
+            }
+            print_message("# %-7s %d disjoint spheres on one ray (EXP, colours): max |d| %.2e\n", kernel_name[j], n,
+                          worst[j]);
+            assert_true(worst[j] <= 1.2e-5);
+        }
+    }
+    {
+        /* no volumes; zero density; NaN and huge vertices (the huge ones match the double kernel) */
+        const float eye[3] = {0.1f, 0.2f, 3};
+        float fd[KN], cd[KN * 3];
+        for (i = 0; i < KN; ++i) rand_point(&pos[3 * i], 3);
+        pos[3 * 5 + 1] = (float)NAN, pos[3 * 9] = (float)INFINITY;
+        pos[3 * 7] = 1e30f, pos[3 * 7 + 2] = -1e30f, pos[3 * 8 + 1] = -3e20f;
+        for (k = 0; k < 2; ++k) {
+            memset(v, 0, sizeof v);
+            v[0].shape = FOGVOL_SHAPE_HALF_SPACE, v[0].plane[1] = 1, v[0].density = k ? 0.0f : 0.2f;
+            v[1].shape = FOGVOL_SHAPE_ELLIPSOID, v[1].density = k ? 0.0f : 0.5f, v[1].color[2] = 1;
+            v[2].shape = FOGVOL_SHAPE_DISTANCE, v[2].max_distance = 0, v[2].density = k ? 0.0f : 1e-3f;
+            assert_int_equal(fogvol_analytic_prepare(&set, v, 3), FOGVOL_SUCCESS);
+            assert_int_equal(kern_batch(&set, 0, eye, pos, FOGVOL_FOG_EXP, fd, cd), 2);
+            for (j = 1; j < 4; ++j) {
+                if (!kernel_there(j)) continue;
+                assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 2);
+                assert_true(fog[5] == 1 && fog[9] == 1 && col[15] == 0 && col[27] == 0);
+                for (i = 0; i < KN; ++i) {
+                    assert_true(fog[i] >= 0 && fog[i] <= 1 && isfinite(col[3 * i]));
+                    assert_true(fabs(fog[i] - fd[i]) <= 1.2e-5);
+                    if (k) assert_true(fog[i] == 1 && col[3 * i] == 0 && col[3 * i + 2] == 0);
+                }
+                assert_true((fog[7] < 1) == (fd[7] < 1) && (fog[8] < 1) == (fd[8] < 1)); /* the huge ones went through the half-space */
+            }
+        }
+        assert_int_equal(fogvol_analytic_prepare(&set, NULL, 0), FOGVOL_SUCCESS);
+        for (j = 0; j < 4; ++j) {
+            if (!kernel_there(j)) continue;
+            assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_LINEAR, fog, col), 2);
+            for (i = 0; i < KN; ++i) assert_true(fog[i] == 1 && col[3 * i] == 0 && col[3 * i + 1] == 0);
+        }
+        /* numbers a float sum could overflow (density 1e7): the call runs the double kernel, bit for bit;
+           a denormal density: no NaN */
+        memset(v, 0, sizeof v);
+        v[0].shape = FOGVOL_SHAPE_SPHERE, v[0].radius = 2, v[0].density = 1e7f, v[0].color[1] = 1;
+        v[1].shape = FOGVOL_SHAPE_SPHERE, v[1].radius = 1, v[1].density = 1e-40f, v[1].color[0] = 1;
+        v[1].center[0] = 0.5f;
+        for (k = 0; k < 2; ++k) {
+            assert_int_equal(fogvol_analytic_prepare(&set, v + k, 1), FOGVOL_SUCCESS);
+            assert_int_equal(kern_batch(&set, 0, eye, pos, FOGVOL_FOG_EXP, fd, cd), 2);
+            for (j = 1; j < 4; ++j) {
+                if (!kernel_there(j)) continue;
+                assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col), 2);
+                for (i = 0; i < KN; ++i) {
+                    assert_true(fog[i] >= 0 && fog[i] <= 1);
+                    assert_true(isfinite(col[3 * i]) && isfinite(col[3 * i + 1]) && isfinite(col[3 * i + 2]));
+                    if (!k) assert_true(fog[i] == fd[i] && col[3 * i + 1] == cd[3 * i + 1]);
+                    else assert_true(fabs(fog[i] - fd[i]) <= 1.2e-5);
+                }
+            }
+        }
+        set.kernel = 99; /* not a kernel */
+        assert_int_equal(fogvol_analytic_batch(&set, eye, pos, KN, 0, FOGVOL_FOG_EXP, FOGVOL_MIX_SEPARATE, fog, 0, NULL,
+                                               0, NULL, NULL),
+                         FOGVOL_ERROR_INVALID_ARGUMENT);
+    }
 }
 
 /* ==== 7: degenerate input ======================================================= */
@@ -1556,6 +1845,7 @@ int main(void)
         TIMED(test_seed_colour),
         TIMED(test_batch_matches_eval),
         TIMED(test_order_coherence),
+        TIMED(test_kernel_edges),
         TIMED(test_degenerate),
         TIMED(test_fold),
         TIMED(test_pack_uniforms),

@@ -1,8 +1,8 @@
 /* libFuzzer target: the analytic fog input. The bytes become up to 8 volume
    descriptions (shape, colour, density, distances, plane, sphere, matrix),
    an eye, a few vertices and the law/mix; fogvol_analytic_prepare, _eval,
-   _batch and _segment must never crash, never read out of bounds and never
-   return NaN or values outside [0, 1] for fog. */
+   _batch (every kernel) and _segment must never crash, never read out of
+   bounds and never return NaN or values outside [0, 1] for fog. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -46,10 +46,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (!in01(t1) || !in01(t2) || t1 > t2) abort();
         }
     }
-    memset(&order, 0, sizeof order);
-    fogvol_analytic_batch(&set, eye, pos, 4, 0, law, mix, fog, 0, col, 0, &order, &invalid);
-    for (i = 0; i < 4; ++i)
-        if (!in01(fog[i]) || col[3 * i] != col[3 * i]) abort();
-    if (invalid < 0 || invalid > 4) abort();
+    for (k = 0; k < (int)FOGVOL_ANALYTIC_KERNEL_COUNT; ++k) { /* every kernel of the batch */
+        memset(&order, 0, sizeof order);
+        set.kernel = k;
+        fogvol_analytic_batch(&set, eye, pos, 4, 0, law, mix, fog, 0, col, 0, &order, &invalid);
+        for (i = 0; i < 4; ++i)
+            if (!in01(fog[i]) || col[3 * i] != col[3 * i] || col[3 * i + 1] != col[3 * i + 1] ||
+                col[3 * i + 2] != col[3 * i + 2])
+                abort();
+        if (invalid < 0 || invalid > 4) abort();
+    }
     return 0;
 }
