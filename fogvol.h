@@ -3974,19 +3974,87 @@ static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
     return fogvol__an_fblock_c;
 }
 
+/* The double kernel's gather of block `base` (checked: x - x is 0 for finite x only), padded with
+   zero-length rays; valid[i]: 1 finite. */
+static void fogvol__an_dgather(fogvol__an_call *c, int base, int nb, unsigned char *valid, fogvol__an_block *blk)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        float x = 0.0f, y = 0.0f, z = 0.0f;
+        int ok = 0;
+        if (i < nb) {
+            const float *p = (const float *)(const void *)(c->src + (size_t)(base + i) * (size_t)c->stride);
+            x = p[0], y = p[1], z = p[2];
+            ok = c->eye_ok & (x - x == 0.0f) & (y - y == 0.0f) & (z - z == 0.0f);
+            c->bad += !ok;
+        }
+        valid[i] = (unsigned char)ok;
+        blk->dx[i] = ok ? (double)x - c->e[0] : 0.0;
+        blk->dy[i] = ok ? (double)y - c->e[1] : 0.0;
+        blk->dz[i] = ok ? (double)z - c->e[2] : 0.0;
+    }
+}
+
+/* Vertex i of a double block: the sorted walk (carrying the event order from vertex to vertex,
+   or per vertex in order->vertex_orders), or the block's own result. */
+static void fogvol__an_dvertex(fogvol__an_call *c, const fogvol__an_block *blk, int i, size_t idx, float *f,
+                               float col[3])
+{
+    const fogvol_analytic_order *order = c->order;
+    int m = 2 * c->set->count;
+    unsigned char *perm = c->carry;
+    if (blk->need[i] == 0.0) {
+        *f = (float)blk->fog[i];
+        col[0] = (float)blk->r[i], col[1] = (float)blk->g[i], col[2] = (float)blk->bl[i];
+        return;
+    }
+    if (order && order->vertex_orders && (idx + 1) * (size_t)m <= order->vertex_orders_size) {
+        perm = order->vertex_orders + idx * (size_t)m;
+        if (!fogvol__an_perm_ok(perm, m)) memcpy(perm, c->carry, (size_t)m);
+    }
+    fogvol__an_sorted_vertex(c->set, (fogvol_fog_law)c->law, (fogvol_fog_mix)c->mix, blk->len[i],
+                             (const float *)(const void *)blk->t1 + i, (const float *)(const void *)blk->t2 + i,
+                             FOGVOL__AN_BLOCK, perm, &c->moves, f, col);
+    ++c->sorted;
+    if (perm != c->carry) memcpy(c->carry, perm, (size_t)m); /* the next vertex starts from it */
+}
+
+/* The DOUBLE kernel: blocks of FOGVOL__AN_BLOCK vertices in double, the reference. */
+static void fogvol__an_dbatch(fogvol__an_call *c)
+{
+    fogvol__an_block blk;
+    unsigned char valid[FOGVOL__AN_BLOCK];
+    int base, i;
+    for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
+        int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
+        fogvol__an_dgather(c, base, nb, valid, &blk);
+        fogvol__an_block_eval(c->set, c->pe, c->limit, &blk);
+        if (c->law == FOGVOL_FOG_EXP)
+            for (i = 0; i < nb; ++i)
+                if (blk.need[i] == 0.0) blk.fog[i] = blk.tau[i] > 0.0 ? FOGVOL_EXP(-blk.tau[i]) : 1.0;
+        for (i = 0; i < nb; ++i) {
+            size_t idx = (size_t)(base + i);
+            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f}; /* invalid: fog 1, colour 0 */
+            if (valid[i]) fogvol__an_dvertex(c, &blk, i, idx, &f, col);
+            if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;
+            if (c->color_out) {
+                float *o = (float *)(void *)((unsigned char *)c->color_out + idx * (size_t)c->color_stride);
+                o[0] = col[0], o[1] = col[1], o[2] = col[2];
+            }
+        }
+    }
+}
+
 FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, const float eye[3],
                                                const float *positions, int count, int stride, fogvol_fog_law law,
                                                fogvol_fog_mix mix, float *fog_out, int fog_stride, float *color_out,
                                                int color_stride, fogvol_analytic_order *order, int *invalid)
 {
-    fogvol__an_block blk;
     fogvol__an_eye pe;
-    unsigned char local[2 * FOGVOL_ANALYTIC_CAPACITY], *carry;
-    unsigned char valid[FOGVOL__AN_BLOCK];
-    const unsigned char *src = (const unsigned char *)positions;
-    double e[3], limit;
-    int base, i, m, bad = 0, eye_ok, sorted = 0;
-    int64_t moves = 0;
+    fogvol__an_call c;
+    unsigned char local[2 * FOGVOL_ANALYTIC_CAPACITY];
+    double e[3];
+    int m;
     fogvol_analytic_kernel kern;
     if (invalid) *invalid = 0;
     if (!fogvol__an_args_ok(set, law, mix)) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -3995,90 +4063,34 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
         (stride > 0 && stride < 12) || fog_stride < 0 || (fog_stride > 0 && fog_stride < 4) || color_stride < 0 ||
         (color_stride > 0 && color_stride < 12))
         return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!stride) stride = 12;
-    if (!fog_stride) fog_stride = 4;
-    if (!color_stride) color_stride = 12;
+    memset(&c, 0, sizeof c);
     m = 2 * set->count;
-    limit = fogvol__an_sort_limit(set, law);
-    eye_ok = fogvol__finite_n(eye, 3);
-    e[0] = eye_ok ? eye[0] : 0.0, e[1] = eye_ok ? eye[1] : 0.0, e[2] = eye_ok ? eye[2] : 0.0;
+    c.eye_ok = fogvol__finite_n(eye, 3);
+    e[0] = c.eye_ok ? eye[0] : 0.0, e[1] = c.eye_ok ? eye[1] : 0.0, e[2] = c.eye_ok ? eye[2] : 0.0;
     fogvol__an_eye_init(set, e, &pe);
-    if (order) {
-        carry = order->carried;
-        if (order->carried_count != set->count || !fogvol__an_perm_ok(carry, m)) {
-            fogvol__an_identity(carry, m);
-            order->carried_count = set->count;
-        }
-    } else {
-        carry = local;
-        fogvol__an_identity(carry, m);
+    c.carry = order ? order->carried : local;
+    if (!order) {
+        fogvol__an_identity(c.carry, m);
+    } else if (order->carried_count != set->count || !fogvol__an_perm_ok(c.carry, m)) {
+        fogvol__an_identity(c.carry, m);
+        order->carried_count = set->count;
     }
-    if (kern != FOGVOL_ANALYTIC_KERNEL_DOUBLE) {
-        fogvol__an_call c;
-        memset(&c, 0, sizeof c);
-        c.set = set, c.pe = &pe, c.e = e, c.src = src, c.order = order, c.carry = carry, c.limit = limit;
-        c.eye_ok = eye_ok, c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride;
-        c.fog_out = fog_out, c.fog_stride = fog_stride, c.color_out = color_out, c.color_stride = color_stride;
-        if (fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
-            bad = c.bad, sorted = c.sorted, moves = c.moves;
-            count = 0; /* done: the double loop below is skipped */
-        }
-    }
-    for (base = 0; base < count; base += FOGVOL__AN_BLOCK) {
-        int nb = count - base < FOGVOL__AN_BLOCK ? count - base : FOGVOL__AN_BLOCK;
-        /* gather (strided, checked: x - x is 0 for finite x only), pad the block
-           with zero-length rays */
-        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
-            float x = 0.0f, y = 0.0f, z = 0.0f;
-            int ok = 0;
-            if (i < nb) {
-                const float *p = (const float *)(const void *)(src + (size_t)(base + i) * (size_t)stride);
-                x = p[0], y = p[1], z = p[2];
-                ok = eye_ok & (x - x == 0.0f) & (y - y == 0.0f) & (z - z == 0.0f);
-                bad += !ok;
-            }
-            valid[i] = (unsigned char)ok;
-            blk.dx[i] = ok ? (double)x - e[0] : 0.0;
-            blk.dy[i] = ok ? (double)y - e[1] : 0.0;
-            blk.dz[i] = ok ? (double)z - e[2] : 0.0;
-        }
-        fogvol__an_block_eval(set, &pe, limit, &blk);
-        if (law == FOGVOL_FOG_EXP)
-            for (i = 0; i < nb; ++i)
-                if (blk.need[i] == 0.0) blk.fog[i] = blk.tau[i] > 0.0 ? FOGVOL_EXP(-blk.tau[i]) : 1.0;
-        for (i = 0; i < nb; ++i) {
-            size_t idx = (size_t)(base + i);
-            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
-            if (!valid[i]) {
-                /* fog 1, colour 0 */
-            } else if (blk.need[i] != 0.0) {
-                unsigned char *perm = carry;
-                if (order && order->vertex_orders && (idx + 1) * (size_t)m <= order->vertex_orders_size) {
-                    perm = order->vertex_orders + idx * (size_t)m;
-                    if (!fogvol__an_perm_ok(perm, m)) memcpy(perm, carry, (size_t)m);
-                }
-                fogvol__an_sorted_vertex(set, law, mix, blk.len[i], (const float *)(const void *)blk.t1 + i,
-                                         (const float *)(const void *)blk.t2 + i, FOGVOL__AN_BLOCK, perm, &moves, &f,
-                                         col);
-                ++sorted;
-                if (perm != carry) memcpy(carry, perm, (size_t)m); /* the next vertex starts from it */
-            } else {
-                f = (float)blk.fog[i];
-                col[0] = (float)blk.r[i], col[1] = (float)blk.g[i], col[2] = (float)blk.bl[i];
-            }
-            if (fog_out) *(float *)(void *)((unsigned char *)fog_out + idx * (size_t)fog_stride) = f;
-            if (color_out) {
-                float *o = (float *)(void *)((unsigned char *)color_out + idx * (size_t)color_stride);
-                o[0] = col[0], o[1] = col[1], o[2] = col[2];
-            }
-        }
+    c.set = set, c.pe = &pe, c.e = e, c.src = (const unsigned char *)positions, c.order = order;
+    c.limit = fogvol__an_sort_limit(set, law);
+    c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
+    c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
+    c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
+    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
+        c.bad = c.sorted = 0;
+        c.moves = 0;
+        fogvol__an_dbatch(&c);
     }
     if (order) {
-        order->sorted_vertices = sorted;
-        order->moves = moves;
+        order->sorted_vertices = c.sorted;
+        order->moves = c.moves;
     }
-    if (invalid) *invalid = bad;
-    return bad ? FOGVOL_ERROR_INVALID_ARGUMENT : FOGVOL_SUCCESS;
+    if (invalid) *invalid = c.bad;
+    return c.bad ? FOGVOL_ERROR_INVALID_ARGUMENT : FOGVOL_SUCCESS;
 }
 
 FOGVOL_API void fogvol_fold_fog(const float diffuse[4], const float specular[4], float fog, const float fog_color[3],
