@@ -799,8 +799,8 @@ typedef struct fogvol_analytic_order {
    volumes of density 0 are kept and add nothing). More than
    FOGVOL_ANALYTIC_CAPACITY volumes: the first ones are kept and the call
    returns FOGVOL_ERROR_BUFFER_TOO_SMALL. */
-FOGVOL_API fogvol_result fogvol_analytic_prepare(fogvol_analytic_set *set, const fogvol_analytic_volume *volumes,
-                                                 int count);
+FOGVOL_API fogvol_result fogvol_analytic_prepare(const fogvol_analytic_volume *volumes, int count,
+                                                 fogvol_analytic_set *set);
 /* Entry/exit of one volume on the ray from eye to p, clamped to [0, 1]. A hit
    gives *t1 < *t2; a miss *t1 = *t2 = 0. Invalid volume or non-finite input:
    FOGVOL_ERROR_INVALID_ARGUMENT (and 0, 0). */
@@ -2920,8 +2920,8 @@ static fogvol_result fogvol__an_prepare_one(const fogvol_analytic_volume *v, int
     return FOGVOL_SUCCESS;
 }
 
-FOGVOL_API fogvol_result fogvol_analytic_prepare(fogvol_analytic_set *set, const fogvol_analytic_volume *volumes,
-                                                 int count)
+FOGVOL_API fogvol_result fogvol_analytic_prepare(const fogvol_analytic_volume *volumes, int count,
+                                                 fogvol_analytic_set *set)
 {
     fogvol_result res = FOGVOL_SUCCESS;
     int i, n = 0, shape = 0, have = 0;

@@ -361,7 +361,7 @@ int main(int argc, char **argv)
             double invs[16 * 16], t[M_COUNT][REPS], rate[M_COUNT], dfl = 0, dsc = 0;
             make_volumes(vols, n);
             for (i = 0; i < n; ++i) naive_inverse(vols[i].transform, invs + 16 * i);
-            if (fogvol_analytic_prepare(&set, vols, n) != FOGVOL_SUCCESS) return 1;
+            if (fogvol_analytic_prepare(vols, n, &set) != FOGVOL_SUCCESS) return 1;
             for (r = 0; r < reps; ++r) /* interleaved: every method once per repetition */
                 for (meth = 0; meth < M_COUNT; ++meth)
                     if (there[meth]) t[meth][r] = time_method(&rn, meth, vols, invs, n, &set, law);

@@ -646,7 +646,7 @@ static void test_fog_integration(void **state)
                 if (law == FOGVOL_FOG_LINEAR) vs[v].v.density *= 0.25f; /* keep some rays below full fog */
                 raw[v] = vs[v].v;
             }
-            assert_int_equal(fogvol_analytic_prepare(&set, raw, n), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_analytic_prepare(raw, n, &set), FOGVOL_SUCCESS);
             rand_point(eye, 4);
             rand_point(p, 4);
             gt_fog(vs, n, eye, p, law, &gf, gc);
@@ -685,7 +685,7 @@ static void test_fog_integration(void **state)
                 for (c = 0; c < 3; ++c) vs[v].v.color[c] = (float)rnd();
                 raw[v] = vs[v].v;
             }
-            assert_int_equal(fogvol_analytic_prepare(&set, raw, 4), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_analytic_prepare(raw, 4, &set), FOGVOL_SUCCESS);
             eye[0] = (float)(k % 2 ? -8 : 8), eye[1] = (float)rnd_range(-1, 1), eye[2] = (float)rnd_range(-1, 1);
             p[0] = (float)-eye[0], p[1] = (float)rnd_range(-1, 1), p[2] = (float)rnd_range(-1, 1);
             gt_fog(vs, 4, eye, p, law, &gf, gc);
@@ -720,7 +720,7 @@ static void test_separate_overlapping(void **state)
                 vs[v].v.density *= 0.4f;
                 raw[v] = vs[v].v;
             }
-            assert_int_equal(fogvol_analytic_prepare(&set, raw, n), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_analytic_prepare(raw, n, &set), FOGVOL_SUCCESS);
             rand_point(eye, 4);
             rand_point(p, 4);
             len = sqrt(((double)p[0] - eye[0]) * ((double)p[0] - eye[0]) + ((double)p[1] - eye[1]) * ((double)p[1] - eye[1]) +
@@ -773,7 +773,7 @@ static void test_seed_colour(void **state)
         a[i] = fmin(1.0, dens[i] * 2.0 * v[i].radius);
     }
     for (n = 2; n <= 3; ++n) {
-        assert_int_equal(fogvol_analytic_prepare(&set, v, n), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_analytic_prepare(v, n, &set), FOGVOL_SUCCESS);
         /* the seed: fogColor = volColor * fog + fogColor * (1 - fog), fog = fog + volFog - 1 */
         fog = 1;
         want[0] = want[1] = want[2] = 0;
@@ -803,7 +803,7 @@ static void test_seed_colour(void **state)
     /* fully fogged: the seed's formula is exact, both agree (0.8 + 0.2 of the 0.9 behind) */
     v[0].density = 0.4f;
     v[1].density = 0.3f;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 2), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 2, &set), FOGVOL_SUCCESS);
     {
         float f2, c2[3];
         fogvol_analytic_eval(&set, eye, p, FOGVOL_FOG_LINEAR_SEED, FOGVOL_MIX_SEPARATE, &f, c);
@@ -832,7 +832,7 @@ static void random_set(fogvol_analytic_set *set, tvol *vs, int n)
         vs[v].v.density *= 0.3f;
         raw[v] = vs[v].v;
     }
-    assert_int_equal(fogvol_analytic_prepare(set, raw, n), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(raw, n, set), FOGVOL_SUCCESS);
 }
 
 static void test_batch_matches_eval(void **state)
@@ -913,7 +913,7 @@ static void test_order_coherence(void **state)
         raw[i].density *= 0.1f;
         raw[i].color[0] = (float)i / 16;
     }
-    assert_int_equal(fogvol_analytic_prepare(&set, raw, 16), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(raw, 16, &set), FOGVOL_SUCCESS);
     set.kernel = FOGVOL_ANALYTIC_KERNEL_DOUBLE; /* the kernel that carries orders (the float ones sort hits only) */
     for (i = 0; i < N; ++i) {
         pos[3 * i] = -4.0f + 8.0f * (float)(i % 64) / 63, pos[3 * i + 1] = -4.0f + 8.0f * (float)(i / 64) / 63;
@@ -1038,7 +1038,7 @@ static void test_kernel_edges(void **state)
     for (j = 0; j < 4; ++j) print_message("# kernel %-7s %s\n", kernel_name[j], kernel_there(j) ? "runs here" : "not available here");
     memset(v, 0, sizeof v);
     v[0].shape = FOGVOL_SHAPE_SPHERE, v[0].radius = 1, v[0].density = (float)dens, v[0].color[0] = 1;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 1), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 1, &set), FOGVOL_SUCCESS);
     {
         /* rays from (0, 0, 5) to (0, y, -5) tangent to the unit sphere (scaled by 1 - delta: grazing it
            inside, or just missing it), and vertices on its boundary: (0, 0, 1) (chord 0), (0, 0, -1) (chord 2), (0.6, 0, -0.8) */
@@ -1095,7 +1095,7 @@ static void test_kernel_edges(void **state)
         memset(&b, 0, sizeof b);
         b.shape = FOGVOL_SHAPE_BOX, b.density = (float)dens;
         glu_translate_scale(b.transform, 0, 0, 0, 2);
-        assert_int_equal(fogvol_analytic_prepare(&set, &b, 1), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_analytic_prepare(&b, 1, &set), FOGVOL_SUCCESS);
         for (i = 0; i < KN; ++i) {
             /* vertex on the back face z = -2 (chord 4 when it enters through the front face) or the front one */
             double x = -2 + 4.0 * (i % 8) / 7, y = -2 + 4.0 * (i / 8) / 7, zf = i % 3 ? -2 : 2, tin;
@@ -1131,7 +1131,7 @@ static void test_kernel_edges(void **state)
             v[i].center[2] = (float)(0.5 - dz * i);
             v[i].color[0] = (float)i / n, v[i].color[1] = 1 - (float)i / n, v[i].color[2] = (float)(i % 3) / 2;
         }
-        assert_int_equal(fogvol_analytic_prepare(&set, v, n), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_analytic_prepare(v, n, &set), FOGVOL_SUCCESS);
         for (i = 0; i < KN; ++i) {
             int last = i % (n + 1); /* spheres passed whole */
             pos[3 * i] = 0, pos[3 * i + 1] = 0;
@@ -1168,7 +1168,7 @@ static void test_kernel_edges(void **state)
             v[0].shape = FOGVOL_SHAPE_HALF_SPACE, v[0].plane[1] = 1, v[0].density = k ? 0.0f : 0.2f;
             v[1].shape = FOGVOL_SHAPE_ELLIPSOID, v[1].density = k ? 0.0f : 0.5f, v[1].color[2] = 1;
             v[2].shape = FOGVOL_SHAPE_DISTANCE, v[2].max_distance = 0, v[2].density = k ? 0.0f : 1e-3f;
-            assert_int_equal(fogvol_analytic_prepare(&set, v, 3), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_analytic_prepare(v, 3, &set), FOGVOL_SUCCESS);
             assert_int_equal(kern_batch(&set, 0, eye, pos, FOGVOL_FOG_EXP, fd, cd), 2);
             for (j = 1; j < 4; ++j) {
                 if (!kernel_there(j)) continue;
@@ -1182,7 +1182,7 @@ static void test_kernel_edges(void **state)
                 assert_true((fog[7] < 1) == (fd[7] < 1) && (fog[8] < 1) == (fd[8] < 1)); /* the huge ones went through the half-space */
             }
         }
-        assert_int_equal(fogvol_analytic_prepare(&set, NULL, 0), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_analytic_prepare(NULL, 0, &set), FOGVOL_SUCCESS);
         for (j = 0; j < 4; ++j) {
             if (!kernel_there(j)) continue;
             assert_int_equal(kern_batch(&set, j, eye, pos, FOGVOL_FOG_LINEAR, fog, col), 2);
@@ -1195,7 +1195,7 @@ static void test_kernel_edges(void **state)
         v[1].shape = FOGVOL_SHAPE_SPHERE, v[1].radius = 1, v[1].density = 1e-40f, v[1].color[0] = 1;
         v[1].center[0] = 0.5f;
         for (k = 0; k < 2; ++k) {
-            assert_int_equal(fogvol_analytic_prepare(&set, v + k, 1), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_analytic_prepare(v + k, 1, &set), FOGVOL_SUCCESS);
             assert_int_equal(kern_batch(&set, 0, eye, pos, FOGVOL_FOG_EXP, fd, cd), 2);
             for (j = 1; j < 4; ++j) {
                 if (!kernel_there(j)) continue;
@@ -1232,7 +1232,7 @@ static void test_degenerate(void **state)
     ok.color[1] = 1;
     /* a zeroed volume is valid (no fog); a zeroed transform is the identity */
     memset(v, 0, sizeof v);
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 1), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 1, &set), FOGVOL_SUCCESS);
     assert_int_equal(set.count, 1);
     v[0].shape = FOGVOL_SHAPE_ELLIPSOID;
     v[0].density = 1;
@@ -1268,7 +1268,7 @@ static void test_degenerate(void **state)
         }
         assert_int_equal(fogvol_analytic_segment(&bad[0], eye, p, &t1, &t2), FOGVOL_ERROR_INVALID_ARGUMENT);
         assert_true(t1 == 0 && t2 == 0);
-        assert_int_equal(fogvol_analytic_prepare(&set, bad, 2), FOGVOL_ERROR_INVALID_ARGUMENT);
+        assert_int_equal(fogvol_analytic_prepare(bad, 2, &set), FOGVOL_ERROR_INVALID_ARGUMENT);
         assert_int_equal(set.count, 1);
         assert_int_equal(set.ignored, 1);
         assert_int_equal(set.source[0], 1);
@@ -1281,18 +1281,18 @@ static void test_degenerate(void **state)
     v[0] = ok;
     v[0].shape = FOGVOL_SHAPE_DISTANCE;
     v[0].min_distance = 1, v[0].max_distance = 3e38f;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 1), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 1, &set), FOGVOL_SUCCESS);
     assert_true(set.map[0][0] == 1 && set.map[0][1] == 0);
     /* too many volumes */
     for (i = 0; i < 40; ++i) v[i] = ok;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 40), FOGVOL_ERROR_BUFFER_TOO_SMALL);
+    assert_int_equal(fogvol_analytic_prepare(v, 40, &set), FOGVOL_ERROR_BUFFER_TOO_SMALL);
     assert_int_equal(set.count, FOGVOL_ANALYTIC_CAPACITY);
     assert_int_equal(set.truncated, 40 - FOGVOL_ANALYTIC_CAPACITY);
     v[0].radius = 0;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 40), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_analytic_prepare(NULL, v, 1), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_analytic_prepare(&set, NULL, 1), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_analytic_prepare(&set, v, -1), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_analytic_prepare(v, 40, &set), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_analytic_prepare(v, 1, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_analytic_prepare(NULL, 1, &set), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_analytic_prepare(v, -1, &set), FOGVOL_ERROR_INVALID_ARGUMENT);
     /* NaN / infinite vertices and eye: fog 1, colour 0, counted; others as eval */
     {
         float pos[8][3] = {{0, 0, -5}, {0, nanf_, -5}, {0.5f, 0, -5}, {inff, 0, 0}, {0, 0, -inff}, {0, 0, 5},
@@ -1310,7 +1310,7 @@ static void test_degenerate(void **state)
         two[2].shape = FOGVOL_SHAPE_HALF_SPACE;
         two[2].plane[1] = 1;
         two[2].density = 0.02f;
-        assert_int_equal(fogvol_analytic_prepare(&set, two, 3), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_analytic_prepare(two, 3, &set), FOGVOL_SUCCESS);
         for (i = 0; i < 3; ++i) {
             int law;
             for (law = 0; law < 3; ++law) {
@@ -1376,7 +1376,7 @@ static void test_degenerate(void **state)
                     if (m != 15) w[j].transform[m] *= scale;
                 w[j].plane[3] *= scale;
             }
-            fogvol_analytic_prepare(&set, w, 4); /* some may be refused (map out of range) */
+            fogvol_analytic_prepare(w, 4, &set); /* some may be refused (map out of range) */
             rand_point(e3, 3);
             rand_point(q, 3);
             for (j = 0; j < 3; ++j) e3[j] *= scale, q[j] *= (float)pow(10.0, rnd_range(-30, 30));
@@ -1438,7 +1438,7 @@ static void test_pack_uniforms(void **state)
     v[3].shape = FOGVOL_SHAPE_BOX;
     glu_translate_scale(v[3].transform, 1, 1, 1, 4);
     v[3].density = 2;
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 4), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 4, &set), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_analytic_pack_uniforms(&set, eye, FOGVOL_FOG_EXP, FOGVOL_MIX_INTERPENETRATING, u),
                      FOGVOL_SUCCESS);
     assert_true(u[0] == 1 && u[1] == 2 && u[2] == 3 && u[3] == 4);
@@ -1453,7 +1453,7 @@ static void test_pack_uniforms(void **state)
     assert_true(u[68] == 0.25f && u[71] == -0.25f && u[73] == 0.25f && u[78] == 0.25f && u[79] == -0.25f && u[84] == 4);
     for (i = 88; i < FOGVOL_ANALYTIC_UNIFORM_FLOATS; ++i) assert_true(u[i] == 0);
     for (i = 4; i < 10; ++i) v[i] = v[0];
-    assert_int_equal(fogvol_analytic_prepare(&set, v, 10), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(v, 10, &set), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_analytic_pack_uniforms(&set, eye, FOGVOL_FOG_LINEAR, FOGVOL_MIX_SEPARATE, u),
                      FOGVOL_ERROR_UNSUPPORTED);
     assert_true(u[3] == 8);
@@ -1676,7 +1676,7 @@ static double gl_compare(GLuint prog, const gl_scene *sc, int law, int mix, int 
     int i, k, inv = 0;
     assert_non_null(px);
     assert_non_null(wp);
-    assert_int_equal(fogvol_analytic_prepare(&set, sc->v, sc->n), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_analytic_prepare(sc->v, sc->n, &set), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_analytic_pack_uniforms(&set, sc->eye, (fogvol_fog_law)law, (fogvol_fog_mix)mix, u),
                      FOGVOL_SUCCESS);
     glu_identity(ident);

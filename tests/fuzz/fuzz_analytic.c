@@ -36,7 +36,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         memcpy(&vols[i], data + (size_t)i * sizeof(fogvol_analytic_volume), sizeof(fogvol_analytic_volume));
         vols[i].shape = (fogvol_analytic_shape)((unsigned)vols[i].shape % 8u); /* also out-of-range shapes */
     }
-    fogvol_analytic_prepare(&set, vols, n);
+    fogvol_analytic_prepare(vols, n, &set);
     for (i = 0; i < 4; ++i) {
         float f = -1, c[3] = {-1, -1, -1}, t1, t2;
         fogvol_analytic_eval(&set, eye, pos + 3 * i, law, mix, &f, c);
