@@ -9996,6 +9996,11 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
 /*
    REVISION HISTORY
+     unreleased        density and colour textures on volumes, volume light by compare,
+                       image-space effects (depth of field, outlines, distance fog), GLES and
+                       WebGL tested, float SIMD analytic kernels, engine conventions (clip
+                       control, reversed-Z, G-buffers, MSAA, engine depth and occluders),
+                       overflow counted every frame; outputs last everywhere (see CHANGELOG.md)
      0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
                        colour-ramp textures, mesh validation, PS20 renderer, GL backend,
                        recording null backend.
