@@ -85,6 +85,10 @@ $(BUILD)/test_gles: tests/test_gles.c tests/egl_util.h tests/scenes.h $(HEADERS)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GLES_LIBS)
 $(BUILD)/test_gles_san: tests/test_gles.c tests/egl_util.h tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GLES_LIBS)
+$(BUILD)/test_colors: tests/test_colors.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_colors_san: tests/test_colors.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
 $(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
@@ -114,6 +118,7 @@ TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUIL
 TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
 TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
 TEST_BINS += $(BUILD)/test_gles $(BUILD)/test_gles_san
+TEST_BINS += $(BUILD)/test_colors $(BUILD)/test_colors_san
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
@@ -157,6 +162,8 @@ test: deps-test deps-run
 	  "overflow_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_overflow_san" \
 	  "gles=$(TAP) $(BUILD)/test_gles" \
 	  "gles_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_gles_san" \
+	  "colors=$(TAP) $(BUILD)/test_colors" \
+	  "colors_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_colors_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
