@@ -98,6 +98,9 @@ $(BUILD)/test_post_san: tests/test_post.c $(HEADERS) | $(BUILD)
 $(BUILD)/test_texlight: tests/test_texlight.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_texlight_san: tests/test_texlight.c $(HEADERS) | $(BUILD)
+$(BUILD)/test_colors: tests/test_colors.c $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_colors_san: tests/test_colors.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
@@ -136,6 +139,7 @@ TEST_BINS += $(BUILD)/web/demo_web.html
 WEB_TEST = "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
 endif
 TEST_BINS += $(BUILD)/test_texlight $(BUILD)/test_texlight_san
+TEST_BINS += $(BUILD)/test_colors $(BUILD)/test_colors_san
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
@@ -183,6 +187,8 @@ test: deps-test deps-run
 	  "gles_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_gles_san" \
 	  "post=$(TAP) $(BUILD)/test_post" \
 	  "post_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_post_san" \
+	  "colors=$(TAP) $(BUILD)/test_colors" \
+	  "colors_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_colors_san" \
 	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
 	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
 	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \

@@ -369,6 +369,12 @@ typedef struct fogvol_ramp_desc {
     int key_count;
     int width;                   /* texels, 0 = 256, 2..4096 */
     fogvol_blend blend;          /* used by the renderer */
+    /* EXTINCTION with FOGVOL_VARIANT_COLORS: the extinction per colour channel is
+       density * extinction_color (all 0 = (1, 1, 1): grey, the same in every channel); each
+       component finite and >= 0. Only the one-pass colour group can use a colour that is not
+       grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
+       density alone (create_ramp logs a warning for a non-grey colour without the variant). */
+    float extinction_color[3];
 } fogvol_ramp_desc;
 
 /* width x 1 texels; texel i holds thickness i/(width-1) * max_thickness.
@@ -525,7 +531,18 @@ enum {
        encoding_bits 0 picks 3 and larger values are refused
        (FOGVOL_ERROR_UNSUPPORTED). Needs GLSL 110-330 or 300 es. */
     FOGVOL_VARIANT_WIDE = 1u << 5,
-    FOGVOL_VARIANT_ALL = (1u << 6) - 1u
+    /* FLOAT: per-volume colours and densities in one pass. Every volume whose ramp has the
+       EXTINCTION model and the FOG blend joins one group: its faces add their optical depth per
+       colour channel (extinction density * extinction_color times signed depth) and their
+       emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
+       pass, and one composite pass blends them all (two full-screen draws, multiply then add,
+       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
+       target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
+       per sample on multisampled framebuffers (fogvol_msaa_supported: use
+       FOGVOL_MSAA_SINGLE_SAMPLE). */
+    FOGVOL_VARIANT_COLORS = 1u << 6,
+    FOGVOL_VARIANT_ALL = (1u << 7) - 1u
 };
 
 typedef enum fogvol_program {
@@ -540,7 +557,10 @@ typedef enum fogvol_program {
     FOGVOL_PROGRAM_LIGHT = 6,          /* volume light by compare (fogvol_add_light): front faces write their
                                           depth into L; back faces light the scene pixels whose opaque
                                           depth lies between L and their own depth (FLOAT, PS20, MRT) */
-    FOGVOL_PROGRAM_COUNT = 7,
+    FOGVOL_PROGRAM_COLOR_FACE = 7,     /* FOGVOL_VARIANT_COLORS: faces add optical depth and emission per
+                                          channel into two RGBA32F targets (outputs fv_frag[2]) */
+    FOGVOL_PROGRAM_COLOR_COMPOSITE = 8,/* FOGVOL_VARIANT_COLORS: full-screen triangle, Beer-Lambert per channel */
+    FOGVOL_PROGRAM_COUNT = 9,
     FOGVOL_PROGRAM_MAX_ENUM = 0x7fffffff
 } fogvol_program;
 
@@ -929,7 +949,8 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
    fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
    fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
-   "fv_sign" (float, FLOAT tier: -1 for negative volumes).
+   "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
+   FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
    Vertex attribute 0: "fv_position" (vec3). */
 #define FOGVOL_MAX_TEXTURE_UNITS 8
 
@@ -946,12 +967,16 @@ typedef struct fogvol_texture_desc {
 
 typedef enum fogvol_format {
     FOGVOL_FORMAT_RGBA8 = 0,
-    FOGVOL_FORMAT_R32F = 1   /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
+                                 wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
+                                 EXT_color_buffer_float + EXT_float_blend) */
 } fogvol_format;
 
 typedef struct fogvol_target_desc {
     int width, height;        /* colour texture, NEAREST, CLAMP */
-    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE), drawn together */
+    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
+                                 both of the format */
     fogvol_format format;
     int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
                                  2D multisample, fixed sample locations) and depth renderbuffer */
@@ -988,7 +1013,10 @@ typedef enum fogvol_pass_blend {
     FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
     FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
     FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
-    FOGVOL_PASS_BLEND_LIGHT = 3  /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
+    FOGVOL_PASS_BLEND_LIGHT = 3, /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
+    /* FOGVOL_VARIANT_COLORS, per-channel transmittance in two steps (alpha_coverage as for FOG) */
+    FOGVOL_PASS_BLEND_MULTIPLY = 5, /* RGB: ZERO, SRC_COLOR; A: ZERO, ONE (coverage: ZERO, SRC_ALPHA) */
+    FOGVOL_PASS_BLEND_EMIT = 6      /* RGB: ONE, ONE; A: ZERO, ONE (coverage: ONE, ONE) */
 } fogvol_pass_blend;
 
 typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
@@ -1023,6 +1051,8 @@ typedef struct fogvol_draw {
     float depth[4];
     float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
     int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
+    float extinction[4]; /* COLOR_FACE ("fv_ext"): per-channel extinction * (far - near), 0; else 0 */
+    float emission[4];   /* COLOR_FACE ("fv_emit"): extinction * the ramp colour; else 0 */
 } fogvol_draw;
 
 /* Capabilities a backend reports (fogvol_backend.caps). */
@@ -1073,7 +1103,7 @@ typedef struct fogvol_backend {
     void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
     void (*end_pass)(void *user_data);        /* optional */
     /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
-       bytes or (R32F targets) floats; size >= w*h*4 */
+       bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
     /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
@@ -1970,6 +2000,9 @@ static fogvol_result fogvol__ramp_check(const fogvol_ramp_desc *d)
     case FOGVOL_RAMP_LINEAR:
         if (!fogvol__finite_n(d->color, 3) || !fogvol__finite(d->density) || !(d->density > 0))
             return FOGVOL_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < 3; ++i)
+            if (!fogvol__finite(d->extinction_color[i]) || d->extinction_color[i] < 0)
+                return FOGVOL_ERROR_INVALID_ARGUMENT;
         return FOGVOL_SUCCESS;
     case FOGVOL_RAMP_GRADIENT:
         if (!d->keys || d->key_count < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -4359,7 +4392,8 @@ static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define 
                                                                    "#define FV_FLOAT\n"};
 static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
-                                                      "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n"};
+                                                      "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n",
+                                                      "#define FV_COLORS\n"};
 #define FOGVOL__VARIANT_COUNT (int)(sizeof fogvol__variant_define / sizeof fogvol__variant_define[0])
 /* one #define per bit of FOGVOL_VARIANT_ALL */
 typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__VARIANT_COUNT) - 1u ? 1 : -1];
@@ -4707,6 +4741,52 @@ static int fogvol__light_ok(fogvol_tier tier, unsigned v)
                                          !(v & FOGVOL_VARIANT_WIDE));
 }
 
+/* >>one-pass colours (FOGVOL_VARIANT_COLORS) */
+/* Faces of every volume of the colour group: the signed, opaque-clamped depth s (as the FLOAT face
+   program) times the volume's per-channel extinction (target 0: optical depth tau) and times its
+   extinction * colour (target 1: emission sum E). */
+static const char fogvol__fs_color_face[] =
+    "FV_VARYING_IN float fv_d;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "uniform float fv_sign;\n"
+    "uniform vec4 fv_nf;\n"
+    "uniform vec4 fv_ext;\n"
+    "uniform vec4 fv_emit;\n"
+    "void main() {\n"
+    "#ifdef FV_ENGINE_DEPTH\n"
+    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
+    "#else\n"
+    "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
+    "#endif\n"
+    "    float d = min(max(fv_d, 0.0), o);\n"
+    "    float s = gl_FrontFacing ? -d * fv_sign : d * fv_sign;\n"
+    "    FV_OUT0 = s * fv_ext;\n"
+    "    FV_OUT1 = s * fv_emit;\n"
+    "}\n";
+
+/* Composite of the colour group: transmittance T = exp(-tau) per channel, in-scattered colour
+   c = E / tau per channel (the optical-depth-weighted mean of the volumes' colours), result
+   scene * T + c * (1 - T). fv_rampmap.z picks the step: 0 one FOG-blended draw (every extinction
+   grey: T the same in each channel), 1 the multiply draw (scene * T), 2 the emission draw. */
+static const char fogvol__fs_color_composite[] =
+    "uniform vec4 fv_rampmap;\n"
+    "uniform FV_TARGET_SAMPLER fv_back;\n"
+    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "void main() {\n"
+    "    vec2 st = fv_st();\n"
+    "    vec3 tau = max(FV_TEXTURE(fv_back, st).rgb, vec3(0.0));\n"
+    "    if (tau == vec3(0.0)) discard;\n"
+    "    vec3 e = max(FV_TEXTURE(fv_front, st).rgb, vec3(0.0));\n"
+    "    vec3 tr = exp(-tau);\n"
+    "    vec3 c = min(e / max(tau, vec3(1e-30)), vec3(1.0));\n"
+    "    float m = dot(tr, vec3(1.0 / 3.0));\n"
+    "    if (fv_rampmap.z < 0.5) FV_FRAGCOLOR = vec4(c, 1.0 - m);\n"
+    "    else if (fv_rampmap.z < 1.5) FV_FRAGCOLOR = vec4(tr, m);\n"
+    "    else FV_FRAGCOLOR = vec4(c * (1.0 - tr), 1.0 - m);\n"
+    "}\n";
+/* <<one-pass colours */
+
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
 {
     if ((int)dialect < 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return "invalid";
@@ -4728,6 +4808,7 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
     if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
     modern = !di->legacy;
     if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
     if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
                                       (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
         return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
@@ -4756,7 +4837,8 @@ FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fog
 {
     if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & FOGVOL_VARIANT_WIDE) return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
+    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
+        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
     if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
         return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
     return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
@@ -4773,6 +4855,8 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_pro
     case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
     case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
     case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
+    case FOGVOL_PROGRAM_COLOR_FACE:
+    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
     default: return 0;
     }
 }
@@ -4814,7 +4898,7 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 {
     if (d->stage == FOGVOL_STAGE_VERTEX) {
         strings[n++] = (d->program == FOGVOL_PROGRAM_COMPOSITE || d->program == FOGVOL_PROGRAM_RESOLVE ||
-                        d->program == FOGVOL_PROGRAM_CHECK ||
+                        d->program == FOGVOL_PROGRAM_CHECK || d->program == FOGVOL_PROGRAM_COLOR_COMPOSITE ||
                         (d->program == FOGVOL_PROGRAM_ENCODE && (d->variants & FOGVOL_VARIANT_ENGINE_DEPTH)))
                            ? fogvol__vs_fullscreen
                            : fogvol__vs_mesh;
@@ -4827,6 +4911,8 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
     case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
     case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
     case FOGVOL_PROGRAM_LIGHT: strings[n++] = fogvol__fs_light; break;
+    case FOGVOL_PROGRAM_COLOR_FACE: strings[n++] = fogvol__fs_color_face; break;
+    case FOGVOL_PROGRAM_COLOR_COMPOSITE: strings[n++] = fogvol__fs_color_composite; break;
     default: strings[n++] = fogvol__fs_composite; break;
     }
     return n;
@@ -4852,8 +4938,9 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     strings[n++] = per_sample ? di->version_msaa : di->version;
     if (d->stage == FOGVOL_STAGE_VERTEX)
         n = fogvol__prelude(strings, n, di->vs);
-    else if ((d->variants & FOGVOL_VARIANT_WIDE) &&
-             (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE))
+    else if (((d->variants & FOGVOL_VARIANT_WIDE) &&
+              (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE)) ||
+             d->program == FOGVOL_PROGRAM_COLOR_FACE)
         n = fogvol__prelude(strings, n, di->fs_two);
     else
         strings[n++] = di->fs;
@@ -5124,6 +5211,10 @@ struct fogvol_ramp {
     int width;
     float max_thickness;
     fogvol_blend blend;
+    int colors;          /* EXTINCTION + FOG: may join the one-pass colour group (FOGVOL_VARIANT_COLORS) */
+    int grey;            /* the same extinction in every channel */
+    float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
+    float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
 };
 
 struct fogvol_volume_texture {
@@ -5179,6 +5270,7 @@ struct fogvol_context {
     fogvol_handle tgt_o, tgt_b, tgt_f, tgt_t; /* SINGLE: B is the one sum target; PS13: T resolved;
                                                  FLOAT: B is the float sum */
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
+    fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
     int target_w, target_h;
     fogvol_msaa msaa;
     int samples, target_samples;     /* this frame's / the targets' samples per pixel (0: single-sample) */
@@ -5288,7 +5380,8 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
     if (ctx->tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_v);
     if (ctx->tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_l);
-    ctx->tgt_v = ctx->tgt_l = 0;
+    if (ctx->tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_c);
+    ctx->tgt_v = ctx->tgt_l = ctx->tgt_c = ctx->tgt_c2 = 0;
     if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
     ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
     ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
@@ -5319,6 +5412,14 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
         td.depth = 0;
         td.label = "fogvol signed depth sum (float)";
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+        if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_COLORS)) {
+            td.format = FOGVOL_FORMAT_RGBA32F;
+            td.color_count = 2;
+            td.label = "fogvol optical depth + emission sums (float, two attachments)";
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_c);
+            if (r == FOGVOL_SUCCESS && !(ctx->tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_c, 1)))
+                r = FOGVOL_ERROR_BACKEND;
+        }
     } else {
         td.depth = ctx->tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
         td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
@@ -5444,7 +5545,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
                                                                     "fv_ctex",   NULL};
     static const char *const labels[FOGVOL_PROGRAM_COUNT] = {
         "fogvol encode", "fogvol face", "fogvol composite", "fogvol composite (geometry)", "fogvol resolve",
-        "fogvol overflow check", "fogvol light"};
+        "fogvol overflow check", "fogvol light", "fogvol colour face", "fogvol colour composite"};
     fogvol_program_desc pd;
     fogvol_shader_desc sd;
     fogvol_result r;
@@ -5465,7 +5566,8 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
         return r;
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
-        pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT)
+        pd.samplers[i] = (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT ||
+                          p == FOGVOL_PROGRAM_COLOR_FACE)
                              ? samp_encode[i]
                              : samp_comp[i];
     if (p == FOGVOL_PROGRAM_ENCODE) pd.samplers[FOGVOL__UNIT_OPAQUE2] = NULL;
@@ -5501,7 +5603,8 @@ static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_conte
     }
     if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
         (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
-        ((ctx->variants & FOGVOL_VARIANT_WIDE) && (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
+        ((ctx->variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+         (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
         ((ctx->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
                     fogvol_tier_name(t), caps);
@@ -5884,6 +5987,25 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__free(&ctx->alloc, mesh);
 }
 
+/* What the one-pass colour group needs of a ramp (FOGVOL_VARIANT_COLORS): EXTINCTION + FOG ramps join
+   it with extinction density * extinction_color (all 0: grey) and their colour as the emission. */
+static void fogvol__ramp_colors(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp *rp)
+{
+    const float *ec = desc->extinction_color;
+    int c, unset = ec[0] == 0.0f && ec[1] == 0.0f && ec[2] == 0.0f;
+    rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG;
+    for (c = 0; c < 3; ++c) {
+        rp->sigma[c] = desc->density * (unset ? 1.0f : ec[c]);
+        rp->emit[c] = desc->color[c] < 0.0f ? 0.0f : desc->color[c] > 1.0f ? 1.0f : desc->color[c];
+    }
+    rp->grey = rp->sigma[0] == rp->sigma[1] && rp->sigma[1] == rp->sigma[2];
+    if (!rp->grey && !(rp->colors && fogvol__has(ctx, FOGVOL_VARIANT_COLORS)))
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: extinction_color (%g, %g, %g) needs an EXTINCTION + FOG ramp in a context with "
+                    "FOGVOL_VARIANT_COLORS; this ramp uses density alone",
+                    (double)ec[0], (double)ec[1], (double)ec[2]);
+}
+
 FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out)
 {
     fogvol_image info;
@@ -5924,6 +6046,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     rp->width = info.width;
     rp->max_thickness = tmax;
     rp->blend = desc->blend;
+    fogvol__ramp_colors(ctx, desc, rp);
     ctx->live_ramps++;
     *out = rp;
     return FOGVOL_SUCCESS;
@@ -6321,6 +6444,8 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
     double m[16], mvp[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
     int j;
     dr->sign = 1.0f;
+    memset(dr->extinction, 0, sizeof dr->extinction);
+    memset(dr->emission, 0, sizeof dr->emission);
     fogvol__tod(m, model);
     fogvol__mul4(mvp, ctx->viewproj, m);
     for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
@@ -7436,6 +7561,107 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     fogvol__end_pass(ctx);
 }
 
+/* >>one-pass colour group (FOGVOL_VARIANT_COLORS) */
+static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
+}
+
+/* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
+   (optical depth per channel, emission per channel). Returns 1 if every member is grey. */
+static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol_pass ps = run->base;
+    double range = (double)ctx->frame.zfar - ctx->frame.znear;
+    int i, c, grey = 1;
+    ps.program = ctx->prog[FOGVOL_PROGRAM_COLOR_FACE];
+    ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
+    ps.target = ctx->tgt_c;
+    ps.clear = 1;
+    ps.blend = FOGVOL_PASS_BLEND_ADD;
+    ctx->be.begin_pass(ctx->be.user_data, &ps);
+    run->st.passes++;
+    for (i = 0; i < ctx->nvol; ++i) {
+        const fogvol__volume *v = &ctx->vols[i];
+        fogvol_draw dr;
+        if (!fogvol__color_member(ctx, v->ramp)) continue;
+        fogvol__draw_for(ctx, v->model, &dr);
+        if (v->negative) dr.sign = -1.0f;
+        for (c = 0; c < 3; ++c) {
+            dr.extinction[c] = (float)(v->ramp->sigma[c] * range);
+            dr.emission[c] = (float)(v->ramp->sigma[c] * range * v->ramp->emit[c]);
+        }
+        grey &= v->ramp->grey;
+        ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
+        run->st.volumes++;
+    }
+    fogvol__end_pass(ctx);
+    return grey;
+}
+
+/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY): the union of their
+   ramps' rectangles. */
+static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
+{
+    int i, k, r[4], lo[2] = {0, 0}, hi[2] = {0, 0}, any = 0;
+    for (i = 0; i < ctx->nvol; ++i) {
+        if (!fogvol__color_member(ctx, ctx->vols[i].ramp)) continue;
+        fogvol__group_rect(ctx, ctx->vols[i].ramp, r);
+        for (k = 0; k < 2; ++k) {
+            if (!any || r[k] < lo[k]) lo[k] = r[k];
+            if (!any || r[k] + r[k + 2] > hi[k]) hi[k] = r[k] + r[k + 2];
+        }
+        any = 1;
+    }
+    rect[0] = lo[0];
+    rect[1] = lo[1];
+    rect[2] = hi[0] - lo[0];
+    rect[3] = hi[1] - lo[1];
+}
+
+/* The composite of the colour group into the engine framebuffer: one FOG-blended draw when every
+   member is grey, else a multiply draw (scene * T) and an emission draw. */
+static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int grey)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_pass ps = run->base;
+    int step;
+    memset(ps.textures, 0, sizeof ps.textures);
+    ps.textures[FOGVOL__UNIT_BACK] = ctx->tgt_c;
+    ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_c2;
+    memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
+    ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
+    ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps.draw_buffer = fd->draw_buffer;
+    ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
+    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__color_rect(ctx, ps.scissor);
+    ps.program = ctx->prog[FOGVOL_PROGRAM_COLOR_COMPOSITE];
+    for (step = grey ? 0 : 1; step <= (grey ? 0 : 2); ++step) {
+        ps.uniforms[FOGVOL_U_RAMP][2] = (float)step;
+        ps.blend = step == 0 ? FOGVOL_PASS_BLEND_FOG : step == 1 ? FOGVOL_PASS_BLEND_MULTIPLY : FOGVOL_PASS_BLEND_EMIT;
+        ctx->be.begin_pass(ctx->be.user_data, &ps);
+        run->st.passes++;
+        ctx->be.draw_fullscreen(ctx->be.user_data);
+        fogvol__end_pass(ctx);
+    }
+}
+
+/* The colour group, drawn where its first member volume g comes in the frame's order (once), if it
+   holds a positive volume. */
+static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    int i, has_pos = 0;
+    for (i = 0; i < g; ++i)
+        if (fogvol__color_member(ctx, ctx->vols[i].ramp)) return;
+    for (i = g; i < ctx->nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->vols[i].ramp) && !ctx->vols[i].negative;
+    if (!has_pos) return;
+    run->st.groups++;
+    fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
+}
+/* <<one-pass colour group */
+
 /* The passes of the colour-ramp group of volume g, unless an earlier volume shares its ramp (the
    groups come in order of first appearance) or the group holds negative volumes only (they
    subtract from nothing). */
@@ -7444,6 +7670,10 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     const fogvol_ramp *ramp = ctx->vols[g].ramp;
     fogvol_pass ps;
     int i, has_pos = 0, has_neg = 0;
+    if (fogvol__color_member(ctx, ramp)) {
+        fogvol__color_group(ctx, run, g);
+        return;
+    }
     for (i = 0; i < g; ++i)
         if (ctx->vols[i].ramp == ramp) return;
     for (i = g; i < ctx->nvol; ++i)
@@ -7893,6 +8123,7 @@ typedef unsigned int fogvol__GLbitfield;
 typedef ptrdiff_t fogvol__GLsizeiptr;
 
 /* GL enums (values from the Khronos registry) */
+enum { FOGVOL__GL_SRC_COLOR = 0x0300, FOGVOL__GL_RGBA32F = 0x8814 }; /* FOGVOL_VARIANT_COLORS */
 enum {
     FOGVOL__GL_NO_ERROR = 0, FOGVOL__GL_TRIANGLES = 0x0004, FOGVOL__GL_NEVER = 0x0200, FOGVOL__GL_LESS = 0x0201,
     FOGVOL__GL_NOTEQUAL = 0x0205, FOGVOL__GL_ZERO = 0, FOGVOL__GL_ONE = 1, FOGVOL__GL_SRC_ALPHA = 0x0302,
@@ -8270,6 +8501,7 @@ typedef struct fogvol__gl_target {
 typedef struct fogvol__gl_program {
     fogvol__GLuint id;
     fogvol__GLint u_mvp, u_depth, u_sign, u_vec[FOGVOL_U_COUNT];
+    fogvol__GLint u_ext, u_emit; /* FOGVOL_PROGRAM_COLOR_FACE */
 } fogvol__gl_program;
 
 typedef struct fogvol__gl_mesh {
@@ -8907,6 +9139,8 @@ static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvo
     gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_WRAP_T, wrap);
     if (format == FOGVOL_FORMAT_R32F)
         gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_R32F, w, h, 0, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, pixels);
+    else if (format == FOGVOL_FORMAT_RGBA32F)
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_RGBA32F, w, h, 0, FOGVOL__GL_RGBA, FOGVOL__GL_FLOAT, pixels);
     else
         gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8, w, h,
                        0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, pixels);
@@ -8984,8 +9218,8 @@ static void fogvol__gl_target_second(fogvol__gl *gl, fogvol__gl_target *t, const
     memset(t2, 0, sizeof *t2); /* no depth of its own, no second attachment */
     t2->width = d->width;
     t2->height = d->height;
-    t2->format = FOGVOL_FORMAT_RGBA8;
-    t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, FOGVOL__GL_NEAREST,
+    t2->format = d->format; /* WIDE: RGBA8; COLORS: RGBA32F */
+    t2->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format, FOGVOL__GL_NEAREST,
                                           FOGVOL__GL_CLAMP_TO_EDGE, NULL);
     gl->GenFramebuffers(1, &t2->fbo); /* for reading it back */
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t2->fbo);
@@ -9165,6 +9399,8 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
         p->u_mvp = gl->GetUniformLocation(p->id, "fv_mvp");
         p->u_depth = gl->GetUniformLocation(p->id, "fv_depth");
         p->u_sign = gl->GetUniformLocation(p->id, "fv_sign");
+        p->u_ext = gl->GetUniformLocation(p->id, "fv_ext");
+        p->u_emit = gl->GetUniformLocation(p->id, "fv_emit");
         for (i = 0; i < FOGVOL_U_COUNT; ++i) p->u_vec[i] = gl->GetUniformLocation(p->id, fogvol_uniform_name((fogvol_uniform)i));
         for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
             if (d->samplers[i]) gl->Uniform1i(gl->GetUniformLocation(p->id, d->samplers[i]), i);
@@ -9321,6 +9557,16 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
                               p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
                               p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
         break;
+    case FOGVOL_PASS_BLEND_MULTIPLY: /* scene * T per channel; coverage: dst.a * mean T */
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_ZERO, FOGVOL__GL_SRC_COLOR, FOGVOL__GL_ZERO,
+                              p->alpha_coverage ? FOGVOL__GL_SRC_ALPHA : FOGVOL__GL_ONE);
+        break;
+    case FOGVOL_PASS_BLEND_EMIT: /* + emission; coverage: + (1 - mean T) */
+        gl->Enable(FOGVOL__GL_BLEND);
+        gl->BlendFuncSeparate(FOGVOL__GL_ONE, FOGVOL__GL_ONE, p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
+                              FOGVOL__GL_ONE);
+        break;
     default: gl->Disable(FOGVOL__GL_BLEND); break;
     }
     if (p->blend == FOGVOL_PASS_BLEND_SUBTRACT) /* dst - src */
@@ -9438,6 +9684,8 @@ static void fogvol__gl_set_draw(void *u, const fogvol_draw *d)
     if (gl->program->u_mvp >= 0) gl->UniformMatrix4fv(gl->program->u_mvp, 1, 0, d->mvp);
     if (gl->program->u_depth >= 0) gl->Uniform4fv(gl->program->u_depth, 1, d->depth);
     if (gl->program->u_sign >= 0) gl->Uniform1f(gl->program->u_sign, d->sign);
+    if (gl->program->u_ext >= 0) gl->Uniform4fv(gl->program->u_ext, 1, d->extinction);
+    if (gl->program->u_emit >= 0) gl->Uniform4fv(gl->program->u_emit, 1, d->emission);
     gl->FrontFace(d->front_cw ? FOGVOL__GL_CW : FOGVOL__GL_CCW);
 }
 
@@ -9571,13 +9819,16 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
     const fogvol__gl_target *t = (const fogvol__gl_target *)h;
     fogvol__gl_state s;
     fogvol_result r;
-    if (!t || !rgba || size < (size_t)t->width * (size_t)t->height * 4u) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!t || !rgba || size < (size_t)t->width * (size_t)t->height * (t->format == FOGVOL_FORMAT_RGBA32F ? 16u : 4u))
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
     gl->GetError();
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     if (t->format == FOGVOL_FORMAT_R32F)
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
+    else if (t->format == FOGVOL_FORMAT_RGBA32F)
+        gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RGBA, FOGVOL__GL_FLOAT, rgba);
     else
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, rgba);
     r = fogvol__gl_check(gl, "read_target");

@@ -1393,6 +1393,122 @@ static void print_summary(const result *rs, int n)
         }
 }
 
+/* ---- 16 coloured volumes: per-ramp groups against one pass (FOGVOL_VARIANT_COLORS) ------ */
+#define NCOL 16
+typedef struct colbench {
+    fogvol_context *ctx;
+    fogvol_backend be;
+    fogvol_mesh *mesh;
+    fogvol_ramp *ramp[NCOL];
+} colbench;
+
+static void colbench_init(colbench *b, unsigned variants, const shp_mesh *m)
+{
+    fogvol_context_desc cd;
+    fogvol_mesh_desc md;
+    int i;
+    memset(b, 0, sizeof *b);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = fv_log;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = variants;
+    if (fogvol_create_context(&cd, &b->ctx) != FOGVOL_SUCCESS) die("fogvol_create_context (colours)");
+    memset(&md, 0, sizeof md);
+    md.positions = m->pos;
+    md.vertex_count = m->vcount;
+    md.indices = m->idx;
+    md.index_count = m->icount;
+    if (fogvol_create_mesh(b->ctx, &md, &b->mesh, NULL) != FOGVOL_SUCCESS) die("mesh (colours)");
+    for (i = 0; i < NCOL; ++i) {
+        fogvol_ramp_desc rd;
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = 0.2f + 0.8f * (float)(i % 4) / 3.0f;
+        rd.color[1] = 0.2f + 0.8f * (float)(i / 4) / 3.0f;
+        rd.color[2] = 1.0f - 0.05f * (float)i;
+        rd.density = 0.3f + 0.15f * (float)i;
+        if (fogvol_create_ramp(b->ctx, &rd, &b->ramp[i]) != FOGVOL_SUCCESS) die("ramp (colours)");
+    }
+}
+
+/* One frame of the 16 volumes (4x4 grid of spheres filling most of the view); fog time in ms. */
+static double colbench_frame(colbench *b, int w, int h, int *passes)
+{
+    fogvol_frame_desc fd;
+    fogvol_frame_stats st;
+    double t0, eye[3] = {0, 0, 7}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    int i;
+    memset(&fd, 0, sizeof fd);
+    glu_look_at(fd.view, eye, at, up);
+    glu_perspective(fd.projection, 45.0, (double)w / h, 0.5, 50.0);
+    fd.znear = 0.5f;
+    fd.zfar = 50.0f;
+    fd.viewport[2] = w;
+    fd.viewport[3] = h;
+    glClear(GL_COLOR_BUFFER_BIT);
+    glFinish();
+    t0 = now_ms();
+    fogvol_begin_frame(b->ctx, &fd);
+    for (i = 0; i < NCOL; ++i) {
+        fogvol_volume_desc vd;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = b->mesh;
+        vd.ramp = b->ramp[i];
+        trs(vd.model, 1.3f * (float)(i % 4) - 1.95f, 0.75f * (float)(i / 4) - 1.1f, 0.0f, 0, 0, 1, 0, 0.6f, 0.6f,
+            0.6f);
+        fogvol_add_volume(b->ctx, &vd);
+    }
+    if (fogvol_end_frame(b->ctx, &st) != FOGVOL_SUCCESS) die("end_frame (colours)");
+    glFinish();
+    *passes = st.passes;
+    return now_ms() - t0;
+}
+
+static void colbench_free(colbench *b)
+{
+    int i;
+    for (i = 0; i < NCOL; ++i) fogvol_destroy_ramp(b->ctx, b->ramp[i]);
+    fogvol_destroy_mesh(b->ctx, b->mesh);
+    fogvol_destroy_context(b->ctx);
+}
+
+/* Per-ramp groups (one sum and one composite pass per colour) against the one-pass colour group,
+   frames interleaved, medians. */
+static void bench_colors(int quick)
+{
+    static const int sizes[2][2] = {{1280, 720}, {640, 360}};
+    shp_mesh m = shp_sphere(1.0f, 64, 32);
+    colbench per, one;
+    int si, f, frames = quick ? 3 : 21, np = 0, no = 0;
+    out("\n## 16 coloured volumes: per-ramp groups vs one pass\n\n16 spheres (64x32 segments), 16 extinction ramps "
+        "of different colours and densities, FLOAT tier; one-pass = FOGVOL_VARIANT_COLORS (one sum pass into two "
+        "RGBA32F targets, one composite). Medians of %d interleaved frames.\n\n"
+        "| size | per-ramp passes | per-ramp ms | one-pass passes | one-pass ms | one pass / per-ramp |\n"
+        "|---|---:|---:|---:|---:|---:|\n", frames);
+    colbench_init(&per, 0, &m);
+    colbench_init(&one, FOGVOL_VARIANT_COLORS, &m);
+    for (si = quick ? 1 : 0; si < 2; ++si) {
+        int w = sizes[si][0], h = sizes[si][1];
+        GLuint col = tex2d(GL_RGBA8, w, h, GL_RGBA, GL_UNSIGNED_BYTE), fb = fbo2(col, 0, 0);
+        double tp[32], to[32];
+        glViewport(0, 0, w, h);
+        colbench_frame(&per, w, h, &np); /* warm-up: targets, shader JIT */
+        colbench_frame(&one, w, h, &no);
+        for (f = 0; f < frames; ++f) {
+            tp[f] = colbench_frame(&per, w, h, &np);
+            to[f] = colbench_frame(&one, w, h, &no);
+        }
+        out("| %dx%d | %d | %.2f | %d | %.2f | %.2f |\n", w, h, np, median(tp, frames), no, median(to, frames),
+            median(to, frames) / median(tp, frames));
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glDeleteFramebuffers(1, &fb);
+        glDeleteTextures(1, &col);
+    }
+    colbench_free(&per);
+    colbench_free(&one);
+    shp_free(&m);
+}
+
 int main(int argc, char **argv)
 {
     static const int sizes[2][2] = {{1280, 720}, {640, 360}};
@@ -1473,6 +1589,7 @@ int main(int argc, char **argv)
     print_results(g_res, g_nres);
     print_summary(g_res, g_nres);
     print_breakdown(g_res, g_nres);
+    if (only < 0) bench_colors(quick);
     out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
     out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
     out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);

@@ -13,7 +13,7 @@
 int main(int argc, char **argv)
 {
     static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh",
-                                                           "resolve", "check"};
+                                                           "resolve", "check", "color_face", "color_composite"};
     static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms;
