@@ -659,5 +659,5 @@ int main(void)
             tests[n].initial_state = t;
             ++n;
         }
-    return _cmocka_run_group_tests("tiers", tests, (size_t)n, setup_all, print_table);
+    return cmocka_run_group_tests_name("tiers", tests, setup_all, print_table); /* zeroed entries are skipped */
 }
