@@ -26,6 +26,7 @@
 #include "tests/raycast.h"
 #include "tests/shapes.h"
 #include "tests/scenes.h"
+#include "tests/fixtures.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -154,12 +155,7 @@ static fogvol_result shell_frame(fogvol_context *fv, const tscene *s, fogvol_mes
                                  float *thick, fogvol_frame_stats *st)
 {
     fogvol_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    rc_camera_matrices(&s->cam, fd.view, fd.projection);
-    fd.znear = (float)s->cam.znear;
-    fd.zfar = (float)s->cam.zfar;
-    fd.viewport[2] = W;
-    fd.viewport[3] = H;
+    fx_frame_desc(&fd, &s->cam, W, H);
     fd.show_overflow = 1;
     fd.debug_thickness = thick;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
