@@ -1,13 +1,17 @@
 /* fixtures.h - GL helpers the cmocka test programs share: the engine's shaders and
- * program, its colour + depth framebuffer, a frame looking through a test camera.
+ * program, its colour + depth framebuffer, a mesh desc of a generated shape, a frame
+ * looking through a test camera.
  * Include after <cmocka.h>, fogvol.h and tests/gl_util.h. A failure
- * fails the running cmocka test (fail_msg / assert_*). */
+ * fails the running cmocka test (fail_msg / assert_*). The GL helpers are there when
+ * the program has the GL 3 prototypes (GL_GLEXT_PROTOTYPES and <GL/glext.h>). */
 #ifndef FOGVOL_TESTS_FIXTURES_H
 #define FOGVOL_TESTS_FIXTURES_H
 
 #include <string.h>
 #include "tests/raycast.h"
+#include "tests/shapes.h"
 
+#if defined(GL_GLEXT_PROTOTYPES) && defined(GL_GLEXT_VERSION)
 /* one shader stage from n strings; the test fails with the info log when it does not compile */
 static inline GLuint fx_compile(GLenum type, const char *const *src, int n)
 {
@@ -58,6 +62,18 @@ static inline void fx_color_depth_fbo(int w, int h, GLenum depth_format, GLenum 
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *color, 0);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, *depth, 0);
     assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+}
+#endif
+
+/* a mesh desc of the shape's positions and indices (allow_open as given); every other field 0 */
+static inline void fx_mesh_desc(fogvol_mesh_desc *md, const shp_mesh *m, int allow_open)
+{
+    memset(md, 0, sizeof *md);
+    md->positions = m->pos;
+    md->vertex_count = m->vcount;
+    md->indices = (const uint32_t *)m->idx;
+    md->index_count = m->icount;
+    md->allow_open = allow_open;
 }
 
 /* a frame through the camera (its matrices, near and far planes) over a w x h viewport at 0,0;

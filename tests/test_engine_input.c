@@ -183,12 +183,7 @@ static fogvol_mesh *mesh_of(fogvol_context *fv, const shp_mesh *m, int open)
 {
     fogvol_mesh_desc md;
     fogvol_mesh *out = NULL;
-    memset(&md, 0, sizeof md);
-    md.positions = m->pos;
-    md.vertex_count = m->vcount;
-    md.indices = (const uint32_t *)m->idx;
-    md.index_count = m->icount;
-    md.allow_open = open;
+    fx_mesh_desc(&md, m, open);
     assert_int_equal(fogvol_create_mesh(fv, &md, &out, NULL), FOGVOL_SUCCESS);
     return out;
 }
@@ -208,12 +203,7 @@ static fogvol_ramp *ramp_of(fogvol_context *fv)
 
 static void frame_of(fogvol_frame_desc *fd, const rc_camera *c, float *thick)
 {
-    memset(fd, 0, sizeof *fd);
-    rc_camera_matrices(c, fd->view, fd->projection);
-    fd->znear = (float)c->znear;
-    fd->zfar = (float)c->zfar;
-    fd->viewport[2] = W;
-    fd->viewport[3] = H;
+    fx_frame_desc(fd, c, W, H);
     fd->debug_thickness = thick;
 }
 
