@@ -44,6 +44,8 @@ $(BUILD):
 #     as NAME_cxx).
 #   - a script or any other command: add "name=command" to SCRIPT_RUNS (and the programs it needs
 #     to TEST_BINS).
+#   CMakeLists.txt reads TESTS, test_NAME_LIBS and test_NAME_FLAGS from here for ctest (keep those
+#   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
 TESTS     = tiers render analytic backend engine_fb glstate engine_input overflow engine_msaa engine_depth cpu
