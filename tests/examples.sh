@@ -144,6 +144,9 @@ if(FOGVOL_SOURCE_DIR)
   if(TARGET demo_glfw OR TARGET demo_headless)
     message(FATAL_ERROR "fogvol's examples must be off in a subproject")
   endif()
+  if(TARGET test_cpu OR TARGET test_raycast)
+    message(FATAL_ERROR "fogvol's tests must be off in a subproject")
+  endif()
 else()
   find_package(fogvol ${FOGVOL_WANT} REQUIRED)
 endif()
@@ -151,7 +154,7 @@ add_executable(consumer main.c)
 target_link_libraries(consumer PRIVATE fogvol::fogvol)
 EOF
   prefix=$cm/prefix
-  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF \
+  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=OFF \
     -DCMAKE_INSTALL_PREFIX='$prefix' && cmake --build '$cm/fogvol' && cmake --install '$cm/fogvol'"
   if [ -f "$prefix/include/fogvol.h" ] && [ -f "$prefix/share/cmake/fogvol/fogvolConfig.cmake" ] &&
      [ -f "$prefix/share/cmake/fogvol/fogvolConfigVersion.cmake" ] && [ -f "$prefix/share/pkgconfig/fogvol.pc" ]; then
