@@ -6,7 +6,8 @@
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
 #   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
-#   make test-web  load it in headless Chromium (software GL) and check the pictures
+# Adding a test program: one name in TESTS (see "test programs" below). JOBS=n sets how many
+# compilers and tests run at once (default: the number of cores).
 CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
@@ -21,8 +22,6 @@ VALGRIND = valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-ki
 FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
-
-HEADERS  = fogvol.h tests/gl_util.h tests/shapes.h tests/raycast.h
 
 .PHONY: all check test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web
@@ -41,170 +40,101 @@ deps-web:
 $(BUILD):
 	@mkdir -p $(BUILD)
 
-# --- test programs: plain and under ASan+UBSan ---------------------------------
-$(BUILD)/test_cpu: tests/test_cpu.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lm
-$(BUILD)/test_cpu_cpp: tests/test_cpu.c fogvol.h | $(BUILD)
-	$(CXX) -x c++ -std=c++11 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lm
-$(BUILD)/test_cpu_san: tests/test_cpu.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka -lm
+# --- test programs ---------------------------------------------------------------------
+# Adding a test program is one line:
+#   - a cmocka program tests/test_NAME.c: add NAME to TESTS. The pattern rules below build
+#     $(BUILD)/test_NAME (C99) and $(BUILD)/test_NAME_san (ASan+UBSan); both go into TEST_BINS and
+#     `make test` runs them as NAME and NAME_asan_ubsan (TAP). It links -lcmocka $(GL_LIBS) unless
+#     you set test_NAME_LIBS (e.g. test_gles_LIBS = -lcmocka -lEGL -lGLESv2 -lm); extra compile
+#     flags: test_NAME_FLAGS. Add NAME to CXX_TESTS as well for a C++11 build (test_NAME_cpp, run
+#     as NAME_cxx).
+#   - a script or any other command: add "name=command" to SCRIPT_RUNS (and the programs it needs
+#     to TEST_BINS).
+#   CMakeLists.txt reads TESTS, test_NAME_LIBS and test_NAME_FLAGS from here for ctest (keep those
+#   assignments on one line each).
+# tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
+# summary line "N passed, M failed". Slow entries first: they start first.
+TESTS     = tiers render analytic gles texlight backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post cpu
+CXX_TESTS = cpu
+JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
+
+TEST_DEPS = fogvol.h $(wildcard tests/*.h)
+TEST_LIBS = -lcmocka $(GL_LIBS)
+test_cpu_LIBS          = -lcmocka -lm
+test_gles_LIBS         = -lcmocka -lEGL -lGLESv2 -lm
+test_engine_msaa_FLAGS = -D_POSIX_C_SOURCE=200809L
+dump_shaders_LIBS      = -lm
+libs_of = $(or $($(1)_LIBS),$(TEST_LIBS))
+
+$(BUILD)/%: tests/%.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+$(BUILD)/%_san: tests/%.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 $($*_FLAGS) $(SAN) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+$(BUILD)/%_cpp: tests/%.c $(TEST_DEPS) | $(BUILD)
+	$(CXX) -x c++ -std=c++11 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+$(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 $($*_FLAGS) -O1 -g $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+
 $(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
-$(BUILD)/test_render: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_render_san: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_glstate: tests/test_glstate.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_glstate_san: tests/test_glstate.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_fb: tests/test_engine_fb.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_fb_san: tests/test_engine_fb.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_tiers: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_tiers_san: tests/test_tiers.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_overflow: tests/test_overflow.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_overflow_san: tests/test_overflow.c tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_backend: tests/test_backend.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_backend_san: tests/test_backend.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_msaa: tests/test_engine_msaa.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_msaa_san: tests/test_engine_msaa.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_depth: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_depth_san: tests/test_engine_depth.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_input: tests/test_engine_input.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_engine_input_san: tests/test_engine_input.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-# OpenGL ES through Mesa's EGL surfaceless platform: -lEGL -lGLESv2, no OSMesa
-GLES_LIBS = -lEGL -lGLESv2 -lm
-$(BUILD)/test_gles: tests/test_gles.c tests/egl_util.h tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GLES_LIBS)
-$(BUILD)/test_gles_san: tests/test_gles.c tests/egl_util.h tests/scenes.h $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GLES_LIBS)
-$(BUILD)/test_post: tests/test_post.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_post_san: tests/test_post.c $(HEADERS) | $(BUILD)
-$(BUILD)/test_texlight: tests/test_texlight.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_texlight_san: tests/test_texlight.c $(HEADERS) | $(BUILD)
-$(BUILD)/test_colors: tests/test_colors.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_colors_san: tests/test_colors.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_cpu_vg: tests/test_cpu.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 -O1 -g $(WARN) $(INC) $< -o $@ -lcmocka -lm
-$(BUILD)/replay_mesh: tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_mesh.c -o $@ -lm
-$(BUILD)/fuzz_mesh: tests/fuzz/fuzz_mesh.c fogvol.h | $(BUILD)
+$(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
+$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
-$(BUILD)/replay_analytic: tests/fuzz/replay.c tests/fuzz/fuzz_analytic.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_analytic.c -o $@ -lm
-$(BUILD)/fuzz_analytic: tests/fuzz/fuzz_analytic.c fogvol.h | $(BUILD)
-	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
-$(BUILD)/test_analytic: tests/test_analytic.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/test_analytic_san: tests/test_analytic.c $(HEADERS) | $(BUILD)
-	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
-$(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
-	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
 
-TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
-            $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
-            $(BUILD)/test_engine_fb $(BUILD)/test_engine_fb_san \
-            $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
-            $(BUILD)/test_engine_input $(BUILD)/test_engine_input_san \
-            $(BUILD)/test_overflow $(BUILD)/test_overflow_san \
-            $(BUILD)/dump_shaders $(BUILD)/test_cpu_vg $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh \
-            $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
-            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/test_analytic $(BUILD)/test_analytic_san
-TEST_BINS += $(BUILD)/test_engine_msaa $(BUILD)/test_engine_msaa_san
-TEST_BINS += $(BUILD)/test_engine_depth $(BUILD)/test_engine_depth_san
-TEST_BINS += $(BUILD)/test_gles $(BUILD)/test_gles_san
-TEST_BINS += $(BUILD)/test_post $(BUILD)/test_post_san
+TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
+            $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
+            $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
+            $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
+            $(BUILD)/demo_headless $(BUILD)/bench
+
+# name=command lines for tests/run.sh, besides the cmocka programs
+SCRIPT_RUNS = \
+  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
+  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
+  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
+  "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
+  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
+  "bench_quick=$(BUILD)/bench --quick" \
+  "raycast_selftest=$(BUILD)/test_raycast" \
+  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
+  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
+  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
+  "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
+  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
 TEST_BINS += $(BUILD)/web/demo_web.html
-WEB_TEST = "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
+SCRIPT_RUNS += "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
 endif
-TEST_BINS += $(BUILD)/test_texlight $(BUILD)/test_texlight_san
-TEST_BINS += $(BUILD)/test_colors $(BUILD)/test_colors_san
+# the cmocka programs: plain, under ASan+UBSan (their files go to $(BUILD)/san so that the two can run
+# at once), C++
+TEST_RUNS = $(foreach t,$(TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)" \
+              "$(t)_asan_ubsan=BUILD=$(BUILD)/san $(TAP) $(LSAN_ENV) $(BUILD)/test_$(t)_san") \
+            $(foreach t,$(CXX_TESTS),"$(t)_cxx=$(TAP) $(BUILD)/test_$(t)_cpp")
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
 check: deps-test
-	@$(MAKE) --no-print-directory -j2 $(BUILD)/test_cpu $(BUILD)/test_backend
-	@LOGDIR=$(BUILD)/logs tests/run.sh "cpu=$(TAP) $(BUILD)/test_cpu" "backend=$(TAP) $(BUILD)/test_backend" \
-	  "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh"
+	@$(MAKE) --no-print-directory -j$(JOBS) $(BUILD)/test_cpu $(BUILD)/test_backend
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(TAP) $(BUILD)/test_backend" \
+	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh"
 
+# everything; the README's test command and CI
 test: deps-test deps-run
-	@$(MAKE) --no-print-directory $(TEST_BINS)
-	@LOGDIR=$(BUILD)/logs tests/run.sh \
-	  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
-	  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
-	  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
-	  "bench_quick=$(BUILD)/bench --quick" \
-	  "analytic=BUILD=$(BUILD) $(TAP) $(BUILD)/test_analytic" \
-	  "analytic_asan_ubsan=BUILD=$(BUILD) $(TAP) $(LSAN_ENV) $(BUILD)/test_analytic_san" \
-	  "shaders=BUILD=$(BUILD) tests/shaders.sh" \
-	  "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
-	  "cpu=$(TAP) $(BUILD)/test_cpu" \
-	  "cpu_cxx=$(TAP) $(BUILD)/test_cpu_cpp" \
-	  "cpu_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_cpu_san" \
-	  "raycast_selftest=$(BUILD)/test_raycast" \
-	  "render=$(TAP) $(BUILD)/test_render" \
-	  "render_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_render_san" \
-	  "glstate=$(TAP) $(BUILD)/test_glstate" \
-	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san" \
-	  "engine_fb=$(TAP) $(BUILD)/test_engine_fb" \
-	  "engine_fb_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_fb_san" \
-	  "tiers=$(TAP) $(BUILD)/test_tiers" \
-	  "tiers_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_tiers_san" \
-	  "backend=$(TAP) $(BUILD)/test_backend" \
-	  "backend_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_backend_san" \
-	  "engine_msaa=$(TAP) $(BUILD)/test_engine_msaa" \
-	  "engine_msaa_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_msaa_san" \
-	  "engine_depth=$(TAP) $(BUILD)/test_engine_depth" \
-	  "engine_depth_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_depth_san" \
-	  "engine_input=$(TAP) $(BUILD)/test_engine_input" \
-	  "engine_input_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_engine_input_san" \
-	  "overflow=$(TAP) $(BUILD)/test_overflow" \
-	  "texlight=$(TAP) $(BUILD)/test_texlight" \
-	  "texlight_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_texlight_san" \
-	  "overflow_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_overflow_san" \
-	  "gles=$(TAP) $(BUILD)/test_gles" \
-	  "gles_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_gles_san" \
-	  "post=$(TAP) $(BUILD)/test_post" \
-	  "post_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_post_san" \
-	  "colors=$(TAP) $(BUILD)/test_colors" \
-	  "colors_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_colors_san" \
-	  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
-	  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
-	  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
-	  "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
-	  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
-	  $(WEB_TEST)
+	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_BINS)
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
 
 # --- demo --------------------------------------------------------------------------
-$(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h $(HEADERS) | $(BUILD)
+$(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ $(GL_LIBS)
 
 demo: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
 	@$(BUILD)/demo_headless $(BUILD)/demo
 
-$(BUILD)/demo_glfw: examples/demo_glfw.c examples/demo_scene.h fogvol.h tests/shapes.h | $(BUILD)
+$(BUILD)/demo_glfw: examples/demo_glfw.c examples/demo_scene.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lglfw -lGL -lm
 
 # the interactive demo; without a display: 120 frames under Xvfb into $(BUILD)/demo_glfw.png
@@ -218,7 +148,7 @@ run: deps-run
 examples: deps-demo deps-run
 	@LOGDIR=$(BUILD)/logs tests/run.sh "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh"
 
-$(BUILD)/bench: bench/bench.c $(HEADERS) | $(BUILD)
+$(BUILD)/bench: bench/bench.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
 
 # full run, 4-5 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run)

@@ -7,7 +7,7 @@
 #    differ (FLOAT + the engine's depth texture, and the PS20 fallback)
 #  - custom_backend: the recording backend renders the same picture as the default one
 #  - the CMake package: install, then find_package(fogvol) and add_subdirectory
-#    consumers build and run; pkg-config --cflags fogvol
+#    consumers build and run; pkg-config --cflags fogvol; the tests build and pass under ctest
 # Needs gcc, libglfw3-dev, libgl-dev, xvfb, xauth, libosmesa6-dev, libstb-dev, and
 # cmake + pkg-config for the packaging tests (skipped when absent).
 # Usage: BUILD=build CC=cc tests/examples.sh
@@ -29,10 +29,10 @@ not_ok() {
   [ -s "$log" ] && tail -n 25 "$log" | sed 's/^/#   /'
 }
 skip() { n=$((n + 1)); echo "ok $n - $1 # SKIP $2"; }
-# run DESCRIPTION COMMAND...: ok when the command exits 0 (output in $log)
+# run DESCRIPTION COMMAND...: ok when the command exits 0 within RUN_TIMEOUT seconds (60; output in $log)
 run() {
   local desc=$1; shift
-  if timeout 60 "$@" > "$log" 2>&1; then ok "$desc"; else not_ok "$desc (exit $?)"; fi
+  if timeout "${RUN_TIMEOUT:-60}" "$@" > "$log" 2>&1; then ok "$desc"; else not_ok "$desc (exit $?)"; fi
 }
 # expect DESCRIPTION REGEX: ok when the last command's output matches (extended regex)
 expect() {
@@ -43,6 +43,7 @@ png_ok() { # a PNG file of at least 10 kB
   [ -f "$1" ] && [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && [ "$(wc -c < "$1")" -gt 10000 ]
 }
 xrun=(xvfb-run -a -s "-screen 0 1280x1024x24")
+CTEST_PROGRAMS=${CTEST_PROGRAMS:-glstate} # the cmocka programs the CMake test builds and runs
 
 # ---- build ---------------------------------------------------------------------------
 flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
@@ -143,6 +144,9 @@ if(FOGVOL_SOURCE_DIR)
   if(TARGET demo_glfw OR TARGET demo_headless)
     message(FATAL_ERROR "fogvol's examples must be off in a subproject")
   endif()
+  if(TARGET test_cpu OR TARGET test_raycast)
+    message(FATAL_ERROR "fogvol's tests must be off in a subproject")
+  endif()
 else()
   find_package(fogvol ${FOGVOL_WANT} REQUIRED)
 endif()
@@ -150,7 +154,7 @@ add_executable(consumer main.c)
 target_link_libraries(consumer PRIVATE fogvol::fogvol)
 EOF
   prefix=$cm/prefix
-  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF \
+  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=OFF \
     -DCMAKE_INSTALL_PREFIX='$prefix' && cmake --build '$cm/fogvol' && cmake --install '$cm/fogvol'"
   if [ -f "$prefix/include/fogvol.h" ] && [ -f "$prefix/share/cmake/fogvol/fogvolConfig.cmake" ] &&
      [ -f "$prefix/share/cmake/fogvol/fogvolConfigVersion.cmake" ] && [ -f "$prefix/share/pkgconfig/fogvol.pc" ]; then
@@ -168,6 +172,13 @@ EOF
   fi
   run "cmake: add_subdirectory consumer builds and runs (examples off)" bash -c "cmake -S '$cm/consumer' \
     -B '$cm/subdir' -DFOGVOL_SOURCE_DIR='$root' && cmake --build '$cm/subdir' && '$cm/subdir/consumer'"
+  # the tests through CMake: configure, build and ctest (one cmocka program, the ray-cast self-test and
+  # the shader script here; `make test` runs the whole list)
+  RUN_TIMEOUT=900 run "cmake -B b && cmake --build b && ctest --test-dir b (tests: $CTEST_PROGRAMS)" bash -c "cmake -S '$root' \
+    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
+    cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|shaders)\$' \
+    --output-on-failure"
+  expect "ctest: every test passed" '100% tests passed, 0 tests failed out of [3-9]'
   if command -v pkg-config > /dev/null; then
     run "pkg-config --cflags --libs fogvol" env PKG_CONFIG_PATH="$prefix/share/pkgconfig" \
       pkg-config --cflags --libs fogvol

@@ -2,16 +2,28 @@
 # Runs every test command given as "name=command", counts TAP lines
 # ("ok ..." / "not ok ...") and prints one closing line "N passed, M failed".
 # A command that exits non-zero without reporting a failure counts as one failure.
+# Up to JOBS commands (default: the number of cores) run at once, each into its own
+# log under LOGDIR; the logs are printed in the order the commands were given, each
+# as soon as it and every one before it have finished, so the output is the same
+# whatever the timing. Give the longest commands first: they start first.
 set -u
 logdir=${LOGDIR:-build/logs}
+jobs=${JOBS:-$(nproc 2> /dev/null || echo 2)}
+[ "$jobs" -ge 1 ] 2> /dev/null || jobs=1
 mkdir -p "$logdir"
-pass=0; fail=0
+names=(); cmds=()
 for spec in "$@"; do
-  name=${spec%%=*}; cmd=${spec#*=}
+  names+=("${spec%%=*}"); cmds+=("${spec#*=}")
+done
+total=${#names[@]}
+for ((i = 0; i < total; ++i)); do rm -f "$logdir/${names[i]}.log" "$logdir/${names[i]}.rc"; done
+
+pass=0; fail=0; shown=0
+# report I: print job I's log and add its counts
+report() {
+  local name=${names[$1]} log="$logdir/${names[$1]}.log" rc p f
+  rc=$(cat "$logdir/$name.rc")
   echo "=== $name"
-  log="$logdir/$name.log"
-  bash -c "$cmd" > "$log" 2>&1
-  rc=$?
   cat "$log"
   p=$(grep -cE '^ok [0-9]+' "$log" || true)
   f=$(grep -cE '^not ok [0-9]+' "$log" || true)
@@ -23,7 +35,23 @@ for spec in "$@"; do
     f=1
   fi
   pass=$((pass + p)); fail=$((fail + f))
+  rm -f "$logdir/$name.rc"
+}
+# print every finished job at the head of the list
+flush() {
+  while [ "$shown" -lt "$total" ] && [ -f "$logdir/${names[shown]}.rc" ]; do
+    report "$shown"; shown=$((shown + 1))
+  done
+}
+for ((i = 0; i < total; ++i)); do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do
+    wait -n; flush
+  done
+  ( bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1
+    echo $? > "$logdir/${names[i]}.rc.tmp" && mv "$logdir/${names[i]}.rc.tmp" "$logdir/${names[i]}.rc" ) &
 done
+wait
+flush
 echo
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]

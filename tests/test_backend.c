@@ -53,6 +53,7 @@
 #include "fogvol.h"
 #include "tests/gl_util.h"
 #include "tests/shapes.h"
+#include "tests/fixtures.h"
 #include <GL/glext.h>
 #include <math.h>
 
@@ -179,12 +180,7 @@ static fogvol_result make_mesh(fogvol_context *fv, const shp_mesh *s, int allow_
     fogvol_mesh_desc md;
     float *strided = NULL;
     fogvol_result r;
-    memset(&md, 0, sizeof md);
-    md.positions = s->pos;
-    md.vertex_count = s->vcount;
-    md.indices = (const uint32_t *)s->idx;
-    md.index_count = s->icount;
-    md.allow_open = allow_open;
+    fx_mesh_desc(&md, s, allow_open);
     if (stride_floats > 3) { /* interleave with padding: exercises the repacking path */
         int i;
         strided = (float *)calloc((size_t)s->vcount * (size_t)stride_floats, sizeof(float));

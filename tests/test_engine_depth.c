@@ -36,6 +36,7 @@
 #include "tests/gl_util.h"
 #include <GL/glext.h>
 #include "tests/shapes.h"
+#include "tests/fixtures.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -315,17 +316,6 @@ typedef struct engine {
     PFNGLCLIPCONTROLPROC clip_control;
 } engine;
 
-static GLuint compile(GLenum type, const char *const *src, int n)
-{
-    GLuint s = glCreateShader(type);
-    GLint ok = 0;
-    glShaderSource(s, n, src, NULL);
-    glCompileShader(s);
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    assert_true(ok);
-    return s;
-}
-
 static void engine_mesh(engine *e, int i, const shp_mesh *m)
 {
     glGenBuffers(1, &e->vbo[i]);
@@ -344,39 +334,19 @@ static void engine_init(engine *e)
                      "out float view_depth;\n"
                      "void main() { gl_Position = mvp * vec4(pos, 1.0); view_depth = -(mv * vec4(pos, 1.0)).z; }\n";
     const char *fs[3];
-    GLint ok = 0;
     fs[0] = "#version 330 core\n";
     fs[1] = fogvol_mrt_snippet();
     fs[2] = "uniform vec4 color;\nin float view_depth;\nlayout(location = 0) out vec4 frag;\n"
             "layout(location = 1) out vec4 fogvol_o;\n"
             "void main() { frag = color; fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
     memset(e, 0, sizeof *e);
-    e->prog = glCreateProgram();
-    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, &vs, 1));
-    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs, 3));
-    glLinkProgram(e->prog);
-    glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
-    assert_true(ok);
+    e->prog = fx_program(&vs, 1, fs, 3);
     e->u_mvp = glGetUniformLocation(e->prog, "mvp");
     e->u_color = glGetUniformLocation(e->prog, "color");
     e->u_mv = glGetUniformLocation(e->prog, "mv");
     e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
     glGenVertexArrays(1, &e->vao);
-    glGenTextures(1, &e->color);
-    glBindTexture(GL_TEXTURE_2D, e->color);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glGenTextures(1, &e->depth);
-    glBindTexture(GL_TEXTURE_2D, e->depth);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, W, H, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, &e->fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->color, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->depth, 0);
-    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    fx_color_depth_fbo(W, H, GL_DEPTH_COMPONENT32F, GL_FLOAT, &e->color, &e->depth, &e->fbo);
     e->clip_control = (PFNGLCLIPCONTROLPROC)OSMesaGetProcAddress("glClipControl");
     assert_non_null(e->clip_control);
 }

@@ -36,6 +36,7 @@
 #include <GL/glext.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
+#include "tests/fixtures.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -170,11 +171,7 @@ static void add_obj(eng *e, shp_mesh m, float tx, float ty, float tz, float s, i
     o->sign = sign;
     o->ramp = ramp;
     glu_translate_scale(o->model, tx, ty, tz, s);
-    memset(&md, 0, sizeof md);
-    md.positions = m.pos;
-    md.vertex_count = m.vcount;
-    md.indices = (const uint32_t *)m.idx;
-    md.index_count = m.icount;
+    fx_mesh_desc(&md, &m, 0);
     assert_int_equal(fogvol_create_mesh(e->fv, &md, &o->m, NULL), FOGVOL_SUCCESS);
 }
 

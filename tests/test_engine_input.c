@@ -31,6 +31,7 @@
 #include <GL/glext.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
+#include "tests/fixtures.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -182,12 +183,7 @@ static fogvol_mesh *mesh_of(fogvol_context *fv, const shp_mesh *m, int open)
 {
     fogvol_mesh_desc md;
     fogvol_mesh *out = NULL;
-    memset(&md, 0, sizeof md);
-    md.positions = m->pos;
-    md.vertex_count = m->vcount;
-    md.indices = (const uint32_t *)m->idx;
-    md.index_count = m->icount;
-    md.allow_open = open;
+    fx_mesh_desc(&md, m, open);
     assert_int_equal(fogvol_create_mesh(fv, &md, &out, NULL), FOGVOL_SUCCESS);
     return out;
 }
@@ -207,12 +203,7 @@ static fogvol_ramp *ramp_of(fogvol_context *fv)
 
 static void frame_of(fogvol_frame_desc *fd, const rc_camera *c, float *thick)
 {
-    memset(fd, 0, sizeof *fd);
-    rc_camera_matrices(c, fd->view, fd->projection);
-    fd->znear = (float)c->znear;
-    fd->zfar = (float)c->zfar;
-    fd->viewport[2] = W;
-    fd->viewport[3] = H;
+    fx_frame_desc(fd, c, W, H);
     fd->debug_thickness = thick;
 }
 
@@ -246,21 +237,6 @@ typedef struct engine {
     GLint u_mvp, u_mv, u_fv;
 } engine;
 
-static GLuint compile(GLenum type, const char *const *src, int n)
-{
-    GLint ok = 0;
-    GLuint sh = glCreateShader(type);
-    glShaderSource(sh, n, src, NULL);
-    glCompileShader(sh);
-    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[1024];
-        glGetShaderInfoLog(sh, sizeof log, NULL, log);
-        fail_msg("engine shader: %s", log);
-    }
-    return sh;
-}
-
 static void engine_init(engine *e)
 {
     static const char *vs = "#version 330 core\nlayout(location = 3) in vec3 e_pos;\n"
@@ -269,17 +245,11 @@ static void engine_init(engine *e)
                             "void main() { e_vd = -(e_mv * vec4(e_pos, 1.0)).z; e_t = e_uv;\n"
                             "    gl_Position = e_mvp * vec4(e_pos, 1.0); }\n";
     const char *fs[3];
-    GLint ok = 0;
     fs[0] = "#version 330 core\n";
     fs[1] = fogvol_occluder_snippet();
     fs[2] = "in float e_vd;\nin vec2 e_t;\nout vec4 e_color;\n"
             "void main() { e_color = fogvol_occluder_color(e_vd) + vec4(0.0 * e_t.x); }\n";
-    e->prog = glCreateProgram();
-    glAttachShader(e->prog, compile(GL_VERTEX_SHADER, &vs, 1));
-    glAttachShader(e->prog, compile(GL_FRAGMENT_SHADER, fs, 3));
-    glLinkProgram(e->prog);
-    glGetProgramiv(e->prog, GL_LINK_STATUS, &ok);
-    assert_true(ok);
+    e->prog = fx_program(&vs, 1, fs, 3);
     e->u_mvp = glGetUniformLocation(e->prog, "e_mvp");
     e->u_mv = glGetUniformLocation(e->prog, "e_mv");
     e->u_fv = glGetUniformLocation(e->prog, "fogvol_mrt");

@@ -45,6 +45,7 @@
 #include "fogvol.h"
 #include "tests/gl_util.h"
 #include "tests/shapes.h"
+#include "tests/fixtures.h"
 #include <GL/glext.h>
 
 #define W 64
@@ -606,11 +607,7 @@ static void upload_mesh(fx *x, const shp_mesh *s, fogvol_mesh **out)
     fogvol_mesh_desc md;
     fogvol_result r;
     assert_non_null(s->pos);
-    memset(&md, 0, sizeof md);
-    md.positions = s->pos;
-    md.vertex_count = s->vcount;
-    md.indices = (const uint32_t *)s->idx;
-    md.index_count = s->icount;
+    fx_mesh_desc(&md, s, 0);
     r = fogvol_create_mesh(x->fv, &md, out, NULL);
     if (r != FOGVOL_SUCCESS) fail_msg("fogvol_create_mesh: %s", fogvol_result_string(r));
 }

@@ -26,6 +26,7 @@
 #include <sys/stat.h>
 
 #include "tests/scenes.h"
+#include "tests/fixtures.h"
 
 typedef struct tcase {
     int scene;
@@ -99,12 +100,7 @@ static void render(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fo
                    fogvol_composite comp, int show_overflow, glu_ctx *g, frame_out *out)
 {
     fogvol_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    rc_camera_matrices(&s->cam, fd.view, fd.projection);
-    fd.znear = (float)s->cam.znear;
-    fd.zfar = (float)s->cam.zfar;
-    fd.viewport[2] = W;
-    fd.viewport[3] = H;
+    fx_frame_desc(&fd, &s->cam, W, H);
     fd.composite = comp;
     fd.show_overflow = show_overflow;
     fd.debug_thickness = out->thick;
@@ -381,12 +377,7 @@ static void test_callback_and_light(void **state)
                  GL_STATIC_DRAW);
     glBindVertexArray(0);
 
-    memset(&fd, 0, sizeof fd);
-    rc_camera_matrices(&s->cam, fd.view, fd.projection);
-    fd.znear = (float)s->cam.znear;
-    fd.zfar = (float)s->cam.zfar;
-    fd.viewport[2] = W;
-    fd.viewport[3] = H;
+    fx_frame_desc(&fd, &s->cam, W, H);
     fd.debug_thickness = b.thick;
     glClearColor(g_scene_rgb[0], g_scene_rgb[1], g_scene_rgb[2], 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
@@ -438,7 +429,7 @@ static void test_callback_and_light(void **state)
 int main(void)
 {
     static tcase cases[40];
-    struct CMUnitTest tests[40];
+    static struct CMUnitTest tests[40]; /* zeroed: the unused entries are skipped */
     char names[40][64];
     int i, n = 0, rc;
     build_scenes();
@@ -459,7 +450,7 @@ int main(void)
     tests[n].name = "callback_occluder_and_light_blend";
     tests[n].test_func = test_callback_and_light;
     ++n;
-    rc = _cmocka_run_group_tests("render", tests, (size_t)n, NULL, NULL);
+    rc = cmocka_run_group_tests_name("render", tests, NULL, NULL);
     free_scenes();
     return rc;
 }
