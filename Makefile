@@ -54,6 +54,10 @@ $(BUILD)/test_render: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_render_san: tests/test_render.c tests/scenes.h $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_speedups: tests/test_speedups.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
+$(BUILD)/test_speedups_san: tests/test_speedups.c tests/scenes.h $(HEADERS) | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_glstate: tests/test_glstate.c $(HEADERS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka $(GL_LIBS)
 $(BUILD)/test_glstate_san: tests/test_glstate.c $(HEADERS) | $(BUILD)
@@ -117,7 +121,7 @@ $(BUILD)/dump_shaders: tests/dump_shaders.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lm
 
 TEST_BINS = $(BUILD)/test_cpu $(BUILD)/test_cpu_cpp $(BUILD)/test_cpu_san $(BUILD)/test_raycast \
-            $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
+            $(BUILD)/test_render $(BUILD)/test_render_san $(BUILD)/test_speedups $(BUILD)/test_speedups_san $(BUILD)/test_glstate $(BUILD)/test_glstate_san \
             $(BUILD)/test_engine_fb $(BUILD)/test_engine_fb_san \
             $(BUILD)/test_tiers $(BUILD)/test_tiers_san $(BUILD)/test_backend $(BUILD)/test_backend_san \
             $(BUILD)/test_engine_input $(BUILD)/test_engine_input_san \
@@ -161,6 +165,8 @@ test: deps-test deps-run
 	  "raycast_selftest=$(BUILD)/test_raycast" \
 	  "render=$(TAP) $(BUILD)/test_render" \
 	  "render_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_render_san" \
+	  "speedups=$(TAP) $(BUILD)/test_speedups" \
+	  "speedups_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_speedups_san" \
 	  "glstate=$(TAP) $(BUILD)/test_glstate" \
 	  "glstate_asan_ubsan=$(TAP) $(LSAN_ENV) $(BUILD)/test_glstate_san" \
 	  "engine_fb=$(TAP) $(BUILD)/test_engine_fb" \
