@@ -1428,22 +1428,35 @@ static void print_results(const result *rs, int n)
     }
 }
 
-/* name of pass p of method m, which ran np passes (a tier that skipped O runs one pass less) */
-static const char *pass_name(int m, int p, int np)
+/* name of pass p of method m in a scene with or without occluders that ran np passes: the
+   default tiers skip O in scenes without occluders; RGBA8 tiers run an overflow check pass
+   before the composite while they count overflow */
+static const char *pass_name(int m, int p, int np, int occluders)
 {
-    static const char *const pn[NTIER + 1][5] = {{"O", "B", "F", "resolve", "composite"},
-                                                 {"O", "B", "F", "composite", ""},
-                                                 {"B", "F", "composite", "", ""},
-                                                 {"O", "B-F", "composite", "", ""},
-                                                 {"B-F", "composite", "", "", ""},
-                                                 {"O", "B-F", "composite", "", ""},
-                                                 {"O", "B", "F", "composite", ""},
-                                                 {"geometry", "composite", "", "", ""}};
-    int full = 0;
-    const char *const *names = pn[m < NTIER ? m : NTIER];
-    while (full < 5 && names[full][0]) ++full;
-    if (np == full - 1 && strcmp(names[0], "O") == 0) ++p;
-    return p < 5 ? names[p] : "?";
+    static const char *const pn[NTIER + 1][6] = {{"O", "B", "F", "resolve", "check", "composite"},
+                                                 {"O", "B", "F", "check", "composite", ""},
+                                                 {"B", "F", "check", "composite", "", ""},
+                                                 {"O", "B-F", "composite", "", "", ""},
+                                                 {"B-F", "composite", "", "", "", ""},
+                                                 {"O", "B-F", "composite", "", "", ""},
+                                                 {"O", "B", "F", "check", "composite", ""},
+                                                 {"geometry", "composite", "", "", "", ""}};
+    const char *names[6];
+    int full = 0, i, k = 0;
+    const char *const *src = pn[m < NTIER ? m : NTIER];
+    while (full < 6 && src[full][0]) ++full;
+    for (i = 0; i < full; ++i) {
+        if (strcmp(src[i], "O") == 0 && m < NDEFAULT && !occluders) continue;
+        names[k++] = src[i];
+    }
+    if (np == k - 1) /* no check pass this frame */
+        for (i = 0; i < k; ++i)
+            if (strcmp(names[i], "check") == 0) {
+                memmove(names + i, names + i + 1, (size_t)(k - i - 1) * sizeof names[0]);
+                --k;
+                break;
+            }
+    return p < k ? names[p] : "?";
 }
 
 static void print_breakdown(const result *rs, int n)
@@ -1467,9 +1480,9 @@ static void print_breakdown(const result *rs, int n)
                          r->engine_ms);
                 sum += r->bd_engine_mrt - r->engine_ms;
             }
-            for (p = 0; p < r->bd_np[m] && p < 5; ++p) {
+            for (p = 0; p < r->bd_np[m] && p < 6; ++p) {
                 snprintf(cells + strlen(cells), sizeof cells - strlen(cells), "%s%s %.2f", p ? ", " : "",
-                         pass_name(m, p, r->bd_np[m]), r->bd_ms[m][p]);
+                         pass_name(m, p, r->bd_np[m], r->occluders), r->bd_ms[m][p]);
                 sum += r->bd_ms[m][p];
             }
             if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) {
