@@ -54,7 +54,7 @@ $(BUILD):
 #   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
-TESTS     = tiers render analytic gles texlight backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post cpu
+TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post cpu
 CXX_TESTS = cpu
 JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
 

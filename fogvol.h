@@ -911,7 +911,10 @@ typedef uintptr_t fogvol_handle;
    DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
    COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
    COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
-   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass) */
+   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
+   SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
+                        COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
+                        not the ramp texture */
 #define FOGVOL_UNIFORMS(X) \
     X(ENC, fv_enc) \
     X(DITHER, fv_dith) \
@@ -931,7 +934,8 @@ typedef uintptr_t fogvol_handle;
     X(DENSITY, fv_dens) \
     X(COLOR_U, fv_ctex_u) \
     X(COLOR_V, fv_ctex_v) \
-    X(LIGHT, fv_light)
+    X(LIGHT, fv_light) \
+    X(SPEEDUP, fv_speed)
 
 typedef enum fogvol_uniform {
 #define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
@@ -1246,7 +1250,29 @@ typedef struct fogvol_context_desc {
     fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
     fogvol_gl_desc gl;     /* for the GL backend */
     fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
+    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
+                                  measuring what each one gives (bench/bench.c) */
 } fogvol_context_desc;
+
+/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels). */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3
+};
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
@@ -4446,6 +4472,12 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
     "vec2 fv_st() { return gl_FragCoord.xy * fv_screen.xy + fv_screen.zw; }\n"
+    /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
+    "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
+    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw / fv_screen.xy), 0)\n"
+    "#else\n"
+    "#define FV_SCREEN(s) FV_TEXTURE(s, fv_st())\n"
+    "#endif\n"
     /* view depth (distance along the view axis) of an engine depth-buffer sample: st in [0,1]
        across the engine viewport, z its window depth; fv_lin / fv_lin2 hold the inverse
        view-projection rows with the window -> NDC mapping (depth range, clip control) folded in */
@@ -4543,12 +4575,14 @@ static const char fogvol__fs_face[] =
     "#ifdef FV_FLOAT\n"
     "uniform float fv_sign;\n"
     "uniform vec4 fv_nf;\n"
+    "uniform vec4 fv_speed;\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
-    "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
+    "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
+    "    if (fv_speed.x < 0.5) o = FV_SCREEN(fv_opaque).r;\n"
     "#endif\n"
     "    float d = min(max(fv_d, 0.0), o);\n"
     "#ifdef FV_DENSITY\n"
@@ -4559,7 +4593,7 @@ static const char fogvol__fs_face[] =
     "#elif defined(FV_WIDE)\n"
     "uniform sampler2D fv_opaque2;\n"
     "void main() {\n"
-    "    vec4 hi, lo, ohi = FV_TEXTURE(fv_opaque, fv_st()), olo = FV_TEXTURE(fv_opaque2, fv_st());\n"
+    "    vec4 hi, lo, ohi = FV_SCREEN(fv_opaque), olo = FV_SCREEN(fv_opaque2);\n"
     "    fv_encode_wide(fv_d, hi, lo);\n"
     "    bool behind = dot(hi - ohi, fv_dec) + dot(lo - olo, fv_dec) / (fv_enc.x * fv_enc.y) >= 0.0;\n"
     "    FV_OUT0 = behind ? ohi : hi;\n"
@@ -4569,7 +4603,7 @@ static const char fogvol__fs_face[] =
     "void main() {\n"
     "#ifdef FV_DENSITY\n"                        /* decoded opaque depth, then v re-encoded */
     "    if (fv_dens.y > 0.5) {\n"
-    "        float od = dot(FV_TEXTURE(fv_opaque, fv_st()), fv_dec) * fv_dens.z;\n"
+    "        float od = dot(FV_SCREEN(fv_opaque), fv_dec) * fv_dens.z;\n"
     "        FV_FRAGCOLOR = fv_encode(fv_density_apply(min(max(fv_d, 0.0), od), od));\n"
     "        return;\n"
     "    }\n"
@@ -4581,7 +4615,7 @@ static const char fogvol__fs_face[] =
     "#ifdef FV_COUNT\n"
     "    FV_FRAGCOLOR = vec4(e.rgb, 1.0 / 255.0);\n"
     "#else\n"
-    "    vec4 o = FV_TEXTURE(fv_opaque, fv_st());\n"
+    "    vec4 o = FV_SCREEN(fv_opaque);\n"
     "#ifdef FV_PS13\n"
     "    vec3 s = clamp((e.rgb - o.rgb) * 255.0, -1.0, 1.0);\n"
     "    FV_FRAGCOLOR = dot(s, vec3(1.0, 0.66, 0.31)) - 0.01 > 0.0 ? o : e;\n"
@@ -4599,10 +4633,10 @@ static const char fogvol__fs_resolve[] =
     "uniform FV_TARGET_SAMPLER fv_front;\n"
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "void main() {\n"
-    "    vec4 b = FV_TEXTURE(fv_back, fv_st()), f = FV_TEXTURE(fv_front, fv_st());\n"
+    "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
     "    vec3 d = floor((b.rgb - f.rgb) * 255.0 + 0.5);\n"
     "#ifdef FV_COUNT\n"                           /* + the opaque depth once per missing back face */
-    "    d += floor((f.a - b.a) * 255.0 + 0.5) * floor(FV_TEXTURE(fv_opaque, fv_st()).rgb * 255.0 + 0.5);\n"
+    "    d += floor((f.a - b.a) * 255.0 + 0.5) * floor(FV_SCREEN(fv_opaque).rgb * 255.0 + 0.5);\n"
     "#endif\n"
     "    float n = fv_enc.x, c = floor(d.b / n);\n"
     "    d.b -= c * n;\n"
@@ -4629,6 +4663,7 @@ static const char fogvol__fs_composite[] =
     "uniform sampler2D fv_colors;\n"
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
+    "uniform vec4 fv_speed;\n"
     "uniform vec4 fv_ctex_u;\n"
     "uniform vec4 fv_ctex_v;\n"
     "#ifdef FV_WIDE\n"
@@ -4637,7 +4672,7 @@ static const char fogvol__fs_composite[] =
     "#endif\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
-    "    vec4 b = FV_TEXTURE(fv_back, st);\n"
+    "    vec4 b = FV_SCREEN(fv_back);\n"
     "    float sat = 0.0, t;\n"
     "#if defined(FV_FLOAT)\n"
     "    if (b.r == 0.0) discard;\n"
@@ -4651,23 +4686,23 @@ static const char fogvol__fs_composite[] =
     "#ifdef FV_CHECK\n"
     "    float peak = 0.0;\n"
     "#else\n"
-    "    float peak = FV_TEXTURE(fv_front, st).r;\n"
+    "    float peak = FV_SCREEN(fv_front).r;\n"
     "    if (s == vec4(0.0) && peak < 0.5) discard;\n"
     "#endif\n"
     "    t = dot(s, fv_dec);\n"
     "    sat = peak > 0.5 || max(max(b.r, b.g), max(b.b, b.a)) > 254.5 / 255.0 ||"
     " min(min(b.r, b.g), min(b.b, b.a)) < 0.5 / 255.0 ? 1.0 : 0.0;\n"
     "#else\n"
-    "    vec4 f = FV_TEXTURE(fv_front, st);\n"
+    "    vec4 f = FV_SCREEN(fv_front);\n"
     "#ifndef FV_WIDE\n"
     "    if (b + f == vec4(0.0)) discard;\n"
     "#endif\n"
     "    vec4 m = max(b, f);\n"
     "    sat = max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
     "#if defined(FV_COUNT)\n"
-    "    t = dot(b.rgb - f.rgb, fv_dec.xyz) + (f.a - b.a) * 255.0 * dot(FV_TEXTURE(fv_opaque, st).rgb, fv_dec.xyz);\n"
+    "    t = dot(b.rgb - f.rgb, fv_dec.xyz) + (f.a - b.a) * 255.0 * dot(FV_SCREEN(fv_opaque).rgb, fv_dec.xyz);\n"
     "#elif defined(FV_WIDE)\n"
-    "    vec4 b2 = FV_TEXTURE(fv_back2, st), f2 = FV_TEXTURE(fv_front2, st);\n"
+    "    vec4 b2 = FV_SCREEN(fv_back2), f2 = FV_SCREEN(fv_front2);\n"
     "    if (b + f + b2 + f2 == vec4(0.0)) discard;\n"
     "    m = max(m, max(b2, f2));\n"
     "    sat = max(max(m.r, m.g), max(m.b, m.a)) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
@@ -4680,7 +4715,9 @@ static const char fogvol__fs_composite[] =
     "    if (sat < 0.5) discard;\n"
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
-    "    vec4 c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "    vec4 c;\n"
+    "    if (fv_speed.w > 0.0) c = vec4(fv_speed.rgb, 1.0 - exp(-fv_speed.w * max(t, 0.0)));\n"
+    "    else c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
     "    if (fv_ctex_u.w > 0.5)\n"
     "        c.rgb *= FV_TEXTURE(fv_ctex, vec2(dot(fv_ctex_u.xyz, vec3(st, 1.0)), dot(fv_ctex_v.xyz, vec3(st, 1.0)))).rgb;\n"
     "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
@@ -4708,7 +4745,7 @@ static const char fogvol__fs_light[] =
     "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
     "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
-    "    return fv_light_depth(FV_TEXTURE(fv_opaque, fv_st()));\n"
+    "    return fv_light_depth(FV_SCREEN(fv_opaque));\n"
     "#endif\n"
     "}\n"
     "void main() {\n"
@@ -4723,7 +4760,7 @@ static const char fogvol__fs_light[] =
     "#endif\n"
     "    } else {\n"
     "        float o = fv_light_opaque();\n"
-    "        if (o < fv_light_depth(FV_TEXTURE(fv_lfront, fv_st())) || o > d) discard;\n"
+    "        if (o < fv_light_depth(FV_SCREEN(fv_lfront)) || o > d) discard;\n"
     "        FV_FRAGCOLOR = vec4(fv_light.rgb, 1.0);\n"
     "    }\n"
     "}\n";
@@ -5215,6 +5252,7 @@ struct fogvol_ramp {
     int grey;            /* the same extinction in every channel */
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
+    float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
 };
 
 struct fogvol_volume_texture {
@@ -5300,6 +5338,8 @@ struct fogvol_context {
     fogvol__light *lights;  /* fogvol_add_light, this frame */
     int nlight, caplight;
     fogvol_handle tgt_l;    /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
+    unsigned speedups_off;  /* fogvol_context_desc.disable_speedups */
+    int o_far;              /* O holds the far plane only (cleared, nothing drawn since) */
 };
 
 /* column-major 4x4 helpers in double */
@@ -5386,6 +5426,7 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
     ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
     ctx->target_w = ctx->target_h = 0;
+    ctx->o_far = 0;
 }
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->variants & variant) != 0; }
@@ -5560,6 +5601,12 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
     if (r == FOGVOL_SUCCESS) r = fogvol_shader_strings(&sd, pd.fs, &pd.fs_count);
+    if (r == FOGVOL_SUCCESS && (ctx->speedups_off & FOGVOL_SPEEDUP_TEXEL_FETCH) &&
+        pd.fs_count < FOGVOL_MAX_SHADER_STRINGS) { /* after the #version line: filtered target reads */
+        memmove(pd.fs + 2, pd.fs + 1, (size_t)(pd.fs_count - 1) * sizeof pd.fs[0]);
+        pd.fs[1] = "#define FV_NO_FETCH\n";
+        pd.fs_count++;
+    }
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s shader for tier %s, variants 0x%x, GLSL %s",
                     labels[p], fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect));
@@ -5740,6 +5787,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->alloc = desc->allocator;
     ctx->log = desc->logger;
     ctx->dither = !desc->disable_dither;
+    ctx->speedups_off = desc->disable_speedups;
     ctx->variants = desc->variants;
     ctx->msaa = desc->msaa;
     fogvol_encoding_init(&ctx->enc, bits);
@@ -6047,6 +6095,13 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     rp->max_thickness = tmax;
     rp->blend = desc->blend;
     fogvol__ramp_colors(ctx, desc, rp);
+    if (desc->model == FOGVOL_RAMP_EXTINCTION && (double)tmax * desc->density >= 7.0 * (1.0 - 1e-6))
+    {
+        rp->exp_rgba[0] = fogvol__unorm8(desc->color[0]) / 255.0f;
+        rp->exp_rgba[1] = fogvol__unorm8(desc->color[1]) / 255.0f;
+        rp->exp_rgba[2] = fogvol__unorm8(desc->color[2]) / 255.0f;
+        rp->exp_rgba[3] = desc->density;
+    }
     ctx->live_ramps++;
     *out = rp;
     return FOGVOL_SUCCESS;
@@ -7215,6 +7270,7 @@ typedef struct fogvol__run {
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
     fogvol_result r;            /* the last error that did not stop the frame */
+    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
 } fogvol__run;
 
 /* >>texlight (volume light by compare) ====================================== */
@@ -7437,7 +7493,13 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
 {
     fogvol_pass ps = run->base;
     int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
-    if (!fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) || ctx->engine_occluders) return;
+    if (!fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) || ctx->engine_occluders) {
+        ctx->o_far = 0; /* the engine wrote O */
+        return;
+    }
+    run->no_opaque = !engine && !run->count && ctx->nocc == 0 && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_OPAQUE);
+    if (run->no_opaque && ctx->o_far) return; /* O still holds the far plane of an earlier frame */
+    ctx->o_far = run->no_opaque;
     ps.target = ctx->tgt_o;
     ps.clear = 1;
     if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
@@ -7474,6 +7536,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_result r;
     ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
+    ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
     ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
         ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
@@ -7548,7 +7611,13 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__group_rect(ctx, ramp, ps->scissor);
+    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
+        fogvol__group_rect(ctx, ramp, ps->scissor);
+        if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
+            ps->scissor[1] = 2 * fd->viewport[1] + fd->viewport[3] - ps->scissor[1] - ps->scissor[3];
+    }
+    if (!(ctx->speedups_off & FOGVOL_SPEEDUP_EXP_COMPOSITE))
+        memcpy(ps->uniforms[FOGVOL_U_SPEEDUP], ramp->exp_rgba, sizeof ramp->exp_rgba);
     ps->program = ctx->prog[FOGVOL_PROGRAM_COMPOSITE];
     ps->textures[FOGVOL__UNIT_RAMP] = ramp->texture;
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));

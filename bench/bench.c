@@ -40,10 +40,15 @@
 #include <time.h>
 #include <sys/utsname.h>
 
-#define NTIER 5
+#define NTIER 7
+#define NDEFAULT 5 /* the first NDEFAULT tiers: fogvol's default configuration (every speed-up on) */
 #define M_FLOOR NTIER
-#define M_PEEL (NTIER + 1)
-#define NMETH (NTIER + 2)
+#define M_OCCFLOOR (NTIER + 1)
+#define M_SCFLOOR (NTIER + 2)
+#define M_PEEL (NTIER + 3)
+#define NMETH (NTIER + 4)
+#define SPEEDUPS_ALL                                                                                              \
+    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR)
 #define MAXI 32 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96
@@ -53,14 +58,18 @@ typedef struct tier_cfg {
     const char *name;
     fogvol_tier tier;
     unsigned variants;
+    unsigned speedups_off; /* fogvol_context_desc.disable_speedups */
 } tier_cfg;
-static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0},
-                                        {"PS20", FOGVOL_TIER_PS20, 0},
-                                        {"MRT", FOGVOL_TIER_MRT, 0},
-                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0},
-                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH}};
-static const char *const g_meth_names[NMETH] = {"PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "floor",
-                                                "depth peeling"};
+static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0},
+                                        {"PS20", FOGVOL_TIER_PS20, 0, 0},
+                                        {"MRT", FOGVOL_TIER_MRT, 0, 0},
+                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0, 0},
+                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0},
+                                        {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL},
+                                        {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL}};
+static const char *const g_meth_names[NMETH] = {
+    "PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "FLOAT, speed-ups off", "PS20, speed-ups off",
+    "floor", "occluder floor", "scissored floor", "depth peeling"};
 
 /* ---- small utilities -------------------------------------------------------- */
 static double now_ms(void)
@@ -230,6 +239,7 @@ static void make_progs(void)
 /* ---- scenes ------------------------------------------------------------------ */
 typedef struct gmesh {
     shp_mesh m;
+    float bmin[3], bmax[3]; /* bounding box */
     GLuint vao, vbo, ibo;
     fogvol_mesh *fm[NTIER];
 } gmesh;
@@ -247,6 +257,7 @@ typedef struct scene {
     float fovy, znear, zfar;
     gmesh mesh[MAXMESH];
     int nmesh;
+    int occluders; /* occluder instances */
     inst in[MAXI];
     int n;
     int k;        /* depth complexity of a shell scene (0: other) */
@@ -266,6 +277,7 @@ static void add_inst(scene *s, int mesh, const float model[16], int occluder)
     i->mesh = mesh;
     memcpy(i->model, model, sizeof i->model);
     i->occluder = occluder;
+    s->occluders += occluder != 0;
     i->col[0] = 0.55f;
     i->col[1] = 0.5f;
     i->col[2] = 0.45f;
@@ -383,7 +395,8 @@ static void build_scene(scene *s, int which)
 typedef struct rt {
     int w, h;
     GLuint eng_color, eng_depth, eng_fbo;   /* the engine framebuffer (colour + depth texture) */
-    GLuint floor_tex, floor_fbo;            /* the floor's RGBA8 sum */
+    GLuint floor_tex, floor_fbo;            /* the floor's R32F sum */
+    GLuint floor_rb, floor_occ_fbo;         /* the occluder floor: the same sum with a depth buffer */
     GLuint po_tex, po_rb, po_fbo;           /* peeling: opaque linear depth */
     GLuint pc[2], pz[2], pfbo[2];           /* peeling: ping-pong (sum, count) + depth */
     GLuint query;
@@ -400,6 +413,10 @@ static void rt_create(rt *r, int w, int h)
     r->eng_fbo = fbo2(r->eng_color, r->eng_depth, 0);
     r->floor_tex = tex2d(GL_R32F, w, h, GL_RED, GL_FLOAT);
     r->floor_fbo = fbo2(r->floor_tex, 0, 0);
+    glGenRenderbuffers(1, &r->floor_rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, r->floor_rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    r->floor_occ_fbo = fbo2(r->floor_tex, 0, r->floor_rb);
     r->po_tex = tex2d(GL_R32F, w, h, GL_RED, GL_FLOAT);
     glGenRenderbuffers(1, &r->po_rb);
     glBindRenderbuffer(GL_RENDERBUFFER, r->po_rb);
@@ -417,11 +434,12 @@ static void rt_create(rt *r, int w, int h)
 static void rt_free(rt *r)
 {
     GLuint t[9] = {r->eng_color, r->eng_depth, r->floor_tex, r->po_tex, r->pc[0], r->pc[1], r->pz[0], r->pz[1], 0};
-    GLuint f[5] = {r->eng_fbo, r->floor_fbo, r->po_fbo, r->pfbo[0], r->pfbo[1]};
+    GLuint f[6] = {r->eng_fbo, r->floor_fbo, r->po_fbo, r->pfbo[0], r->pfbo[1], r->floor_occ_fbo};
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteFramebuffers(5, f);
+    glDeleteFramebuffers(6, f);
     glDeleteTextures(8, t);
     glDeleteRenderbuffers(1, &r->po_rb);
+    glDeleteRenderbuffers(1, &r->floor_rb);
     glDeleteQueries(1, &r->query);
 }
 
@@ -577,19 +595,76 @@ static fogvol_result fog_frame(fogs *F, int t, const scene *s, const view *vw, c
     return fogvol_end_frame(c, st);
 }
 
-/* the floor: volume triangles once, constant colour, additive, + one full-screen composite */
-static void floor_frame(const scene *s, const view *vw, const rt *r)
+/* The window rectangle holding the volumes' bounding boxes projected (the whole viewport when a
+   corner lies behind the near plane), for the scissored floor. */
+static void vol_rect(const scene *s, const view *vw, int w, int h, int rect[4])
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, r->floor_fbo);
+    double lo[2] = {1e30, 1e30}, hi[2] = {-1e30, -1e30};
+    int i, k, c;
+    rect[0] = rect[1] = 0;
+    rect[2] = w;
+    rect[3] = h;
+    for (i = 0; i < s->n; ++i) {
+        const inst *in = &s->in[i];
+        const gmesh *g = &s->mesh[in->mesh];
+        float mvp[16];
+        if (in->occluder) continue;
+        shp_mat_mul(mvp, vw->vp, in->model);
+        for (k = 0; k < 8; ++k) {
+            double p[3], cl[4];
+            for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? g->bmax[c] : g->bmin[c];
+            for (c = 0; c < 4; ++c) cl[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
+            if (cl[3] < s->znear * 0.999) return;
+            for (c = 0; c < 2; ++c) {
+                double win = (cl[c] / cl[3] * 0.5 + 0.5) * (c ? h : w);
+                if (win < lo[c]) lo[c] = win;
+                if (win > hi[c]) hi[c] = win;
+            }
+        }
+    }
+    for (c = 0; c < 2; ++c) {
+        double a = floor(lo[c]) - 1, b = floor(hi[c]) + 2, lim = c ? h : w;
+        if (a < 0) a = 0;
+        if (b > lim) b = lim;
+        rect[c] = (int)a;
+        rect[c + 2] = b > a ? (int)(b - a) : 1;
+    }
+}
+
+/* The floor: volume triangles once, constant colour, additive, + one full-screen composite.
+   mode 1 (occluder floor): the occluders first, depth only, and the volume triangles depth-tested
+   against them; mode 2 (scissored floor): the composite scissored to the volumes' rectangle. */
+static void floor_frame(const scene *s, const view *vw, const rt *r, int mode)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, mode == 1 ? r->floor_occ_fbo : r->floor_fbo);
     glViewport(0, 0, r->w, r->h);
     glClearColor(0, 0, 0, 0);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glClear(mode == 1 ? GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT : GL_COLOR_BUFFER_BIT);
     glDisable(GL_CULL_FACE);
+    glUseProgram(P.cnst);
+    if (mode == 1) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        draw_insts(s, vw, P.cnst, 1);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthMask(GL_FALSE);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+    }
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(P.cnst);
     draw_insts(s, vw, P.cnst, 0);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    if (mode == 2) {
+        int rc[4];
+        vol_rect(s, vw, r->w, r->h, rc);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(rc[0], rc[1], rc[2], rc[3]);
+    }
     if (g_pt.on) {
         glFinish();
         g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
@@ -605,6 +680,7 @@ static void floor_frame(const scene *s, const view *vw, const rt *r)
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     glDisable(GL_BLEND);
+    glDisable(GL_SCISSOR_TEST);
     glUseProgram(0);
     if (g_pt.on) {
         glFinish();
@@ -618,8 +694,10 @@ static void bind_tex(int unit, GLuint t)
     glBindTexture(GL_TEXTURE_2D, t);
 }
 
-/* Depth peeling; returns the number of layers found (geometry passes = layers + 1). */
-static int peel_frame(const scene *s, const view *vw, const rt *r)
+/* Depth peeling; returns the number of layers found. known = 0: an occlusion query after every
+   layer finds the count (geometry passes = layers + 1); known > 0: exactly that many layers, no
+   query (the timed frames, once the debug frame found the count). */
+static int peel_frame(const scene *s, const view *vw, const rt *r, int known)
 {
     static const float zero[4] = {0, 0, 0, 0};
     GLint u_first = glGetUniformLocation(P.peel, "first");
@@ -648,13 +726,17 @@ static int peel_frame(const scene *s, const view *vw, const rt *r)
     glUniform1i(glGetUniformLocation(P.peel, "opq"), 2);
     glUniform1f(glGetUniformLocation(P.peel, "eps"), 1e-7f);
     bind_tex(2, r->po_tex);
-    for (k = 0; k < MAXLAYERS; ++k) {
+    for (k = 0; k < (known > 0 ? known : MAXLAYERS); ++k) {
         GLuint any = 0;
         glBindFramebuffer(GL_FRAMEBUFFER, r->pfbo[k & 1]);
         glClear(GL_DEPTH_BUFFER_BIT); /* a fresh depth buffer per layer */
         bind_tex(0, r->pc[(k + 1) & 1]);
         bind_tex(1, r->pz[(k + 1) & 1]);
         glUniform1f(u_first, k == 0 ? 1.0f : 0.0f);
+        if (known > 0) {
+            draw_insts(s, vw, P.peel, 0);
+            continue;
+        }
         glBeginQuery(GL_ANY_SAMPLES_PASSED, r->query);
         draw_insts(s, vw, P.peel, 0);
         glEndQuery(GL_ANY_SAMPLES_PASSED);
@@ -715,6 +797,11 @@ static void scene_upload(scene *s, fogs *F)
         int occ = 0, j;
         fogvol_mesh_desc md;
         for (j = 0; j < s->n; ++j) occ |= s->in[j].mesh == i && s->in[j].occluder;
+        for (j = 0; j < 3; ++j) g->bmin[j] = 1e30f, g->bmax[j] = -1e30f;
+        for (j = 0; j < 3 * g->m.vcount; ++j) {
+            if (g->m.pos[j] < g->bmin[j % 3]) g->bmin[j % 3] = g->m.pos[j];
+            if (g->m.pos[j] > g->bmax[j % 3]) g->bmax[j % 3] = g->m.pos[j];
+        }
         glGenVertexArrays(1, &g->vao);
         glBindVertexArray(g->vao);
         glGenBuffers(1, &g->vbo);
@@ -764,6 +851,7 @@ typedef struct result {
     int overflow[NTIER];
     int frames;
     /* breakdown (glFinish around every pass; medians): per-pass ms, whole frame, plain engine pass */
+    int occluders;         /* occluder instances in the scene */
     int bd, bd_np[NMETH];
     double bd_ms[NMETH][MAXPASS], bd_frame[NMETH], engine_ms, bd_engine_mrt;
     double cpu_us[NTIER]; /* fogvol_begin_frame .. fogvol_end_frame on the null backend */
@@ -874,6 +962,14 @@ static double null_frame_us(const scene *s, int t, int w, int h)
 }
 
 /* ---- one scene at one resolution ------------------------------------------------- */
+/* One frame of a reference method (a floor or the peeling); returns its passes. */
+static int ref_frame(int m, const scene *s, const view *vw, const rt *r, int layers)
+{
+    if (m == M_PEEL) return 1 + peel_frame(s, vw, r, layers) + 1;
+    floor_frame(s, vw, r, m == M_OCCFLOOR ? 1 : m == M_SCFLOOR ? 2 : 0);
+    return 2;
+}
+
 static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, result *res)
 {
     rt r;
@@ -893,6 +989,7 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
     res->w = w;
     res->h = h;
     res->k = s->k;
+    res->occluders = s->occluders;
     res->triangles = s->triangles;
     res->frames = frames;
     rt_create(&r, w, h);
@@ -906,8 +1003,7 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
         glFinish();
         t0 = now_ms();
         if (i < NTIER) fog_frame(F, i, s, &vw, &r, NULL, &st);
-        else if (i == M_FLOOR) floor_frame(s, &vw, &r);
-        else peel_frame(s, &vw, &r);
+        else ref_frame(i, s, &vw, &r, 0);
         glFinish();
         res->first_ms[i] = now_ms() - t0;
     }
@@ -923,7 +1019,7 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
         res->overflow[i] = st.overflow_pixels;
     }
     engine_pass(s, &vw, &r, NULL);
-    res->layers = peel_frame(s, &vw, &r);
+    res->layers = peel_frame(s, &vw, &r, 0);
     peel_read(s, &r, pt, pc);
     for (i = 0; i < (int)npx; ++i) res->fogged += dbg[3][i] != 0.0f;
     for (i = 0; i < NTIER; ++i) {
@@ -957,11 +1053,8 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
                 fogvol_result fr = fog_frame(F, m, s, &vw, &r, NULL, &st);
                 if (fr != FOGVOL_SUCCESS) die(fogvol_result_string(fr));
                 passes = st.passes;
-            } else if (m == M_FLOOR) {
-                floor_frame(s, &vw, &r);
-                passes = 2;
             } else {
-                passes = 1 + peel_frame(s, &vw, &r) + 1 + 1;
+                passes = ref_frame(m, s, &vw, &r, res->layers);
             }
             glFinish();
             t1 = now_ms();
@@ -996,7 +1089,7 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
                 glFinish();
                 t0 = g_pt.t0 = now_ms();
                 if (m < NTIER) fog_frame(F, m, s, &vw, &r, NULL, &st);
-                else floor_frame(s, &vw, &r);
+                else floor_frame(s, &vw, &r, 0);
                 glFinish();
                 bf[m][b] = now_ms() - t0;
                 g_pt.on = 0;
@@ -1094,6 +1187,7 @@ static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
     cd.tier = g_tiers[t].tier;
     cd.variants = g_tiers[t].variants;
     cd.engine_mrt = g_tiers[t].tier == FOGVOL_TIER_MRT;
+    cd.disable_speedups = g_tiers[t].speedups_off;
     glFinish();
     t0 = now_ms();
     if (fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, be) != FOGVOL_SUCCESS) die("fogvol_gl_backend_create");
@@ -1171,10 +1265,14 @@ static double step125(double v, int up)
     return r;
 }
 
+/* the plot shows the default tiers, the floor and the peeling */
+static int plotted(int m) { return m < NDEFAULT || m == M_FLOOR || m == M_PEEL; }
+
 static void plot(const char *path, const result *rs, int n, int w, int h)
 {
-    static const unsigned char col[NMETH][3] = {{214, 39, 40}, {255, 127, 14}, {148, 103, 189}, {31, 119, 180},
-                                                {23, 190, 207}, {60, 60, 60}, {44, 160, 44}};
+    static const unsigned char col[NMETH][3] = {{214, 39, 40},  {255, 127, 14}, {148, 103, 189}, {31, 119, 180},
+                                                {23, 190, 207}, {140, 86, 75},  {227, 119, 194}, {60, 60, 60},
+                                                {127, 127, 127}, {188, 189, 34}, {44, 160, 44}};
     static const unsigned char black[3] = {0, 0, 0}, grid[3] = {225, 225, 225};
     static const char *xlabel = "depth complexity k (back faces per ray at the centre, log2 scale)";
     canvas c;
@@ -1223,6 +1321,7 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
     text(&c, L + (c.w - L - R) / 2 - text_w(xlabel, 2) / 2, c.h - B + 38, xlabel, 2, black);
     for (m = 0; m < NMETH; ++m) {
         int dash = m == M_FLOOR ? 8 : 0;
+        if (!plotted(m)) continue;
         for (i = 0; i < np; ++i) {
             double x = PX(pts[i]->k), y = PY(pts[i]->ms[m]);
             if (i) line(&c, PX(pts[i - 1]->k), PY(pts[i - 1]->ms[m]), x, y, 3, col[m], dash);
@@ -1233,6 +1332,7 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
     ly = c.h - 58;
     for (m = 0; m < NMETH; ++m) {
         int tw;
+        if (!plotted(m)) continue;
         snprintf(s, sizeof s, "%s", m < NTIER ? g_meth_names[m] : m == M_FLOOR ? "floor (1 geometry + 1 full-screen pass)"
                                                                                  : "depth peeling (exact)");
         tw = text_w(s, 2);
@@ -1285,54 +1385,90 @@ static void loadavg(char *buf, size_t cap)
 
 static const char *pf(int ok) { return ok ? "PASS" : "MISS"; }
 
+/* The issue's target for tier row m in scene r: limit x the reference floor (the occluder floor
+   where the scene has occluders); 0: no target (the rows with speed-ups off). */
+static double target(int m, const result *r, double *ref, const char **refname)
+{
+    fogvol_tier t = g_tiers[m].tier;
+    *ref = r->occluders ? r->ms[M_OCCFLOOR] : r->ms[M_FLOOR];
+    *refname = r->occluders ? "occluder floor" : "floor";
+    if (m >= NDEFAULT) return 0;
+    if (t == FOGVOL_TIER_FLOAT) return r->occluders ? 1.5 : 1.2;
+    return t == FOGVOL_TIER_PS13 ? 2.5 : 2.0;
+}
+
 static void print_results(const result *rs, int n)
 {
     int i, m;
-    out("| scene | size | method | passes | ms/frame | x floor | ours/peel | fog Mpx/s | vs peeling: max / mean | "
-        "targets |\n|---|---|---|---:|---:|---:|---:|---:|---|---|\n");
+    out("| scene | size | method | passes | ms/frame | x floor | x occluder floor | x scissored floor | ours/peel | "
+        "fog Mpx/s | vs peeling: max / mean | targets |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
     for (i = 0; i < n; ++i) {
         const result *r = &rs[i];
         for (m = 0; m < NMETH; ++m) {
-            char tgt[96] = "", diff[64] = "", ratio[32] = "", xf[32] = "";
+            char tgt[128] = "", diff[64] = "", ratio[32] = "";
             double floor_ms = r->ms[M_FLOOR];
             if (m < NTIER) {
                 int is_float = g_tiers[m].tier == FOGVOL_TIER_FLOAT;
-                double lim = is_float ? 1.3 : 2.0;
-                snprintf(tgt, sizeof tgt, "<=%.1fx floor %s", lim, pf(r->ms[m] <= lim * floor_ms));
-                if (r->k == 8)
-                    snprintf(tgt + strlen(tgt), sizeof tgt - strlen(tgt), "; >=5x faster than peeling %s",
-                             pf(r->ms[m] * 5.0 <= r->ms[M_PEEL]));
+                const char *rn;
+                double ref, lim = target(m, r, &ref, &rn);
+                if (lim > 0) snprintf(tgt, sizeof tgt, "<=%.1fx %s %s", lim, rn, pf(r->ms[m] <= lim * ref));
+                if (lim > 0 && r->layers >= 6)
+                    snprintf(tgt + strlen(tgt), sizeof tgt - strlen(tgt), "; peeling >=6x slower %s",
+                             pf(r->ms[M_PEEL] >= 6.0 * r->ms[m]));
                 snprintf(diff, sizeof diff, is_float ? "%.2g / %.2g units" : "%.2f / %.3f LSB", r->dmax[m], r->dmean[m]);
                 if (r->overflow[m]) snprintf(diff + strlen(diff), sizeof diff - strlen(diff), " (%d ovf)", r->overflow[m]);
                 snprintf(ratio, sizeof ratio, "%.3f", r->ms[m] / r->ms[M_PEEL]);
-                snprintf(xf, sizeof xf, "%.2f", r->ms[m] / floor_ms);
             } else if (m == M_PEEL) {
-                snprintf(xf, sizeof xf, "%.2f", r->ms[m] / floor_ms);
                 snprintf(diff, sizeof diff, "(%d layers)", r->layers);
-            } else {
-                snprintf(xf, sizeof xf, "1");
             }
-            out("| %s | %dx%d | %s | %d | %.2f | %s | %s | %.1f | %s | %s |\n", m == 0 ? r->scene : "", r->w, r->h,
-                g_meth_names[m], r->passes[m], r->ms[m], xf, ratio, r->fogged / r->ms[m] / 1e3, diff, tgt);
+            out("| %s | %dx%d | %s | %d | %.2f | %.2f | %.2f | %.2f | %s | %.1f | %s | %s |\n", m == 0 ? r->scene : "",
+                r->w, r->h, g_meth_names[m], r->passes[m], r->ms[m], r->ms[m] / floor_ms, r->ms[m] / r->ms[M_OCCFLOOR],
+                r->ms[m] / r->ms[M_SCFLOOR], ratio, r->fogged / r->ms[m] / 1e3, diff, tgt);
         }
     }
 }
 
+/* name of pass p of method m in a scene with or without occluders that ran np passes: the
+   default tiers skip O in scenes without occluders; RGBA8 tiers run an overflow check pass
+   before the composite while they count overflow */
+static const char *pass_name(int m, int p, int np, int occluders)
+{
+    static const char *const pn[NTIER + 1][6] = {{"O", "B", "F", "resolve", "check", "composite"},
+                                                 {"O", "B", "F", "check", "composite", ""},
+                                                 {"B", "F", "check", "composite", "", ""},
+                                                 {"O", "B-F", "composite", "", "", ""},
+                                                 {"B-F", "composite", "", "", "", ""},
+                                                 {"O", "B-F", "composite", "", "", ""},
+                                                 {"O", "B", "F", "check", "composite", ""},
+                                                 {"geometry", "composite", "", "", "", ""}};
+    const char *names[6];
+    int full = 0, i, k = 0;
+    const char *const *src = pn[m < NTIER ? m : NTIER];
+    while (full < 6 && src[full][0]) ++full;
+    for (i = 0; i < full; ++i) {
+        if (strcmp(src[i], "O") == 0 && m < NDEFAULT && !occluders) continue;
+        names[k++] = src[i];
+    }
+    if (np == k - 1) /* no check pass this frame */
+        for (i = 0; i < k; ++i)
+            if (strcmp(names[i], "check") == 0) {
+                memmove(names + i, names + i + 1, (size_t)(k - i - 1) * sizeof names[0]);
+                --k;
+                break;
+            }
+    return p < k ? names[p] : "?";
+}
+
 static void print_breakdown(const result *rs, int n)
 {
-    static const char *const pn[NMETH - 1][5] = {{"O", "B", "F", "resolve", "composite"},
-                                                 {"O", "B", "F", "composite", ""},
-                                                 {"B", "F", "composite", "", ""},
-                                                 {"O", "B-F", "composite", "", ""},
-                                                 {"B-F", "composite", "", "", ""},
-                                                 {"geometry", "composite", "", "", ""}};
     int i, m, p;
     out("\n### Where the time goes (1280x720; every pass bracketed by glFinish, medians of 7 frames)\n\n"
         "Passes serialised by glFinish, so the frame is slower than in the main table (no overlap of vertex work "
         "on the calling thread with the rasteriser threads). outside = frame - passes: fogvol's CPU work, GL state "
         "save/restore and the calls between passes. CPU (null): the same frame on fogvol's recording null backend "
-        "(the library's own CPU cost).\n\n| scene | method | passes (ms) | sum | frame | outside | CPU (null) |\n"
-        "|---|---|---|---:|---:|---:|---:|\n");
+        "(the library's own CPU cost). The rows with speed-ups off are the configuration before the speed-ups "
+        "(an O pass in every frame, filtered target reads, ramp lookup, full-screen composite).\n\n"
+        "| scene | method | passes (ms) | sum | frame | outside | CPU (null) |\n|---|---|---|---:|---:|---:|---:|\n");
     for (i = 0; i < n; ++i) {
         const result *r = &rs[i];
         if (!r->bd) continue;
@@ -1344,9 +1480,9 @@ static void print_breakdown(const result *rs, int n)
                          r->engine_ms);
                 sum += r->bd_engine_mrt - r->engine_ms;
             }
-            for (p = 0; p < r->bd_np[m] && p < 5; ++p) {
-                snprintf(cells + strlen(cells), sizeof cells - strlen(cells), "%s%s %.2f", p ? ", " : "", pn[m][p],
-                         r->bd_ms[m][p]);
+            for (p = 0; p < r->bd_np[m] && p < 6; ++p) {
+                snprintf(cells + strlen(cells), sizeof cells - strlen(cells), "%s%s %.2f", p ? ", " : "",
+                         pass_name(m, p, r->bd_np[m], r->occluders), r->bd_ms[m][p]);
                 sum += r->bd_ms[m][p];
             }
             if (m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT) {
@@ -1362,35 +1498,72 @@ static void print_breakdown(const result *rs, int n)
     }
 }
 
+/* The worst ratio of tier m to its target's reference over the scenes (occluders: 0 without, 1
+   with, -1 all), and the scene it is in. */
+static double worst_ratio(const result *rs, int n, int m, int occluders, const char **where)
+{
+    double worst = 0, ref;
+    const char *rn;
+    int i;
+    *where = "-";
+    for (i = 0; i < n; ++i) {
+        const result *r = &rs[i];
+        if (occluders >= 0 && (r->occluders > 0) != occluders) continue;
+        target(m, r, &ref, &rn);
+        if (r->ms[m] / ref > worst) {
+            worst = r->ms[m] / ref;
+            *where = r->scene;
+        }
+    }
+    return worst;
+}
+
+/* the smallest peeling / tier time over the default tiers and the scenes with >= 6 layers */
+static double peel_min(const result *rs, int n)
+{
+    double lo = 1e30;
+    int i, m;
+    for (i = 0; i < n; ++i)
+        for (m = 0; m < NDEFAULT && rs[i].layers >= 6; ++m)
+            if (rs[i].ms[M_PEEL] / rs[i].ms[m] < lo) lo = rs[i].ms[M_PEEL] / rs[i].ms[m];
+    return lo < 1e30 ? lo : 0;
+}
+
 static void print_summary(const result *rs, int n)
 {
-    int i, m, s;
-    static const int sizes[2][2] = {{1280, 720}, {640, 360}};
-    out("\n### Targets (worst scene per tier and size)\n\n| tier | size | worst x floor (scene) | target | "
-        "k=8: ours/peel | target |\n|---|---|---|---|---:|---|\n");
-    for (s = 0; s < 2; ++s)
-        for (m = 0; m < NTIER; ++m) {
-            double worst = 0, k8 = -1, lim = g_tiers[m].tier == FOGVOL_TIER_FLOAT ? 1.3 : 2.0;
-            const char *ws = "";
-            int any = 0;
-            for (i = 0; i < n; ++i) {
-                const result *r = &rs[i];
-                if (r->w != sizes[s][0]) continue;
-                any = 1;
-                if (r->ms[m] / r->ms[M_FLOOR] > worst) {
-                    worst = r->ms[m] / r->ms[M_FLOOR];
-                    ws = r->scene;
-                }
-                if (r->k == 8) k8 = r->ms[m] / r->ms[M_PEEL];
-            }
-            if (!any) continue;
-            if (k8 >= 0)
-                out("| %s | %dx%d | %.2f (%s) | <=%.1f %s | %.3f (%.1fx faster) | <=0.2 %s |\n", g_meth_names[m],
-                    sizes[s][0], sizes[s][1], worst, ws, lim, pf(worst <= lim), k8, 1.0 / k8, pf(k8 <= 0.2));
-            else
-                out("| %s | %dx%d | %.2f (%s) | <=%.1f %s | - | - |\n", g_meth_names[m], sizes[s][0], sizes[s][1],
-                    worst, ws, lim, pf(worst <= lim));
-        }
+    static const struct {
+        int m, occ;
+        double lim;
+        const char *what;
+    } rows[] = {{3, 0, 1.2, "FLOAT, scenes without occluders, x floor"},
+                {3, 1, 1.5, "FLOAT, scenes with occluders, x occluder floor"},
+                {4, -1, 1.5, "FLOAT+engine depth (x floor / occluder floor)"},
+                {1, -1, 2.0, "PS20 (x floor / occluder floor)"},
+                {2, -1, 2.0, "MRT (x floor / occluder floor)"},
+                {0, -1, 2.5, "PS13 (x floor / occluder floor)"},
+                {5, 0, 1.2, "FLOAT, speed-ups off, without occluders (for comparison)"},
+                {6, -1, 2.0, "PS20, speed-ups off (for comparison)"}};
+    int j;
+    double pm = peel_min(rs, n);
+    out("\n### Targets (worst over scenes and sizes)\n\n| configuration | worst | scene | target |\n|---|---:|---|---|\n");
+    for (j = 0; j < (int)(sizeof rows / sizeof rows[0]); ++j) {
+        const char *w;
+        double x = worst_ratio(rs, n, rows[j].m, rows[j].occ, &w);
+        out("| %s | %.2fx | %s | <=%.1fx %s |\n", rows[j].what, x, w, rows[j].lim,
+            rows[j].m < NDEFAULT && rows[j].m != 4 ? pf(x <= rows[j].lim) : "(info)");
+    }
+    out("| depth peeling / fogvol, smallest over the default tiers at >= 6 layers | %.2fx | | >=6x %s |\n", pm,
+        pf(pm >= 6.0));
+}
+
+/* the last line of the output: the figures to compare between runs */
+static void print_summary_line(const result *rs, int n)
+{
+    const char *w;
+    out("\nsummary: FLOAT worst %.2fx floor, FLOAT occluders %.2fx occluder floor, PS20 worst %.2fx, MRT worst %.2fx, "
+        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, analytic n/a\n",
+        worst_ratio(rs, n, 3, 0, &w), worst_ratio(rs, n, 3, 1, &w), worst_ratio(rs, n, 1, -1, &w),
+        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n));
 }
 
 /* ---- 16 coloured volumes: per-ramp groups against one pass (FOGVOL_VARIANT_COLORS) ------ */
@@ -1584,7 +1757,14 @@ int main(int argc, char **argv)
         "time / depth-peeling time. Mpx/s: pixels with nonzero thickness (FLOAT debug read-back) per second. "
         "vs peeling: |fogvol debug thickness - peeled thickness| over pixels where both are nonzero and the 3x3 "
         "neighbourhood has one layer count (no silhouettes); LSB = (far - near) / 4096 for the RGBA8 tiers, world "
-        "units for FLOAT.\n\n",
+        "units for FLOAT. References: floor = the volume triangles once + one full-screen composite; occluder floor = "
+        "the same with the occluders drawn once depth-only first and the volume triangles depth-tested against them "
+        "(the least a method can do that does not read the engine's depth); scissored floor = the floor with the "
+        "composite scissored to the volumes' screen rectangle. Depth peeling: the timed frames draw the layer count "
+        "the debug frame found, without an occlusion query per layer. Targets: FLOAT <= 1.2x floor (<= 1.5x the "
+        "occluder floor in scenes with occluders), PS20 and MRT <= 2.0x, PS13 <= 2.5x (against the occluder floor "
+        "in scenes with occluders), depth peeling >= 6x slower at >= 6 layers. The rows \"speed-ups off\" run with "
+        "fogvol_context_desc.disable_speedups = every FOGVOL_SPEEDUP_* bit (the configuration before them).\n\n",
         quick ? 3 : 15, quick ? 1 : 3);
     print_results(g_res, g_nres);
     print_summary(g_res, g_nres);
@@ -1606,6 +1786,7 @@ int main(int argc, char **argv)
     out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
         "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
         (now_ms() - t_start) / 1e3, load0, load1, ncpu);
+    print_summary_line(g_res, g_nres);
     if (g_md) {
         fclose(g_md);
         plot("bench/plot.png", g_res, g_nres, 1280, 720);

@@ -1,0 +1,190 @@
+/* test_speedups.c - the speed-ups fogvol turns on by default (FOGVOL_SPEEDUP_*):
+   SKIP_OPAQUE, TEXEL_FETCH and SCISSOR give the same pixels as with them off, frame after frame
+   while occluders come and go (O kept from an earlier frame must be the far plane, and redrawn
+   when occluders return); SKIP_OPAQUE draws one pass less from the second frame on;
+   EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
+   differs from the ramp by at most 1/255 per channel. Accuracy against ray-cast ground truth
+   with the defaults is tested in test_render.c, test_tiers.c and test_engine_depth.c. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#define FOGVOL_IMPLEMENTATION
+#include "fogvol.h"
+#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#include "tests/gl_util.h"
+#include <GL/glext.h>
+#include "tests/raycast.h"
+#include "tests/shapes.h"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#include <sys/stat.h>
+
+#include "tests/scenes.h"
+
+#define NFRAMES 4
+/* frame f draws the occluders: frames 0, 1 and 3 without, frame 2 with */
+static int with_occluders(int f) { return f == 2; }
+
+static void logger(void *u, fogvol_log_level l, const char *m)
+{
+    (void)u;
+    if (l <= FOGVOL_LOG_WARNING) print_message("  [fogvol %s] %s\n", l == 0 ? "error" : "warning", m);
+}
+
+typedef struct run_out {
+    unsigned char px[NFRAMES][W * H * 4];
+    int passes[NFRAMES];
+} run_out;
+
+/* NFRAMES frames of scene s on tier t with these speed-ups off, into out */
+static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
+{
+    fogvol_context_desc cd;
+    fogvol_ramp_desc rd;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    int f, i;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.tier = t;
+    cd.disable_speedups = off;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.9f;
+    rd.color[1] = 0.6f;
+    rd.color[2] = 0.3f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    for (f = 0; f < NFRAMES; ++f) {
+        fogvol_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        rc_camera_matrices(&s->cam, fd.view, fd.projection);
+        fd.znear = (float)s->cam.znear;
+        fd.zfar = (float)s->cam.zfar;
+        fd.viewport[2] = W;
+        fd.viewport[3] = H;
+        glClearColor(0.2f, 0.5f, 0.8f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        add_scene(fv, s, meshes, ramp, with_occluders(f));
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        glFinish();
+        memcpy(out->px[f], g->pixels, sizeof out->px[f]);
+        out->passes[f] = st.passes;
+    }
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+}
+
+static int max_diff(const unsigned char *a, const unsigned char *b, int *count)
+{
+    int i, m = 0;
+    *count = 0;
+    for (i = 0; i < W * H * 4; ++i) {
+        int d = abs((int)a[i] - (int)b[i]);
+        if (d > m) m = d;
+        *count += d != 0;
+    }
+    return m;
+}
+
+static void write_png(const char *name, const unsigned char *px)
+{
+    char path[128];
+    mkdir("build", 0755);
+    snprintf(path, sizeof path, "build/speedups_%s.png", name);
+    stbi_flip_vertically_on_write(1);
+    assert_true(stbi_write_png(path, W, H, 4, px, W * 4) != 0);
+}
+
+/* FLOAT, frame with occluders: every interior pixel against the ray-cast thickness through the
+   extinction law, mix(background, fog colour, 1 - exp(-density t)), in bytes; returns the max error */
+static int check_ground_truth(const tscene *s, const unsigned char *px)
+{
+    static double gt[W * H], tmax;
+    static int pairs[W * H], maxf;
+    static unsigned char interior[W * H], covered[W * H];
+    static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
+    int i, c, worst = 0, n = 0;
+    ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax);
+    for (i = 0; i < W * H; ++i) {
+        double a = 1.0 - exp(-(double)s->density * gt[i]);
+        if (!interior[i]) continue;
+        ++n;
+        for (c = 0; c < 3; ++c) {
+            double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
+            int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[4 * i + c]);
+            if (d > worst) worst = d;
+        }
+    }
+    assert_true(n > W * H / 4);
+    return worst;
+}
+
+static const fogvol_tier g_tiers[] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20, FOGVOL_TIER_PS13};
+static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
+#define ALL_OFF \
+    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR)
+
+static void test_same_pixels_and_exp(void **state)
+{
+    static run_out def, noexp, off;
+    const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
+    glu_ctx g;
+    int ti, si, f, n;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (ti = 0; ti < 3; ++ti)
+        for (si = 0; si < 2; ++si) {
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            int exp_max = 0, exp_n = 0, occluded = 0;
+            run_frames(s, g_tiers[ti], 0, &g, &def);
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_EXP_COMPOSITE, &g, &noexp);
+            run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
+            for (f = 0; f < NFRAMES; ++f) {
+                int m;
+                /* SKIP_OPAQUE, TEXEL_FETCH and SCISSOR: the same bytes as with every speed-up off */
+                assert_int_equal(max_diff(noexp.px[f], off.px[f], &n), 0);
+                m = max_diff(def.px[f], noexp.px[f], &n);
+                if (m > exp_max) exp_max = m;
+                exp_n += n;
+                /* one O pass drawn with speed-ups off in every frame; on: only in the first frame
+                   and where occluders come (or leave: O must become the far plane again) */
+                assert_int_equal(def.passes[f], off.passes[f] - (f == 1 ? 1 : 0));
+            }
+            write_png(g_tier_names[ti], def.px[2]);
+            if (g_tiers[ti] == FOGVOL_TIER_FLOAT) {
+                int e = check_ground_truth(s, def.px[2]);
+                print_message("# FLOAT %-22s with occluders: composite vs ray-cast extinction max %d/255\n", names[si], e);
+                assert_true(e <= 2);
+            }
+            /* the occluders change the picture, and frame 3 (no occluders) is frame 0 again */
+            occluded = max_diff(def.px[2], def.px[0], &n);
+            assert_true(occluded > 8);
+            assert_int_equal(max_diff(def.px[3], def.px[0], &n), 0);
+            print_message("# %-5s %-22s exp() composite vs 8-bit ramp: max %d/255 over %d channel values of %d "
+                          "frames; other speed-ups: identical bytes; passes %d %d %d %d (off: %d %d %d %d)\n",
+                          g_tier_names[ti], names[si], exp_max, exp_n, NFRAMES, def.passes[0], def.passes[1],
+                          def.passes[2], def.passes[3], off.passes[0], off.passes[1], off.passes[2], off.passes[3]);
+            assert_true(exp_max <= 1);
+        }
+    glu_destroy(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp)};
+    int r;
+    build_scenes();
+    r = cmocka_run_group_tests(tests, NULL, NULL);
+    free_scenes();
+    return r;
+}
