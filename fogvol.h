@@ -253,13 +253,13 @@ typedef struct fogvol_encoding {
 #define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
 
 /* Fill *out for L = bits (1..8). */
-FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits);
+FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out);
 /* Most precise encoding that sums at least max_faces faces (1..128).
    max_faces < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 128: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces);
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out);
 /* Encoding with the most faces that still gives at least precision_bits (1..24).
    precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits);
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out);
 /* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
    writes min(count, capacity) rows when rows != NULL. */
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
@@ -293,7 +293,7 @@ FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double 
                                              unsigned char out_rgba[4]);
 /* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
    Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
-FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4]);
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
 /* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
    tells whether any channel saturated. */
 FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
@@ -1743,7 +1743,7 @@ static int fogvol__finite_n(const float *v, int n)
 
 /* ---- encoding ---- */
 
-FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits)
+FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out)
 {
     if (!out || bits < 1 || bits > 8) return FOGVOL_ERROR_INVALID_ARGUMENT;
     out->bits = bits;
@@ -1757,37 +1757,37 @@ FOGVOL_API fogvol_result fogvol_encoding_init(fogvol_encoding *out, int bits)
     return FOGVOL_SUCCESS;
 }
 
-FOGVOL_API fogvol_result fogvol_encoding_from_faces(fogvol_encoding *out, int max_faces)
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out)
 {
     int bits;
     if (!out || max_faces < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (max_faces > 128) return FOGVOL_ERROR_UNSUPPORTED;
     for (bits = 8; bits >= 1; --bits)
-        if ((1 << (8 - bits)) >= max_faces) return fogvol_encoding_init(out, bits);
+        if ((1 << (8 - bits)) >= max_faces) return fogvol_encoding_init(bits, out);
     return FOGVOL_ERROR_UNSUPPORTED;
 }
 
-FOGVOL_API fogvol_result fogvol_encoding_from_precision(fogvol_encoding *out, int precision_bits)
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out)
 {
     int bits;
     if (!out || precision_bits < 1) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (precision_bits > 24) return FOGVOL_ERROR_UNSUPPORTED;
     for (bits = 1; bits <= 8; ++bits)
-        if (3 * bits >= precision_bits) return fogvol_encoding_init(out, bits);
+        if (3 * bits >= precision_bits) return fogvol_encoding_init(bits, out);
     return FOGVOL_ERROR_UNSUPPORTED;
 }
 
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity)
 {
     int i;
-    for (i = 0; rows && i < 8 && i < capacity; ++i) fogvol_encoding_init(&rows[i], i + 1);
+    for (i = 0; rows && i < 8 && i < capacity; ++i) fogvol_encoding_init(i + 1, &rows[i]);
     return 8;
 }
 
 static int fogvol__enc_ok(const fogvol_encoding *e)
 {
     fogvol_encoding ref;
-    if (!e || fogvol_encoding_init(&ref, e->bits) != FOGVOL_SUCCESS) return 0;
+    if (!e || fogvol_encoding_init(e->bits, &ref) != FOGVOL_SUCCESS) return 0;
     return ref.levels == e->levels && ref.dither_steps == e->dither_steps;
 }
 
@@ -1872,7 +1872,7 @@ FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double 
     return FOGVOL_SUCCESS;
 }
 
-FOGVOL_API int fogvol_sum_rgba8(unsigned char acc[4], const unsigned char value[4])
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4])
 {
     int i, sat = 0;
     for (i = 0; i < 4; ++i) {
@@ -1892,7 +1892,7 @@ FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int cou
     int i, sat = 0;
     if (!out_rgba || count < 0 || (count > 0 && !values)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out_rgba, 0, 4);
-    for (i = 0; i < count; ++i) sat |= fogvol_sum_rgba8(out_rgba, values + 4 * i);
+    for (i = 0; i < count; ++i) sat |= fogvol_sum_rgba8(values + 4 * i, out_rgba);
     if (saturated) *saturated = sat;
     return FOGVOL_SUCCESS;
 }
@@ -5790,7 +5790,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->speedups_off = desc->disable_speedups;
     ctx->variants = desc->variants;
     ctx->msaa = desc->msaa;
-    fogvol_encoding_init(&ctx->enc, bits);
+    fogvol_encoding_init(bits, &ctx->enc);
     r = fogvol__attach_backend(ctx, desc);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&desc->allocator, ctx);
@@ -7214,7 +7214,7 @@ static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
     cur[0] = &ctx->tex_rg;
     cur[1] = &ctx->tex_blue;
     cur[2] = &ctx->tex_dither;
-    fogvol_encoding_init(&ctx->enc, old.bits - 1);
+    fogvol_encoding_init(old.bits - 1, &ctx->enc);
     for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
         if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
     if (r != FOGVOL_SUCCESS) {

@@ -1150,7 +1150,7 @@ static void cpu_measure(cpu_figs *c, int quick)
     fogvol_mesh_report rep;
     double v[7];
     int i, reps = quick ? 3 : 7;
-    fogvol_encoding_init(&e, FOGVOL_DEFAULT_BITS);
+    fogvol_encoding_init(FOGVOL_DEFAULT_BITS, &e);
     c->rg_us = time_ramp(0, &e, buf, sizeof buf, 200, &info);
     c->rg_w = info.width;
     c->rg_h = info.height;

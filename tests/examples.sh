@@ -131,7 +131,7 @@ else
 int main(void)
 {
     fogvol_encoding e;
-    if (fogvol_encoding_init(&e, FOGVOL_DEFAULT_BITS) != FOGVOL_SUCCESS) return 1;
+    if (fogvol_encoding_init(FOGVOL_DEFAULT_BITS, &e) != FOGVOL_SUCCESS) return 1;
     printf("fogvol %s: %d-bit encoding, %d faces\n", FOGVOL_VERSION_STRING, e.precision_bits, e.max_faces);
     return e.max_faces == 16 ? 0 : 1;
 }

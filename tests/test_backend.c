@@ -858,7 +858,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     }
 
     /* uniforms */
-    assert_int_equal(fogvol_encoding_init(&e, 4), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_init(4, &e), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_compute_constants(&e, A_NEAR, A_FAR, 0.0f, &k), FOGVOL_SUCCESS);
     for (i = 0; i < 9; ++i) check_common_uniforms(&r->nb.passes[i], &k, 1, "pass uniforms");
     for (i = 5; i < 9; i += 3) {

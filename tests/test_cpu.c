@@ -92,7 +92,7 @@ static fogvol_encoding make_enc(int bits)
 {
     fogvol_encoding e;
     memset(&e, 0, sizeof e);
-    assert_int_equal(fogvol_encoding_init(&e, bits), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_init(bits, &e), FOGVOL_SUCCESS);
     return e;
 }
 
@@ -185,61 +185,61 @@ static void test_encoding_table(void **state)
     }
 
     /* from_faces: the most precise L with 2^(8-L) >= faces */
-    assert_int_equal(fogvol_encoding_from_faces(&e, 16), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(16, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 4);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 17), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(17, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 3);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 8), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(8, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 5);
     assert_int_equal(e.max_faces, 8);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 9), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(9, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 4);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 1), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(1, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 8);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 2), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(2, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 7);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 128), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_faces(128, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 1);
     /* every count 1..128 against a brute-force search written here */
     for (f = 1; f <= 128; ++f) {
         int want = 0;
         for (L = 1; L <= 8; ++L)
             if ((256 >> L) >= f) want = L; /* keep the largest L that still fits */
-        assert_int_equal(fogvol_encoding_from_faces(&e, f), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_encoding_from_faces(f, &e), FOGVOL_SUCCESS);
         assert_int_equal(e.bits, want);
         assert_true(e.max_faces >= f);
     }
     /* Rejections. Below the documented range 1..128: INVALID_ARGUMENT; above it
        (a count no encoding can sum): UNSUPPORTED. */
-    assert_int_equal(fogvol_encoding_from_faces(&e, 0), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_from_faces(&e, -3), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 129), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(fogvol_encoding_from_faces(&e, 100000), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(fogvol_encoding_from_faces(NULL, 16), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_faces(0, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_faces(-3, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_faces(129, &e), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_encoding_from_faces(100000, &e), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_encoding_from_faces(16, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
 
     /* from_precision: the fewest bits (most faces) with 3L >= precision */
-    assert_int_equal(fogvol_encoding_from_precision(&e, 12), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_precision(12, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 4);
-    assert_int_equal(fogvol_encoding_from_precision(&e, 13), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_precision(13, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 5);
-    assert_int_equal(fogvol_encoding_from_precision(&e, 24), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_precision(24, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 8);
-    assert_int_equal(fogvol_encoding_from_precision(&e, 1), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_precision(1, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 1);
-    assert_int_equal(fogvol_encoding_from_precision(&e, 4), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_encoding_from_precision(4, &e), FOGVOL_SUCCESS);
     assert_int_equal(e.bits, 2);
     for (p = 1; p <= 24; ++p) {
-        assert_int_equal(fogvol_encoding_from_precision(&e, p), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_encoding_from_precision(p, &e), FOGVOL_SUCCESS);
         assert_int_equal(e.bits, (p + 2) / 3); /* ceil(p/3) */
     }
-    assert_int_equal(fogvol_encoding_from_precision(&e, 0), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_from_precision(&e, -12), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_from_precision(&e, 25), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(fogvol_encoding_from_precision(NULL, 12), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_precision(0, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_precision(-12, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_from_precision(25, &e), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_encoding_from_precision(12, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
 
-    assert_int_equal(fogvol_encoding_init(&e, 0), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_init(&e, 9), FOGVOL_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(fogvol_encoding_init(NULL, 4), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_init(0, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_init(9, &e), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(fogvol_encoding_init(4, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -467,13 +467,13 @@ static void test_sums(void **state)
     {
         unsigned char acc[4] = {200, 10, 0, 255};
         static const unsigned char v1[4] = {100, 20, 0, 0}, v0[4] = {1, 1, 1, 0};
-        assert_int_equal(fogvol_sum_rgba8(acc, v1), 1);
+        assert_int_equal(fogvol_sum_rgba8(v1, acc), 1);
         assert_int_equal(acc[0], 255);
         assert_int_equal(acc[1], 30);
         assert_int_equal(acc[2], 0);
         assert_int_equal(acc[3], 255);
         acc[0] = 10;
-        assert_int_equal(fogvol_sum_rgba8(acc, v0), 0); /* 255 + 0 in alpha: not saturated */
+        assert_int_equal(fogvol_sum_rgba8(v0, acc), 0); /* 255 + 0 in alpha: not saturated */
         assert_int_equal(acc[0], 11);
     }
 

@@ -498,7 +498,7 @@ static void test_single_target_limit(void **state)
     double err;
     fogvol_encoding e;
     (void)state;
-    fogvol_encoding_init(&e, 4);
+    fogvol_encoding_init(4, &e);
     assert_int_equal(e.max_faces_single, e.max_faces / 2);
     shells(8, FOGVOL_VARIANT_SINGLE_TARGET, &r, &ov, &err);
     print_message("  single target, 8 shells: %s, %d saturated pixels, centre error %.2f LSB\n",

@@ -4,5 +4,5 @@
 int main(void)
 {
     fogvol_encoding e;
-    return fogvol_encoding_init(&e, 5) == FOGVOL_SUCCESS && e.max_faces == 8 ? 0 : 1;
+    return fogvol_encoding_init(5, &e) == FOGVOL_SUCCESS && e.max_faces == 8 ? 0 : 1;
 }
