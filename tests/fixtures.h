@@ -3,7 +3,8 @@
  * looking through a test camera.
  * Include after <cmocka.h>, fogvol.h and tests/gl_util.h. A failure
  * fails the running cmocka test (fail_msg / assert_*). The GL helpers are there when
- * the program has the GL 3 prototypes (GL_GLEXT_PROTOTYPES and <GL/glext.h>). */
+ * the program has the GL 3 prototypes (GL_GLEXT_PROTOTYPES and <GL/glext.h>); the shader
+ * helpers also with the GLES headers. */
 #ifndef FOGVOL_TESTS_FIXTURES_H
 #define FOGVOL_TESTS_FIXTURES_H
 
@@ -11,7 +12,7 @@
 #include "tests/raycast.h"
 #include "tests/shapes.h"
 
-#if defined(GL_GLEXT_PROTOTYPES) && defined(GL_GLEXT_VERSION)
+#if (defined(GL_GLEXT_PROTOTYPES) && defined(GL_GLEXT_VERSION)) || defined(GL_ES_VERSION_2_0)
 /* one shader stage from n strings; the test fails with the info log when it does not compile */
 static inline GLuint fx_compile(GLenum type, const char *const *src, int n)
 {
@@ -41,6 +42,9 @@ static inline GLuint fx_program(const char *const *vs, int nvs, const char *cons
     assert_true(ok);
     return prog;
 }
+#endif
+
+#if defined(GL_GLEXT_PROTOTYPES) && defined(GL_GLEXT_VERSION)
 
 /* an RGBA8 colour texture and a depth texture (depth_format, read as depth_type), both nearest-
    filtered, attached to a new framebuffer, which is left bound; the test fails when it is incomplete */

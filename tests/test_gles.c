@@ -37,6 +37,7 @@
 #include "tests/raycast.h"
 #include "tests/shapes.h"
 #include "tests/scenes.h"
+#include "tests/fixtures.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -55,42 +56,6 @@ static const es_ctx g_ctx[] = {
     {"ES 2.0", "es20", "2.0", 2, 0}, {"ES 3.x", "es3x", NULL, 3, 0}, {"ES 3.0", "es30", "3.0", 3, 1}};
 #define NCTX 3
 
-typedef struct combo {
-    fogvol_tier tier;
-    unsigned variants;
-    const char *name;
-    int bits; /* 0: the scene's */
-} combo;
-
-static const combo g_combos[] = {
-    {FOGVOL_TIER_PS13, 0, "PS13", 0},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 0},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp", 0},
-    {FOGVOL_TIER_PS20, 0, "PS20", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, "PS20+enginedepth", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, "PS20+wide(L=3)", 3},
-    {FOGVOL_TIER_MRT, 0, "MRT", 0},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu", 0},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single", 0},
-    {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp", 0},
-};
-#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
-
-static const char *const g_scene_names[] = {"sphere",
-                                            "two_spheres",
-                                            "plane_cuts_sphere",
-                                            "negative_sphere_in_box",
-                                            "negative_pokes_out",
-                                            "layers_opaque_between",
-                                            "camera_inside_sphere"};
-#define NSCENE ((int)(sizeof g_scene_names / sizeof g_scene_names[0]))
 
 typedef struct gt_cache {
     double *gt;
@@ -227,21 +192,6 @@ typedef struct engine {
     GLint u_mvp, u_mv, u_mrt;
 } engine;
 
-static GLuint compile(GLenum type, const char *const *src, int n)
-{
-    GLint ok = 0;
-    GLuint sh = glCreateShader(type);
-    glShaderSource(sh, n, src, NULL);
-    glCompileShader(sh);
-    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[1024];
-        glGetShaderInfoLog(sh, sizeof log, NULL, log);
-        fail_msg("engine shader: %s", log);
-    }
-    return sh;
-}
-
 static void engine_init(engine *e, int es3)
 {
     static const char *vs2 = "#version 100\nattribute vec3 p;\nuniform mat4 mvp;\n"
@@ -258,8 +208,8 @@ static void engine_init(engine *e, int es3)
     fs3[1] = fogvol_mrt_snippet();
     fs3[2] = "in float view_depth;\nlayout(location = 0) out vec4 color;\nlayout(location = 1) out vec4 fogvol_o;\n"
              "void main() { color = vec4(0.35, 0.3, 0.25, 1.0); fogvol_o = fogvol_encode_view_depth(view_depth); }\n";
-    vs = compile(GL_VERTEX_SHADER, es3 ? &vs3 : &vs2, 1);
-    fs = es3 ? compile(GL_FRAGMENT_SHADER, fs3, 3) : compile(GL_FRAGMENT_SHADER, &fs2, 1);
+    vs = fx_compile(GL_VERTEX_SHADER, es3 ? &vs3 : &vs2, 1);
+    fs = es3 ? fx_compile(GL_FRAGMENT_SHADER, fs3, 3) : fx_compile(GL_FRAGMENT_SHADER, &fs2, 1);
     e->prog = glCreateProgram();
     glAttachShader(e->prog, vs);
     glAttachShader(e->prog, fs);

@@ -31,41 +31,6 @@
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
 
-typedef struct combo {
-    fogvol_tier tier;
-    unsigned variants;
-    const char *name;
-    int bits; /* 0: the scene's */
-} combo;
-
-static const combo g_combos[] = {
-    {FOGVOL_TIER_PS13, 0, "PS13", 0},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 0},
-    {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp", 0},
-    {FOGVOL_TIER_PS20, 0, "PS20", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU, "PS20+alu", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_SINGLE_TARGET, "PS20+alu+single", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp", 0},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, "PS20+wide (L=3, 18 bits)", 3},
-    {FOGVOL_TIER_MRT, 0, "MRT", 0},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_ALU, "MRT+alu", 0},
-    {FOGVOL_TIER_MRT, FOGVOL_VARIANT_SINGLE_TARGET, "MRT+single", 0},
-    {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp", 0},
-};
-#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
-
-static const char *const g_scene_names[] = {"sphere",
-                                            "two_spheres",
-                                            "plane_cuts_sphere",
-                                            "negative_sphere_in_box",
-                                            "negative_pokes_out",
-                                            "layers_opaque_between",
-                                            "camera_inside_sphere"};
-#define NSCENE ((int)(sizeof g_scene_names / sizeof g_scene_names[0]))
 
 /* dialects and the context that compiles them: desktop 110..130 in the
    compatibility context, the rest in the core context */
