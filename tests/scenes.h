@@ -299,14 +299,14 @@ static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char 
 
 /* Every tier and variant combination the GL tests render (test_tiers on desktop dialects,
    test_gles on OpenGL ES), and the scenes they compare against the ray cast. */
-typedef struct combo {
+typedef struct tier_combo {
     fogvol_tier tier;
     unsigned variants;
     const char *name;
     int bits; /* 0: the scene's */
-} combo;
+} tier_combo;
 
-static const combo g_combos[] = {
+static const tier_combo g_tier_combos[] = {
     {FOGVOL_TIER_PS13, 0, "PS13", 0},
     {FOGVOL_TIER_PS13, FOGVOL_VARIANT_COUNT, "PS13+count", 0},
     {FOGVOL_TIER_PS13, FOGVOL_VARIANT_NEAR_CLAMP, "PS13+nearclamp", 0},
@@ -325,7 +325,7 @@ static const combo g_combos[] = {
     {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
     {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_NEAR_CLAMP, "FLOAT+nearclamp", 0},
 };
-#define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
+#define NTIER_COMBO ((int)(sizeof g_tier_combos / sizeof g_tier_combos[0]))
 
 static const char *const g_scene_names[] = {"sphere",
                                             "two_spheres",

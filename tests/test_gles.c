@@ -67,8 +67,8 @@ typedef struct gt_cache {
 
 static gt_cache g_gt[NSCENE];
 /* measured: max error per context, combo, scene (LSB per pair of faces, or units of 3e-5 range on FLOAT) */
-static double g_err[NCTX][NCOMBO][NSCENE], g_mean[NCTX][NCOMBO], g_comp[NCTX][NCOMBO];
-static int g_ran[NCTX][NCOMBO];
+static double g_err[NCTX][NTIER_COMBO][NSCENE], g_mean[NCTX][NTIER_COMBO], g_comp[NCTX][NTIER_COMBO];
+static int g_ran[NCTX][NTIER_COMBO];
 static char g_version[NCTX][2][96]; /* GL_VERSION, GL_SHADING_LANGUAGE_VERSION */
 static fogvol_tier g_auto_tier[NCTX];
 static fogvol_dialect g_auto_dialect[NCTX];
@@ -359,7 +359,7 @@ static void write_png(const char *ctx_file, const char *what, const unsigned cha
     stbi_write_png(path, W, H, 4, px, W * 4);
 }
 
-static fogvol_context *make_context(const combo *cb, int bits)
+static fogvol_context *make_context(const tier_combo *cb, int bits)
 {
     fogvol_context_desc cd;
     fogvol_context *fv = NULL;
@@ -417,7 +417,7 @@ typedef struct scene_out {
 } scene_out;
 
 /* Thickness against the ray cast and the composite against mix(engine, fog, 1 - exp(-density t)). */
-static void compare(const combo *cb, const tscene *s, const gt_cache *t, const float *thick,
+static void compare(const tier_combo *cb, const tscene *s, const gt_cache *t, const float *thick,
                     const unsigned char *base, const unsigned char *fogged, scene_out *o)
 {
     double range = s->cam.zfar - s->cam.znear;
@@ -458,7 +458,7 @@ typedef struct tcase {
 static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, unsigned char *base,
                       unsigned char *fogged, scene_out *o)
 {
-    const combo *cb = &g_combos[tc->combo];
+    const tier_combo *cb = &g_tier_combos[tc->combo];
     const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
     fogvol_context *fv = make_context(cb, cb->bits ? cb->bits : s->bits);
     fogvol_mesh *meshes[MAX_OBJ];
@@ -502,7 +502,7 @@ static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, uns
 static void test_combo(void **state)
 {
     const tcase *tc = (const tcase *)*state;
-    const combo *cb = &g_combos[tc->combo];
+    const tier_combo *cb = &g_tier_combos[tc->combo];
     unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged = (unsigned char *)malloc((size_t)W * H * 4);
     double t0 = now(), sum_pp = 0, comp = 0;
     int sc, n = 0, bad = 0;
@@ -543,7 +543,7 @@ static void test_overflow(void **state)
 {
     int ci = (int)(intptr_t)*state, i, sc = scene_index("overflow_shells"), wrong = 0, unmarked = 0, magenta = 0;
     const tscene *s = &g_scenes[sc];
-    static const combo cb = {FOGVOL_TIER_PS20, 0, "PS20", 0};
+    static const tier_combo cb = {FOGVOL_TIER_PS20, 0, "PS20", 0};
     double *gt = (double *)calloc((size_t)W * H, sizeof(double)), tmax, lsb = (s->cam.zfar - s->cam.znear) / 4096.0;
     int *pairs = (int *)calloc((size_t)W * H, sizeof(int)), max_faces, frame;
     unsigned char *interior = (unsigned char *)calloc((size_t)W * H, 1), *covered = (unsigned char *)calloc((size_t)W * H, 1);
@@ -635,9 +635,9 @@ static int print_table(void **state)
         print_message(" mean/pair | composite |\n|---|");
         for (sc = 0; sc < NSCENE + 2; ++sc) print_message("---|");
         print_message("\n");
-        for (k = 0; k < NCOMBO; ++k) {
+        for (k = 0; k < NTIER_COMBO; ++k) {
             if (!g_ran[ci][k]) continue;
-            print_message("| %s (%s) |", g_combos[k].name, g_combos[k].tier == FOGVOL_TIER_FLOAT ? "3e-5 range" : "LSB/pair");
+            print_message("| %s (%s) |", g_tier_combos[k].name, g_tier_combos[k].tier == FOGVOL_TIER_FLOAT ? "3e-5 range" : "LSB/pair");
             for (sc = 0; sc < NSCENE; ++sc) print_message(" %.3f |", g_err[ci][k][sc]);
             print_message(" %.3f | %.1f/255 |\n", g_mean[ci][k], g_comp[ci][k]);
         }
@@ -659,9 +659,9 @@ static int print_table(void **state)
    context ci, the parent waits for it. */
 static int run_context(int ci)
 {
-    static tcase cases[NCOMBO];
-    static struct CMUnitTest tests[NCOMBO + 2];
-    static char names[NCOMBO + 2][64], group[32];
+    static tcase cases[NTIER_COMBO];
+    static struct CMUnitTest tests[NTIER_COMBO + 2];
+    static char names[NTIER_COMBO + 2][64], group[32];
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
@@ -670,12 +670,12 @@ static int run_context(int ci)
     tests[n].test_func = test_auto_choice;
     tests[n].initial_state = (void *)(intptr_t)ci;
     ++n;
-    for (k = 0; k < NCOMBO; ++k) {
-        if (fogvol_combination_supported(g_combos[k].tier, g_combos[k].variants, d) != FOGVOL_SUCCESS) continue;
-        if (g_ctx[ci].plain_tiers_only && g_combos[k].variants) continue;
+    for (k = 0; k < NTIER_COMBO; ++k) {
+        if (fogvol_combination_supported(g_tier_combos[k].tier, g_tier_combos[k].variants, d) != FOGVOL_SUCCESS) continue;
+        if (g_ctx[ci].plain_tiers_only && g_tier_combos[k].variants) continue;
         cases[nc].ctx = ci;
         cases[nc].combo = k;
-        snprintf(names[n], sizeof names[n], "%s_%s", g_ctx[ci].file, g_combos[k].name);
+        snprintf(names[n], sizeof names[n], "%s_%s", g_ctx[ci].file, g_tier_combos[k].name);
         tests[n].name = names[n];
         tests[n].test_func = test_combo;
         tests[n].initial_state = &cases[nc++];

@@ -47,8 +47,8 @@ typedef struct gt_cache {
 } gt_cache;
 
 static gt_cache g_gt[NSCENE];
-static double g_max[NCOMBO][NDIALECT], g_mean[NCOMBO][NDIALECT], g_comp[NCOMBO][NDIALECT];
-static int g_ran[NCOMBO][NDIALECT];
+static double g_max[NTIER_COMBO][NDIALECT], g_mean[NTIER_COMBO][NDIALECT], g_comp[NTIER_COMBO][NDIALECT];
+static int g_ran[NTIER_COMBO][NDIALECT];
 
 static void logger(void *u, fogvol_log_level l, const char *m)
 {
@@ -144,14 +144,14 @@ static int first_dialect(int ci)
 {
     int di;
     for (di = 0; di < NDIALECT; ++di)
-        if (fogvol_combination_supported(g_combos[ci].tier, g_combos[ci].variants, g_dialects[di]) == 0) return di;
+        if (fogvol_combination_supported(g_tier_combos[ci].tier, g_tier_combos[ci].variants, g_dialects[di]) == 0) return di;
     return -1;
 }
 
 /* ---- one tier/variant/dialect on every scene ------------------------------ */
 static void run(int ci, int di)
 {
-    const combo *c = &g_combos[ci];
+    const tier_combo *c = &g_tier_combos[ci];
     fogvol_dialect dialect = g_dialects[di];
     int core = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_130;
     int sc, i, j, bad = 0, n = 0;
@@ -520,8 +520,8 @@ static int print_table(void **state)
     print_message("\n|---|");
     for (di = 0; di < NDIALECT; ++di) print_message("---|");
     print_message("\n");
-    for (ci = 0; ci < NCOMBO; ++ci) {
-        print_message("| %s (%s) | ", g_combos[ci].name, g_combos[ci].tier == FOGVOL_TIER_FLOAT ? "3e-5 range" : "LSB");
+    for (ci = 0; ci < NTIER_COMBO; ++ci) {
+        print_message("| %s (%s) | ", g_tier_combos[ci].name, g_tier_combos[ci].tier == FOGVOL_TIER_FLOAT ? "3e-5 range" : "LSB");
         for (di = 0; di < NDIALECT; ++di) {
             if (g_ran[ci][di]) print_message("%.2f / %.3f / %.1f | ", g_max[ci][di], g_mean[ci][di], g_comp[ci][di]);
             else print_message("n/a | ");
@@ -559,9 +559,9 @@ static int setup_all(void **state)
 
 int main(void)
 {
-    static tcase cases[NCOMBO * NDIALECT];
-    static struct CMUnitTest tests[NCOMBO * NDIALECT + 3];
-    static char names[NCOMBO * NDIALECT][64];
+    static tcase cases[NTIER_COMBO * NDIALECT];
+    static struct CMUnitTest tests[NTIER_COMBO * NDIALECT + 3];
+    static char names[NTIER_COMBO * NDIALECT][64];
     int ci, di, n = 0;
     tests[n].name = "choice_and_support";
     tests[n].test_func = test_choice_and_support;
@@ -572,13 +572,13 @@ int main(void)
     tests[n].name = "single_target_limit";
     tests[n].test_func = test_single_target_limit;
     ++n;
-    for (ci = 0; ci < NCOMBO; ++ci)
+    for (ci = 0; ci < NTIER_COMBO; ++ci)
         for (di = 0; di < NDIALECT; ++di) {
             tcase *t = &cases[n - 3];
-            if (fogvol_combination_supported(g_combos[ci].tier, g_combos[ci].variants, g_dialects[di]) != 0) continue;
+            if (fogvol_combination_supported(g_tier_combos[ci].tier, g_tier_combos[ci].variants, g_dialects[di]) != 0) continue;
             t->combo = ci;
             t->dialect = di;
-            snprintf(names[n - 3], sizeof names[n - 3], "%s_glsl_%s", g_combos[ci].name,
+            snprintf(names[n - 3], sizeof names[n - 3], "%s_glsl_%s", g_tier_combos[ci].name,
                      fogvol_dialect_name(g_dialects[di]));
             tests[n].name = names[n - 3];
             tests[n].test_func = run_case;
