@@ -581,7 +581,24 @@ typedef struct fogvol_shader_desc {
     int samples;           /* 0 or 1: single-sample targets; > 1: the fragment shader reads fogvol's
                               targets as multisample textures at gl_SampleID (FV_MSAA; see
                               fogvol_msaa_supported). Vertex shaders are the same either way. */
+    unsigned specialize;   /* FOGVOL_SPECIALIZE_* bits (0: the general program, which switches its
+                              optional parts on uniforms): a program built for one configuration runs
+                              faster where the GPU executes both sides of a uniform branch (llvmpipe). */
 } fogvol_shader_desc;
+
+/* fogvol_shader_desc.specialize: parts of a program left out at compile time. FACE: NO_OPAQUE (the
+   opaque depth O is the far plane and not read: FLOAT without ENGINE_DEPTH, PS20, PS13, MRT; no
+   effect on COUNT, WIDE or ENGINE_DEPTH, which read other sources), NO_DENSITY (no density texture).
+   COMPOSITE and COMPOSITE_MESH: EXP (alpha = 1 - exp(-density t) from fv_speed, no ramp texture) or
+   RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex). Other bits, EXP with RAMP, or bits
+   for another program: FOGVOL_ERROR_UNSUPPORTED. */
+enum {
+    FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
+    FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
+    FOGVOL_SPECIALIZE_EXP = 1u << 2,
+    FOGVOL_SPECIALIZE_RAMP = 1u << 3,
+    FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE = 1u << 4
+};
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
    Combinations that do not exist (fogvol_combination_supported) or programs a
@@ -1266,12 +1283,18 @@ typedef struct fogvol_context_desc {
                  the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
                  interpolation error, rgb is the same).
    SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels). */
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
+                 overflow check passes likewise.
+   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
+                 no O read without occluders, no density texture outside textured volumes, exp or
+                 ramp composite, no colour texture) instead of one program that switches on
+                 uniforms; built on first use (same pixels). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
     FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4
 };
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
@@ -4582,7 +4605,9 @@ static const char fogvol__fs_face[] =
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
+    "#ifndef FV_NO_OPAQUE\n"
     "    if (fv_speed.x < 0.5) o = FV_SCREEN(fv_opaque).r;\n"
+    "#endif\n"
     "#endif\n"
     "    float d = min(max(fv_d, 0.0), o);\n"
     "#ifdef FV_DENSITY\n"
@@ -4614,6 +4639,8 @@ static const char fogvol__fs_face[] =
     "#endif\n"
     "#ifdef FV_COUNT\n"
     "    FV_FRAGCOLOR = vec4(e.rgb, 1.0 / 255.0);\n"
+    "#elif defined(FV_NO_OPAQUE)\n"             /* O is the far plane: e never lies behind it */
+    "    FV_FRAGCOLOR = e;\n"
     "#else\n"
     "    vec4 o = FV_SCREEN(fv_opaque);\n"
     "#ifdef FV_PS13\n"
@@ -4716,10 +4743,18 @@ static const char fogvol__fs_composite[] =
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
     "    vec4 c;\n"
+    "#if defined(FV_EXP)\n"
+    "    c = vec4(fv_speed.rgb, 1.0 - exp(-fv_speed.w * max(t, 0.0)));\n"
+    "#elif defined(FV_RAMP)\n"
+    "    c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "#else\n"
     "    if (fv_speed.w > 0.0) c = vec4(fv_speed.rgb, 1.0 - exp(-fv_speed.w * max(t, 0.0)));\n"
     "    else c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
+    "#endif\n"
+    "#ifndef FV_NO_CTEX\n"
     "    if (fv_ctex_u.w > 0.5)\n"
     "        c.rgb *= FV_TEXTURE(fv_ctex, vec2(dot(fv_ctex_u.xyz, vec3(st, 1.0)), dot(fv_ctex_v.xyz, vec3(st, 1.0)))).rgb;\n"
+    "#endif\n"
     "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
     "#endif\n"
     "}\n";
@@ -4955,6 +4990,34 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
     return n;
 }
 
+/* fogvol_shader_desc.specialize: the bits a program accepts (FOGVOL_SPECIALIZE_*). */
+static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
+{
+    unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY;
+    unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
+    if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
+    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
+    if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
+    return bits == 0;
+}
+
+/* The one string of #defines for fogvol_shader_desc.specialize (NO_DENSITY leaves FV_DENSITY out). */
+static const char *fogvol__specialize_define(const fogvol_shader_desc *d)
+{
+    static const char *const comp[8] = {"",
+                                        "#define FV_EXP\n",
+                                        "#define FV_RAMP\n",
+                                        "",
+                                        "#define FV_NO_CTEX\n",
+                                        "#define FV_EXP\n#define FV_NO_CTEX\n",
+                                        "#define FV_RAMP\n#define FV_NO_CTEX\n",
+                                        ""};
+    if (d->stage != FOGVOL_STAGE_FRAGMENT) return "";
+    if (d->program == FOGVOL_PROGRAM_FACE)
+        return (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE) ? "#define FV_NO_OPAQUE\n" : "";
+    return comp[(d->specialize >> 2) & 7u];
+}
+
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
 {
     const fogvol__dialect_info *di;
@@ -4970,6 +5033,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->stage != FOGVOL_STAGE_VERTEX && d->stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     if (d->samples > 1 && fogvol_msaa_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
         return FOGVOL_ERROR_UNSUPPORTED;
+    if (!fogvol__specialize_ok(d->program, d->specialize)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
     strings[n++] = per_sample ? di->version_msaa : di->version;
@@ -4985,8 +5049,10 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (per_sample) strings[n++] = fogvol__fs_msaa;
-    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants))
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants) &&
+        !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
+    if (fogvol__specialize_define(d)[0]) strings[n++] = fogvol__specialize_define(d);
     n = fogvol__program_strings(d, strings, n);
     FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
     *count = n;
@@ -5003,6 +5069,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     d.dialect = dialect;
     d.stage = stage;
     d.samples = 0;
+    d.specialize = 0;
     return fogvol_shader_strings(&d, strings, count);
 }
 
@@ -5243,6 +5310,16 @@ static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
     }
 }
 
+/* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
+   it failed to build and the general program stands in. */
+#define FOGVOL__SPEC_MAX 16
+typedef struct fogvol__spec_program {
+    fogvol_program program;
+    unsigned bits;
+    int ms;
+    fogvol_handle handle;
+} fogvol__spec_program;
+
 struct fogvol_ramp {
     fogvol_handle texture;
     int width;
@@ -5315,6 +5392,8 @@ struct fogvol_context {
     int prog_ms, compile_samples;    /* prog holds the per-sample set; samples for fogvol__make_program */
     int msaa_warned;
     fogvol_handle prog_alt[FOGVOL_PROGRAM_COUNT]; /* the other set (single-sample or per-sample), 0 = not built */
+    fogvol__spec_program spec[FOGVOL__SPEC_MAX];  /* specialised programs (FOGVOL_SPEEDUP_SPECIALIZE), first use */
+    int nspec;
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -5514,6 +5593,8 @@ static void fogvol__release(fogvol_context *ctx)
         if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
         if (ctx->prog_alt[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog_alt[i]);
+    for (i = 0; i < ctx->nspec; ++i)
+        if (ctx->spec[i].handle) ctx->be.destroy_program(ctx->be.user_data, ctx->spec[i].handle);
     for (i = 0; i < FOGVOL__POST_PROGRAMS; ++i)
         if (ctx->post_prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->post_prog[i]);
     if (ctx->tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_rg);
@@ -5577,7 +5658,8 @@ enum {
     FOGVOL__UNIT_CTEX = 6     /* fv_ctex: the group's colour texture */
 };
 
-static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, fogvol_handle *out)
+static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, unsigned specialize,
+                                          fogvol_handle *out)
 {
     static const char *const samp_encode[FOGVOL_MAX_TEXTURE_UNITS] = {
         "fv_rg", "fv_blue", "fv_dither", "fv_opaque", "fv_opaque2", NULL, "fv_density", "fv_lfront"};
@@ -5597,6 +5679,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     sd.program = p;
     sd.dialect = ctx->be.dialect;
     sd.samples = ctx->compile_samples;
+    sd.specialize = specialize;
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
@@ -5764,7 +5847,7 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
             i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)
-            r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
     return r;
 }
 
@@ -6579,6 +6662,7 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
+        ps.program = ctx->prog[FOGVOL_PROGRAM_FACE]; /* the general program: density texture */
         ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
@@ -6817,9 +6901,37 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
     ctx->compile_samples = ms ? 2 : 0;
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (!ctx->prog[i] && fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
-            r = fogvol__make_program(ctx, (fogvol_program)i, &ctx->prog[i]);
+            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
     ctx->compile_samples = 0;
     return r;
+}
+
+/* The program p built for this configuration (fogvol_shader_desc.specialize = bits) in the current
+   sample set, made on first use (the GL backend builds programs inside a frame without disturbing
+   it); the general program when specialising is off or the build failed (logged once). */
+static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
+{
+    fogvol__spec_program *sp;
+    int i;
+    if (!bits || (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE)) return ctx->prog[p];
+    for (i = 0; i < ctx->nspec; ++i) {
+        sp = &ctx->spec[i];
+        if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
+            return sp->handle ? sp->handle : ctx->prog[p];
+    }
+    if (ctx->nspec == FOGVOL__SPEC_MAX) return ctx->prog[p];
+    sp = &ctx->spec[ctx->nspec++];
+    sp->program = p;
+    sp->bits = bits;
+    sp->ms = ctx->prog_ms;
+    ctx->compile_samples = ctx->prog_ms ? 2 : 0;
+    if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
+        sp->handle = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the specialised program (0x%x) did not build; the general program draws instead", bits);
+    }
+    ctx->compile_samples = 0;
+    return sp->handle ? sp->handle : ctx->prog[p];
 }
 
 /* The engine framebuffer's samples decide this frame's targets and programs
@@ -7157,7 +7269,7 @@ static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
 {
     fogvol_target_desc td;
     fogvol_result r = FOGVOL_SUCCESS;
-    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
+    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, 0, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
     if (r == FOGVOL_SUCCESS && !ctx->tgt_v) {
         memset(&td, 0, sizeof td);
         td.width = ctx->target_w;
@@ -7271,6 +7383,7 @@ typedef struct fogvol__run {
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
     fogvol_result r;            /* the last error that did not stop the frame */
     int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
+    int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
 } fogvol__run;
 
 /* >>texlight (volume light by compare) ====================================== */
@@ -7320,7 +7433,7 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx)
     fogvol_target_desc td;
     fogvol_result r = FOGVOL_SUCCESS;
     if (!ctx->prog[FOGVOL_PROGRAM_LIGHT])
-        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
+        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, 0, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
     if (r == FOGVOL_SUCCESS && !ctx->tgt_l) {
         memset(&td, 0, sizeof td);
         td.width = ctx->target_w;
@@ -7534,7 +7647,9 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_pass ps = run->base;
     unsigned char *peak = NULL;
     fogvol_result r;
-    ps.program = ctx->prog[FOGVOL_PROGRAM_FACE];
+    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY; /* textured volumes: the general program */
+    if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
     ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
     ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
@@ -7576,11 +7691,24 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol__free(&ctx->alloc, peak);
 }
 
-/* *ps: target-space state reading the sums (composite texture units); PS13 first resolves B - F
-   into T, which the later passes read instead. */
-static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps)
+/* *ps: target-space state reading the sums (composite texture units), scissored to the group's
+   window rectangle when the composite is (the passes after the sums read nothing outside it); PS13
+   first resolves B - F into T, which the later passes read instead. */
+static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
+    const fogvol_frame_desc *fd = &ctx->frame;
+    int *rc = run->rect;
     *ps = run->base;
+    memset(rc, 0, sizeof run->rect);
+    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
+        fogvol__group_rect(ctx, ramp, rc);
+        if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
+            rc[1] = 2 * fd->viewport[1] + fd->viewport[3] - rc[1] - rc[3];
+        ps->scissor[0] = rc[0] - fd->viewport[0]; /* target pixel = window pixel - viewport origin */
+        ps->scissor[1] = rc[1] - fd->viewport[1];
+        ps->scissor[2] = rc[2];
+        ps->scissor[3] = rc[3];
+    }
     memset(ps->textures, 0, sizeof ps->textures);
     ps->textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
     ps->textures[FOGVOL__UNIT_FRONT] = ctx->tgt_f;
@@ -7603,27 +7731,26 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, fogvol_pa
 static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, const fogvol_ramp *ramp)
 {
     const fogvol_frame_desc *fd = &ctx->frame;
+    unsigned spec;
     ps->target = 0;
     ps->clear = 0;
     memcpy(ps->viewport, fd->viewport, sizeof ps->viewport);
+    memcpy(ps->scissor, run->rect, sizeof ps->scissor);
     ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
     ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
-        fogvol__group_rect(ctx, ramp, ps->scissor);
-        if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
-            ps->scissor[1] = 2 * fd->viewport[1] + fd->viewport[3] - ps->scissor[1] - ps->scissor[3];
-    }
     if (!(ctx->speedups_off & FOGVOL_SPEEDUP_EXP_COMPOSITE))
         memcpy(ps->uniforms[FOGVOL_U_SPEEDUP], ramp->exp_rgba, sizeof ramp->exp_rgba);
-    ps->program = ctx->prog[FOGVOL_PROGRAM_COMPOSITE];
     ps->textures[FOGVOL__UNIT_RAMP] = ramp->texture;
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
     ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
     fogvol__group_color(ctx, ramp, ps);
+    spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
+    if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;
     ctx->be.draw_fullscreen(ctx->be.user_data);
@@ -7754,7 +7881,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     run->st.groups++;
     for (i = g; i < ctx->nvol; ++i) run->st.volumes += ctx->vols[i].ramp == ramp;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
-    fogvol__sum_sources(ctx, run, &ps);
+    fogvol__sum_sources(ctx, run, ramp, &ps);
     if (run->counted) fogvol__check_pass(ctx, &ps, !run->single, &run->st);
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);

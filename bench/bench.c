@@ -48,7 +48,8 @@
 #define M_PEEL (NTIER + 3)
 #define NMETH (NTIER + 4)
 #define SPEEDUPS_ALL                                                                                              \
-    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR)
+    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
+     FOGVOL_SPEEDUP_SPECIALIZE)
 #define MAXI 32 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96

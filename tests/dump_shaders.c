@@ -3,21 +3,42 @@
    glslangValidator, and checks that combinations that do not exist give
    FOGVOL_ERROR_UNSUPPORTED and no strings. The per-sample fragment shaders
    (fogvol_shader_desc.samples = 4, where fogvol_msaa_supported) go to
-   <tier>_v<variants>_<program>_<dialect>_ms.frag. */
+   <tier>_v<variants>_<program>_<dialect>_ms.frag. The programs built for one configuration
+   (fogvol_shader_desc.specialize) that fogvol's renderer uses, FACE and COMPOSITE, get _s<bits>
+   before the extension; other programs must refuse those bits. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
 #include <stdio.h>
 #include <string.h>
 
+/* The documented rule of fogvol_shader_desc.specialize: which bits a program takes. */
+static int spec_applies(int p, unsigned bits)
+{
+    const unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY;
+    const unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
+    if (!bits) return 1;
+    if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
+    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
+    if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh",
-                                                           "resolve", "check", "color_face", "color_composite"};
+                                                           "resolve", "check", "light", "color_face", "color_composite"};
     static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
+    static const unsigned specs[] = {0,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP};
     const char *dir = argc > 1 ? argv[1] : ".";
-    int t, p, d, st, n = 0, refused = 0, ms;
+    int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;
+    for (k = 0; k < (int)(sizeof specs / sizeof specs[0]); ++k)
     for (ms = 0; ms < 2; ++ms)
     for (t = 1; t < FOGVOL_TIER_COUNT; ++t)
         for (v = 0; v <= FOGVOL_VARIANT_ALL; ++v)
@@ -36,9 +57,11 @@ int main(int argc, char **argv)
                         sd.dialect = (fogvol_dialect)d;
                         sd.stage = (fogvol_stage)st;
                         sd.samples = ms ? 4 : 0;
+                        sd.specialize = specs[k];
                         if (ms && st == FOGVOL_STAGE_VERTEX) continue; /* the same as single-sample */
                         r = fogvol_shader_strings(&sd, s, &count);
                         if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
+                            !spec_applies(p, specs[k]) ||
                             !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p) ||
                             (ms && fogvol_msaa_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS)) {
                             if (r != FOGVOL_ERROR_UNSUPPORTED || count != 0) {
@@ -53,8 +76,9 @@ int main(int argc, char **argv)
                                     dia[d]);
                             return 1;
                         }
-                        snprintf(path, sizeof path, "%s/%s_v%02u_%s_%s%s.%s", dir, fogvol_tier_name((fogvol_tier)t), v,
-                                 prog[p], dia[d], ms ? "_ms" : "", st ? "frag" : "vert");
+                        snprintf(path, sizeof path, "%s/%s_v%02u_%s_%s%s%s%.0u.%s", dir, fogvol_tier_name((fogvol_tier)t),
+                                 v, prog[p], dia[d], ms ? "_ms" : "", specs[k] ? "_s" : "", specs[k],
+                                 st ? "frag" : "vert");
                         f = fopen(path, "w");
                         if (!f) return 1;
                         for (i = 0; i < count; ++i) fputs(s[i], f);
