@@ -183,6 +183,7 @@ extern "C" {
 
 /* >>declarations ========================================================== */
 
+/* ---- basic types: result codes, logging, allocation -------------------- */
 typedef enum fogvol_result {
     FOGVOL_SUCCESS = 0,
     FOGVOL_ERROR_INVALID_ARGUMENT = -1,   /* NULL, out of range, non-finite, near >= far ... */
@@ -222,6 +223,27 @@ typedef struct fogvol_logger {
     void (*func)(void *user_data, fogvol_log_level level, const char *message);
     void *user_data;
 } fogvol_logger;
+
+/* Declared here, not with the backend table, because the frames section uses them
+   (fogvol_create_volume_texture, fogvol_occluder_info) and C declares before use. */
+typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
+typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
+
+typedef struct fogvol_texture_desc {
+    int width, height;
+    const unsigned char *pixels; /* RGBA8, rows bottom to top */
+    fogvol_filter filter;
+    fogvol_wrap wrap;
+    const char *label;
+} fogvol_texture_desc;
+
+typedef enum fogvol_format {
+    FOGVOL_FORMAT_RGBA8 = 0,
+    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
+                                 wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
+                                 EXT_color_buffer_float + EXT_float_blend) */
+} fogvol_format;
 
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
@@ -957,25 +979,6 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
    FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
    Vertex attribute 0: "fv_position" (vec3). */
 #define FOGVOL_MAX_TEXTURE_UNITS 8
-
-typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
-typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
-
-typedef struct fogvol_texture_desc {
-    int width, height;
-    const unsigned char *pixels; /* RGBA8, rows bottom to top */
-    fogvol_filter filter;
-    fogvol_wrap wrap;
-    const char *label;
-} fogvol_texture_desc;
-
-typedef enum fogvol_format {
-    FOGVOL_FORMAT_RGBA8 = 0,
-    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
-    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
-                                 wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
-                                 EXT_color_buffer_float + EXT_float_blend) */
-} fogvol_format;
 
 typedef struct fogvol_target_desc {
     int width, height;        /* colour texture, NEAREST, CLAMP */
