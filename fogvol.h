@@ -245,6 +245,203 @@ typedef enum fogvol_format {
                                  EXT_color_buffer_float + EXT_float_blend) */
 } fogvol_format;
 
+/* ---- context: handles, tiers, variants, dialects, the GL backend's desc ---- */
+typedef struct fogvol_context fogvol_context;
+typedef struct fogvol_mesh fogvol_mesh;
+typedef struct fogvol_ramp fogvol_ramp;
+
+/* A new dialect: its value here before FOGVOL_GLSL_COUNT and its row in
+   fogvol__dialects (the >>dialects section says what a row holds). */
+typedef enum fogvol_dialect {
+    FOGVOL_GLSL_AUTO = 0,
+    FOGVOL_GLSL_110 = 1,
+    FOGVOL_GLSL_120 = 2,
+    FOGVOL_GLSL_130 = 3,
+    FOGVOL_GLSL_150 = 4,
+    FOGVOL_GLSL_330 = 5, /* 330 core */
+    FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
+    FOGVOL_GLSL_300ES = 7,
+    FOGVOL_GLSL_COUNT = 8,
+    FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
+} fogvol_dialect;
+
+/* Tiers: the shader-model tiers of the "Fog Polygon Volumes" white paper (ps.1.3, ps.2.0,
+   MRT, float blending), in GLSL terms.
+   passes = screen passes per frame for one colour-ramp group as the white paper
+   counts them (the engine's own opaque pass included):
+     PS13   6  RGBA8; engine, O, B, F, resolve B-F to an encoded thickness,
+              composite decoding by dependent lookup; per-channel compare
+              (works with lowp/mediump fragment precision)
+     PS20   5  RGBA8; engine, O, B, F, composite; decoded compare
+     MRT    4  RGBA8; the engine's opaque pass writes O as a second colour
+              target (fogvol_mrt_prepare + fogvol_mrt_snippet), B, F, composite
+     FLOAT  3  R32F with signed additive float blending; engine, O, one pass for
+              all faces (sign from gl_FrontFacing), composite; 2 library passes
+              with FOGVOL_VARIANT_ENGINE_DEPTH (O comes from the engine's depth
+              texture) */
+typedef enum fogvol_tier {
+    FOGVOL_TIER_AUTO = 0,
+    FOGVOL_TIER_PS13 = 1,
+    FOGVOL_TIER_PS20 = 2,
+    FOGVOL_TIER_MRT = 3,
+    FOGVOL_TIER_FLOAT = 4,
+    FOGVOL_TIER_COUNT = 5,
+    FOGVOL_TIER_MAX_ENUM = 0x7fffffff
+} fogvol_tier;
+
+/* Variants (bit flags) that combine with tiers; fogvol_combination_supported()
+   says which combinations exist. A new variant: its bit at the end here,
+   FOGVOL_VARIANT_ALL, and its #define line in fogvol__variant_define (the
+   >>shaders section). */
+enum {
+    /* RGBA8 tiers: one sum target starting from mid-range (128), back faces
+       added, front faces subtracted by reverse-subtract blending; half the
+       face limit (fogvol_encoding.max_faces_single). */
+    FOGVOL_VARIANT_SINGLE_TARGET = 1u << 0,
+    /* PS20/PS13: Baker's inside/outside count in alpha instead of the min
+       compare: faces are depth-tested against the opaque depth, and the
+       opaque depth is added once per missing back face. The camera must be
+       outside the volumes, and the near plane must not cut them: fogvol_end_frame
+       checks each volume's bounds and refuses such a frame
+       (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). */
+    FOGVOL_VARIANT_COUNT = 1u << 1,
+    /* PS20/MRT: RGB-encode by arithmetic in the fragment shader instead of
+       ramp textures ("newer hardware can calculate the ramp values"). Same bytes. */
+    FOGVOL_VARIANT_ALU = 1u << 2,
+    /* Snap vertices behind the near plane onto it (Baker) instead of relying
+       on near-plane clipping for a camera partly inside a volume. */
+    FOGVOL_VARIANT_NEAR_CLAMP = 1u << 3,
+    /* FLOAT: the opaque depth comes from the engine's depth texture
+       (fogvol_frame_desc.engine_depth_texture, or a depth buffer it names),
+       linearised; no O pass. PS20 (GLSL 130+ / 300 es, not with COUNT or
+       WIDE): a full-screen pass linearises and encodes it into O instead of
+       drawing occluders. fogvol_add_occluder* calls are not drawn. */
+    FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
+    /* PS20: more precision by spreading the encoding over two RGBA8 targets
+       per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
+       arithmetic; fp32 fragment maths bounds it to about 23 bits, so only
+       L <= FOGVOL_WIDE_EXACT_BITS (3: 18 bits with 32 faces) is exact:
+       encoding_bits 0 picks 3 and larger values are refused
+       (FOGVOL_ERROR_UNSUPPORTED). Needs GLSL 110-330 or 300 es. */
+    FOGVOL_VARIANT_WIDE = 1u << 5,
+    /* FLOAT: per-volume colours and densities in one pass. Every volume whose ramp has the
+       EXTINCTION model and the FOG blend joins one group: its faces add their optical depth per
+       colour channel (extinction density * extinction_color times signed depth) and their
+       emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
+       pass, and one composite pass blends them all (two full-screen draws, multiply then add,
+       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
+       target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
+       per sample on multisampled framebuffers (fogvol_msaa_supported: use
+       FOGVOL_MSAA_SINGLE_SAMPLE). */
+    FOGVOL_VARIANT_COLORS = 1u << 6,
+    FOGVOL_VARIANT_ALL = (1u << 7) - 1u
+};
+
+/* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
+   else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
+   so on; see the table in the README). */
+FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+/* FOGVOL_SUCCESS if the tier with these variants can render into a
+   multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
+   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
+   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
+   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+
+typedef struct fogvol_tier_info {
+    int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
+    int library_passes; /* passes fogvol issues per frame for one colour-ramp group
+                           (+1 per negative group pass in the RGBA8 tiers) */
+    int targets;        /* render targets fogvol allocates */
+    const char *name;
+} fogvol_tier_info;
+FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
+FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
+
+FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
+
+typedef void (*fogvol_gl_proc)(void);
+typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
+
+typedef struct fogvol_gl_desc {
+    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    void *user_data;
+    fogvol_dialect dialect;   /* 0 = from the context */
+    int version_major;        /* 0 = from the context; else treat the context as this GL version */
+    int version_minor;
+    int gles;                 /* with version_major: 1 = treat as OpenGL ES */
+    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
+} fogvol_gl_desc;
+
+/* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
+   fogvol_end_frame). AUTO: fogvol's targets get the engine's sample count and
+   every pass is shaded per sample, so each sample of the engine framebuffer
+   gets the fog of its own ray and the engine's resolve averages them; where
+   the tier, variants or GLSL dialect cannot (fogvol_msaa_supported) or the
+   backend lacks FOGVOL_CAP_MULTISAMPLE, end_frame logs why and returns
+   FOGVOL_ERROR_UNSUPPORTED without drawing. SINGLE_SAMPLE (opt-in): single-
+   sample targets, one fog value per pixel for all its samples (edges of
+   occluders inside fog come out wrong by up to the full fog contrast); logged
+   as a warning once and reported in fogvol_frame_stats.msaa_fallback.
+   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
+   fragment work and 4x the target memory of fogvol's passes (measured by
+   fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
+   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
+   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
+typedef enum fogvol_msaa {
+    FOGVOL_MSAA_AUTO = 0,
+    FOGVOL_MSAA_SINGLE_SAMPLE = 1,
+    FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
+} fogvol_msaa;
+/* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
+   reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
+   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
+   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
+   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
+typedef enum fogvol_overflow_policy {
+    FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
+    FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
+    FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
+                                       3 bits less precision: fogvol_context_encoding changes, the lookup
+                                       textures are rebuilt after the frame), logged as a warning each
+                                       time; the next frame uses it (MRT: the engine takes the new snippet
+                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
+                                       change do not lower it again. At L = 1 it warns once */
+    FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
+    FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
+} fogvol_overflow_policy;
+
+/* fogvol_context_desc holds a fogvol_backend by value, so its fields come after the backend
+   table (search "---- context desc"). */
+typedef struct fogvol_context_desc fogvol_context_desc;
+
+/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels). */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3
+};
+
+FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
+FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
+FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
+
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
    L-bit digits: red (most significant), green, blue, each stored in the low L
@@ -285,6 +482,7 @@ FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogv
 /* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
    writes min(count, capacity) rows when rows != NULL. */
 FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
+FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx);
 
 /* Constants a shader needs (all float, ready for uniforms). */
 typedef struct fogvol_constants {
@@ -479,93 +677,6 @@ FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, cons
                                               fogvol_mesh_report *report);
 
 /* ---- shaders ------------------------------------------------------------- */
-/* A new dialect: its value here before FOGVOL_GLSL_COUNT and its row in
-   fogvol__dialects (the >>dialects section says what a row holds). */
-typedef enum fogvol_dialect {
-    FOGVOL_GLSL_AUTO = 0,
-    FOGVOL_GLSL_110 = 1,
-    FOGVOL_GLSL_120 = 2,
-    FOGVOL_GLSL_130 = 3,
-    FOGVOL_GLSL_150 = 4,
-    FOGVOL_GLSL_330 = 5, /* 330 core */
-    FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
-    FOGVOL_GLSL_300ES = 7,
-    FOGVOL_GLSL_COUNT = 8,
-    FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
-} fogvol_dialect;
-
-/* Tiers: the shader-model tiers of the "Fog Polygon Volumes" white paper (ps.1.3, ps.2.0,
-   MRT, float blending), in GLSL terms.
-   passes = screen passes per frame for one colour-ramp group as the white paper
-   counts them (the engine's own opaque pass included):
-     PS13   6  RGBA8; engine, O, B, F, resolve B-F to an encoded thickness,
-              composite decoding by dependent lookup; per-channel compare
-              (works with lowp/mediump fragment precision)
-     PS20   5  RGBA8; engine, O, B, F, composite; decoded compare
-     MRT    4  RGBA8; the engine's opaque pass writes O as a second colour
-              target (fogvol_mrt_prepare + fogvol_mrt_snippet), B, F, composite
-     FLOAT  3  R32F with signed additive float blending; engine, O, one pass for
-              all faces (sign from gl_FrontFacing), composite; 2 library passes
-              with FOGVOL_VARIANT_ENGINE_DEPTH (O comes from the engine's depth
-              texture) */
-typedef enum fogvol_tier {
-    FOGVOL_TIER_AUTO = 0,
-    FOGVOL_TIER_PS13 = 1,
-    FOGVOL_TIER_PS20 = 2,
-    FOGVOL_TIER_MRT = 3,
-    FOGVOL_TIER_FLOAT = 4,
-    FOGVOL_TIER_COUNT = 5,
-    FOGVOL_TIER_MAX_ENUM = 0x7fffffff
-} fogvol_tier;
-
-/* Variants (bit flags) that combine with tiers; fogvol_combination_supported()
-   says which combinations exist. A new variant: its bit at the end here,
-   FOGVOL_VARIANT_ALL, and its #define line in fogvol__variant_define (the
-   >>shaders section). */
-enum {
-    /* RGBA8 tiers: one sum target starting from mid-range (128), back faces
-       added, front faces subtracted by reverse-subtract blending; half the
-       face limit (fogvol_encoding.max_faces_single). */
-    FOGVOL_VARIANT_SINGLE_TARGET = 1u << 0,
-    /* PS20/PS13: Baker's inside/outside count in alpha instead of the min
-       compare: faces are depth-tested against the opaque depth, and the
-       opaque depth is added once per missing back face. The camera must be
-       outside the volumes, and the near plane must not cut them: fogvol_end_frame
-       checks each volume's bounds and refuses such a frame
-       (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). */
-    FOGVOL_VARIANT_COUNT = 1u << 1,
-    /* PS20/MRT: RGB-encode by arithmetic in the fragment shader instead of
-       ramp textures ("newer hardware can calculate the ramp values"). Same bytes. */
-    FOGVOL_VARIANT_ALU = 1u << 2,
-    /* Snap vertices behind the near plane onto it (Baker) instead of relying
-       on near-plane clipping for a camera partly inside a volume. */
-    FOGVOL_VARIANT_NEAR_CLAMP = 1u << 3,
-    /* FLOAT: the opaque depth comes from the engine's depth texture
-       (fogvol_frame_desc.engine_depth_texture, or a depth buffer it names),
-       linearised; no O pass. PS20 (GLSL 130+ / 300 es, not with COUNT or
-       WIDE): a full-screen pass linearises and encodes it into O instead of
-       drawing occluders. fogvol_add_occluder* calls are not drawn. */
-    FOGVOL_VARIANT_ENGINE_DEPTH = 1u << 4,
-    /* PS20: more precision by spreading the encoding over two RGBA8 targets
-       per sum (MRT): six L-bit digits, 6L bits, the same face limit. Encoded by
-       arithmetic; fp32 fragment maths bounds it to about 23 bits, so only
-       L <= FOGVOL_WIDE_EXACT_BITS (3: 18 bits with 32 faces) is exact:
-       encoding_bits 0 picks 3 and larger values are refused
-       (FOGVOL_ERROR_UNSUPPORTED). Needs GLSL 110-330 or 300 es. */
-    FOGVOL_VARIANT_WIDE = 1u << 5,
-    /* FLOAT: per-volume colours and densities in one pass. Every volume whose ramp has the
-       EXTINCTION model and the FOG blend joins one group: its faces add their optical depth per
-       colour channel (extinction density * extinction_color times signed depth) and their
-       emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
-       pass, and one composite pass blends them all (two full-screen draws, multiply then add,
-       when some extinction colour is not grey). Other ramps keep their own group. Model and
-       error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
-       target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
-       per sample on multisampled framebuffers (fogvol_msaa_supported: use
-       FOGVOL_MSAA_SINGLE_SAMPLE). */
-    FOGVOL_VARIANT_COLORS = 1u << 6,
-    FOGVOL_VARIANT_ALL = (1u << 7) - 1u
-};
 
 typedef enum fogvol_program {
     FOGVOL_PROGRAM_ENCODE = 0,         /* opaque depth into O */
@@ -612,28 +723,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *desc, c
 /* Shorthand for variants = 0. */
 FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
                                               fogvol_stage stage, const char **strings, int *count);
-/* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
-   else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
-   so on; see the table in the README). */
-FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
-/* FOGVOL_SUCCESS if the tier with these variants can render into a
-   multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
-   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
-   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
-   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* 1 if the tier runs this program. */
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
-
-typedef struct fogvol_tier_info {
-    int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
-    int library_passes; /* passes fogvol issues per frame for one colour-ramp group
-                           (+1 per negative group pass in the RGBA8 tiers) */
-    int targets;        /* render targets fogvol allocates */
-    const char *name;
-} fogvol_tier_info;
-FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
-FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
 
 /* MRT tier: GLSL for the engine's opaque fragment shader. It declares
    uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
@@ -641,7 +732,6 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
    writes to its second colour output. Insert after the #version line and the
    engine's precision statements. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
-FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
@@ -1165,80 +1255,10 @@ typedef struct fogvol_null_backend {
    change table->caps before creating a context to test other choices. */
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
 
-/* ---- renderer ------------------------------------------------------------ */
-typedef struct fogvol_context fogvol_context;
-typedef struct fogvol_mesh fogvol_mesh;
-typedef struct fogvol_ramp fogvol_ramp;
-
-typedef void (*fogvol_gl_proc)(void);
-typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
-
-typedef struct fogvol_gl_desc {
-    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
-    void *user_data;
-    fogvol_dialect dialect;   /* 0 = from the context */
-    int version_major;        /* 0 = from the context; else treat the context as this GL version */
-    int version_minor;
-    int gles;                 /* with version_major: 1 = treat as OpenGL ES */
-    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
-} fogvol_gl_desc;
-
-/* Both composites write the same pixels with the same values and leave the
-   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
-   the window rectangle of each ramp group's volumes (the 8 corners of each
-   mesh's bounding box projected; the whole viewport when a box reaches behind
-   the near plane), which saves fill rate when the volumes cover little of the
-   screen. */
-typedef enum fogvol_composite {
-    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
-    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
-} fogvol_composite;
-
-/* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
-   fogvol_end_frame). AUTO: fogvol's targets get the engine's sample count and
-   every pass is shaded per sample, so each sample of the engine framebuffer
-   gets the fog of its own ray and the engine's resolve averages them; where
-   the tier, variants or GLSL dialect cannot (fogvol_msaa_supported) or the
-   backend lacks FOGVOL_CAP_MULTISAMPLE, end_frame logs why and returns
-   FOGVOL_ERROR_UNSUPPORTED without drawing. SINGLE_SAMPLE (opt-in): single-
-   sample targets, one fog value per pixel for all its samples (edges of
-   occluders inside fog come out wrong by up to the full fog contrast); logged
-   as a warning once and reported in fogvol_frame_stats.msaa_fallback.
-   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
-   fragment work and 4x the target memory of fogvol's passes (measured by
-   fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
-   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
-   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
-   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
-typedef enum fogvol_msaa {
-    FOGVOL_MSAA_AUTO = 0,
-    FOGVOL_MSAA_SINGLE_SAMPLE = 1,
-    FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
-} fogvol_msaa;
-/* What the composite does to the alpha of the engine's colour target. */
-typedef enum fogvol_alpha {
-    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
-    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
-} fogvol_alpha;
-/* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
-   reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
-   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
-   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
-   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
-typedef enum fogvol_overflow_policy {
-    FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
-    FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
-    FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
-                                       3 bits less precision: fogvol_context_encoding changes, the lookup
-                                       textures are rebuilt after the frame), logged as a warning each
-                                       time; the next frame uses it (MRT: the engine takes the new snippet
-                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
-                                       change do not lower it again. At L = 1 it warns once */
-    FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
-    FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
-} fogvol_overflow_policy;
-
-typedef struct fogvol_context_desc {
+/* ---- context desc --------------------------------------------------------
+   Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
+   the struct complete); fogvol_create_context is in the context section. */
+struct fogvol_context_desc {
     fogvol_allocator allocator;
     fogvol_logger logger;
     int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
@@ -1255,32 +1275,25 @@ typedef struct fogvol_context_desc {
     fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
     unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
                                   measuring what each one gives (bench/bench.c) */
-} fogvol_context_desc;
-
-/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
-   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
-                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
-                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
-                 O pass (same pixels).
-   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
-                 instead of a filtered lookup at computed coordinates (same pixels).
-   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
-                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
-                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
-                 interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels). */
-enum {
-    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
-    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
-    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3
 };
 
-FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
-FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
-FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx);
-FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
+/* ---- renderer ------------------------------------------------------------ */
+/* Both composites write the same pixels with the same values and leave the
+   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
+   the window rectangle of each ramp group's volumes (the 8 corners of each
+   mesh's bounding box projected; the whole viewport when a box reaches behind
+   the near plane), which saves fill rate when the volumes cover little of the
+   screen. */
+typedef enum fogvol_composite {
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
+} fogvol_composite;
+
+/* What the composite does to the alpha of the engine's colour target. */
+typedef enum fogvol_alpha {
+    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
+    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
+} fogvol_alpha;
 
 /* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
    open (desc->allow_open). *report (may be NULL) receives the check. */
@@ -1497,7 +1510,6 @@ typedef struct fogvol_light_desc {
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
-FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
 
 /* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
    makes the O texture the size of the frame's viewport (this touches the GPU,
