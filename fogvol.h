@@ -442,6 +442,86 @@ FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
 FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
 
+/* ---- meshes --------------------------------------------------------------
+   Volumes are closed hulls: every undirected edge used by exactly two
+   triangles, in opposite directions; triangles counter-clockwise seen from
+   outside. */
+typedef enum fogvol_index_type {
+    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
+    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
+    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
+} fogvol_index_type;
+
+typedef struct fogvol_mesh_desc {
+    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
+    int vertex_count;
+    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
+    const uint32_t *indices;   /* 3 per triangle */
+    int index_count;
+    int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
+    /* Engine vertex buffers as they are: offset is the byte offset of x inside
+       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
+       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
+       the GL backend among them, upload the bytes and read them in place). */
+    int offset;
+    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
+    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
+    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
+       most weld_distance from an earlier kept vertex is merged into it (seams of
+       UV spheres, per-face vertices of cubes); the validation, the report and
+       the uploaded indices then describe the welded mesh. 0 = off (indices as
+       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
+    float weld_distance;
+} fogvol_mesh_desc;
+
+typedef struct fogvol_mesh_report {
+    int vertices, triangles;
+    int open_edges;            /* undirected edges used by one triangle */
+    int nonmanifold_edges;     /* used by more than two */
+    int inconsistent_edges;    /* used by two triangles in the same direction */
+    int flipped_faces;         /* triangles whose winding disagrees with the majority of their part */
+    int degenerate_triangles;  /* repeated index or (near) zero area */
+    int nonfinite_vertices;    /* NaN or infinite coordinate */
+    int out_of_range_indices;  /* index >= vertex_count */
+    int components;            /* edge-connected parts */
+    double volume;             /* signed volume (positive for outward winding) */
+    int closed;                /* no open and no non-manifold edges */
+    int consistent;            /* no inconsistent edge, no flipped face */
+    int inverted;              /* closed, consistent, but wound inward (volume < 0) */
+    int inward_components;     /* components whose own signed volume is negative: harmless inside
+                                  another part (a cavity), refused where nothing encloses them */
+    int negative_winding;      /* probes that found a region of negative winding number (entered fewer
+                                  times than left): a part wound inward that no other part encloses,
+                                  or an inverted lobe of a self-intersecting hull; it would render
+                                  negative thickness and subtract from its ramp's other volumes */
+    int negative_triangle;     /* a triangle bounding such a region (index / 3 into the indices), -1: none */
+    int valid;                 /* usable as a fog volume */
+    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
+                                  vertices counts the rest */
+    /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
+       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
+       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
+       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
+       2^26 triangle x vertex pairs). */
+    int convex;
+} fogvol_mesh_report;
+
+/* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
+   hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
+   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
+   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
+   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
+   stride, unknown index_type, missing arrays, bad weld_distance). */
+FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                              fogvol_mesh_report *report);
+
+/* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
+   open (desc->allow_open). *report (may be NULL) receives the check. */
+FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
+                                            fogvol_mesh_report *report);
+FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
+
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
    L-bit digits: red (most significant), green, blue, each stored in the low L
@@ -601,80 +681,6 @@ typedef struct fogvol_ramp_desc {
    *max_thickness_out (may be NULL) receives the resolved max_thickness. */
 FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, unsigned char *pixels,
                                                 size_t capacity, fogvol_image *info, float *max_thickness_out);
-
-/* ---- meshes --------------------------------------------------------------
-   Volumes are closed hulls: every undirected edge used by exactly two
-   triangles, in opposite directions; triangles counter-clockwise seen from
-   outside. */
-typedef enum fogvol_index_type {
-    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
-    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
-    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
-} fogvol_index_type;
-
-typedef struct fogvol_mesh_desc {
-    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
-    int vertex_count;
-    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
-    const uint32_t *indices;   /* 3 per triangle */
-    int index_count;
-    int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
-    /* Engine vertex buffers as they are: offset is the byte offset of x inside
-       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
-       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
-       the GL backend among them, upload the bytes and read them in place). */
-    int offset;
-    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
-    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
-    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
-       most weld_distance from an earlier kept vertex is merged into it (seams of
-       UV spheres, per-face vertices of cubes); the validation, the report and
-       the uploaded indices then describe the welded mesh. 0 = off (indices as
-       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
-    float weld_distance;
-} fogvol_mesh_desc;
-
-typedef struct fogvol_mesh_report {
-    int vertices, triangles;
-    int open_edges;            /* undirected edges used by one triangle */
-    int nonmanifold_edges;     /* used by more than two */
-    int inconsistent_edges;    /* used by two triangles in the same direction */
-    int flipped_faces;         /* triangles whose winding disagrees with the majority of their part */
-    int degenerate_triangles;  /* repeated index or (near) zero area */
-    int nonfinite_vertices;    /* NaN or infinite coordinate */
-    int out_of_range_indices;  /* index >= vertex_count */
-    int components;            /* edge-connected parts */
-    double volume;             /* signed volume (positive for outward winding) */
-    int closed;                /* no open and no non-manifold edges */
-    int consistent;            /* no inconsistent edge, no flipped face */
-    int inverted;              /* closed, consistent, but wound inward (volume < 0) */
-    int inward_components;     /* components whose own signed volume is negative: harmless inside
-                                  another part (a cavity), refused where nothing encloses them */
-    int negative_winding;      /* probes that found a region of negative winding number (entered fewer
-                                  times than left): a part wound inward that no other part encloses,
-                                  or an inverted lobe of a self-intersecting hull; it would render
-                                  negative thickness and subtract from its ramp's other volumes */
-    int negative_triangle;     /* a triangle bounding such a region (index / 3 into the indices), -1: none */
-    int valid;                 /* usable as a fog volume */
-    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
-                                  vertices counts the rest */
-    /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
-       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
-       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
-       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
-       2^26 triangle x vertex pairs). */
-    int convex;
-} fogvol_mesh_report;
-
-/* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
-   hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
-   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
-   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
-   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
-   stride, unknown index_type, missing arrays, bad weld_distance). */
-FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
-                                              fogvol_mesh_report *report);
 
 /* ---- shaders ------------------------------------------------------------- */
 
@@ -1294,12 +1300,6 @@ typedef enum fogvol_alpha {
     FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
     FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
 } fogvol_alpha;
-
-/* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
-   open (desc->allow_open). *report (may be NULL) receives the check. */
-FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
-                                            fogvol_mesh_report *report);
-FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
 
 FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
 FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
