@@ -522,6 +522,60 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
                                             fogvol_mesh_report *report);
 FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
 
+/* ---- ramps ---------------------------------------------------------------- */
+/* Thickness -> colour ramps. */
+typedef enum fogvol_ramp_model {
+    FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
+    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, the GDC 2001 analytic fog law) */
+    FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
+    FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
+} fogvol_ramp_model;
+
+/* Colour space. Ramp colours are used as given: the texel bytes are the
+   fragment colour the composite outputs, and GL blends it with the engine's
+   target like any draw. So
+   - an sRGB engine target (e.g. GL_SRGB8_ALPHA8) with GL_FRAMEBUFFER_SRGB
+     enabled: the colours are linear; GL decodes the target, blends in linear
+     light and encodes the result (fogvol leaves FRAMEBUFFER_SRGB as the
+     engine set it);
+   - a linear-format target (RGBA8, the default framebuffer), or
+     FRAMEBUFFER_SRGB disabled: colours and blending are in the space of the
+     stored values (usually sRGB-encoded: give sRGB colours).
+   The gradient model interpolates the keys in the space they are given in.
+   fogvol's own RGBA8 and R32F targets are linear formats, which
+   FRAMEBUFFER_SRGB does not affect. */
+typedef enum fogvol_blend {
+    FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
+    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, Baker's "Image-Space Rendering Techniques") */
+    FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
+} fogvol_blend;
+
+typedef struct fogvol_color_key {
+    float thickness; /* world units */
+    float rgba[4];   /* [0,1] */
+} fogvol_color_key;
+
+typedef struct fogvol_ramp_desc {
+    fogvol_ramp_model model;
+    float color[3];
+    float density;               /* per world unit (extinction, linear) */
+    float max_thickness;         /* thickness of the last texel; 0 = auto: extinction 7/density,
+                                    linear 1/density, gradient the last key */
+    const fogvol_color_key *keys; /* gradient: key_count >= 1, any order */
+    int key_count;
+    int width;                   /* texels, 0 = 256, 2..4096 */
+    fogvol_blend blend;          /* used by the renderer */
+    /* EXTINCTION with FOGVOL_VARIANT_COLORS: the extinction per colour channel is
+       density * extinction_color (all 0 = (1, 1, 1): grey, the same in every channel); each
+       component finite and >= 0. Only the one-pass colour group can use a colour that is not
+       grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
+       density alone (create_ramp logs a warning for a non-grey colour without the variant). */
+    float extinction_color[3];
+} fogvol_ramp_desc;
+
+FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
+FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
+
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
    L-bit digits: red (most significant), green, blue, each stored in the low L
@@ -626,56 +680,6 @@ FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, un
                                                   size_t capacity, fogvol_image *info);
 /* Rounding threshold of blue-ramp row r, in blue LSBs (row 0: 0.5). */
 FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row);
-
-/* Thickness -> colour ramps. */
-typedef enum fogvol_ramp_model {
-    FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
-    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, the GDC 2001 analytic fog law) */
-    FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
-    FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
-} fogvol_ramp_model;
-
-/* Colour space. Ramp colours are used as given: the texel bytes are the
-   fragment colour the composite outputs, and GL blends it with the engine's
-   target like any draw. So
-   - an sRGB engine target (e.g. GL_SRGB8_ALPHA8) with GL_FRAMEBUFFER_SRGB
-     enabled: the colours are linear; GL decodes the target, blends in linear
-     light and encodes the result (fogvol leaves FRAMEBUFFER_SRGB as the
-     engine set it);
-   - a linear-format target (RGBA8, the default framebuffer), or
-     FRAMEBUFFER_SRGB disabled: colours and blending are in the space of the
-     stored values (usually sRGB-encoded: give sRGB colours).
-   The gradient model interpolates the keys in the space they are given in.
-   fogvol's own RGBA8 and R32F targets are linear formats, which
-   FRAMEBUFFER_SRGB does not affect. */
-typedef enum fogvol_blend {
-    FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
-    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, Baker's "Image-Space Rendering Techniques") */
-    FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
-} fogvol_blend;
-
-typedef struct fogvol_color_key {
-    float thickness; /* world units */
-    float rgba[4];   /* [0,1] */
-} fogvol_color_key;
-
-typedef struct fogvol_ramp_desc {
-    fogvol_ramp_model model;
-    float color[3];
-    float density;               /* per world unit (extinction, linear) */
-    float max_thickness;         /* thickness of the last texel; 0 = auto: extinction 7/density,
-                                    linear 1/density, gradient the last key */
-    const fogvol_color_key *keys; /* gradient: key_count >= 1, any order */
-    int key_count;
-    int width;                   /* texels, 0 = 256, 2..4096 */
-    fogvol_blend blend;          /* used by the renderer */
-    /* EXTINCTION with FOGVOL_VARIANT_COLORS: the extinction per colour channel is
-       density * extinction_color (all 0 = (1, 1, 1): grey, the same in every channel); each
-       component finite and >= 0. Only the one-pass colour group can use a colour that is not
-       grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
-       density alone (create_ramp logs a warning for a non-grey colour without the variant). */
-    float extinction_color[3];
-} fogvol_ramp_desc;
 
 /* width x 1 texels; texel i holds thickness i/(width-1) * max_thickness.
    *max_thickness_out (may be NULL) receives the resolved max_thickness. */
@@ -1300,9 +1304,6 @@ typedef enum fogvol_alpha {
     FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
     FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
 } fogvol_alpha;
-
-FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
-FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
 
 typedef struct fogvol_frame_stats {
     int passes;             /* passes issued this frame */
