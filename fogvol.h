@@ -576,6 +576,360 @@ typedef struct fogvol_ramp_desc {
 FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
 FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
 
+/* ---- frames: camera, occluders, volumes, lights; MRT and engine-drawn occluders ---- */
+/* Both composites write the same pixels with the same values and leave the
+   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
+   the window rectangle of each ramp group's volumes (the 8 corners of each
+   mesh's bounding box projected; the whole viewport when a box reaches behind
+   the near plane), which saves fill rate when the volumes cover little of the
+   screen. */
+typedef enum fogvol_composite {
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
+} fogvol_composite;
+
+/* What the composite does to the alpha of the engine's colour target. */
+typedef enum fogvol_alpha {
+    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
+    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
+} fogvol_alpha;
+
+typedef struct fogvol_frame_stats {
+    int passes;             /* passes issued this frame */
+    int volumes, occluders; /* drawn */
+    int groups;             /* colour-ramp groups composited */
+    int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
+    int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
+    int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
+                               drew one fog value per pixel */
+    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
+       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
+       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
+       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
+       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
+       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
+       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
+    int overflow_pixels_late;
+    int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
+    int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
+    int overflow_passes;     /* check passes issued this frame (not included in passes) */
+    int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
+} fogvol_frame_stats;
+
+typedef enum fogvol_depth_source {
+    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
+    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
+    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
+    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
+} fogvol_depth_source;
+
+/* What the frame's camera is given as (fogvol_frame_desc.camera). */
+typedef enum fogvol_camera {
+    FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
+    FOGVOL_CAMERA_VIEW_PROJECTION = 1      /* view_projection (clip from world), eye and forward */
+} fogvol_camera;
+
+/* Derives the planes of a projection (perspective, reversed, infinite or orthographic).
+   zero_to_one: 1 if the projection maps the depth range to NDC z in [0,1] (D3D style, for
+   glClipControl ZERO_TO_ONE), 0 for [-1,1]; reversed projections (z_ndc high at near) are
+   recognised. Perspective projections need w = -s * z_view (s > 0), orthographic ones w
+   constant > 0; anything else, or planes that are not 0 < near < far (near > 0 for
+   perspective), is FOGVOL_ERROR_INVALID_ARGUMENT. An infinite far plane gives infinite = 1
+   and zfar = 0: choose the far limit of the thickness range yourself. */
+typedef struct fogvol_projection_info {
+    float znear, zfar;
+    int orthographic; /* 1: w constant */
+    int reversed;     /* 1: NDC z decreases with distance */
+    int infinite;     /* 1: no far plane */
+} fogvol_projection_info;
+FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
+                                                  fogvol_projection_info *out);
+
+/* Camera: any projection whose clip w is the view depth times a positive constant
+   (perspective: standard, reversed-Z, [0,1] or [-1,1] depth, infinite far, jittered,
+   oblique near plane) or a positive constant (orthographic); others are refused with
+   FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
+   so the projection's depth convention does not matter to it (only to the engine depth
+   texture, see fogvol_frame_info), and decides the winding from how the projection
+   orients the screen (mirrored x or y flip it). */
+typedef struct fogvol_frame_desc {
+    float view[16];
+    float projection[16];
+    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
+                               depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    fogvol_composite composite;
+    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
+                               source compatibility) */
+    /* The engine's draw buffer the composite writes (index into its
+       glDrawBuffers list; 0 = the first, the only one for most engines); the
+       other draw buffers stay byte-identical. GL: an index past
+       GL_MAX_DRAW_BUFFERS, one whose buffer is GL_NONE, or > 0 on the default
+       framebuffer or on OpenGL ES (where list position i can only name
+       COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
+    int draw_buffer;
+    fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
+    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
+                               variant; SINGLE_TARGET runs one check pass after its additions for it,
+                               into the overflow mask V); FLOAT cannot saturate */
+    /* Debug read-back of the decoded thickness per pixel of the viewport, rows
+       bottom to top, for the group of debug_ramp (NULL = the first group). Set
+       debug_thickness to a width*height float buffer. Units: view-space w (the
+       distance along the view axis, world units when the view matrix has no
+       scale), between znear and zfar; this read-back stalls, for debugging only. */
+    float *debug_thickness;
+    const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
+                                      sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
+       object, GL: texture name), sampled with its .r; its window depth is mapped back
+       to view depth through the inverse of projection * view (any projection above) and
+       the depth conventions the backend reports (fogvol_frame_info) unless overridden by
+       the two fields below */
+    uintptr_t engine_depth_texture;
+    int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
+    float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
+    /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
+       (world-space direction the camera looks, any length) instead of view and projection;
+       view depth is then measured along forward from eye */
+    fogvol_camera camera;
+    float view_projection[16];
+    float eye[3], forward[3];
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
+       The other sources are depth buffers that cannot be sampled (the default
+       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
+       copies the viewport's depth into a single-sample depth texture of its own
+       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
+       format, which resolves a multisampled source to one sample per pixel;
+       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED). */
+    fogvol_depth_source engine_depth_source;
+    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+                                           (GL: framebuffer name, 0 = the default framebuffer) */
+} fogvol_frame_desc;
+
+/* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
+   the GPU before end_frame. A begin_frame while a frame is open discards the
+   open frame (logged as a warning).
+   GL backend, the engine's state (restored, or set for fogvol's passes and
+   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
+   the engine left pending are still pending after every fogvol call
+   (out-of-memory and context-loss codes cannot be raised again: logged as a
+   warning); an active transform feedback is paused during the call (GL 4.0 /
+   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
+   one); fogvol must not be called between glBeginConditionalRender and
+   glEndConditionalRender (not queryable: its passes could be skipped). */
+FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
+FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
+/* The callback runs inside the O pass with the depth-encode program bound:
+   for each engine draw call fogvol_occluder_transform(ctx, model) first and
+   keep the position in vertex attribute 0; change no other state. */
+typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
+FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
+FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
+
+typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
+typedef struct fogvol_volume_desc {
+    const fogvol_mesh *mesh;
+    float model[16];
+    const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
+    int negative;             /* 1: subtracts thickness from the volumes of its ramp */
+    /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
+       density factor rho in [0,1] sampled on every face fragment at the surface point, with
+       texture coordinates s = dot(density_map[0..3], (p, 1)), t = dot(density_map[4..7], (p, 1))
+       from the model-space position p (all 8 zero: s = x, t = y). Scroll it for drifting fog by
+       adding velocity * time to density_map[3] and [7] every frame; a 1-texel-high gradient with
+       FOGVOL_WRAP_CLAMP and s along a shaft's axis thins a light shaft towards its base.
+       What is summed: each face adds v = c + rho * (min(d, o) - c) instead of min(d, o) (d the
+       face's depth, o the opaque depth, c = min(o, depth of the centre of the volume's bounds),
+       c = 0 when the bounds reach nearer than znear). A closed hull's faces enter and leave
+       every ray equally often, so the c terms cancel and each chord [a, b] of the volume (b
+       clamped to o) contributes  rho_b (b - c) - rho_a (a - c)  (rho_a, rho_b: the density at
+       the entry and exit faces' surface points, also where the exit face is hidden behind o).
+       Exact (= rho * (b - a)) when the density is the same at both ends of every chord: a
+       density that does not vary along the rays (a 2D texture projected along the view
+       direction, e.g. an orthographic camera looking along the texture's projection axis, or a
+       density varying only across the screen). A chord hidden behind o entirely adds nothing
+       when o <= the centre depth (both faces add o). Otherwise an approximation, a two-point
+       rule: with rho_m the mean density along the chord the error per chord is
+       (rho_b - rho_m) (b - c) - (rho_a - rho_m) (a - c), at most the density contrast along the
+       chord times (|a - c| + |b - c|), i.e. about the contrast times the volume's depth extent.
+       RGBA8 tiers encode v like any depth (1 LSB per face). Tiers FLOAT, PS20 and MRT (with
+       SINGLE_TARGET, ALU, NEAR_CLAMP, ENGINE_DEPTH); PS13 (mediump cannot re-encode), COUNT
+       (the opaque depth it adds per missing back face carries no density) and WIDE:
+       fogvol_add_volume returns FOGVOL_ERROR_UNSUPPORTED, logged. A textured volume costs one
+       more pass per sum pass. */
+    const fogvol_volume_texture *density;
+    float density_map[8];
+    /* Colour texture (NULL = none): the composite multiplies the ramp colour's rgb by the
+       texture's rgb at s = dot(color_map[0..2], (x, y, 1)), t = dot(color_map[3..5], (x, y, 1)),
+       (x, y) the pixel's position across the viewport in [0,1] (all 6 zero = s = x, t = y).
+       The composite draws one colour-ramp group at a time, so the volumes of one ramp share one
+       colour texture: a volume whose colour texture or map differs from an earlier volume of
+       its ramp in this frame is refused (FOGVOL_ERROR_INVALID_ARGUMENT, logged); volumes
+       without one take the group's. Every tier and dialect. */
+    const fogvol_volume_texture *color;
+    float color_map[6];
+} fogvol_volume_desc;
+FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
+
+/* Textures for volumes (density, colour): RGBA8, rows bottom to top, desc->filter and wrap
+   as given (width, height 1..4096; pixels required). */
+FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
+                                                      fogvol_volume_texture **out);
+/* Inside a frame, the volumes that use it are dropped from the frame (logged). */
+FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture);
+
+/* Volume light by compare: the scene pixels whose opaque depth (fogvol's occluders, the MRT
+   target or the engine's depth texture: whatever the tier's O is) lies between the depth of
+   the light volume's front face and its back face are lit: colour * intensity is added to
+   them (the engine framebuffer's RGB; alpha kept); pixels outside the volume, in front of it
+   or behind it, are untouched. A scene point is inside a convex volume exactly when its depth
+   lies between the one front and the one back face on its ray, so the mesh must be convex
+   (fogvol_mesh_report.convex == 1); a concave mesh is refused with FOGVOL_ERROR_INVALID_MESH
+   and a logged message. A camera inside the light works (no front face: from the near plane).
+   Lights are drawn after the opaque depth and before the fog groups, so fog covers lit pixels.
+   RGBA8 tiers compare depths decoded from the encoding (12 bits by default: a pixel within
+   about one encoding LSB of the volume's surface may fall either way). Tiers FLOAT, PS20 (not
+   WIDE) and MRT; PS13 and WIDE: FOGVOL_ERROR_UNSUPPORTED, logged. Two passes per light. */
+typedef struct fogvol_light_desc {
+    const fogvol_mesh *mesh;  /* closed, convex */
+    float model[16];
+    float color[3];           /* added to lit pixels */
+    float intensity;          /* 0 = 1 */
+} fogvol_light_desc;
+FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
+FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
+FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
+
+/* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
+   makes the O texture the size of the frame's viewport (this touches the GPU,
+   state restored) and returns what the engine needs: the texture to attach as
+   its second colour target (backend API object, GL: texture name), the colour
+   to clear that attachment to before drawing ("far"), and the values of the
+   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
+   viewport-sized with origin (0,0). */
+typedef struct fogvol_mrt_info {
+    uintptr_t texture;
+    float clear_color[4];
+    float uniforms[8];
+} fogvol_mrt_info;
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
+/* MRT tier: GLSL for the engine's opaque fragment shader. It declares
+   uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
+   vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
+   writes to its second colour output. Insert after the #version line and the
+   engine's precision statements. */
+FOGVOL_API const char *fogvol_mrt_snippet(void);
+
+/* Occluders drawn by the engine with its own programs, pipelines and vertex
+   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
+   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
+   before fogvol_end_frame: makes fogvol's O target the size of the viewport
+   (touches the GPU, state restored) and returns what the engine needs to draw
+   its occluders into it: attach texture as the only colour target of a
+   framebuffer of width x height with the engine's own depth buffer, clear
+   colour to clear_color and depth to "far", draw with a depth test that keeps
+   the nearest surface, and write fogvol_occluder_color(view_depth) from
+   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
+   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
+   uniforms. end_frame then uses what the engine drew instead of its own O
+   pass; fogvol_add_occluder* in the same frame is refused. */
+typedef struct fogvol_occluder_info {
+    uintptr_t texture;        /* backend API object (GL: texture name) */
+    int width, height;
+    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
+    float clear_color[4];
+    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
+} fogvol_occluder_info;
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
+/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
+   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
+   line and the engine's precision statements. */
+FOGVOL_API const char *fogvol_occluder_snippet(void);
+
+/* ---- image-space effects ---------------------------------------------------
+   Screen-space passes over the engine's depth (and colour, normals), drawn
+   into the framebuffer bound when they are called, GL state restored like a
+   frame. Call them outside a frame (not between fogvol_begin_frame and
+   fogvol_end_frame: FOGVOL_ERROR_INVALID_STATE). Each desc points at a
+   fogvol_frame_desc that supplies the camera (view and projection, or
+   view_projection + eye + forward), znear < zfar (validated as for a frame;
+   not used otherwise), the viewport written, draw_buffer, alpha (outlines,
+   distance fog) and the engine depth texture with its conventions:
+   engine_depth_texture (required: FOGVOL_ERROR_INVALID_ARGUMENT without it),
+   engine_depth_zero_to_one and engine_depth_range (0 = as the backend reports
+   the context's clip control and depth range). View depth e is the distance
+   along the view axis, recovered from window depth exactly as the
+   ENGINE_DEPTH variant does (any projection fogvol_frame_desc accepts:
+   reversed-Z, [0,1] depth, infinite far, orthographic).
+   Engine textures (GL texture names) are read at texel centres, texel =
+   framebuffer pixel (the texture covers the framebuffer from its origin);
+   texture_size 0 = (viewport x + width, viewport y + height). Taps outside
+   the viewport are clamped to its edge pixels. A texture sampled must not be
+   attached to the framebuffer written. Needs FOGVOL_CAP_DEPTH_TEXTURE and
+   FOGVOL_CAP_HIGHP_FRAGMENT (view depth from window depth in mediump is
+   useless): else FOGVOL_ERROR_UNSUPPORTED. Every GLSL dialect fogvol has
+   (110 ... 330 core, ES 100 with highp, ES 300) compiles every effect. */
+typedef enum fogvol_post_effect {
+    FOGVOL_POST_DOF = 0,          /* depth of field */
+    FOGVOL_POST_OUTLINES = 1,     /* edges from depth (and normal) deltas */
+    FOGVOL_POST_DISTANCE_FOG = 2, /* a colour ramp of view depth */
+    FOGVOL_POST_EFFECT_COUNT = 3
+} fogvol_post_effect;
+
+/* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
+   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
+   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
+   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
+   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
+   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
+   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
+   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
+   without blending (in-focus pixels keep their colour exactly). */
+typedef struct fogvol_dof_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
+    float focus_distance;    /* view depth in focus (> 0) */
+    float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
+    float max_radius;        /* pixels, 0 = 4, at most 64 */
+    int taps;                /* 0 = 6; 3, 6 or 12 */
+} fogvol_dof_desc;
+FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
+
+/* Outlines (cel-shading look) by a 3x3 moving kernel. Depth: with g = 1/e
+   (perspective; e for orthographic), which is linear across the screen on any
+   plane, an edge is where a line of three pixels through the centre
+   (horizontal, vertical, both diagonals, both ends inside the viewport) has
+   |g(-o) + g(+o) - 2 g0| > depth_threshold * |g0|: depth discontinuities and
+   creases, never a flat slope. Normals (optional): n = 2 rgb - 1 normalised,
+   an edge where 1 - dot(n0, nk) > normal_threshold for one of the 8
+   neighbours. Edge pixels get color blended like the fog composite
+   (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
+typedef struct fogvol_outline_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
+    float color[4];           /* rgb, a = opacity; all 0 = opaque black */
+    float depth_threshold;    /* relative second difference, 0 = 0.05 */
+    float normal_threshold;   /* 1 - cos(angle), 0 = 0.3 */
+} fogvol_outline_desc;
+FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc);
+
+/* Image-space distance fog: thickness t = max(e - start, 0) looked up in a
+   colour ramp exactly as the volume composite does (texel i holds
+   i / (width - 1) * max_thickness, linear filtering, clamped at the ends) and
+   blended by the ramp's blend (FOG: rgb = mix(rgb, ramp.rgb, ramp.a); LIGHT:
+   rgb += ramp.rgb * ramp.a) over the viewport. Pixels at the far plane (sky)
+   get the fog of e = zfar of the projection (infinite: the ramp's end). */
+typedef struct fogvol_distance_fog_desc {
+    const fogvol_frame_desc *frame;
+    const fogvol_ramp *ramp;  /* required */
+    int texture_size[2];      /* of the depth texture; 0 = from the viewport */
+    float start;              /* view depth where the fog begins (>= 0) */
+} fogvol_distance_fog_desc;
+FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
+
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
    L-bit digits: red (most significant), green, blue, each stored in the low L
@@ -736,12 +1090,11 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 /* 1 if the tier runs this program. */
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
 
-/* MRT tier: GLSL for the engine's opaque fragment shader. It declares
-   uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
-   vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
-   writes to its second colour output. Insert after the #version line and the
-   engine's precision statements. */
-FOGVOL_API const char *fogvol_mrt_snippet(void);
+/* The GLSL of an effect for the engine's own use or validation. variant: DOF the
+   tap count (3, 6, 12), OUTLINES 1 = with normals, DISTANCE_FOG 0. Samplers:
+   fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
+FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
+                                                    fogvol_stage stage, const char **strings, int *count);
 
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
@@ -1286,360 +1639,6 @@ struct fogvol_context_desc {
     unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
                                   measuring what each one gives (bench/bench.c) */
 };
-
-/* ---- renderer ------------------------------------------------------------ */
-/* Both composites write the same pixels with the same values and leave the
-   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
-   the window rectangle of each ramp group's volumes (the 8 corners of each
-   mesh's bounding box projected; the whole viewport when a box reaches behind
-   the near plane), which saves fill rate when the volumes cover little of the
-   screen. */
-typedef enum fogvol_composite {
-    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
-    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
-} fogvol_composite;
-
-/* What the composite does to the alpha of the engine's colour target. */
-typedef enum fogvol_alpha {
-    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
-    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
-} fogvol_alpha;
-
-typedef struct fogvol_frame_stats {
-    int passes;             /* passes issued this frame */
-    int volumes, occluders; /* drawn */
-    int groups;             /* colour-ramp groups composited */
-    int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
-    int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
-    int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
-                               drew one fog value per pixel */
-    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
-       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
-       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
-       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
-       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
-       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
-       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
-    int overflow_pixels_late;
-    int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
-    int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
-    int overflow_passes;     /* check passes issued this frame (not included in passes) */
-    int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
-} fogvol_frame_stats;
-
-typedef enum fogvol_depth_source {
-    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
-    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
-    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
-    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
-} fogvol_depth_source;
-
-/* What the frame's camera is given as (fogvol_frame_desc.camera). */
-typedef enum fogvol_camera {
-    FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
-    FOGVOL_CAMERA_VIEW_PROJECTION = 1      /* view_projection (clip from world), eye and forward */
-} fogvol_camera;
-
-/* Derives the planes of a projection (perspective, reversed, infinite or orthographic).
-   zero_to_one: 1 if the projection maps the depth range to NDC z in [0,1] (D3D style, for
-   glClipControl ZERO_TO_ONE), 0 for [-1,1]; reversed projections (z_ndc high at near) are
-   recognised. Perspective projections need w = -s * z_view (s > 0), orthographic ones w
-   constant > 0; anything else, or planes that are not 0 < near < far (near > 0 for
-   perspective), is FOGVOL_ERROR_INVALID_ARGUMENT. An infinite far plane gives infinite = 1
-   and zfar = 0: choose the far limit of the thickness range yourself. */
-typedef struct fogvol_projection_info {
-    float znear, zfar;
-    int orthographic; /* 1: w constant */
-    int reversed;     /* 1: NDC z decreases with distance */
-    int infinite;     /* 1: no far plane */
-} fogvol_projection_info;
-FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
-                                                  fogvol_projection_info *out);
-
-/* Camera: any projection whose clip w is the view depth times a positive constant
-   (perspective: standard, reversed-Z, [0,1] or [-1,1] depth, infinite far, jittered,
-   oblique near plane) or a positive constant (orthographic); others are refused with
-   FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
-   so the projection's depth convention does not matter to it (only to the engine depth
-   texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
-typedef struct fogvol_frame_desc {
-    float view[16];
-    float projection[16];
-    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
-                               depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
-    int viewport[4];        /* x, y, width, height in the engine framebuffer */
-    fogvol_composite composite;
-    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
-                               source compatibility) */
-    /* The engine's draw buffer the composite writes (index into its
-       glDrawBuffers list; 0 = the first, the only one for most engines); the
-       other draw buffers stay byte-identical. GL: an index past
-       GL_MAX_DRAW_BUFFERS, one whose buffer is GL_NONE, or > 0 on the default
-       framebuffer or on OpenGL ES (where list position i can only name
-       COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
-    int draw_buffer;
-    fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
-    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
-                               variant; SINGLE_TARGET runs one check pass after its additions for it,
-                               into the overflow mask V); FLOAT cannot saturate */
-    /* Debug read-back of the decoded thickness per pixel of the viewport, rows
-       bottom to top, for the group of debug_ramp (NULL = the first group). Set
-       debug_thickness to a width*height float buffer. Units: view-space w (the
-       distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
-    float *debug_thickness;
-    const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
-                                      sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
-    /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
-       object, GL: texture name), sampled with its .r; its window depth is mapped back
-       to view depth through the inverse of projection * view (any projection above) and
-       the depth conventions the backend reports (fogvol_frame_info) unless overridden by
-       the two fields below */
-    uintptr_t engine_depth_texture;
-    int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
-    float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
-    /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
-       (world-space direction the camera looks, any length) instead of view and projection;
-       view depth is then measured along forward from eye */
-    fogvol_camera camera;
-    float view_projection[16];
-    float eye[3], forward[3];
-    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
-       The other sources are depth buffers that cannot be sampled (the default
-       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
-       copies the viewport's depth into a single-sample depth texture of its own
-       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
-       format, which resolves a multisampled source to one sample per pixel;
-       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
-       FOGVOL_ERROR_UNSUPPORTED). */
-    fogvol_depth_source engine_depth_source;
-    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
-                                           (GL: framebuffer name, 0 = the default framebuffer) */
-} fogvol_frame_desc;
-
-/* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
-   the GPU before end_frame. A begin_frame while a frame is open discards the
-   open frame (logged as a warning).
-   GL backend, the engine's state (restored, or set for fogvol's passes and
-   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); fogvol must not be called between glBeginConditionalRender and
-   glEndConditionalRender (not queryable: its passes could be skipped). */
-FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
-FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
-/* The callback runs inside the O pass with the depth-encode program bound:
-   for each engine draw call fogvol_occluder_transform(ctx, model) first and
-   keep the position in vertex attribute 0; change no other state. */
-typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
-FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
-FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
-
-typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
-typedef struct fogvol_volume_desc {
-    const fogvol_mesh *mesh;
-    float model[16];
-    const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
-    int negative;             /* 1: subtracts thickness from the volumes of its ramp */
-    /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
-       density factor rho in [0,1] sampled on every face fragment at the surface point, with
-       texture coordinates s = dot(density_map[0..3], (p, 1)), t = dot(density_map[4..7], (p, 1))
-       from the model-space position p (all 8 zero: s = x, t = y). Scroll it for drifting fog by
-       adding velocity * time to density_map[3] and [7] every frame; a 1-texel-high gradient with
-       FOGVOL_WRAP_CLAMP and s along a shaft's axis thins a light shaft towards its base.
-       What is summed: each face adds v = c + rho * (min(d, o) - c) instead of min(d, o) (d the
-       face's depth, o the opaque depth, c = min(o, depth of the centre of the volume's bounds),
-       c = 0 when the bounds reach nearer than znear). A closed hull's faces enter and leave
-       every ray equally often, so the c terms cancel and each chord [a, b] of the volume (b
-       clamped to o) contributes  rho_b (b - c) - rho_a (a - c)  (rho_a, rho_b: the density at
-       the entry and exit faces' surface points, also where the exit face is hidden behind o).
-       Exact (= rho * (b - a)) when the density is the same at both ends of every chord: a
-       density that does not vary along the rays (a 2D texture projected along the view
-       direction, e.g. an orthographic camera looking along the texture's projection axis, or a
-       density varying only across the screen). A chord hidden behind o entirely adds nothing
-       when o <= the centre depth (both faces add o). Otherwise an approximation, a two-point
-       rule: with rho_m the mean density along the chord the error per chord is
-       (rho_b - rho_m) (b - c) - (rho_a - rho_m) (a - c), at most the density contrast along the
-       chord times (|a - c| + |b - c|), i.e. about the contrast times the volume's depth extent.
-       RGBA8 tiers encode v like any depth (1 LSB per face). Tiers FLOAT, PS20 and MRT (with
-       SINGLE_TARGET, ALU, NEAR_CLAMP, ENGINE_DEPTH); PS13 (mediump cannot re-encode), COUNT
-       (the opaque depth it adds per missing back face carries no density) and WIDE:
-       fogvol_add_volume returns FOGVOL_ERROR_UNSUPPORTED, logged. A textured volume costs one
-       more pass per sum pass. */
-    const fogvol_volume_texture *density;
-    float density_map[8];
-    /* Colour texture (NULL = none): the composite multiplies the ramp colour's rgb by the
-       texture's rgb at s = dot(color_map[0..2], (x, y, 1)), t = dot(color_map[3..5], (x, y, 1)),
-       (x, y) the pixel's position across the viewport in [0,1] (all 6 zero = s = x, t = y).
-       The composite draws one colour-ramp group at a time, so the volumes of one ramp share one
-       colour texture: a volume whose colour texture or map differs from an earlier volume of
-       its ramp in this frame is refused (FOGVOL_ERROR_INVALID_ARGUMENT, logged); volumes
-       without one take the group's. Every tier and dialect. */
-    const fogvol_volume_texture *color;
-    float color_map[6];
-} fogvol_volume_desc;
-FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
-
-/* Textures for volumes (density, colour): RGBA8, rows bottom to top, desc->filter and wrap
-   as given (width, height 1..4096; pixels required). */
-FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
-                                                      fogvol_volume_texture **out);
-/* Inside a frame, the volumes that use it are dropped from the frame (logged). */
-FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture);
-
-/* Volume light by compare: the scene pixels whose opaque depth (fogvol's occluders, the MRT
-   target or the engine's depth texture: whatever the tier's O is) lies between the depth of
-   the light volume's front face and its back face are lit: colour * intensity is added to
-   them (the engine framebuffer's RGB; alpha kept); pixels outside the volume, in front of it
-   or behind it, are untouched. A scene point is inside a convex volume exactly when its depth
-   lies between the one front and the one back face on its ray, so the mesh must be convex
-   (fogvol_mesh_report.convex == 1); a concave mesh is refused with FOGVOL_ERROR_INVALID_MESH
-   and a logged message. A camera inside the light works (no front face: from the near plane).
-   Lights are drawn after the opaque depth and before the fog groups, so fog covers lit pixels.
-   RGBA8 tiers compare depths decoded from the encoding (12 bits by default: a pixel within
-   about one encoding LSB of the volume's surface may fall either way). Tiers FLOAT, PS20 (not
-   WIDE) and MRT; PS13 and WIDE: FOGVOL_ERROR_UNSUPPORTED, logged. Two passes per light. */
-typedef struct fogvol_light_desc {
-    const fogvol_mesh *mesh;  /* closed, convex */
-    float model[16];
-    float color[3];           /* added to lit pixels */
-    float intensity;          /* 0 = 1 */
-} fogvol_light_desc;
-FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
-FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
-FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
-
-/* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
-   makes the O texture the size of the frame's viewport (this touches the GPU,
-   state restored) and returns what the engine needs: the texture to attach as
-   its second colour target (backend API object, GL: texture name), the colour
-   to clear that attachment to before drawing ("far"), and the values of the
-   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
-   viewport-sized with origin (0,0). */
-typedef struct fogvol_mrt_info {
-    uintptr_t texture;
-    float clear_color[4];
-    float uniforms[8];
-} fogvol_mrt_info;
-FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
-
-/* Occluders drawn by the engine with its own programs, pipelines and vertex
-   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
-   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
-   before fogvol_end_frame: makes fogvol's O target the size of the viewport
-   (touches the GPU, state restored) and returns what the engine needs to draw
-   its occluders into it: attach texture as the only colour target of a
-   framebuffer of width x height with the engine's own depth buffer, clear
-   colour to clear_color and depth to "far", draw with a depth test that keeps
-   the nearest surface, and write fogvol_occluder_color(view_depth) from
-   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
-   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
-   uniforms. end_frame then uses what the engine drew instead of its own O
-   pass; fogvol_add_occluder* in the same frame is refused. */
-typedef struct fogvol_occluder_info {
-    uintptr_t texture;        /* backend API object (GL: texture name) */
-    int width, height;
-    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
-    float clear_color[4];
-    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
-} fogvol_occluder_info;
-FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
-/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
-   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
-   line and the engine's precision statements. */
-FOGVOL_API const char *fogvol_occluder_snippet(void);
-
-/* ---- image-space effects ---------------------------------------------------
-   Screen-space passes over the engine's depth (and colour, normals), drawn
-   into the framebuffer bound when they are called, GL state restored like a
-   frame. Call them outside a frame (not between fogvol_begin_frame and
-   fogvol_end_frame: FOGVOL_ERROR_INVALID_STATE). Each desc points at a
-   fogvol_frame_desc that supplies the camera (view and projection, or
-   view_projection + eye + forward), znear < zfar (validated as for a frame;
-   not used otherwise), the viewport written, draw_buffer, alpha (outlines,
-   distance fog) and the engine depth texture with its conventions:
-   engine_depth_texture (required: FOGVOL_ERROR_INVALID_ARGUMENT without it),
-   engine_depth_zero_to_one and engine_depth_range (0 = as the backend reports
-   the context's clip control and depth range). View depth e is the distance
-   along the view axis, recovered from window depth exactly as the
-   ENGINE_DEPTH variant does (any projection fogvol_frame_desc accepts:
-   reversed-Z, [0,1] depth, infinite far, orthographic).
-   Engine textures (GL texture names) are read at texel centres, texel =
-   framebuffer pixel (the texture covers the framebuffer from its origin);
-   texture_size 0 = (viewport x + width, viewport y + height). Taps outside
-   the viewport are clamped to its edge pixels. A texture sampled must not be
-   attached to the framebuffer written. Needs FOGVOL_CAP_DEPTH_TEXTURE and
-   FOGVOL_CAP_HIGHP_FRAGMENT (view depth from window depth in mediump is
-   useless): else FOGVOL_ERROR_UNSUPPORTED. Every GLSL dialect fogvol has
-   (110 ... 330 core, ES 100 with highp, ES 300) compiles every effect. */
-typedef enum fogvol_post_effect {
-    FOGVOL_POST_DOF = 0,          /* depth of field */
-    FOGVOL_POST_OUTLINES = 1,     /* edges from depth (and normal) deltas */
-    FOGVOL_POST_DISTANCE_FOG = 2, /* a colour ramp of view depth */
-    FOGVOL_POST_EFFECT_COUNT = 3
-} fogvol_post_effect;
-
-/* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
-   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
-   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
-   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
-   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
-   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
-   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
-   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
-   without blending (in-focus pixels keep their colour exactly). */
-typedef struct fogvol_dof_desc {
-    const fogvol_frame_desc *frame;
-    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
-    int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
-    float focus_distance;    /* view depth in focus (> 0) */
-    float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
-    float max_radius;        /* pixels, 0 = 4, at most 64 */
-    int taps;                /* 0 = 6; 3, 6 or 12 */
-} fogvol_dof_desc;
-FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
-
-/* Outlines (cel-shading look) by a 3x3 moving kernel. Depth: with g = 1/e
-   (perspective; e for orthographic), which is linear across the screen on any
-   plane, an edge is where a line of three pixels through the centre
-   (horizontal, vertical, both diagonals, both ends inside the viewport) has
-   |g(-o) + g(+o) - 2 g0| > depth_threshold * |g0|: depth discontinuities and
-   creases, never a flat slope. Normals (optional): n = 2 rgb - 1 normalised,
-   an edge where 1 - dot(n0, nk) > normal_threshold for one of the 8
-   neighbours. Edge pixels get color blended like the fog composite
-   (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
-typedef struct fogvol_outline_desc {
-    const fogvol_frame_desc *frame;
-    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
-    int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
-    float color[4];           /* rgb, a = opacity; all 0 = opaque black */
-    float depth_threshold;    /* relative second difference, 0 = 0.05 */
-    float normal_threshold;   /* 1 - cos(angle), 0 = 0.3 */
-} fogvol_outline_desc;
-FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc);
-
-/* Image-space distance fog: thickness t = max(e - start, 0) looked up in a
-   colour ramp exactly as the volume composite does (texel i holds
-   i / (width - 1) * max_thickness, linear filtering, clamped at the ends) and
-   blended by the ramp's blend (FOG: rgb = mix(rgb, ramp.rgb, ramp.a); LIGHT:
-   rgb += ramp.rgb * ramp.a) over the viewport. Pixels at the far plane (sky)
-   get the fog of e = zfar of the projection (infinite: the ramp's end). */
-typedef struct fogvol_distance_fog_desc {
-    const fogvol_frame_desc *frame;
-    const fogvol_ramp *ramp;  /* required */
-    int texture_size[2];      /* of the depth texture; 0 = from the viewport */
-    float start;              /* view depth where the fog begins (>= 0) */
-} fogvol_distance_fog_desc;
-FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
-
-/* The GLSL of an effect for the engine's own use or validation. variant: DOF the
-   tap count (3, 6, 12), OUTLINES 1 = with normals, DISTANCE_FOG 0. Samplers:
-   fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
-FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
-                                                    fogvol_stage stage, const char **strings, int *count);
 
 #ifndef FOGVOL_NO_GL
 /* The default GL backend on its own (fogvol_create_context makes one when the
