@@ -930,6 +930,305 @@ typedef struct fogvol_distance_fog_desc {
 } fogvol_distance_fog_desc;
 FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
 
+/* ---- backend table -------------------------------------------------------
+   Contract. Every entry gets the table's user_data first. Handles are
+   non-zero on success; 0 means "none". The renderer calls begin_frame, then
+   passes (begin_pass, draws, end_pass), then end_frame; create/destroy calls
+   may come inside or outside a frame. A backend must leave the engine's
+   state as it found it at begin_frame when end_frame returns, and resource
+   entries called outside a frame must not change engine state either.
+   NULL optional entries (marked) are skipped. */
+typedef uintptr_t fogvol_handle;
+
+/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
+   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
+   end. fogvol_uniform_name gives the name.
+   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   DECODE   fv_dec:     decode weights (world units)
+   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
+   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
+   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
+                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
+                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
+   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
+                        zw: offset of the engine depth texel (ENGINE_DEPTH)
+   LINEAR_W fv_lin2:    the denominator row of fv_lin
+   image-space effects (fogvol_post_*):
+   POST_TEXEL  fv_ptexel:  (1/texture width, 1/texture height, 1 = perspective, 0)
+   POST_RECT   fv_prect:   centres of the viewport's first and last pixels (x0, y0, x1, y1)
+   POST_PARAMS fv_pparams: per effect (see fogvol__post_* in the implementation)
+   POST_COLOR  fv_pcolor:  outline colour
+   density and colour textures on volumes, volume light by compare:
+   DENSITY_U fv_dens_u: density texture s = dot(fv_dens_u, (model-space position, 1))
+   DENSITY_V fv_dens_v: density texture t, likewise
+   DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
+   COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
+   COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
+   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
+   SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
+                        COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
+                        not the ramp texture */
+#define FOGVOL_UNIFORMS(X) \
+    X(ENC, fv_enc) \
+    X(DITHER, fv_dith) \
+    X(SCREEN, fv_screen) \
+    X(DECODE, fv_dec) \
+    X(RAMP, fv_rampmap) \
+    X(MISC, fv_misc) \
+    X(LINEAR, fv_lin) \
+    X(NEARFAR, fv_nf) \
+    X(LINEAR_W, fv_lin2) \
+    X(POST_TEXEL, fv_ptexel) \
+    X(POST_RECT, fv_prect) \
+    X(POST_PARAMS, fv_pparams) \
+    X(POST_COLOR, fv_pcolor) \
+    X(DENSITY_U, fv_dens_u) \
+    X(DENSITY_V, fv_dens_v) \
+    X(DENSITY, fv_dens) \
+    X(COLOR_U, fv_ctex_u) \
+    X(COLOR_V, fv_ctex_v) \
+    X(LIGHT, fv_light) \
+    X(SPEEDUP, fv_speed)
+
+typedef enum fogvol_uniform {
+#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
+    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
+#undef FOGVOL__UNIFORM_ENUM
+    FOGVOL_U_COUNT
+} fogvol_uniform;
+FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
+
+/* Sampler units, fixed per program:
+   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
+   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
+   (the "2" samplers: second attachments of WIDE targets); FACE: fv_density 6 (density
+   texture); COMPOSITE*: fv_ctex 6 (colour texture); LIGHT: fv_rg 0, fv_blue 1, fv_dither 2,
+   fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
+   fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
+   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
+   "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
+   FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
+   Vertex attribute 0: "fv_position" (vec3). */
+#define FOGVOL_MAX_TEXTURE_UNITS 8
+
+typedef struct fogvol_target_desc {
+    int width, height;        /* colour texture, NEAREST, CLAMP */
+    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
+                                 both of the format */
+    fogvol_format format;
+    int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
+                                 2D multisample, fixed sample locations) and depth renderbuffer */
+    int depth;                /* 1: with a depth buffer */
+    fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
+    const char *label;
+} fogvol_target_desc;
+
+#define FOGVOL_MAX_SHADER_STRINGS 16
+
+typedef struct fogvol_program_desc {
+    const char *vs[FOGVOL_MAX_SHADER_STRINGS];
+    int vs_count;
+    const char *fs[FOGVOL_MAX_SHADER_STRINGS];
+    int fs_count;
+    const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
+    const char *label;
+} fogvol_program_desc;
+
+typedef struct fogvol_mesh_data {
+    const float *positions; /* tightly packed xyz (see stride, offset) */
+    int vertex_count;
+    const uint32_t *indices;
+    int index_count;
+    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
+       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
+       offset + i * stride of positions (stride 0 = 12), and with index_type
+       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
+    int stride, offset;
+    fogvol_index_type index_type;
+    const uint16_t *indices16;
+} fogvol_mesh_data;
+
+typedef enum fogvol_pass_blend {
+    FOGVOL_PASS_BLEND_NONE = 0,
+    FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
+    FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
+    FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
+    FOGVOL_PASS_BLEND_LIGHT = 3, /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
+    /* FOGVOL_VARIANT_COLORS, per-channel transmittance in two steps (alpha_coverage as for FOG) */
+    FOGVOL_PASS_BLEND_MULTIPLY = 5, /* RGB: ZERO, SRC_COLOR; A: ZERO, ONE (coverage: ZERO, SRC_ALPHA) */
+    FOGVOL_PASS_BLEND_EMIT = 6      /* RGB: ONE, ONE; A: ZERO, ONE (coverage: ONE, ONE) */
+} fogvol_pass_blend;
+
+typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
+
+typedef struct fogvol_pass {
+    fogvol_handle target;   /* 0 = the framebuffer bound when begin_frame was called */
+    int viewport[4];        /* x, y, w, h */
+    int clear;              /* clear colour (and depth to 1 when the target has one) */
+    float clear_color[4];
+    fogvol_pass_blend blend;
+    fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
+    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
+    int depth_write;
+    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
+                               stencil buffer; the bit is zero before and after the pass */
+    unsigned stencil_bit;
+    int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
+                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
+    int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
+    int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
+    int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
+    fogvol_handle program;
+    fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
+                                                         sampled as its colour texture) */
+    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+                                                            backend's own API (GL: a texture name) */
+    float uniforms[FOGVOL_U_COUNT][4];
+} fogvol_pass;
+
+typedef struct fogvol_draw {
+    float mvp[16];
+    float depth[4];
+    float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
+    int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
+    float extinction[4]; /* COLOR_FACE ("fv_ext"): per-channel extinction * (far - near), 0; else 0 */
+    float emission[4];   /* COLOR_FACE ("fv_emit"): extinction * the ramp colour; else 0 */
+} fogvol_draw;
+
+/* Capabilities a backend reports (fogvol_backend.caps). */
+enum {
+    FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
+    FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
+    FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
+    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
+    FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
+                                             (GL 4.0, or GL 3.2 + ARB_sample_shading) */
+    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
+};
+
+typedef struct fogvol_frame_info {
+    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
+    int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
+                         GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
+    /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
+       GL defaults): depth_zero_to_one 1 = clip control ZERO_TO_ONE (NDC z in [0,1]);
+       clip_upper_left 1 = clip control origin UPPER_LEFT (NDC y points down the window);
+       depth_range = glDepthRange (both 0 = (0, 1)). The GL backend reads them from the
+       context and draws its own passes with NEGATIVE_ONE_TO_ONE and depth range (0, 1). */
+    int depth_zero_to_one;
+    int clip_upper_left;
+    float depth_range[2];
+    int draw_buffer;  /* in: the engine draw buffer the composite writes (fogvol_frame_desc.draw_buffer);
+                         a backend that cannot write it returns an error from begin_frame */
+} fogvol_frame_info;
+
+typedef struct fogvol_backend {
+    void *user_data;
+    fogvol_dialect dialect; /* shader dialect the backend compiles */
+    unsigned caps;          /* FOGVOL_CAP_* */
+    /* optional: save engine state, report the engine framebuffer */
+    fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
+    void (*end_frame)(void *user_data);                      /* optional: restore engine state */
+    fogvol_result (*create_texture)(void *user_data, const fogvol_texture_desc *desc, fogvol_handle *out);
+    void (*destroy_texture)(void *user_data, fogvol_handle texture);
+    fogvol_result (*create_target)(void *user_data, const fogvol_target_desc *desc, fogvol_handle *out);
+    void (*destroy_target)(void *user_data, fogvol_handle target);
+    fogvol_result (*create_program)(void *user_data, const fogvol_program_desc *desc, fogvol_handle *out);
+    void (*destroy_program)(void *user_data, fogvol_handle program);
+    fogvol_result (*create_mesh)(void *user_data, const fogvol_mesh_data *data, fogvol_handle *out);
+    void (*destroy_mesh)(void *user_data, fogvol_handle mesh);
+    void (*begin_pass)(void *user_data, const fogvol_pass *pass);
+    void (*set_draw)(void *user_data, const fogvol_draw *draw); /* per-draw uniforms, for engine draws */
+    void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
+    void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
+    void (*end_pass)(void *user_data);        /* optional */
+    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+       bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
+    fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
+    void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
+    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
+    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    /* optional (WIDE): the second colour attachment of a two-attachment target,
+       as a target handle of its own (sampled and read back like any target) */
+    fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
+       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
+       bound at begin_frame; else framebuffer, an API object) into a
+       single-sample depth texture the backend owns, with the same texel
+       coordinates, and returns that texture's API object in *texture. */
+    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
+                                uintptr_t *texture);
+    /* optional (overflow counting without read-back; all five or none): occlusion queries that count
+       the samples passing between begin_query and end_query, which fogvol calls around the draws of
+       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
+       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
+       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
+       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
+       1, "any sample passed"). */
+    fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
+    void (*destroy_query)(void *user_data, fogvol_handle query);
+    int (*begin_query)(void *user_data, fogvol_handle query);
+    void (*end_query)(void *user_data, fogvol_handle query);
+    int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+} fogvol_backend;
+
+/* Recording null backend: no GPU, every call counted and the passes kept. */
+#define FOGVOL_NULL_MAX_PASSES 64
+typedef struct fogvol_null_backend {
+    int creates, destroys;  /* live handles = creates - destroys */
+    int frames_begun, frames_ended;
+    int pass_count;         /* passes in the current/last frame */
+    fogvol_pass passes[FOGVOL_NULL_MAX_PASSES];
+    int draws[FOGVOL_NULL_MAX_PASSES];    /* mesh draws per pass */
+    int fullscreen[FOGVOL_NULL_MAX_PASSES];
+    int in_pass;
+    fogvol_handle next_handle;
+    int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
+    int create_calls;
+    int stencil_bits;       /* reported by begin_frame */
+    int samples;            /* reported by begin_frame (engine framebuffer samples) */
+    /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
+       with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
+    int queries;
+    uint64_t query_samples;
+    int query_not_ready;
+    int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
+} fogvol_null_backend;
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
+   change table->caps before creating a context to test other choices. */
+FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
+
+#ifndef FOGVOL_NO_GL
+/* The default GL backend on its own (fogvol_create_context makes one when the
+   desc's backend table is empty). destroy it with table->destroy(table->user_data). */
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out);
+#endif
+
+/* ---- context desc --------------------------------------------------------
+   Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
+   the struct complete); fogvol_create_context is in the context section. */
+struct fogvol_context_desc {
+    fogvol_allocator allocator;
+    fogvol_logger logger;
+    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
+                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
+    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
+                              FLOAT if float blending, else MRT if engine_mrt and MRT,
+                              else PS20 if highp fragment shaders, else PS13 */
+    unsigned variants;     /* FOGVOL_VARIANT_* */
+    int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
+    int disable_dither;    /* dithering is on by default */
+    fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
+    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
+    fogvol_gl_desc gl;     /* for the GL backend */
+    fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
+    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
+                                  measuring what each one gives (bench/bench.c) */
+};
+
 /* ---- encoding ------------------------------------------------------------
    A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
    L-bit digits: red (most significant), green, blue, each stored in the low L
@@ -1066,8 +1365,6 @@ typedef enum fogvol_stage {
     FOGVOL_STAGE_FRAGMENT = 1,
     FOGVOL_STAGE_MAX_ENUM = 0x7fffffff
 } fogvol_stage;
-
-#define FOGVOL_MAX_SHADER_STRINGS 16
 
 typedef struct fogvol_shader_desc {
     fogvol_tier tier;      /* not AUTO */
@@ -1349,303 +1646,6 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
 FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
 
 #endif /* FOGVOL_NO_ANALYTIC */
-
-/* ---- backend table -------------------------------------------------------
-   Contract. Every entry gets the table's user_data first. Handles are
-   non-zero on success; 0 means "none". The renderer calls begin_frame, then
-   passes (begin_pass, draws, end_pass), then end_frame; create/destroy calls
-   may come inside or outside a frame. A backend must leave the engine's
-   state as it found it at begin_frame when end_frame returns, and resource
-   entries called outside a frame must not change engine state either.
-   NULL optional entries (marked) are skipped. */
-typedef uintptr_t fogvol_handle;
-
-/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
-   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
-   end. fogvol_uniform_name gives the name.
-   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
-   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
-   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
-   DECODE   fv_dec:     decode weights (world units)
-   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
-   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
-   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
-                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
-                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
-   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
-                        zw: offset of the engine depth texel (ENGINE_DEPTH)
-   LINEAR_W fv_lin2:    the denominator row of fv_lin
-   image-space effects (fogvol_post_*):
-   POST_TEXEL  fv_ptexel:  (1/texture width, 1/texture height, 1 = perspective, 0)
-   POST_RECT   fv_prect:   centres of the viewport's first and last pixels (x0, y0, x1, y1)
-   POST_PARAMS fv_pparams: per effect (see fogvol__post_* in the implementation)
-   POST_COLOR  fv_pcolor:  outline colour
-   density and colour textures on volumes, volume light by compare:
-   DENSITY_U fv_dens_u: density texture s = dot(fv_dens_u, (model-space position, 1))
-   DENSITY_V fv_dens_v: density texture t, likewise
-   DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
-   COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
-   COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
-   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
-   SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
-                        COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
-                        not the ramp texture */
-#define FOGVOL_UNIFORMS(X) \
-    X(ENC, fv_enc) \
-    X(DITHER, fv_dith) \
-    X(SCREEN, fv_screen) \
-    X(DECODE, fv_dec) \
-    X(RAMP, fv_rampmap) \
-    X(MISC, fv_misc) \
-    X(LINEAR, fv_lin) \
-    X(NEARFAR, fv_nf) \
-    X(LINEAR_W, fv_lin2) \
-    X(POST_TEXEL, fv_ptexel) \
-    X(POST_RECT, fv_prect) \
-    X(POST_PARAMS, fv_pparams) \
-    X(POST_COLOR, fv_pcolor) \
-    X(DENSITY_U, fv_dens_u) \
-    X(DENSITY_V, fv_dens_v) \
-    X(DENSITY, fv_dens) \
-    X(COLOR_U, fv_ctex_u) \
-    X(COLOR_V, fv_ctex_v) \
-    X(LIGHT, fv_light) \
-    X(SPEEDUP, fv_speed)
-
-typedef enum fogvol_uniform {
-#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
-    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
-#undef FOGVOL__UNIFORM_ENUM
-    FOGVOL_U_COUNT
-} fogvol_uniform;
-FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
-
-/* Sampler units, fixed per program:
-   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
-   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
-   (the "2" samplers: second attachments of WIDE targets); FACE: fv_density 6 (density
-   texture); COMPOSITE*: fv_ctex 6 (colour texture); LIGHT: fv_rg 0, fv_blue 1, fv_dither 2,
-   fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
-   fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
-   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
-   "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
-   FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
-   Vertex attribute 0: "fv_position" (vec3). */
-#define FOGVOL_MAX_TEXTURE_UNITS 8
-
-typedef struct fogvol_target_desc {
-    int width, height;        /* colour texture, NEAREST, CLAMP */
-    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
-                                 both of the format */
-    fogvol_format format;
-    int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
-                                 2D multisample, fixed sample locations) and depth renderbuffer */
-    int depth;                /* 1: with a depth buffer */
-    fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
-    const char *label;
-} fogvol_target_desc;
-
-typedef struct fogvol_program_desc {
-    const char *vs[FOGVOL_MAX_SHADER_STRINGS];
-    int vs_count;
-    const char *fs[FOGVOL_MAX_SHADER_STRINGS];
-    int fs_count;
-    const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
-    const char *label;
-} fogvol_program_desc;
-
-typedef struct fogvol_mesh_data {
-    const float *positions; /* tightly packed xyz (see stride, offset) */
-    int vertex_count;
-    const uint32_t *indices;
-    int index_count;
-    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
-       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
-       offset + i * stride of positions (stride 0 = 12), and with index_type
-       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
-    int stride, offset;
-    fogvol_index_type index_type;
-    const uint16_t *indices16;
-} fogvol_mesh_data;
-
-typedef enum fogvol_pass_blend {
-    FOGVOL_PASS_BLEND_NONE = 0,
-    FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
-    FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
-    FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
-    FOGVOL_PASS_BLEND_LIGHT = 3, /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
-    /* FOGVOL_VARIANT_COLORS, per-channel transmittance in two steps (alpha_coverage as for FOG) */
-    FOGVOL_PASS_BLEND_MULTIPLY = 5, /* RGB: ZERO, SRC_COLOR; A: ZERO, ONE (coverage: ZERO, SRC_ALPHA) */
-    FOGVOL_PASS_BLEND_EMIT = 6      /* RGB: ONE, ONE; A: ZERO, ONE (coverage: ONE, ONE) */
-} fogvol_pass_blend;
-
-typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
-
-typedef struct fogvol_pass {
-    fogvol_handle target;   /* 0 = the framebuffer bound when begin_frame was called */
-    int viewport[4];        /* x, y, w, h */
-    int clear;              /* clear colour (and depth to 1 when the target has one) */
-    float clear_color[4];
-    fogvol_pass_blend blend;
-    fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
-    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
-    int depth_write;
-    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
-                               stencil buffer; the bit is zero before and after the pass */
-    unsigned stencil_bit;
-    int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
-                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
-    int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
-    int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
-    int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
-    fogvol_handle program;
-    fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
-                                                         sampled as its colour texture) */
-    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
-                                                            backend's own API (GL: a texture name) */
-    float uniforms[FOGVOL_U_COUNT][4];
-} fogvol_pass;
-
-typedef struct fogvol_draw {
-    float mvp[16];
-    float depth[4];
-    float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
-    int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
-    float extinction[4]; /* COLOR_FACE ("fv_ext"): per-channel extinction * (far - near), 0; else 0 */
-    float emission[4];   /* COLOR_FACE ("fv_emit"): extinction * the ramp colour; else 0 */
-} fogvol_draw;
-
-/* Capabilities a backend reports (fogvol_backend.caps). */
-enum {
-    FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
-    FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
-    FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
-    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
-    FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
-                                             (GL 4.0, or GL 3.2 + ARB_sample_shading) */
-    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
-};
-
-typedef struct fogvol_frame_info {
-    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
-    int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
-                         GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
-    /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
-       GL defaults): depth_zero_to_one 1 = clip control ZERO_TO_ONE (NDC z in [0,1]);
-       clip_upper_left 1 = clip control origin UPPER_LEFT (NDC y points down the window);
-       depth_range = glDepthRange (both 0 = (0, 1)). The GL backend reads them from the
-       context and draws its own passes with NEGATIVE_ONE_TO_ONE and depth range (0, 1). */
-    int depth_zero_to_one;
-    int clip_upper_left;
-    float depth_range[2];
-    int draw_buffer;  /* in: the engine draw buffer the composite writes (fogvol_frame_desc.draw_buffer);
-                         a backend that cannot write it returns an error from begin_frame */
-} fogvol_frame_info;
-
-typedef struct fogvol_backend {
-    void *user_data;
-    fogvol_dialect dialect; /* shader dialect the backend compiles */
-    unsigned caps;          /* FOGVOL_CAP_* */
-    /* optional: save engine state, report the engine framebuffer */
-    fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
-    void (*end_frame)(void *user_data);                      /* optional: restore engine state */
-    fogvol_result (*create_texture)(void *user_data, const fogvol_texture_desc *desc, fogvol_handle *out);
-    void (*destroy_texture)(void *user_data, fogvol_handle texture);
-    fogvol_result (*create_target)(void *user_data, const fogvol_target_desc *desc, fogvol_handle *out);
-    void (*destroy_target)(void *user_data, fogvol_handle target);
-    fogvol_result (*create_program)(void *user_data, const fogvol_program_desc *desc, fogvol_handle *out);
-    void (*destroy_program)(void *user_data, fogvol_handle program);
-    fogvol_result (*create_mesh)(void *user_data, const fogvol_mesh_data *data, fogvol_handle *out);
-    void (*destroy_mesh)(void *user_data, fogvol_handle mesh);
-    void (*begin_pass)(void *user_data, const fogvol_pass *pass);
-    void (*set_draw)(void *user_data, const fogvol_draw *draw); /* per-draw uniforms, for engine draws */
-    void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
-    void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
-    void (*end_pass)(void *user_data);        /* optional */
-    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
-       bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
-    fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
-    void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
-    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
-    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
-    /* optional (WIDE): the second colour attachment of a two-attachment target,
-       as a target handle of its own (sampled and read back like any target) */
-    fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
-    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
-       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
-       bound at begin_frame; else framebuffer, an API object) into a
-       single-sample depth texture the backend owns, with the same texel
-       coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
-                                uintptr_t *texture);
-    /* optional (overflow counting without read-back; all five or none): occlusion queries that count
-       the samples passing between begin_query and end_query, which fogvol calls around the draws of
-       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
-       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
-       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
-       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
-       1, "any sample passed"). */
-    fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
-    void (*destroy_query)(void *user_data, fogvol_handle query);
-    int (*begin_query)(void *user_data, fogvol_handle query);
-    void (*end_query)(void *user_data, fogvol_handle query);
-    int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
-} fogvol_backend;
-
-/* Recording null backend: no GPU, every call counted and the passes kept. */
-#define FOGVOL_NULL_MAX_PASSES 64
-typedef struct fogvol_null_backend {
-    int creates, destroys;  /* live handles = creates - destroys */
-    int frames_begun, frames_ended;
-    int pass_count;         /* passes in the current/last frame */
-    fogvol_pass passes[FOGVOL_NULL_MAX_PASSES];
-    int draws[FOGVOL_NULL_MAX_PASSES];    /* mesh draws per pass */
-    int fullscreen[FOGVOL_NULL_MAX_PASSES];
-    int in_pass;
-    fogvol_handle next_handle;
-    int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
-    int create_calls;
-    int stencil_bits;       /* reported by begin_frame */
-    int samples;            /* reported by begin_frame (engine framebuffer samples) */
-    /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
-       with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
-    int queries;
-    uint64_t query_samples;
-    int query_not_ready;
-    int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
-} fogvol_null_backend;
-/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
-   change table->caps before creating a context to test other choices. */
-FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
-
-/* ---- context desc --------------------------------------------------------
-   Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
-   the struct complete); fogvol_create_context is in the context section. */
-struct fogvol_context_desc {
-    fogvol_allocator allocator;
-    fogvol_logger logger;
-    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
-                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
-    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
-                              FLOAT if float blending, else MRT if engine_mrt and MRT,
-                              else PS20 if highp fragment shaders, else PS13 */
-    unsigned variants;     /* FOGVOL_VARIANT_* */
-    int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
-    int disable_dither;    /* dithering is on by default */
-    fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
-    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
-    fogvol_gl_desc gl;     /* for the GL backend */
-    fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
-    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
-                                  measuring what each one gives (bench/bench.c) */
-};
-
-#ifndef FOGVOL_NO_GL
-/* The default GL backend on its own (fogvol_create_context makes one when the
-   desc's backend table is empty). destroy it with table->destroy(table->user_data). */
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
-                                                  const fogvol_logger *logger, fogvol_backend *out);
-#endif
 
 #ifdef __cplusplus
 }
