@@ -1290,27 +1290,6 @@ typedef struct fogvol_constants {
 FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar,
                                                   float scale, fogvol_constants *out);
 
-/* CPU reference of the GPU arithmetic. The renderer does not call these: they
-   model byte for byte what the encode, blend and decode passes compute, for
-   tests (fogvol's own and a custom backend's) and for offline tools. */
-/* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
-   depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
-   row 0 is the undithered (round-to-nearest) row. */
-FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
-                                             unsigned char out_rgba[4]);
-/* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
-   Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
-FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
-/* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
-   tells whether any channel saturated. */
-FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
-                                            int *saturated);
-/* Decoded value in units of (far - near): R/N + G/N^2 + B/N^3 - A/N^2. */
-FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4]);
-/* decode(a) - decode(b), computed as decode of the channel differences. */
-FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
-                                           const unsigned char b[4]);
-
 /* ---- textures (caller-owned RGBA8 buffers, rows bottom to top) -----------
    Each generator fills *info (width, height, size in bytes) and writes the
    texels when pixels != NULL. pixels == NULL is a size query. A capacity
@@ -1646,6 +1625,28 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
 FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
 
 #endif /* FOGVOL_NO_ANALYTIC */
+
+/* ---- CPU reference (tests and tools; the renderer does not use it) ------- */
+/* CPU reference of the GPU arithmetic. The renderer does not call these: they
+   model byte for byte what the encode, blend and decode passes compute, for
+   tests (fogvol's own and a custom backend's) and for offline tools. */
+/* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
+   depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
+   row 0 is the undithered (round-to-nearest) row. */
+FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
+                                             unsigned char out_rgba[4]);
+/* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
+   Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
+/* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
+   tells whether any channel saturated. */
+FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
+                                            int *saturated);
+/* Decoded value in units of (far - near): R/N + G/N^2 + B/N^3 - A/N^2. */
+FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4]);
+/* decode(a) - decode(b), computed as decode of the channel differences. */
+FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
+                                           const unsigned char b[4]);
 
 #ifdef __cplusplus
 }
