@@ -14,6 +14,25 @@
    8-L carry bits on top) so that additive blending sums up to 2^(8-L) faces
    exactly; a colour ramp maps thickness to colour, blended over the scene.
 
+   WHERE TO FIND WHAT (the declarations, in this order; search for "---- NAME")
+   ==================
+       basic types          result codes, logger, allocator, texture desc, formats
+       context              handles, tiers, variants, dialects, fogvol_gl_desc,
+                            fogvol_create_context
+       meshes               fogvol_mesh_desc, the validation report, create/destroy
+       ramps                thickness -> colour ramps, blend modes
+       frames               fogvol_frame_desc, begin/add/end frame, volume textures,
+                            lights, MRT and engine-drawn occluders
+       image-space effects  depth of field, outlines, distance fog
+       backend table        the contract of a custom backend, the null backend, the
+                            GL backend on its own
+       context desc         fogvol_context_desc (after the table, which it holds)
+       encoding             the RGB encoding of depths, fogvol_context_encoding
+       textures             the lookup textures and colour ramps on the CPU
+       shaders              the GLSL strings of each tier, variant and dialect
+       analytic fog         the analytic volumes (left out by FOGVOL_NO_ANALYTIC)
+       CPU reference        the GPU arithmetic on the CPU, for tests and tools
+
    BUILDING
    ========
    In exactly one C or C++ file:
