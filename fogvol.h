@@ -1645,7 +1645,7 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
 
 #endif /* FOGVOL_NO_ANALYTIC */
 
-/* ---- CPU reference (tests and tools; the renderer does not use it) ------- */
+/* ---- CPU reference ------------------------------------------------------- */
 /* CPU reference of the GPU arithmetic. The renderer does not call these: they
    model byte for byte what the encode, blend and decode passes compute, for
    tests (fogvol's own and a custom backend's) and for offline tools. */
