@@ -14,6 +14,25 @@
    8-L carry bits on top) so that additive blending sums up to 2^(8-L) faces
    exactly; a colour ramp maps thickness to colour, blended over the scene.
 
+   WHERE TO FIND WHAT (the declarations, in this order; search for "---- NAME")
+   ==================
+       basic types          result codes, logger, allocator, texture desc, formats
+       context              handles, tiers, variants, dialects, fogvol_gl_desc,
+                            fogvol_create_context
+       meshes               fogvol_mesh_desc, the validation report, create/destroy
+       ramps                thickness -> colour ramps, blend modes
+       frames               fogvol_frame_desc, begin/add/end frame, volume textures,
+                            lights, MRT and engine-drawn occluders
+       image-space effects  depth of field, outlines, distance fog
+       backend table        the contract of a custom backend, the null backend, the
+                            GL backend on its own
+       context desc         fogvol_context_desc (after the table, which it holds)
+       encoding             the RGB encoding of depths, fogvol_context_encoding
+       textures             the lookup textures and colour ramps on the CPU
+       shaders              the GLSL strings of each tier, variant and dialect
+       analytic fog         the analytic volumes (left out by FOGVOL_NO_ANALYTIC)
+       CPU reference        the GPU arithmetic on the CPU, for tests and tools
+
    BUILDING
    ========
    In exactly one C or C++ file:
@@ -183,6 +202,7 @@ extern "C" {
 
 /* >>declarations ========================================================== */
 
+/* ---- basic types: result codes, logging, allocation -------------------- */
 typedef enum fogvol_result {
     FOGVOL_SUCCESS = 0,
     FOGVOL_ERROR_INVALID_ARGUMENT = -1,   /* NULL, out of range, non-finite, near >= far ... */
@@ -223,240 +243,32 @@ typedef struct fogvol_logger {
     void *user_data;
 } fogvol_logger;
 
-/* ---- encoding ------------------------------------------------------------
-   A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
-   L-bit digits: red (most significant), green, blue, each stored in the low L
-   bits of an 8-bit channel. Additive blending then sums up to 2^(8-L) encoded
-   values with no loss (the 8-L high bits take the carries).
+/* Declared here, not with the backend table, because the frames section uses them
+   (fogvol_create_volume_texture, fogvol_occluder_info) and C declares before use. */
+typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
+typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
 
-   Dithering (on by default): the blue digit comes from a 2D ramp whose rows
-   hold different rounding thresholds; a pixel picks its row from an 8x8
-   ordered pattern. Row 0 rounds to nearest (no dither). Where a dithered row
-   rounds below the start of a blue period the texel holds blue = 2^L - 1 and
-   alpha = 1, meaning "minus one green step"; the alpha channel sums these
-   borrows and the decode weights carry -2^-L for alpha, so every channel of a
-   single encoded face stays <= 2^L - 1 and the sum stays exact and unbiased.
-
-   decode(RGBA bytes) = R/N + G/N^2 + B/N^3 - A/N^2   (N = 2^L, in units of far-near)
-*/
-typedef struct fogvol_encoding {
-    int bits;             /* L: low bits used per channel, 1..8 */
-    int levels;           /* N = 2^L */
-    int precision_bits;   /* 3L */
-    int max_faces;        /* faces summable without error per target: 2^(8-L) */
-    int max_faces_single; /* single-target variant with mid-range bias: 2^(7-L) (0 for L = 8) */
-    int dither_steps;     /* D: blue-ramp texels per blue LSB = dither rows (32, fewer for L >= 7) */
-} fogvol_encoding;
-
-#define FOGVOL_DEFAULT_BITS 4
-#define FOGVOL_WIDE_EXACT_BITS 3 /* largest L the WIDE variant encodes exactly (6L = 18 bits) */
-#define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
-
-/* Fill *out for L = bits (1..8). */
-FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out);
-/* Most precise encoding that sums at least max_faces faces (1..128).
-   max_faces < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 128: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out);
-/* Encoding with the most faces that still gives at least precision_bits (1..24).
-   precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out);
-/* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
-   writes min(count, capacity) rows when rows != NULL. */
-FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
-
-/* Constants a shader needs (all float, ready for uniforms). */
-typedef struct fogvol_constants {
-    float near_far[2];    /* (1/(far-near), -near/(far-near)): d = w*near_far[0] + near_far[1] */
-    float ramp_scale[4];  /* (1, 2^L, 2^2L, 0): texture coordinates of the red, green, blue ramps */
-    float depth_offset;   /* 2^-3L: added to the clamped d before the ramp lookups (one blue LSB;
-                             it pairs with the "-1" of the blue ramp's borrow convention) */
-    float depth_max;      /* d is clamped to [0, depth_max] = 1 - 1.5 * 2^-3L */
-    float decode[4];      /* scale * (1, 2^-L, 2^-2L, -2^-L): dot with RGBA normalised to [0,1] */
-    float scale;          /* the scale used: default (far-near) * 255 / 2^L (world units) */
-    float bias[4];        /* mid-range bias of the single-target variant, normalised (128/255 in RGB) */
-    float bias_decoded;   /* dot(bias, decode) */
-    float lsb;            /* one blue LSB in decoded units: scale / (255 * 2^2L) (world units by default) */
-    float dither_rows;    /* D */
-} fogvol_constants;
-
-/* scale == 0 means "decode to world units" ((far-near) * 255 / 2^L). */
-FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar,
-                                                  float scale, fogvol_constants *out);
-
-/* CPU reference of the GPU arithmetic. The renderer does not call these: they
-   model byte for byte what the encode, blend and decode passes compute, for
-   tests (fogvol's own and a custom backend's) and for offline tools. */
-/* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
-   depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
-   row 0 is the undithered (round-to-nearest) row. */
-FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
-                                             unsigned char out_rgba[4]);
-/* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
-   Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
-FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
-/* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
-   tells whether any channel saturated. */
-FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
-                                            int *saturated);
-/* Decoded value in units of (far - near): R/N + G/N^2 + B/N^3 - A/N^2. */
-FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4]);
-/* decode(a) - decode(b), computed as decode of the channel differences. */
-FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
-                                           const unsigned char b[4]);
-
-/* ---- textures (caller-owned RGBA8 buffers, rows bottom to top) -----------
-   Each generator fills *info (width, height, size in bytes) and writes the
-   texels when pixels != NULL. pixels == NULL is a size query. A capacity
-   smaller than info->size gives FOGVOL_ERROR_BUFFER_TOO_SMALL. */
-typedef struct fogvol_image {
+typedef struct fogvol_texture_desc {
     int width, height;
-    size_t size; /* width * height * 4 */
-} fogvol_image;
+    const unsigned char *pixels; /* RGBA8, rows bottom to top */
+    fogvol_filter filter;
+    fogvol_wrap wrap;
+    const char *label;
+} fogvol_texture_desc;
 
-/* N x N: texel (x, y) = (x, y, 0, 0). Sampled NEAREST + REPEAT at (u, u*N). */
-FOGVOL_API fogvol_result fogvol_make_rg_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
-                                             fogvol_image *info);
-/* (N*D) x D: row r, texel x -> blue digit with the dither threshold of row r
-   and the borrow in alpha. Sampled NEAREST + REPEAT(x) at (u*N^2, (row+0.5)/D). */
-FOGVOL_API fogvol_result fogvol_make_blue_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
-                                               fogvol_image *info);
-/* 8 x 8: red = blue-ramp row for the pixel (an ordered pattern over the
-   thresholds). Sampled NEAREST + REPEAT at gl_FragCoord.xy / 8. */
-FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, unsigned char *pixels,
-                                                  size_t capacity, fogvol_image *info);
-/* Rounding threshold of blue-ramp row r, in blue LSBs (row 0: 0.5). */
-FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row);
+typedef enum fogvol_format {
+    FOGVOL_FORMAT_RGBA8 = 0,
+    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
+                                 wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
+                                 EXT_color_buffer_float + EXT_float_blend) */
+} fogvol_format;
 
-/* Thickness -> colour ramps. */
-typedef enum fogvol_ramp_model {
-    FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
-    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, the GDC 2001 analytic fog law) */
-    FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
-    FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
-} fogvol_ramp_model;
+/* ---- context: handles, tiers, variants, dialects, the GL backend's desc ---- */
+typedef struct fogvol_context fogvol_context;
+typedef struct fogvol_mesh fogvol_mesh;
+typedef struct fogvol_ramp fogvol_ramp;
 
-/* Colour space. Ramp colours are used as given: the texel bytes are the
-   fragment colour the composite outputs, and GL blends it with the engine's
-   target like any draw. So
-   - an sRGB engine target (e.g. GL_SRGB8_ALPHA8) with GL_FRAMEBUFFER_SRGB
-     enabled: the colours are linear; GL decodes the target, blends in linear
-     light and encodes the result (fogvol leaves FRAMEBUFFER_SRGB as the
-     engine set it);
-   - a linear-format target (RGBA8, the default framebuffer), or
-     FRAMEBUFFER_SRGB disabled: colours and blending are in the space of the
-     stored values (usually sRGB-encoded: give sRGB colours).
-   The gradient model interpolates the keys in the space they are given in.
-   fogvol's own RGBA8 and R32F targets are linear formats, which
-   FRAMEBUFFER_SRGB does not affect. */
-typedef enum fogvol_blend {
-    FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
-    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, Baker's "Image-Space Rendering Techniques") */
-    FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
-} fogvol_blend;
-
-typedef struct fogvol_color_key {
-    float thickness; /* world units */
-    float rgba[4];   /* [0,1] */
-} fogvol_color_key;
-
-typedef struct fogvol_ramp_desc {
-    fogvol_ramp_model model;
-    float color[3];
-    float density;               /* per world unit (extinction, linear) */
-    float max_thickness;         /* thickness of the last texel; 0 = auto: extinction 7/density,
-                                    linear 1/density, gradient the last key */
-    const fogvol_color_key *keys; /* gradient: key_count >= 1, any order */
-    int key_count;
-    int width;                   /* texels, 0 = 256, 2..4096 */
-    fogvol_blend blend;          /* used by the renderer */
-    /* EXTINCTION with FOGVOL_VARIANT_COLORS: the extinction per colour channel is
-       density * extinction_color (all 0 = (1, 1, 1): grey, the same in every channel); each
-       component finite and >= 0. Only the one-pass colour group can use a colour that is not
-       grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
-       density alone (create_ramp logs a warning for a non-grey colour without the variant). */
-    float extinction_color[3];
-} fogvol_ramp_desc;
-
-/* width x 1 texels; texel i holds thickness i/(width-1) * max_thickness.
-   *max_thickness_out (may be NULL) receives the resolved max_thickness. */
-FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, unsigned char *pixels,
-                                                size_t capacity, fogvol_image *info, float *max_thickness_out);
-
-/* ---- meshes --------------------------------------------------------------
-   Volumes are closed hulls: every undirected edge used by exactly two
-   triangles, in opposite directions; triangles counter-clockwise seen from
-   outside. */
-typedef enum fogvol_index_type {
-    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
-    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
-    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
-} fogvol_index_type;
-
-typedef struct fogvol_mesh_desc {
-    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
-    int vertex_count;
-    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
-    const uint32_t *indices;   /* 3 per triangle */
-    int index_count;
-    int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
-    /* Engine vertex buffers as they are: offset is the byte offset of x inside
-       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
-       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
-       the GL backend among them, upload the bytes and read them in place). */
-    int offset;
-    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
-    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
-    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
-       most weld_distance from an earlier kept vertex is merged into it (seams of
-       UV spheres, per-face vertices of cubes); the validation, the report and
-       the uploaded indices then describe the welded mesh. 0 = off (indices as
-       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
-    float weld_distance;
-} fogvol_mesh_desc;
-
-typedef struct fogvol_mesh_report {
-    int vertices, triangles;
-    int open_edges;            /* undirected edges used by one triangle */
-    int nonmanifold_edges;     /* used by more than two */
-    int inconsistent_edges;    /* used by two triangles in the same direction */
-    int flipped_faces;         /* triangles whose winding disagrees with the majority of their part */
-    int degenerate_triangles;  /* repeated index or (near) zero area */
-    int nonfinite_vertices;    /* NaN or infinite coordinate */
-    int out_of_range_indices;  /* index >= vertex_count */
-    int components;            /* edge-connected parts */
-    double volume;             /* signed volume (positive for outward winding) */
-    int closed;                /* no open and no non-manifold edges */
-    int consistent;            /* no inconsistent edge, no flipped face */
-    int inverted;              /* closed, consistent, but wound inward (volume < 0) */
-    int inward_components;     /* components whose own signed volume is negative: harmless inside
-                                  another part (a cavity), refused where nothing encloses them */
-    int negative_winding;      /* probes that found a region of negative winding number (entered fewer
-                                  times than left): a part wound inward that no other part encloses,
-                                  or an inverted lobe of a self-intersecting hull; it would render
-                                  negative thickness and subtract from its ramp's other volumes */
-    int negative_triangle;     /* a triangle bounding such a region (index / 3 into the indices), -1: none */
-    int valid;                 /* usable as a fog volume */
-    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
-                                  vertices counts the rest */
-    /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
-       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
-       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
-       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
-       2^26 triangle x vertex pairs). */
-    int convex;
-} fogvol_mesh_report;
-
-/* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
-   hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
-   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
-   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
-   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
-   stride, unknown index_type, missing arrays, bad weld_distance). */
-FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
-                                              fogvol_mesh_report *report);
-
-/* ---- shaders ------------------------------------------------------------- */
 /* A new dialect: its value here before FOGVOL_GLSL_COUNT and its row in
    fogvol__dialects (the >>dialects section says what a row holds). */
 typedef enum fogvol_dialect {
@@ -545,6 +357,994 @@ enum {
     FOGVOL_VARIANT_ALL = (1u << 7) - 1u
 };
 
+/* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
+   else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
+   so on; see the table in the README). */
+FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+/* FOGVOL_SUCCESS if the tier with these variants can render into a
+   multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
+   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
+   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
+   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
+
+typedef struct fogvol_tier_info {
+    int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
+    int library_passes; /* passes fogvol issues per frame for one colour-ramp group
+                           (+1 per negative group pass in the RGBA8 tiers) */
+    int targets;        /* render targets fogvol allocates */
+    const char *name;
+} fogvol_tier_info;
+FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
+FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
+
+FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
+
+typedef void (*fogvol_gl_proc)(void);
+typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
+
+typedef struct fogvol_gl_desc {
+    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    void *user_data;
+    fogvol_dialect dialect;   /* 0 = from the context */
+    int version_major;        /* 0 = from the context; else treat the context as this GL version */
+    int version_minor;
+    int gles;                 /* with version_major: 1 = treat as OpenGL ES */
+    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
+} fogvol_gl_desc;
+
+/* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
+   fogvol_end_frame). AUTO: fogvol's targets get the engine's sample count and
+   every pass is shaded per sample, so each sample of the engine framebuffer
+   gets the fog of its own ray and the engine's resolve averages them; where
+   the tier, variants or GLSL dialect cannot (fogvol_msaa_supported) or the
+   backend lacks FOGVOL_CAP_MULTISAMPLE, end_frame logs why and returns
+   FOGVOL_ERROR_UNSUPPORTED without drawing. SINGLE_SAMPLE (opt-in): single-
+   sample targets, one fog value per pixel for all its samples (edges of
+   occluders inside fog come out wrong by up to the full fog contrast); logged
+   as a warning once and reported in fogvol_frame_stats.msaa_fallback.
+   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
+   fragment work and 4x the target memory of fogvol's passes (measured by
+   fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
+   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
+   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
+typedef enum fogvol_msaa {
+    FOGVOL_MSAA_AUTO = 0,
+    FOGVOL_MSAA_SINGLE_SAMPLE = 1,
+    FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
+} fogvol_msaa;
+/* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
+   reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
+   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
+   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
+   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
+typedef enum fogvol_overflow_policy {
+    FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
+    FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
+    FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
+                                       3 bits less precision: fogvol_context_encoding changes, the lookup
+                                       textures are rebuilt after the frame), logged as a warning each
+                                       time; the next frame uses it (MRT: the engine takes the new snippet
+                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
+                                       change do not lower it again. At L = 1 it warns once */
+    FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
+    FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
+} fogvol_overflow_policy;
+
+/* fogvol_context_desc holds a fogvol_backend by value, so its fields come after the backend
+   table (search "---- context desc"). */
+typedef struct fogvol_context_desc fogvol_context_desc;
+
+/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
+                 overflow check passes likewise.
+   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
+                 no O read without occluders, no density texture outside textured volumes, exp or
+                 ramp composite, no colour texture) instead of one program that switches on
+                 uniforms; built on first use (same pixels). */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4
+};
+
+FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
+FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
+FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
+
+/* ---- meshes --------------------------------------------------------------
+   Volumes are closed hulls: every undirected edge used by exactly two
+   triangles, in opposite directions; triangles counter-clockwise seen from
+   outside. */
+typedef enum fogvol_index_type {
+    FOGVOL_INDEX_UINT32 = 0, /* fogvol_mesh_desc.indices */
+    FOGVOL_INDEX_UINT16 = 1, /* fogvol_mesh_desc.indices16 */
+    FOGVOL_INDEX_MAX_ENUM = 0x7fffffff
+} fogvol_index_type;
+
+typedef struct fogvol_mesh_desc {
+    const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
+    int vertex_count;
+    int stride;                /* bytes between vertices, 0 = 12; at least 12 */
+    const uint32_t *indices;   /* 3 per triangle */
+    int index_count;
+    int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
+    /* Engine vertex buffers as they are: offset is the byte offset of x inside
+       each vertex (0 = 0; 0 <= offset, offset + 12 <= stride), so an interleaved
+       buffer goes in without copying (backends with FOGVOL_CAP_MESH_LAYOUT,
+       the GL backend among them, upload the bytes and read them in place). */
+    int offset;
+    fogvol_index_type index_type; /* 0 = 32-bit indices; FOGVOL_INDEX_UINT16: indices16 instead */
+    const uint16_t *indices16;    /* 3 per triangle, with FOGVOL_INDEX_UINT16 */
+    /* > 0: weld before validation: a vertex whose x, y and z each differ by at
+       most weld_distance from an earlier kept vertex is merged into it (seams of
+       UV spheres, per-face vertices of cubes); the validation, the report and
+       the uploaded indices then describe the welded mesh. 0 = off (indices as
+       given); negative or non-finite: FOGVOL_ERROR_INVALID_ARGUMENT. */
+    float weld_distance;
+} fogvol_mesh_desc;
+
+typedef struct fogvol_mesh_report {
+    int vertices, triangles;
+    int open_edges;            /* undirected edges used by one triangle */
+    int nonmanifold_edges;     /* used by more than two */
+    int inconsistent_edges;    /* used by two triangles in the same direction */
+    int flipped_faces;         /* triangles whose winding disagrees with the majority of their part */
+    int degenerate_triangles;  /* repeated index or (near) zero area */
+    int nonfinite_vertices;    /* NaN or infinite coordinate */
+    int out_of_range_indices;  /* index >= vertex_count */
+    int components;            /* edge-connected parts */
+    double volume;             /* signed volume (positive for outward winding) */
+    int closed;                /* no open and no non-manifold edges */
+    int consistent;            /* no inconsistent edge, no flipped face */
+    int inverted;              /* closed, consistent, but wound inward (volume < 0) */
+    int inward_components;     /* components whose own signed volume is negative: harmless inside
+                                  another part (a cavity), refused where nothing encloses them */
+    int negative_winding;      /* probes that found a region of negative winding number (entered fewer
+                                  times than left): a part wound inward that no other part encloses,
+                                  or an inverted lobe of a self-intersecting hull; it would render
+                                  negative thickness and subtract from its ramp's other volumes */
+    int negative_triangle;     /* a triangle bounding such a region (index / 3 into the indices), -1: none */
+    int valid;                 /* usable as a fog volume */
+    int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
+                                  vertices counts the rest */
+    /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
+       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
+       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
+       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
+       2^26 triangle x vertex pairs). */
+    int convex;
+} fogvol_mesh_report;
+
+/* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
+   hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
+   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
+   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   the vertex_count vertices (stride, offset) or indices[0 .. index_count).
+   FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
+   stride, unknown index_type, missing arrays, bad weld_distance). */
+FOGVOL_API fogvol_result fogvol_validate_mesh(const fogvol_mesh_desc *desc, const fogvol_allocator *alloc,
+                                              fogvol_mesh_report *report);
+
+/* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
+   open (desc->allow_open). *report (may be NULL) receives the check. */
+FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
+                                            fogvol_mesh_report *report);
+FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
+
+/* ---- ramps ---------------------------------------------------------------- */
+/* Thickness -> colour ramps. */
+typedef enum fogvol_ramp_model {
+    FOGVOL_RAMP_EXTINCTION = 0, /* rgb = color, a = 1 - exp(-density * t) */
+    FOGVOL_RAMP_LINEAR = 1,     /* rgb = color, a = clamp01(t * density) (fog = 1 - a, the GDC 2001 analytic fog law) */
+    FOGVOL_RAMP_GRADIENT = 2,   /* artist keys, linear interpolation of RGBA */
+    FOGVOL_RAMP_MODEL_MAX_ENUM = 0x7fffffff
+} fogvol_ramp_model;
+
+/* Colour space. Ramp colours are used as given: the texel bytes are the
+   fragment colour the composite outputs, and GL blends it with the engine's
+   target like any draw. So
+   - an sRGB engine target (e.g. GL_SRGB8_ALPHA8) with GL_FRAMEBUFFER_SRGB
+     enabled: the colours are linear; GL decodes the target, blends in linear
+     light and encodes the result (fogvol leaves FRAMEBUFFER_SRGB as the
+     engine set it);
+   - a linear-format target (RGBA8, the default framebuffer), or
+     FRAMEBUFFER_SRGB disabled: colours and blending are in the space of the
+     stored values (usually sRGB-encoded: give sRGB colours).
+   The gradient model interpolates the keys in the space they are given in.
+   fogvol's own RGBA8 and R32F targets are linear formats, which
+   FRAMEBUFFER_SRGB does not affect. */
+typedef enum fogvol_blend {
+    FOGVOL_BLEND_FOG = 0,   /* scene = mix(scene, rgb, a) */
+    FOGVOL_BLEND_LIGHT = 1, /* scene += rgb * a (volume light, Baker's "Image-Space Rendering Techniques") */
+    FOGVOL_BLEND_MAX_ENUM = 0x7fffffff
+} fogvol_blend;
+
+typedef struct fogvol_color_key {
+    float thickness; /* world units */
+    float rgba[4];   /* [0,1] */
+} fogvol_color_key;
+
+typedef struct fogvol_ramp_desc {
+    fogvol_ramp_model model;
+    float color[3];
+    float density;               /* per world unit (extinction, linear) */
+    float max_thickness;         /* thickness of the last texel; 0 = auto: extinction 7/density,
+                                    linear 1/density, gradient the last key */
+    const fogvol_color_key *keys; /* gradient: key_count >= 1, any order */
+    int key_count;
+    int width;                   /* texels, 0 = 256, 2..4096 */
+    fogvol_blend blend;          /* used by the renderer */
+    /* EXTINCTION with FOGVOL_VARIANT_COLORS: the extinction per colour channel is
+       density * extinction_color (all 0 = (1, 1, 1): grey, the same in every channel); each
+       component finite and >= 0. Only the one-pass colour group can use a colour that is not
+       grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
+       density alone (create_ramp logs a warning for a non-grey colour without the variant). */
+    float extinction_color[3];
+} fogvol_ramp_desc;
+
+FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
+FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
+
+/* ---- frames: camera, occluders, volumes, lights; MRT and engine-drawn occluders ---- */
+/* Both composites write the same pixels with the same values and leave the
+   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
+   the window rectangle of each ramp group's volumes (the 8 corners of each
+   mesh's bounding box projected; the whole viewport when a box reaches behind
+   the near plane), which saves fill rate when the volumes cover little of the
+   screen. */
+typedef enum fogvol_composite {
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
+} fogvol_composite;
+
+/* What the composite does to the alpha of the engine's colour target. */
+typedef enum fogvol_alpha {
+    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
+    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
+} fogvol_alpha;
+
+typedef struct fogvol_frame_stats {
+    int passes;             /* passes issued this frame */
+    int volumes, occluders; /* drawn */
+    int groups;             /* colour-ramp groups composited */
+    int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
+    int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
+    int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
+                               drew one fog value per pixel */
+    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
+       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
+       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
+       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
+       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
+       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
+       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
+    int overflow_pixels_late;
+    int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
+    int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
+    int overflow_passes;     /* check passes issued this frame (not included in passes) */
+    int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
+} fogvol_frame_stats;
+
+typedef enum fogvol_depth_source {
+    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
+    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
+    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
+    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
+} fogvol_depth_source;
+
+/* What the frame's camera is given as (fogvol_frame_desc.camera). */
+typedef enum fogvol_camera {
+    FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
+    FOGVOL_CAMERA_VIEW_PROJECTION = 1      /* view_projection (clip from world), eye and forward */
+} fogvol_camera;
+
+/* Derives the planes of a projection (perspective, reversed, infinite or orthographic).
+   zero_to_one: 1 if the projection maps the depth range to NDC z in [0,1] (D3D style, for
+   glClipControl ZERO_TO_ONE), 0 for [-1,1]; reversed projections (z_ndc high at near) are
+   recognised. Perspective projections need w = -s * z_view (s > 0), orthographic ones w
+   constant > 0; anything else, or planes that are not 0 < near < far (near > 0 for
+   perspective), is FOGVOL_ERROR_INVALID_ARGUMENT. An infinite far plane gives infinite = 1
+   and zfar = 0: choose the far limit of the thickness range yourself. */
+typedef struct fogvol_projection_info {
+    float znear, zfar;
+    int orthographic; /* 1: w constant */
+    int reversed;     /* 1: NDC z decreases with distance */
+    int infinite;     /* 1: no far plane */
+} fogvol_projection_info;
+FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
+                                                  fogvol_projection_info *out);
+
+/* Camera: any projection whose clip w is the view depth times a positive constant
+   (perspective: standard, reversed-Z, [0,1] or [-1,1] depth, infinite far, jittered,
+   oblique near plane) or a positive constant (orthographic); others are refused with
+   FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
+   so the projection's depth convention does not matter to it (only to the engine depth
+   texture, see fogvol_frame_info), and decides the winding from how the projection
+   orients the screen (mirrored x or y flip it). */
+typedef struct fogvol_frame_desc {
+    float view[16];
+    float projection[16];
+    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
+                               depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    fogvol_composite composite;
+    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
+                               source compatibility) */
+    /* The engine's draw buffer the composite writes (index into its
+       glDrawBuffers list; 0 = the first, the only one for most engines); the
+       other draw buffers stay byte-identical. GL: an index past
+       GL_MAX_DRAW_BUFFERS, one whose buffer is GL_NONE, or > 0 on the default
+       framebuffer or on OpenGL ES (where list position i can only name
+       COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
+    int draw_buffer;
+    fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
+    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
+                               variant; SINGLE_TARGET runs one check pass after its additions for it,
+                               into the overflow mask V); FLOAT cannot saturate */
+    /* Debug read-back of the decoded thickness per pixel of the viewport, rows
+       bottom to top, for the group of debug_ramp (NULL = the first group). Set
+       debug_thickness to a width*height float buffer. Units: view-space w (the
+       distance along the view axis, world units when the view matrix has no
+       scale), between znear and zfar; this read-back stalls, for debugging only. */
+    float *debug_thickness;
+    const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
+                                      sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
+       object, GL: texture name), sampled with its .r; its window depth is mapped back
+       to view depth through the inverse of projection * view (any projection above) and
+       the depth conventions the backend reports (fogvol_frame_info) unless overridden by
+       the two fields below */
+    uintptr_t engine_depth_texture;
+    int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
+    float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
+    /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
+       (world-space direction the camera looks, any length) instead of view and projection;
+       view depth is then measured along forward from eye */
+    fogvol_camera camera;
+    float view_projection[16];
+    float eye[3], forward[3];
+    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
+       The other sources are depth buffers that cannot be sampled (the default
+       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
+       copies the viewport's depth into a single-sample depth texture of its own
+       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
+       format, which resolves a multisampled source to one sample per pixel;
+       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED). */
+    fogvol_depth_source engine_depth_source;
+    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+                                           (GL: framebuffer name, 0 = the default framebuffer) */
+} fogvol_frame_desc;
+
+/* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
+   the GPU before end_frame. A begin_frame while a frame is open discards the
+   open frame (logged as a warning).
+   GL backend, the engine's state (restored, or set for fogvol's passes and
+   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
+   the engine left pending are still pending after every fogvol call
+   (out-of-memory and context-loss codes cannot be raised again: logged as a
+   warning); an active transform feedback is paused during the call (GL 4.0 /
+   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
+   one); fogvol must not be called between glBeginConditionalRender and
+   glEndConditionalRender (not queryable: its passes could be skipped). */
+FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
+FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
+/* The callback runs inside the O pass with the depth-encode program bound:
+   for each engine draw call fogvol_occluder_transform(ctx, model) first and
+   keep the position in vertex attribute 0; change no other state. */
+typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
+FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
+FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
+
+typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
+typedef struct fogvol_volume_desc {
+    const fogvol_mesh *mesh;
+    float model[16];
+    const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
+    int negative;             /* 1: subtracts thickness from the volumes of its ramp */
+    /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
+       density factor rho in [0,1] sampled on every face fragment at the surface point, with
+       texture coordinates s = dot(density_map[0..3], (p, 1)), t = dot(density_map[4..7], (p, 1))
+       from the model-space position p (all 8 zero: s = x, t = y). Scroll it for drifting fog by
+       adding velocity * time to density_map[3] and [7] every frame; a 1-texel-high gradient with
+       FOGVOL_WRAP_CLAMP and s along a shaft's axis thins a light shaft towards its base.
+       What is summed: each face adds v = c + rho * (min(d, o) - c) instead of min(d, o) (d the
+       face's depth, o the opaque depth, c = min(o, depth of the centre of the volume's bounds),
+       c = 0 when the bounds reach nearer than znear). A closed hull's faces enter and leave
+       every ray equally often, so the c terms cancel and each chord [a, b] of the volume (b
+       clamped to o) contributes  rho_b (b - c) - rho_a (a - c)  (rho_a, rho_b: the density at
+       the entry and exit faces' surface points, also where the exit face is hidden behind o).
+       Exact (= rho * (b - a)) when the density is the same at both ends of every chord: a
+       density that does not vary along the rays (a 2D texture projected along the view
+       direction, e.g. an orthographic camera looking along the texture's projection axis, or a
+       density varying only across the screen). A chord hidden behind o entirely adds nothing
+       when o <= the centre depth (both faces add o). Otherwise an approximation, a two-point
+       rule: with rho_m the mean density along the chord the error per chord is
+       (rho_b - rho_m) (b - c) - (rho_a - rho_m) (a - c), at most the density contrast along the
+       chord times (|a - c| + |b - c|), i.e. about the contrast times the volume's depth extent.
+       RGBA8 tiers encode v like any depth (1 LSB per face). Tiers FLOAT, PS20 and MRT (with
+       SINGLE_TARGET, ALU, NEAR_CLAMP, ENGINE_DEPTH); PS13 (mediump cannot re-encode), COUNT
+       (the opaque depth it adds per missing back face carries no density) and WIDE:
+       fogvol_add_volume returns FOGVOL_ERROR_UNSUPPORTED, logged. A textured volume costs one
+       more pass per sum pass. */
+    const fogvol_volume_texture *density;
+    float density_map[8];
+    /* Colour texture (NULL = none): the composite multiplies the ramp colour's rgb by the
+       texture's rgb at s = dot(color_map[0..2], (x, y, 1)), t = dot(color_map[3..5], (x, y, 1)),
+       (x, y) the pixel's position across the viewport in [0,1] (all 6 zero = s = x, t = y).
+       The composite draws one colour-ramp group at a time, so the volumes of one ramp share one
+       colour texture: a volume whose colour texture or map differs from an earlier volume of
+       its ramp in this frame is refused (FOGVOL_ERROR_INVALID_ARGUMENT, logged); volumes
+       without one take the group's. Every tier and dialect. */
+    const fogvol_volume_texture *color;
+    float color_map[6];
+} fogvol_volume_desc;
+FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
+
+/* Textures for volumes (density, colour): RGBA8, rows bottom to top, desc->filter and wrap
+   as given (width, height 1..4096; pixels required). */
+FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
+                                                      fogvol_volume_texture **out);
+/* Inside a frame, the volumes that use it are dropped from the frame (logged). */
+FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture);
+
+/* Volume light by compare: the scene pixels whose opaque depth (fogvol's occluders, the MRT
+   target or the engine's depth texture: whatever the tier's O is) lies between the depth of
+   the light volume's front face and its back face are lit: colour * intensity is added to
+   them (the engine framebuffer's RGB; alpha kept); pixels outside the volume, in front of it
+   or behind it, are untouched. A scene point is inside a convex volume exactly when its depth
+   lies between the one front and the one back face on its ray, so the mesh must be convex
+   (fogvol_mesh_report.convex == 1); a concave mesh is refused with FOGVOL_ERROR_INVALID_MESH
+   and a logged message. A camera inside the light works (no front face: from the near plane).
+   Lights are drawn after the opaque depth and before the fog groups, so fog covers lit pixels.
+   RGBA8 tiers compare depths decoded from the encoding (12 bits by default: a pixel within
+   about one encoding LSB of the volume's surface may fall either way). Tiers FLOAT, PS20 (not
+   WIDE) and MRT; PS13 and WIDE: FOGVOL_ERROR_UNSUPPORTED, logged. Two passes per light. */
+typedef struct fogvol_light_desc {
+    const fogvol_mesh *mesh;  /* closed, convex */
+    float model[16];
+    float color[3];           /* added to lit pixels */
+    float intensity;          /* 0 = 1 */
+} fogvol_light_desc;
+FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
+FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
+FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
+
+/* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
+   makes the O texture the size of the frame's viewport (this touches the GPU,
+   state restored) and returns what the engine needs: the texture to attach as
+   its second colour target (backend API object, GL: texture name), the colour
+   to clear that attachment to before drawing ("far"), and the values of the
+   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
+   viewport-sized with origin (0,0). */
+typedef struct fogvol_mrt_info {
+    uintptr_t texture;
+    float clear_color[4];
+    float uniforms[8];
+} fogvol_mrt_info;
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
+/* MRT tier: GLSL for the engine's opaque fragment shader. It declares
+   uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
+   vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
+   writes to its second colour output. Insert after the #version line and the
+   engine's precision statements. */
+FOGVOL_API const char *fogvol_mrt_snippet(void);
+
+/* Occluders drawn by the engine with its own programs, pipelines and vertex
+   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
+   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
+   before fogvol_end_frame: makes fogvol's O target the size of the viewport
+   (touches the GPU, state restored) and returns what the engine needs to draw
+   its occluders into it: attach texture as the only colour target of a
+   framebuffer of width x height with the engine's own depth buffer, clear
+   colour to clear_color and depth to "far", draw with a depth test that keeps
+   the nearest surface, and write fogvol_occluder_color(view_depth) from
+   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
+   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
+   uniforms. end_frame then uses what the engine drew instead of its own O
+   pass; fogvol_add_occluder* in the same frame is refused. */
+typedef struct fogvol_occluder_info {
+    uintptr_t texture;        /* backend API object (GL: texture name) */
+    int width, height;
+    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
+    float clear_color[4];
+    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
+} fogvol_occluder_info;
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
+/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
+   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
+   line and the engine's precision statements. */
+FOGVOL_API const char *fogvol_occluder_snippet(void);
+
+/* ---- image-space effects ---------------------------------------------------
+   Screen-space passes over the engine's depth (and colour, normals), drawn
+   into the framebuffer bound when they are called, GL state restored like a
+   frame. Call them outside a frame (not between fogvol_begin_frame and
+   fogvol_end_frame: FOGVOL_ERROR_INVALID_STATE). Each desc points at a
+   fogvol_frame_desc that supplies the camera (view and projection, or
+   view_projection + eye + forward), znear < zfar (validated as for a frame;
+   not used otherwise), the viewport written, draw_buffer, alpha (outlines,
+   distance fog) and the engine depth texture with its conventions:
+   engine_depth_texture (required: FOGVOL_ERROR_INVALID_ARGUMENT without it),
+   engine_depth_zero_to_one and engine_depth_range (0 = as the backend reports
+   the context's clip control and depth range). View depth e is the distance
+   along the view axis, recovered from window depth exactly as the
+   ENGINE_DEPTH variant does (any projection fogvol_frame_desc accepts:
+   reversed-Z, [0,1] depth, infinite far, orthographic).
+   Engine textures (GL texture names) are read at texel centres, texel =
+   framebuffer pixel (the texture covers the framebuffer from its origin);
+   texture_size 0 = (viewport x + width, viewport y + height). Taps outside
+   the viewport are clamped to its edge pixels. A texture sampled must not be
+   attached to the framebuffer written. Needs FOGVOL_CAP_DEPTH_TEXTURE and
+   FOGVOL_CAP_HIGHP_FRAGMENT (view depth from window depth in mediump is
+   useless): else FOGVOL_ERROR_UNSUPPORTED. Every GLSL dialect fogvol has
+   (110 ... 330 core, ES 100 with highp, ES 300) compiles every effect. */
+typedef enum fogvol_post_effect {
+    FOGVOL_POST_DOF = 0,          /* depth of field */
+    FOGVOL_POST_OUTLINES = 1,     /* edges from depth (and normal) deltas */
+    FOGVOL_POST_DISTANCE_FOG = 2, /* a colour ramp of view depth */
+    FOGVOL_POST_EFFECT_COUNT = 3
+} fogvol_post_effect;
+
+/* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
+   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
+   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
+   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
+   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
+   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
+   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
+   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
+   without blending (in-focus pixels keep their colour exactly). */
+typedef struct fogvol_dof_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
+    float focus_distance;    /* view depth in focus (> 0) */
+    float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
+    float max_radius;        /* pixels, 0 = 4, at most 64 */
+    int taps;                /* 0 = 6; 3, 6 or 12 */
+} fogvol_dof_desc;
+FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
+
+/* Outlines (cel-shading look) by a 3x3 moving kernel. Depth: with g = 1/e
+   (perspective; e for orthographic), which is linear across the screen on any
+   plane, an edge is where a line of three pixels through the centre
+   (horizontal, vertical, both diagonals, both ends inside the viewport) has
+   |g(-o) + g(+o) - 2 g0| > depth_threshold * |g0|: depth discontinuities and
+   creases, never a flat slope. Normals (optional): n = 2 rgb - 1 normalised,
+   an edge where 1 - dot(n0, nk) > normal_threshold for one of the 8
+   neighbours. Edge pixels get color blended like the fog composite
+   (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
+typedef struct fogvol_outline_desc {
+    const fogvol_frame_desc *frame;
+    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
+    float color[4];           /* rgb, a = opacity; all 0 = opaque black */
+    float depth_threshold;    /* relative second difference, 0 = 0.05 */
+    float normal_threshold;   /* 1 - cos(angle), 0 = 0.3 */
+} fogvol_outline_desc;
+FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc);
+
+/* Image-space distance fog: thickness t = max(e - start, 0) looked up in a
+   colour ramp exactly as the volume composite does (texel i holds
+   i / (width - 1) * max_thickness, linear filtering, clamped at the ends) and
+   blended by the ramp's blend (FOG: rgb = mix(rgb, ramp.rgb, ramp.a); LIGHT:
+   rgb += ramp.rgb * ramp.a) over the viewport. Pixels at the far plane (sky)
+   get the fog of e = zfar of the projection (infinite: the ramp's end). */
+typedef struct fogvol_distance_fog_desc {
+    const fogvol_frame_desc *frame;
+    const fogvol_ramp *ramp;  /* required */
+    int texture_size[2];      /* of the depth texture; 0 = from the viewport */
+    float start;              /* view depth where the fog begins (>= 0) */
+} fogvol_distance_fog_desc;
+FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
+
+/* ---- backend table -------------------------------------------------------
+   Contract. Every entry gets the table's user_data first. Handles are
+   non-zero on success; 0 means "none". The renderer calls begin_frame, then
+   passes (begin_pass, draws, end_pass), then end_frame; create/destroy calls
+   may come inside or outside a frame. A backend must leave the engine's
+   state as it found it at begin_frame when end_frame returns, and resource
+   entries called outside a frame must not change engine state either.
+   NULL optional entries (marked) are skipped. */
+typedef uintptr_t fogvol_handle;
+
+/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
+   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
+   end. fogvol_uniform_name gives the name.
+   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   DECODE   fv_dec:     decode weights (world units)
+   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
+   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
+   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
+                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
+                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
+   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
+                        zw: offset of the engine depth texel (ENGINE_DEPTH)
+   LINEAR_W fv_lin2:    the denominator row of fv_lin
+   image-space effects (fogvol_post_*):
+   POST_TEXEL  fv_ptexel:  (1/texture width, 1/texture height, 1 = perspective, 0)
+   POST_RECT   fv_prect:   centres of the viewport's first and last pixels (x0, y0, x1, y1)
+   POST_PARAMS fv_pparams: per effect (see fogvol__post_* in the implementation)
+   POST_COLOR  fv_pcolor:  outline colour
+   density and colour textures on volumes, volume light by compare:
+   DENSITY_U fv_dens_u: density texture s = dot(fv_dens_u, (model-space position, 1))
+   DENSITY_V fv_dens_v: density texture t, likewise
+   DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
+   COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
+   COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
+   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
+   SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
+                        COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
+                        not the ramp texture */
+#define FOGVOL_UNIFORMS(X) \
+    X(ENC, fv_enc) \
+    X(DITHER, fv_dith) \
+    X(SCREEN, fv_screen) \
+    X(DECODE, fv_dec) \
+    X(RAMP, fv_rampmap) \
+    X(MISC, fv_misc) \
+    X(LINEAR, fv_lin) \
+    X(NEARFAR, fv_nf) \
+    X(LINEAR_W, fv_lin2) \
+    X(POST_TEXEL, fv_ptexel) \
+    X(POST_RECT, fv_prect) \
+    X(POST_PARAMS, fv_pparams) \
+    X(POST_COLOR, fv_pcolor) \
+    X(DENSITY_U, fv_dens_u) \
+    X(DENSITY_V, fv_dens_v) \
+    X(DENSITY, fv_dens) \
+    X(COLOR_U, fv_ctex_u) \
+    X(COLOR_V, fv_ctex_v) \
+    X(LIGHT, fv_light) \
+    X(SPEEDUP, fv_speed)
+
+typedef enum fogvol_uniform {
+#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
+    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
+#undef FOGVOL__UNIFORM_ENUM
+    FOGVOL_U_COUNT
+} fogvol_uniform;
+FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
+
+/* Sampler units, fixed per program:
+   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
+   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
+   (the "2" samplers: second attachments of WIDE targets); FACE: fv_density 6 (density
+   texture); COMPOSITE*: fv_ctex 6 (colour texture); LIGHT: fv_rg 0, fv_blue 1, fv_dither 2,
+   fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
+   fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
+   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
+   "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
+   FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
+   Vertex attribute 0: "fv_position" (vec3). */
+#define FOGVOL_MAX_TEXTURE_UNITS 8
+
+typedef struct fogvol_target_desc {
+    int width, height;        /* colour texture, NEAREST, CLAMP */
+    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
+                                 both of the format */
+    fogvol_format format;
+    int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
+                                 2D multisample, fixed sample locations) and depth renderbuffer */
+    int depth;                /* 1: with a depth buffer */
+    fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
+    const char *label;
+} fogvol_target_desc;
+
+#define FOGVOL_MAX_SHADER_STRINGS 16
+
+typedef struct fogvol_program_desc {
+    const char *vs[FOGVOL_MAX_SHADER_STRINGS];
+    int vs_count;
+    const char *fs[FOGVOL_MAX_SHADER_STRINGS];
+    int fs_count;
+    const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
+    const char *label;
+} fogvol_program_desc;
+
+typedef struct fogvol_mesh_data {
+    const float *positions; /* tightly packed xyz (see stride, offset) */
+    int vertex_count;
+    const uint32_t *indices;
+    int index_count;
+    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
+       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
+       offset + i * stride of positions (stride 0 = 12), and with index_type
+       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
+    int stride, offset;
+    fogvol_index_type index_type;
+    const uint16_t *indices16;
+} fogvol_mesh_data;
+
+typedef enum fogvol_pass_blend {
+    FOGVOL_PASS_BLEND_NONE = 0,
+    FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
+    FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
+    FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
+    FOGVOL_PASS_BLEND_LIGHT = 3, /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
+    /* FOGVOL_VARIANT_COLORS, per-channel transmittance in two steps (alpha_coverage as for FOG) */
+    FOGVOL_PASS_BLEND_MULTIPLY = 5, /* RGB: ZERO, SRC_COLOR; A: ZERO, ONE (coverage: ZERO, SRC_ALPHA) */
+    FOGVOL_PASS_BLEND_EMIT = 6      /* RGB: ONE, ONE; A: ZERO, ONE (coverage: ONE, ONE) */
+} fogvol_pass_blend;
+
+typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
+
+typedef struct fogvol_pass {
+    fogvol_handle target;   /* 0 = the framebuffer bound when begin_frame was called */
+    int viewport[4];        /* x, y, w, h */
+    int clear;              /* clear colour (and depth to 1 when the target has one) */
+    float clear_color[4];
+    fogvol_pass_blend blend;
+    fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
+    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
+    int depth_write;
+    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
+                               stencil buffer; the bit is zero before and after the pass */
+    unsigned stencil_bit;
+    int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
+                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
+    int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
+    int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
+    int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
+    fogvol_handle program;
+    fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
+                                                         sampled as its colour texture) */
+    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+                                                            backend's own API (GL: a texture name) */
+    float uniforms[FOGVOL_U_COUNT][4];
+} fogvol_pass;
+
+typedef struct fogvol_draw {
+    float mvp[16];
+    float depth[4];
+    float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
+    int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
+    float extinction[4]; /* COLOR_FACE ("fv_ext"): per-channel extinction * (far - near), 0; else 0 */
+    float emission[4];   /* COLOR_FACE ("fv_emit"): extinction * the ramp colour; else 0 */
+} fogvol_draw;
+
+/* Capabilities a backend reports (fogvol_backend.caps). */
+enum {
+    FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
+    FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
+    FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
+    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
+    FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
+                                             (GL 4.0, or GL 3.2 + ARB_sample_shading) */
+    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
+};
+
+typedef struct fogvol_frame_info {
+    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
+    int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
+                         GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
+    /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
+       GL defaults): depth_zero_to_one 1 = clip control ZERO_TO_ONE (NDC z in [0,1]);
+       clip_upper_left 1 = clip control origin UPPER_LEFT (NDC y points down the window);
+       depth_range = glDepthRange (both 0 = (0, 1)). The GL backend reads them from the
+       context and draws its own passes with NEGATIVE_ONE_TO_ONE and depth range (0, 1). */
+    int depth_zero_to_one;
+    int clip_upper_left;
+    float depth_range[2];
+    int draw_buffer;  /* in: the engine draw buffer the composite writes (fogvol_frame_desc.draw_buffer);
+                         a backend that cannot write it returns an error from begin_frame */
+} fogvol_frame_info;
+
+typedef struct fogvol_backend {
+    void *user_data;
+    fogvol_dialect dialect; /* shader dialect the backend compiles */
+    unsigned caps;          /* FOGVOL_CAP_* */
+    /* optional: save engine state, report the engine framebuffer */
+    fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
+    void (*end_frame)(void *user_data);                      /* optional: restore engine state */
+    fogvol_result (*create_texture)(void *user_data, const fogvol_texture_desc *desc, fogvol_handle *out);
+    void (*destroy_texture)(void *user_data, fogvol_handle texture);
+    fogvol_result (*create_target)(void *user_data, const fogvol_target_desc *desc, fogvol_handle *out);
+    void (*destroy_target)(void *user_data, fogvol_handle target);
+    fogvol_result (*create_program)(void *user_data, const fogvol_program_desc *desc, fogvol_handle *out);
+    void (*destroy_program)(void *user_data, fogvol_handle program);
+    fogvol_result (*create_mesh)(void *user_data, const fogvol_mesh_data *data, fogvol_handle *out);
+    void (*destroy_mesh)(void *user_data, fogvol_handle mesh);
+    void (*begin_pass)(void *user_data, const fogvol_pass *pass);
+    void (*set_draw)(void *user_data, const fogvol_draw *draw); /* per-draw uniforms, for engine draws */
+    void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
+    void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
+    void (*end_pass)(void *user_data);        /* optional */
+    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+       bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
+    fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
+    void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
+    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
+    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    /* optional (WIDE): the second colour attachment of a two-attachment target,
+       as a target handle of its own (sampled and read back like any target) */
+    fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
+       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
+       bound at begin_frame; else framebuffer, an API object) into a
+       single-sample depth texture the backend owns, with the same texel
+       coordinates, and returns that texture's API object in *texture. */
+    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
+                                uintptr_t *texture);
+    /* optional (overflow counting without read-back; all five or none): occlusion queries that count
+       the samples passing between begin_query and end_query, which fogvol calls around the draws of
+       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
+       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
+       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
+       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
+       1, "any sample passed"). */
+    fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
+    void (*destroy_query)(void *user_data, fogvol_handle query);
+    int (*begin_query)(void *user_data, fogvol_handle query);
+    void (*end_query)(void *user_data, fogvol_handle query);
+    int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+} fogvol_backend;
+
+/* Recording null backend: no GPU, every call counted and the passes kept. */
+#define FOGVOL_NULL_MAX_PASSES 64
+typedef struct fogvol_null_backend {
+    int creates, destroys;  /* live handles = creates - destroys */
+    int frames_begun, frames_ended;
+    int pass_count;         /* passes in the current/last frame */
+    fogvol_pass passes[FOGVOL_NULL_MAX_PASSES];
+    int draws[FOGVOL_NULL_MAX_PASSES];    /* mesh draws per pass */
+    int fullscreen[FOGVOL_NULL_MAX_PASSES];
+    int in_pass;
+    fogvol_handle next_handle;
+    int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
+    int create_calls;
+    int stencil_bits;       /* reported by begin_frame */
+    int samples;            /* reported by begin_frame (engine framebuffer samples) */
+    /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
+       with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
+    int queries;
+    uint64_t query_samples;
+    int query_not_ready;
+    int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
+} fogvol_null_backend;
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
+   change table->caps before creating a context to test other choices. */
+FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
+
+#ifndef FOGVOL_NO_GL
+/* The default GL backend on its own (fogvol_create_context makes one when the
+   desc's backend table is empty). destroy it with table->destroy(table->user_data). */
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+                                                  const fogvol_logger *logger, fogvol_backend *out);
+#endif
+
+/* ---- context desc --------------------------------------------------------
+   Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
+   the struct complete); fogvol_create_context is in the context section. */
+struct fogvol_context_desc {
+    fogvol_allocator allocator;
+    fogvol_logger logger;
+    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
+                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
+    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
+                              FLOAT if float blending, else MRT if engine_mrt and MRT,
+                              else PS20 if highp fragment shaders, else PS13 */
+    unsigned variants;     /* FOGVOL_VARIANT_* */
+    int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
+    int disable_dither;    /* dithering is on by default */
+    fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
+    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
+    fogvol_gl_desc gl;     /* for the GL backend */
+    fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
+    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
+                                  measuring what each one gives (bench/bench.c) */
+};
+
+/* ---- encoding ------------------------------------------------------------
+   A depth d in [0,1) becomes D = d * 2^(3L) blue-LSB units, split into three
+   L-bit digits: red (most significant), green, blue, each stored in the low L
+   bits of an 8-bit channel. Additive blending then sums up to 2^(8-L) encoded
+   values with no loss (the 8-L high bits take the carries).
+
+   Dithering (on by default): the blue digit comes from a 2D ramp whose rows
+   hold different rounding thresholds; a pixel picks its row from an 8x8
+   ordered pattern. Row 0 rounds to nearest (no dither). Where a dithered row
+   rounds below the start of a blue period the texel holds blue = 2^L - 1 and
+   alpha = 1, meaning "minus one green step"; the alpha channel sums these
+   borrows and the decode weights carry -2^-L for alpha, so every channel of a
+   single encoded face stays <= 2^L - 1 and the sum stays exact and unbiased.
+
+   decode(RGBA bytes) = R/N + G/N^2 + B/N^3 - A/N^2   (N = 2^L, in units of far-near)
+*/
+typedef struct fogvol_encoding {
+    int bits;             /* L: low bits used per channel, 1..8 */
+    int levels;           /* N = 2^L */
+    int precision_bits;   /* 3L */
+    int max_faces;        /* faces summable without error per target: 2^(8-L) */
+    int max_faces_single; /* single-target variant with mid-range bias: 2^(7-L) (0 for L = 8) */
+    int dither_steps;     /* D: blue-ramp texels per blue LSB = dither rows (32, fewer for L >= 7) */
+} fogvol_encoding;
+
+#define FOGVOL_DEFAULT_BITS 4
+#define FOGVOL_WIDE_EXACT_BITS 3 /* largest L the WIDE variant encodes exactly (6L = 18 bits) */
+#define FOGVOL_DITHER_PATTERN 8 /* the dither index texture is 8x8 */
+
+/* Fill *out for L = bits (1..8). */
+FOGVOL_API fogvol_result fogvol_encoding_init(int bits, fogvol_encoding *out);
+/* Most precise encoding that sums at least max_faces faces (1..128).
+   max_faces < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 128: FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_encoding_from_faces(int max_faces, fogvol_encoding *out);
+/* Encoding with the most faces that still gives at least precision_bits (1..24).
+   precision_bits < 1: FOGVOL_ERROR_INVALID_ARGUMENT; > 24: FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_encoding_from_precision(int precision_bits, fogvol_encoding *out);
+/* The table of every L = 1..8 (Figure 3 of the "Fog Polygon Volumes" white paper). Returns the row count (8);
+   writes min(count, capacity) rows when rows != NULL. */
+FOGVOL_API int fogvol_encoding_table(fogvol_encoding *rows, int capacity);
+FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx);
+
+/* Constants a shader needs (all float, ready for uniforms). */
+typedef struct fogvol_constants {
+    float near_far[2];    /* (1/(far-near), -near/(far-near)): d = w*near_far[0] + near_far[1] */
+    float ramp_scale[4];  /* (1, 2^L, 2^2L, 0): texture coordinates of the red, green, blue ramps */
+    float depth_offset;   /* 2^-3L: added to the clamped d before the ramp lookups (one blue LSB;
+                             it pairs with the "-1" of the blue ramp's borrow convention) */
+    float depth_max;      /* d is clamped to [0, depth_max] = 1 - 1.5 * 2^-3L */
+    float decode[4];      /* scale * (1, 2^-L, 2^-2L, -2^-L): dot with RGBA normalised to [0,1] */
+    float scale;          /* the scale used: default (far-near) * 255 / 2^L (world units) */
+    float bias[4];        /* mid-range bias of the single-target variant, normalised (128/255 in RGB) */
+    float bias_decoded;   /* dot(bias, decode) */
+    float lsb;            /* one blue LSB in decoded units: scale / (255 * 2^2L) (world units by default) */
+    float dither_rows;    /* D */
+} fogvol_constants;
+
+/* scale == 0 means "decode to world units" ((far-near) * 255 / 2^L). */
+FOGVOL_API fogvol_result fogvol_compute_constants(const fogvol_encoding *enc, float znear, float zfar,
+                                                  float scale, fogvol_constants *out);
+
+/* ---- textures (caller-owned RGBA8 buffers, rows bottom to top) -----------
+   Each generator fills *info (width, height, size in bytes) and writes the
+   texels when pixels != NULL. pixels == NULL is a size query. A capacity
+   smaller than info->size gives FOGVOL_ERROR_BUFFER_TOO_SMALL. */
+typedef struct fogvol_image {
+    int width, height;
+    size_t size; /* width * height * 4 */
+} fogvol_image;
+
+/* N x N: texel (x, y) = (x, y, 0, 0). Sampled NEAREST + REPEAT at (u, u*N). */
+FOGVOL_API fogvol_result fogvol_make_rg_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                             fogvol_image *info);
+/* (N*D) x D: row r, texel x -> blue digit with the dither threshold of row r
+   and the borrow in alpha. Sampled NEAREST + REPEAT(x) at (u*N^2, (row+0.5)/D). */
+FOGVOL_API fogvol_result fogvol_make_blue_ramp(const fogvol_encoding *enc, unsigned char *pixels, size_t capacity,
+                                               fogvol_image *info);
+/* 8 x 8: red = blue-ramp row for the pixel (an ordered pattern over the
+   thresholds). Sampled NEAREST + REPEAT at gl_FragCoord.xy / 8. */
+FOGVOL_API fogvol_result fogvol_make_dither_index(const fogvol_encoding *enc, unsigned char *pixels,
+                                                  size_t capacity, fogvol_image *info);
+/* Rounding threshold of blue-ramp row r, in blue LSBs (row 0: 0.5). */
+FOGVOL_API double fogvol_dither_threshold(const fogvol_encoding *enc, int row);
+
+/* width x 1 texels; texel i holds thickness i/(width-1) * max_thickness.
+   *max_thickness_out (may be NULL) receives the resolved max_thickness. */
+FOGVOL_API fogvol_result fogvol_make_color_ramp(const fogvol_ramp_desc *desc, unsigned char *pixels,
+                                                size_t capacity, fogvol_image *info, float *max_thickness_out);
+
+/* ---- shaders ------------------------------------------------------------- */
+
 typedef enum fogvol_program {
     FOGVOL_PROGRAM_ENCODE = 0,         /* opaque depth into O */
     FOGVOL_PROGRAM_FACE = 1,           /* volume faces into B / F (FLOAT: signed, one target) */
@@ -569,8 +1369,6 @@ typedef enum fogvol_stage {
     FOGVOL_STAGE_FRAGMENT = 1,
     FOGVOL_STAGE_MAX_ENUM = 0x7fffffff
 } fogvol_stage;
-
-#define FOGVOL_MAX_SHADER_STRINGS 16
 
 typedef struct fogvol_shader_desc {
     fogvol_tier tier;      /* not AUTO */
@@ -607,36 +1405,14 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *desc, c
 /* Shorthand for variants = 0. */
 FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program program, fogvol_dialect dialect,
                                               fogvol_stage stage, const char **strings, int *count);
-/* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
-   else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
-   so on; see the table in the README). */
-FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
-/* FOGVOL_SUCCESS if the tier with these variants can render into a
-   multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
-   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
-   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
-   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
-FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* 1 if the tier runs this program. */
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fogvol_program program);
 
-typedef struct fogvol_tier_info {
-    int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
-    int library_passes; /* passes fogvol issues per frame for one colour-ramp group
-                           (+1 per negative group pass in the RGBA8 tiers) */
-    int targets;        /* render targets fogvol allocates */
-    const char *name;
-} fogvol_tier_info;
-FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
-FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier);
-
-/* MRT tier: GLSL for the engine's opaque fragment shader. It declares
-   uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
-   vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
-   writes to its second colour output. Insert after the #version line and the
-   engine's precision statements. */
-FOGVOL_API const char *fogvol_mrt_snippet(void);
-FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
+/* The GLSL of an effect for the engine's own use or validation. variant: DOF the
+   tap count (3, 6, 12), OUTLINES 1 = with normals, DISTANCE_FOG 0. Samplers:
+   fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
+FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
+                                                    fogvol_stage stage, const char **strings, int *count);
 
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
@@ -892,768 +1668,27 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity);
 
 #endif /* FOGVOL_NO_ANALYTIC */
 
-/* ---- backend table -------------------------------------------------------
-   Contract. Every entry gets the table's user_data first. Handles are
-   non-zero on success; 0 means "none". The renderer calls begin_frame, then
-   passes (begin_pass, draws, end_pass), then end_frame; create/destroy calls
-   may come inside or outside a frame. A backend must leave the engine's
-   state as it found it at begin_frame when end_frame returns, and resource
-   entries called outside a frame must not change engine state either.
-   NULL optional entries (marked) are skipped. */
-typedef uintptr_t fogvol_handle;
-
-/* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
-   the order of their fogvol_uniform values (0, 1, ...); add new ones at the
-   end. fogvol_uniform_name gives the name.
-   ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
-   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
-   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
-   DECODE   fv_dec:     decode weights (world units)
-   RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
-   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
-   LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
-                        view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
-                        (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
-   NEARFAR  fv_nf:      (1/(far-near), -near/(far-near), viewport x, viewport y): view depth -> d;
-                        zw: offset of the engine depth texel (ENGINE_DEPTH)
-   LINEAR_W fv_lin2:    the denominator row of fv_lin
-   image-space effects (fogvol_post_*):
-   POST_TEXEL  fv_ptexel:  (1/texture width, 1/texture height, 1 = perspective, 0)
-   POST_RECT   fv_prect:   centres of the viewport's first and last pixels (x0, y0, x1, y1)
-   POST_PARAMS fv_pparams: per effect (see fogvol__post_* in the implementation)
-   POST_COLOR  fv_pcolor:  outline colour
-   density and colour textures on volumes, volume light by compare:
-   DENSITY_U fv_dens_u: density texture s = dot(fv_dens_u, (model-space position, 1))
-   DENSITY_V fv_dens_v: density texture t, likewise
-   DENSITY   fv_dens:   (reference depth c, 1 = density texture on, 1/(far-near), 0)
-   COLOR_U   fv_ctex_u: colour texture s = dot(xyz, (screen s, t, 1)), w: 1 = on
-   COLOR_V   fv_ctex_v: colour texture t = dot(xyz, (screen s, t, 1))
-   LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
-   SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
-                        COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
-                        not the ramp texture */
-#define FOGVOL_UNIFORMS(X) \
-    X(ENC, fv_enc) \
-    X(DITHER, fv_dith) \
-    X(SCREEN, fv_screen) \
-    X(DECODE, fv_dec) \
-    X(RAMP, fv_rampmap) \
-    X(MISC, fv_misc) \
-    X(LINEAR, fv_lin) \
-    X(NEARFAR, fv_nf) \
-    X(LINEAR_W, fv_lin2) \
-    X(POST_TEXEL, fv_ptexel) \
-    X(POST_RECT, fv_prect) \
-    X(POST_PARAMS, fv_pparams) \
-    X(POST_COLOR, fv_pcolor) \
-    X(DENSITY_U, fv_dens_u) \
-    X(DENSITY_V, fv_dens_v) \
-    X(DENSITY, fv_dens) \
-    X(COLOR_U, fv_ctex_u) \
-    X(COLOR_V, fv_ctex_v) \
-    X(LIGHT, fv_light) \
-    X(SPEEDUP, fv_speed)
-
-typedef enum fogvol_uniform {
-#define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
-    FOGVOL_UNIFORMS(FOGVOL__UNIFORM_ENUM)
-#undef FOGVOL__UNIFORM_ENUM
-    FOGVOL_U_COUNT
-} fogvol_uniform;
-FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
-
-/* Sampler units, fixed per program:
-   ENCODE, FACE:  fv_rg 0, fv_blue 1, fv_dither 2, fv_opaque 3, fv_opaque2 4 (FACE only)
-   COMPOSITE*, RESOLVE: fv_back 0, fv_front 1, fv_colors 2, fv_opaque 3, fv_back2 4, fv_front2 5
-   (the "2" samplers: second attachments of WIDE targets); FACE: fv_density 6 (density
-   texture); COMPOSITE*: fv_ctex 6 (colour texture); LIGHT: fv_rg 0, fv_blue 1, fv_dither 2,
-   fv_opaque 3, fv_lfront 7 (the light's front depth L). Fragment outputs:
-   fv_fragcolor, or the array fv_frag[2] for WIDE (bind it to location 0).
-   Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
-   "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
-   FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
-   Vertex attribute 0: "fv_position" (vec3). */
-#define FOGVOL_MAX_TEXTURE_UNITS 8
-
-typedef enum fogvol_filter { FOGVOL_FILTER_NEAREST = 0, FOGVOL_FILTER_LINEAR = 1 } fogvol_filter;
-typedef enum fogvol_wrap { FOGVOL_WRAP_REPEAT = 0, FOGVOL_WRAP_CLAMP = 1 } fogvol_wrap;
-
-typedef struct fogvol_texture_desc {
-    int width, height;
-    const unsigned char *pixels; /* RGBA8, rows bottom to top */
-    fogvol_filter filter;
-    fogvol_wrap wrap;
-    const char *label;
-} fogvol_texture_desc;
-
-typedef enum fogvol_format {
-    FOGVOL_FORMAT_RGBA8 = 0,
-    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
-    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
-                                 wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
-                                 EXT_color_buffer_float + EXT_float_blend) */
-} fogvol_format;
-
-typedef struct fogvol_target_desc {
-    int width, height;        /* colour texture, NEAREST, CLAMP */
-    int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
-                                 both of the format */
-    fogvol_format format;
-    int samples;              /* 0 or 1: single-sample; > 1: multisample colour texture(s) (GL: texture
-                                 2D multisample, fixed sample locations) and depth renderbuffer */
-    int depth;                /* 1: with a depth buffer */
-    fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
-    const char *label;
-} fogvol_target_desc;
-
-typedef struct fogvol_program_desc {
-    const char *vs[FOGVOL_MAX_SHADER_STRINGS];
-    int vs_count;
-    const char *fs[FOGVOL_MAX_SHADER_STRINGS];
-    int fs_count;
-    const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
-    const char *label;
-} fogvol_program_desc;
-
-typedef struct fogvol_mesh_data {
-    const float *positions; /* tightly packed xyz (see stride, offset) */
-    int vertex_count;
-    const uint32_t *indices;
-    int index_count;
-    /* Only for backends reporting FOGVOL_CAP_MESH_LAYOUT (others always get
-       packed xyz and 32-bit indices, these fields 0): vertex i's x is at byte
-       offset + i * stride of positions (stride 0 = 12), and with index_type
-       FOGVOL_INDEX_UINT16 the indices are indices16 (indices is NULL). */
-    int stride, offset;
-    fogvol_index_type index_type;
-    const uint16_t *indices16;
-} fogvol_mesh_data;
-
-typedef enum fogvol_pass_blend {
-    FOGVOL_PASS_BLEND_NONE = 0,
-    FOGVOL_PASS_BLEND_ADD = 1,   /* ONE, ONE on RGBA */
-    FOGVOL_PASS_BLEND_SUBTRACT = 4, /* dst - src on RGBA (reverse subtract, ONE, ONE) */
-    FOGVOL_PASS_BLEND_FOG = 2,   /* RGB: SRC_ALPHA, ONE_MINUS_SRC_ALPHA; A: ZERO, ONE */
-    FOGVOL_PASS_BLEND_LIGHT = 3, /* RGB: SRC_ALPHA, ONE; A: ZERO, ONE */
-    /* FOGVOL_VARIANT_COLORS, per-channel transmittance in two steps (alpha_coverage as for FOG) */
-    FOGVOL_PASS_BLEND_MULTIPLY = 5, /* RGB: ZERO, SRC_COLOR; A: ZERO, ONE (coverage: ZERO, SRC_ALPHA) */
-    FOGVOL_PASS_BLEND_EMIT = 6      /* RGB: ONE, ONE; A: ZERO, ONE (coverage: ONE, ONE) */
-} fogvol_pass_blend;
-
-typedef enum fogvol_cull { FOGVOL_CULL_NONE = 0, FOGVOL_CULL_BACK = 1, FOGVOL_CULL_FRONT = 2 } fogvol_cull;
-
-typedef struct fogvol_pass {
-    fogvol_handle target;   /* 0 = the framebuffer bound when begin_frame was called */
-    int viewport[4];        /* x, y, w, h */
-    int clear;              /* clear colour (and depth to 1 when the target has one) */
-    float clear_color[4];
-    fogvol_pass_blend blend;
-    fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
-    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
-    int depth_write;
-    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
-                               stencil buffer; the bit is zero before and after the pass */
-    unsigned stencil_bit;
-    int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
-                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
-    int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
-    int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
-    int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
-    fogvol_handle program;
-    fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
-                                                         sampled as its colour texture) */
-    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
-                                                            backend's own API (GL: a texture name) */
-    float uniforms[FOGVOL_U_COUNT][4];
-} fogvol_pass;
-
-typedef struct fogvol_draw {
-    float mvp[16];
-    float depth[4];
-    float sign;   /* +1, or -1 for a negative volume (FLOAT tier) */
-    int front_cw; /* 1: front faces are clockwise for this draw (mirroring transform) */
-    float extinction[4]; /* COLOR_FACE ("fv_ext"): per-channel extinction * (far - near), 0; else 0 */
-    float emission[4];   /* COLOR_FACE ("fv_emit"): extinction * the ramp colour; else 0 */
-} fogvol_draw;
-
-/* Capabilities a backend reports (fogvol_backend.caps). */
-enum {
-    FOGVOL_CAP_FLOAT_BLEND = 1u << 0,     /* R32F targets with additive blending */
-    FOGVOL_CAP_MRT = 1u << 1,             /* several colour outputs (engine MRT) */
-    FOGVOL_CAP_HIGHP_FRAGMENT = 1u << 2,  /* fp32 in fragment shaders */
-    FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
-    FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
-                                             (GL 4.0, or GL 3.2 + ARB_sample_shading) */
-    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
-};
-
-typedef struct fogvol_frame_info {
-    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
-    int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
-                         GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
-    /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
-       GL defaults): depth_zero_to_one 1 = clip control ZERO_TO_ONE (NDC z in [0,1]);
-       clip_upper_left 1 = clip control origin UPPER_LEFT (NDC y points down the window);
-       depth_range = glDepthRange (both 0 = (0, 1)). The GL backend reads them from the
-       context and draws its own passes with NEGATIVE_ONE_TO_ONE and depth range (0, 1). */
-    int depth_zero_to_one;
-    int clip_upper_left;
-    float depth_range[2];
-    int draw_buffer;  /* in: the engine draw buffer the composite writes (fogvol_frame_desc.draw_buffer);
-                         a backend that cannot write it returns an error from begin_frame */
-} fogvol_frame_info;
-
-typedef struct fogvol_backend {
-    void *user_data;
-    fogvol_dialect dialect; /* shader dialect the backend compiles */
-    unsigned caps;          /* FOGVOL_CAP_* */
-    /* optional: save engine state, report the engine framebuffer */
-    fogvol_result (*begin_frame)(void *user_data, fogvol_frame_info *info);
-    void (*end_frame)(void *user_data);                      /* optional: restore engine state */
-    fogvol_result (*create_texture)(void *user_data, const fogvol_texture_desc *desc, fogvol_handle *out);
-    void (*destroy_texture)(void *user_data, fogvol_handle texture);
-    fogvol_result (*create_target)(void *user_data, const fogvol_target_desc *desc, fogvol_handle *out);
-    void (*destroy_target)(void *user_data, fogvol_handle target);
-    fogvol_result (*create_program)(void *user_data, const fogvol_program_desc *desc, fogvol_handle *out);
-    void (*destroy_program)(void *user_data, fogvol_handle program);
-    fogvol_result (*create_mesh)(void *user_data, const fogvol_mesh_data *data, fogvol_handle *out);
-    void (*destroy_mesh)(void *user_data, fogvol_handle mesh);
-    void (*begin_pass)(void *user_data, const fogvol_pass *pass);
-    void (*set_draw)(void *user_data, const fogvol_draw *draw); /* per-draw uniforms, for engine draws */
-    void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
-    void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
-    void (*end_pass)(void *user_data);        /* optional */
-    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
-       bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
-    fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
-    void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
-    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
-    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
-    /* optional (WIDE): the second colour attachment of a two-attachment target,
-       as a target handle of its own (sampled and read back like any target) */
-    fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
-    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
-       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
-       bound at begin_frame; else framebuffer, an API object) into a
-       single-sample depth texture the backend owns, with the same texel
-       coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
-                                uintptr_t *texture);
-    /* optional (overflow counting without read-back; all five or none): occlusion queries that count
-       the samples passing between begin_query and end_query, which fogvol calls around the draws of
-       one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
-       frame and fails where the context has none. begin_query returns 0 when it cannot start one now
-       (GL: the engine has an occlusion query active; the frame is then not counted). query_result is
-       called in a later frame and never waits: 0 = not available yet, 1 = *samples set (GLES 3: 0 or
-       1, "any sample passed"). */
-    fogvol_result (*create_query)(void *user_data, fogvol_handle *out);
-    void (*destroy_query)(void *user_data, fogvol_handle query);
-    int (*begin_query)(void *user_data, fogvol_handle query);
-    void (*end_query)(void *user_data, fogvol_handle query);
-    int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
-} fogvol_backend;
-
-/* Recording null backend: no GPU, every call counted and the passes kept. */
-#define FOGVOL_NULL_MAX_PASSES 64
-typedef struct fogvol_null_backend {
-    int creates, destroys;  /* live handles = creates - destroys */
-    int frames_begun, frames_ended;
-    int pass_count;         /* passes in the current/last frame */
-    fogvol_pass passes[FOGVOL_NULL_MAX_PASSES];
-    int draws[FOGVOL_NULL_MAX_PASSES];    /* mesh draws per pass */
-    int fullscreen[FOGVOL_NULL_MAX_PASSES];
-    int in_pass;
-    fogvol_handle next_handle;
-    int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
-    int create_calls;
-    int stencil_bits;       /* reported by begin_frame */
-    int samples;            /* reported by begin_frame (engine framebuffer samples) */
-    /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
-       with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
-    int queries;
-    uint64_t query_samples;
-    int query_not_ready;
-    int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
-} fogvol_null_backend;
-/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
-   change table->caps before creating a context to test other choices. */
-FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
-
-/* ---- renderer ------------------------------------------------------------ */
-typedef struct fogvol_context fogvol_context;
-typedef struct fogvol_mesh fogvol_mesh;
-typedef struct fogvol_ramp fogvol_ramp;
-
-typedef void (*fogvol_gl_proc)(void);
-typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
-
-typedef struct fogvol_gl_desc {
-    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
-    void *user_data;
-    fogvol_dialect dialect;   /* 0 = from the context */
-    int version_major;        /* 0 = from the context; else treat the context as this GL version */
-    int version_minor;
-    int gles;                 /* with version_major: 1 = treat as OpenGL ES */
-    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
-} fogvol_gl_desc;
-
-/* Both composites write the same pixels with the same values and leave the
-   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
-   the window rectangle of each ramp group's volumes (the 8 corners of each
-   mesh's bounding box projected; the whole viewport when a box reaches behind
-   the near plane), which saves fill rate when the volumes cover little of the
-   screen. */
-typedef enum fogvol_composite {
-    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
-    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
-} fogvol_composite;
-
-/* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
-   fogvol_end_frame). AUTO: fogvol's targets get the engine's sample count and
-   every pass is shaded per sample, so each sample of the engine framebuffer
-   gets the fog of its own ray and the engine's resolve averages them; where
-   the tier, variants or GLSL dialect cannot (fogvol_msaa_supported) or the
-   backend lacks FOGVOL_CAP_MULTISAMPLE, end_frame logs why and returns
-   FOGVOL_ERROR_UNSUPPORTED without drawing. SINGLE_SAMPLE (opt-in): single-
-   sample targets, one fog value per pixel for all its samples (edges of
-   occluders inside fog come out wrong by up to the full fog contrast); logged
-   as a warning once and reported in fogvol_frame_stats.msaa_fallback.
-   Cost: the per-sample passes shade every sample: 4x MSAA is about 4x the
-   fragment work and 4x the target memory of fogvol's passes (measured by
-   fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
-   3.9-4.6x the time of the same scene on a single-sample framebuffer, one
-   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
-   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
-typedef enum fogvol_msaa {
-    FOGVOL_MSAA_AUTO = 0,
-    FOGVOL_MSAA_SINGLE_SAMPLE = 1,
-    FOGVOL_MSAA_MAX_ENUM = 0x7fffffff
-} fogvol_msaa;
-/* What the composite does to the alpha of the engine's colour target. */
-typedef enum fogvol_alpha {
-    FOGVOL_ALPHA_KEEP = 0,    /* dst.a unchanged (RGB blended with the ramp's alpha a) */
-    FOGVOL_ALPHA_COVERAGE = 1 /* dst.a = a + dst.a * (1 - a): the fog's coverage, "over" operator */
-} fogvol_alpha;
-/* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
-   reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
-   occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
-   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
-   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
-typedef enum fogvol_overflow_policy {
-    FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
-    FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
-    FOGVOL_OVERFLOW_LOWER_BITS = 2, /* count; on overflow lower the encoding's L by one (twice the faces,
-                                       3 bits less precision: fogvol_context_encoding changes, the lookup
-                                       textures are rebuilt after the frame), logged as a warning each
-                                       time; the next frame uses it (MRT: the engine takes the new snippet
-                                       uniforms from fogvol_mrt_prepare). Counts of frames drawn before the
-                                       change do not lower it again. At L = 1 it warns once */
-    FOGVOL_OVERFLOW_OFF = 3,        /* no check passes, no queries: overflow_pixels_late stays -1 */
-    FOGVOL_OVERFLOW_MAX_ENUM = 0x7fffffff
-} fogvol_overflow_policy;
-
-typedef struct fogvol_context_desc {
-    fogvol_allocator allocator;
-    fogvol_logger logger;
-    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
-                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
-    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
-                              FLOAT if float blending, else MRT if engine_mrt and MRT,
-                              else PS20 if highp fragment shaders, else PS13 */
-    unsigned variants;     /* FOGVOL_VARIANT_* */
-    int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
-    int disable_dither;    /* dithering is on by default */
-    fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
-    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
-    fogvol_gl_desc gl;     /* for the GL backend */
-    fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
-    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
-                                  measuring what each one gives (bench/bench.c) */
-} fogvol_context_desc;
-
-/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
-   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
-                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
-                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
-                 O pass (same pixels).
-   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
-                 instead of a filtered lookup at computed coordinates (same pixels).
-   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
-                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
-                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
-                 interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
-                 overflow check passes likewise.
-   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
-                 no O read without occluders, no density texture outside textured volumes, exp or
-                 ramp composite, no colour texture) instead of one program that switches on
-                 uniforms; built on first use (same pixels). */
-enum {
-    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
-    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
-    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
-    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4
-};
-
-FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
-FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
-FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx);
-FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
-
-/* Validates (fogvol_validate_mesh) and uploads. Occluder-only meshes may be
-   open (desc->allow_open). *report (may be NULL) receives the check. */
-FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
-                                            fogvol_mesh_report *report);
-FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh);
-
-FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
-FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
-
-typedef struct fogvol_frame_stats {
-    int passes;             /* passes issued this frame */
-    int volumes, occluders; /* drawn */
-    int groups;             /* colour-ramp groups composited */
-    int overflow_pixels;    /* pixels whose sums saturated (only counted when debug_thickness is set) */
-    int samples;            /* samples per pixel of fogvol's targets this frame (1: single-sample) */
-    int msaa_fallback;      /* 1: the engine framebuffer was multisampled and FOGVOL_MSAA_SINGLE_SAMPLE
-                               drew one fog value per pixel */
-    /* Overflow counted on the GPU every frame, no read-back, no stall: a full-screen check pass per
-       colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
-       discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
-       result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
-       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
-       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
-       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
-    int overflow_pixels_late;
-    int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
-    int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
-    int overflow_passes;     /* check passes issued this frame (not included in passes) */
-    int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
-} fogvol_frame_stats;
-
-typedef enum fogvol_depth_source {
-    FOGVOL_DEPTH_SOURCE_TEXTURE = 0,            /* fogvol_frame_desc.engine_depth_texture */
-    FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER = 1,  /* the depth buffer of the draw framebuffer bound at end_frame */
-    FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT = 2, /* the depth buffer of engine_depth_framebuffer */
-    FOGVOL_DEPTH_SOURCE_MAX_ENUM = 0x7fffffff
-} fogvol_depth_source;
-
-/* What the frame's camera is given as (fogvol_frame_desc.camera). */
-typedef enum fogvol_camera {
-    FOGVOL_CAMERA_VIEW_AND_PROJECTION = 0, /* view and projection */
-    FOGVOL_CAMERA_VIEW_PROJECTION = 1      /* view_projection (clip from world), eye and forward */
-} fogvol_camera;
-
-/* Derives the planes of a projection (perspective, reversed, infinite or orthographic).
-   zero_to_one: 1 if the projection maps the depth range to NDC z in [0,1] (D3D style, for
-   glClipControl ZERO_TO_ONE), 0 for [-1,1]; reversed projections (z_ndc high at near) are
-   recognised. Perspective projections need w = -s * z_view (s > 0), orthographic ones w
-   constant > 0; anything else, or planes that are not 0 < near < far (near > 0 for
-   perspective), is FOGVOL_ERROR_INVALID_ARGUMENT. An infinite far plane gives infinite = 1
-   and zfar = 0: choose the far limit of the thickness range yourself. */
-typedef struct fogvol_projection_info {
-    float znear, zfar;
-    int orthographic; /* 1: w constant */
-    int reversed;     /* 1: NDC z decreases with distance */
-    int infinite;     /* 1: no far plane */
-} fogvol_projection_info;
-FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
-                                                  fogvol_projection_info *out);
-
-/* Camera: any projection whose clip w is the view depth times a positive constant
-   (perspective: standard, reversed-Z, [0,1] or [-1,1] depth, infinite far, jittered,
-   oblique near plane) or a positive constant (orthographic); others are refused with
-   FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
-   so the projection's depth convention does not matter to it (only to the engine depth
-   texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
-typedef struct fogvol_frame_desc {
-    float view[16];
-    float projection[16];
-    float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
-                               depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
-    int viewport[4];        /* x, y, width, height in the engine framebuffer */
-    fogvol_composite composite;
-    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
-                               source compatibility) */
-    /* The engine's draw buffer the composite writes (index into its
-       glDrawBuffers list; 0 = the first, the only one for most engines); the
-       other draw buffers stay byte-identical. GL: an index past
-       GL_MAX_DRAW_BUFFERS, one whose buffer is GL_NONE, or > 0 on the default
-       framebuffer or on OpenGL ES (where list position i can only name
-       COLOR_ATTACHMENTi) makes end_frame fail with FOGVOL_ERROR_UNSUPPORTED. */
-    int draw_buffer;
-    fogvol_alpha alpha;     /* 0 = FOGVOL_ALPHA_KEEP */
-    int show_overflow;      /* 1: paint pixels whose face sums saturated in magenta (every RGBA8 tier and
-                               variant; SINGLE_TARGET runs one check pass after its additions for it,
-                               into the overflow mask V); FLOAT cannot saturate */
-    /* Debug read-back of the decoded thickness per pixel of the viewport, rows
-       bottom to top, for the group of debug_ramp (NULL = the first group). Set
-       debug_thickness to a width*height float buffer. Units: view-space w (the
-       distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
-    float *debug_thickness;
-    const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
-                                      sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
-    /* FOGVOL_VARIANT_ENGINE_DEPTH: the engine's depth texture (backend API
-       object, GL: texture name), sampled with its .r; its window depth is mapped back
-       to view depth through the inverse of projection * view (any projection above) and
-       the depth conventions the backend reports (fogvol_frame_info) unless overridden by
-       the two fields below */
-    uintptr_t engine_depth_texture;
-    int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
-    float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
-    /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
-       (world-space direction the camera looks, any length) instead of view and projection;
-       view depth is then measured along forward from eye */
-    fogvol_camera camera;
-    float view_projection[16];
-    float eye[3], forward[3];
-    /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
-       The other sources are depth buffers that cannot be sampled (the default
-       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
-       copies the viewport's depth into a single-sample depth texture of its own
-       (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
-       format, which resolves a multisampled source to one sample per pixel;
-       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
-       FOGVOL_ERROR_UNSUPPORTED). */
-    fogvol_depth_source engine_depth_source;
-    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
-                                           (GL: framebuffer name, 0 = the default framebuffer) */
-} fogvol_frame_desc;
-
-/* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
-   the GPU before end_frame. A begin_frame while a frame is open discards the
-   open frame (logged as a warning).
-   GL backend, the engine's state (restored, or set for fogvol's passes and
-   restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); fogvol must not be called between glBeginConditionalRender and
-   glEndConditionalRender (not queryable: its passes could be skipped). */
-FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
-FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
-/* The callback runs inside the O pass with the depth-encode program bound:
-   for each engine draw call fogvol_occluder_transform(ctx, model) first and
-   keep the position in vertex attribute 0; change no other state. */
-typedef void (*fogvol_occluder_fn)(fogvol_context *ctx, void *user_data);
-FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvol_occluder_fn fn, void *user_data);
-FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16]);
-
-typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
-typedef struct fogvol_volume_desc {
-    const fogvol_mesh *mesh;
-    float model[16];
-    const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
-    int negative;             /* 1: subtracts thickness from the volumes of its ramp */
-    /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
-       density factor rho in [0,1] sampled on every face fragment at the surface point, with
-       texture coordinates s = dot(density_map[0..3], (p, 1)), t = dot(density_map[4..7], (p, 1))
-       from the model-space position p (all 8 zero: s = x, t = y). Scroll it for drifting fog by
-       adding velocity * time to density_map[3] and [7] every frame; a 1-texel-high gradient with
-       FOGVOL_WRAP_CLAMP and s along a shaft's axis thins a light shaft towards its base.
-       What is summed: each face adds v = c + rho * (min(d, o) - c) instead of min(d, o) (d the
-       face's depth, o the opaque depth, c = min(o, depth of the centre of the volume's bounds),
-       c = 0 when the bounds reach nearer than znear). A closed hull's faces enter and leave
-       every ray equally often, so the c terms cancel and each chord [a, b] of the volume (b
-       clamped to o) contributes  rho_b (b - c) - rho_a (a - c)  (rho_a, rho_b: the density at
-       the entry and exit faces' surface points, also where the exit face is hidden behind o).
-       Exact (= rho * (b - a)) when the density is the same at both ends of every chord: a
-       density that does not vary along the rays (a 2D texture projected along the view
-       direction, e.g. an orthographic camera looking along the texture's projection axis, or a
-       density varying only across the screen). A chord hidden behind o entirely adds nothing
-       when o <= the centre depth (both faces add o). Otherwise an approximation, a two-point
-       rule: with rho_m the mean density along the chord the error per chord is
-       (rho_b - rho_m) (b - c) - (rho_a - rho_m) (a - c), at most the density contrast along the
-       chord times (|a - c| + |b - c|), i.e. about the contrast times the volume's depth extent.
-       RGBA8 tiers encode v like any depth (1 LSB per face). Tiers FLOAT, PS20 and MRT (with
-       SINGLE_TARGET, ALU, NEAR_CLAMP, ENGINE_DEPTH); PS13 (mediump cannot re-encode), COUNT
-       (the opaque depth it adds per missing back face carries no density) and WIDE:
-       fogvol_add_volume returns FOGVOL_ERROR_UNSUPPORTED, logged. A textured volume costs one
-       more pass per sum pass. */
-    const fogvol_volume_texture *density;
-    float density_map[8];
-    /* Colour texture (NULL = none): the composite multiplies the ramp colour's rgb by the
-       texture's rgb at s = dot(color_map[0..2], (x, y, 1)), t = dot(color_map[3..5], (x, y, 1)),
-       (x, y) the pixel's position across the viewport in [0,1] (all 6 zero = s = x, t = y).
-       The composite draws one colour-ramp group at a time, so the volumes of one ramp share one
-       colour texture: a volume whose colour texture or map differs from an earlier volume of
-       its ramp in this frame is refused (FOGVOL_ERROR_INVALID_ARGUMENT, logged); volumes
-       without one take the group's. Every tier and dialect. */
-    const fogvol_volume_texture *color;
-    float color_map[6];
-} fogvol_volume_desc;
-FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc);
-
-/* Textures for volumes (density, colour): RGBA8, rows bottom to top, desc->filter and wrap
-   as given (width, height 1..4096; pixels required). */
-FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
-                                                      fogvol_volume_texture **out);
-/* Inside a frame, the volumes that use it are dropped from the frame (logged). */
-FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture);
-
-/* Volume light by compare: the scene pixels whose opaque depth (fogvol's occluders, the MRT
-   target or the engine's depth texture: whatever the tier's O is) lies between the depth of
-   the light volume's front face and its back face are lit: colour * intensity is added to
-   them (the engine framebuffer's RGB; alpha kept); pixels outside the volume, in front of it
-   or behind it, are untouched. A scene point is inside a convex volume exactly when its depth
-   lies between the one front and the one back face on its ray, so the mesh must be convex
-   (fogvol_mesh_report.convex == 1); a concave mesh is refused with FOGVOL_ERROR_INVALID_MESH
-   and a logged message. A camera inside the light works (no front face: from the near plane).
-   Lights are drawn after the opaque depth and before the fog groups, so fog covers lit pixels.
-   RGBA8 tiers compare depths decoded from the encoding (12 bits by default: a pixel within
-   about one encoding LSB of the volume's surface may fall either way). Tiers FLOAT, PS20 (not
-   WIDE) and MRT; PS13 and WIDE: FOGVOL_ERROR_UNSUPPORTED, logged. Two passes per light. */
-typedef struct fogvol_light_desc {
-    const fogvol_mesh *mesh;  /* closed, convex */
-    float model[16];
-    float color[3];           /* added to lit pixels */
-    float intensity;          /* 0 = 1 */
-} fogvol_light_desc;
-FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
-FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
-FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
-FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
-
-/* MRT tier, after fogvol_begin_frame and before the engine's opaque pass:
-   makes the O texture the size of the frame's viewport (this touches the GPU,
-   state restored) and returns what the engine needs: the texture to attach as
-   its second colour target (backend API object, GL: texture name), the colour
-   to clear that attachment to before drawing ("far"), and the values of the
-   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
-   viewport-sized with origin (0,0). */
-typedef struct fogvol_mrt_info {
-    uintptr_t texture;
-    float clear_color[4];
-    float uniforms[8];
-} fogvol_mrt_info;
-FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
-
-/* Occluders drawn by the engine with its own programs, pipelines and vertex
-   layouts (PS20 without COUNT/WIDE, and FLOAT without ENGINE_DEPTH; other
-   configurations: FOGVOL_ERROR_UNSUPPORTED). After fogvol_begin_frame and
-   before fogvol_end_frame: makes fogvol's O target the size of the viewport
-   (touches the GPU, state restored) and returns what the engine needs to draw
-   its occluders into it: attach texture as the only colour target of a
-   framebuffer of width x height with the engine's own depth buffer, clear
-   colour to clear_color and depth to "far", draw with a depth test that keeps
-   the nearest surface, and write fogvol_occluder_color(view_depth) from
-   fogvol_occluder_snippet() (view_depth: the distance along the view axis,
-   -z in view space) as the fragment colour, with fogvol_mrt[2] set to
-   uniforms. end_frame then uses what the engine drew instead of its own O
-   pass; fogvol_add_occluder* in the same frame is refused. */
-typedef struct fogvol_occluder_info {
-    uintptr_t texture;        /* backend API object (GL: texture name) */
-    int width, height;
-    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
-    float clear_color[4];
-    float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
-} fogvol_occluder_info;
-FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info);
-/* GLSL for the engine's occluder fragment shader (any dialect): fogvol_mrt_snippet()
-   plus vec4 fogvol_occluder_color(float view_depth). Insert after the #version
-   line and the engine's precision statements. */
-FOGVOL_API const char *fogvol_occluder_snippet(void);
-
-/* ---- image-space effects ---------------------------------------------------
-   Screen-space passes over the engine's depth (and colour, normals), drawn
-   into the framebuffer bound when they are called, GL state restored like a
-   frame. Call them outside a frame (not between fogvol_begin_frame and
-   fogvol_end_frame: FOGVOL_ERROR_INVALID_STATE). Each desc points at a
-   fogvol_frame_desc that supplies the camera (view and projection, or
-   view_projection + eye + forward), znear < zfar (validated as for a frame;
-   not used otherwise), the viewport written, draw_buffer, alpha (outlines,
-   distance fog) and the engine depth texture with its conventions:
-   engine_depth_texture (required: FOGVOL_ERROR_INVALID_ARGUMENT without it),
-   engine_depth_zero_to_one and engine_depth_range (0 = as the backend reports
-   the context's clip control and depth range). View depth e is the distance
-   along the view axis, recovered from window depth exactly as the
-   ENGINE_DEPTH variant does (any projection fogvol_frame_desc accepts:
-   reversed-Z, [0,1] depth, infinite far, orthographic).
-   Engine textures (GL texture names) are read at texel centres, texel =
-   framebuffer pixel (the texture covers the framebuffer from its origin);
-   texture_size 0 = (viewport x + width, viewport y + height). Taps outside
-   the viewport are clamped to its edge pixels. A texture sampled must not be
-   attached to the framebuffer written. Needs FOGVOL_CAP_DEPTH_TEXTURE and
-   FOGVOL_CAP_HIGHP_FRAGMENT (view depth from window depth in mediump is
-   useless): else FOGVOL_ERROR_UNSUPPORTED. Every GLSL dialect fogvol has
-   (110 ... 330 core, ES 100 with highp, ES 300) compiles every effect. */
-typedef enum fogvol_post_effect {
-    FOGVOL_POST_DOF = 0,          /* depth of field */
-    FOGVOL_POST_OUTLINES = 1,     /* edges from depth (and normal) deltas */
-    FOGVOL_POST_DISTANCE_FOG = 2, /* a colour ramp of view depth */
-    FOGVOL_POST_EFFECT_COUNT = 3
-} fogvol_post_effect;
-
-/* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
-   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
-   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
-   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
-   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
-   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
-   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
-   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
-   without blending (in-focus pixels keep their colour exactly). */
-typedef struct fogvol_dof_desc {
-    const fogvol_frame_desc *frame;
-    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
-    int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
-    float focus_distance;    /* view depth in focus (> 0) */
-    float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
-    float max_radius;        /* pixels, 0 = 4, at most 64 */
-    int taps;                /* 0 = 6; 3, 6 or 12 */
-} fogvol_dof_desc;
-FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
-
-/* Outlines (cel-shading look) by a 3x3 moving kernel. Depth: with g = 1/e
-   (perspective; e for orthographic), which is linear across the screen on any
-   plane, an edge is where a line of three pixels through the centre
-   (horizontal, vertical, both diagonals, both ends inside the viewport) has
-   |g(-o) + g(+o) - 2 g0| > depth_threshold * |g0|: depth discontinuities and
-   creases, never a flat slope. Normals (optional): n = 2 rgb - 1 normalised,
-   an edge where 1 - dot(n0, nk) > normal_threshold for one of the 8
-   neighbours. Edge pixels get color blended like the fog composite
-   (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
-typedef struct fogvol_outline_desc {
-    const fogvol_frame_desc *frame;
-    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
-    int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
-    float color[4];           /* rgb, a = opacity; all 0 = opaque black */
-    float depth_threshold;    /* relative second difference, 0 = 0.05 */
-    float normal_threshold;   /* 1 - cos(angle), 0 = 0.3 */
-} fogvol_outline_desc;
-FOGVOL_API fogvol_result fogvol_post_outlines(fogvol_context *ctx, const fogvol_outline_desc *desc);
-
-/* Image-space distance fog: thickness t = max(e - start, 0) looked up in a
-   colour ramp exactly as the volume composite does (texel i holds
-   i / (width - 1) * max_thickness, linear filtering, clamped at the ends) and
-   blended by the ramp's blend (FOG: rgb = mix(rgb, ramp.rgb, ramp.a); LIGHT:
-   rgb += ramp.rgb * ramp.a) over the viewport. Pixels at the far plane (sky)
-   get the fog of e = zfar of the projection (infinite: the ramp's end). */
-typedef struct fogvol_distance_fog_desc {
-    const fogvol_frame_desc *frame;
-    const fogvol_ramp *ramp;  /* required */
-    int texture_size[2];      /* of the depth texture; 0 = from the viewport */
-    float start;              /* view depth where the fog begins (>= 0) */
-} fogvol_distance_fog_desc;
-FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fogvol_distance_fog_desc *desc);
-
-/* The GLSL of an effect for the engine's own use or validation. variant: DOF the
-   tap count (3, 6, 12), OUTLINES 1 = with normals, DISTANCE_FOG 0. Samplers:
-   fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
-FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
-                                                    fogvol_stage stage, const char **strings, int *count);
-
-#ifndef FOGVOL_NO_GL
-/* The default GL backend on its own (fogvol_create_context makes one when the
-   desc's backend table is empty). destroy it with table->destroy(table->user_data). */
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
-                                                  const fogvol_logger *logger, fogvol_backend *out);
-#endif
+/* ---- CPU reference ------------------------------------------------------- */
+/* CPU reference of the GPU arithmetic. The renderer does not call these: they
+   model byte for byte what the encode, blend and decode passes compute, for
+   tests (fogvol's own and a custom backend's) and for offline tools. */
+/* Reference encoder: exactly the RGBA8 bytes the GPU writes for normalised
+   depth d (nearest sampling of the ramps). dither_row in [0, dither_steps);
+   row 0 is the undithered (round-to-nearest) row. */
+FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double d, int dither_row,
+                                             unsigned char out_rgba[4]);
+/* Saturating per-channel sum, as RGBA8 additive blending does: acc += value.
+   Returns 1 if any channel saturated (the true sum exceeded 255), else 0. */
+FOGVOL_API int fogvol_sum_rgba8(const unsigned char value[4], unsigned char acc[4]);
+/* Sum count encoded values (count*4 bytes) from zero; *saturated (may be NULL)
+   tells whether any channel saturated. */
+FOGVOL_API fogvol_result fogvol_sum_encoded(const unsigned char *values, int count, unsigned char out_rgba[4],
+                                            int *saturated);
+/* Decoded value in units of (far - near): R/N + G/N^2 + B/N^3 - A/N^2. */
+FOGVOL_API double fogvol_decode(const fogvol_encoding *enc, const unsigned char rgba[4]);
+/* decode(a) - decode(b), computed as decode of the channel differences. */
+FOGVOL_API double fogvol_decode_difference(const fogvol_encoding *enc, const unsigned char a[4],
+                                           const unsigned char b[4]);
 
 #ifdef __cplusplus
 }
