@@ -453,13 +453,17 @@ typedef struct fogvol_context_desc fogvol_context_desc;
    SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
                  no O read without occluders, no density texture outside textured volumes, exp or
                  ramp composite, no colour texture) instead of one program that switches on
-                 uniforms; built on first use (same pixels). */
+                 uniforms; built on first use (same pixels).
+   ALU           PS20 and MRT (not WIDE) take FOGVOL_VARIANT_ALU: the depth is encoded and the dither
+                 row computed by arithmetic instead of three lookup texture reads per face fragment
+                 (same bytes; fogvol_context_tier reports the variant). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
     FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
     FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
-    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
+    FOGVOL_SPEEDUP_ALU = 1u << 5
 };
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
@@ -4551,9 +4555,21 @@ static const char fogvol__fs_common[] =
     "uniform sampler2D fv_rg;\n"
     "uniform sampler2D fv_blue;\n"
     "#endif\n"
+    "#ifdef FV_ALU\n"                           /* the row of fogvol_make_dither_index, by arithmetic */
+    "float fv_dither_row() {\n"
+    "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
+    "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
+    "    float v = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
+    "              abs(b2.x - b2.y) * 2.0 + b2.y;\n"    /* 8x8 Bayer index by bit interleaving */
+    "    float dd = fv_dith.z;\n"
+    "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5), dd) : 0.0;\n"
+    "}\n"
+    "#else\n"
+    "float fv_dither_row() { return floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5); }\n"
+    "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
-    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n"
+    "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
     "    float n = fv_enc.x, dd = fv_dith.z;\n"
     "    float t = u * fv_enc.y * n;\n"            /* blue LSBs; scaling by powers of two is exact */
@@ -4574,7 +4590,7 @@ static const char fogvol__fs_common[] =
     "#ifdef FV_WIDE\n"                            /* six digits: V = floor(u N^6 + threshold), no borrow */
     "void fv_encode_wide(float d, out vec4 hi, out vec4 lo) {\n"
     "    float n = fv_enc.x, n3 = fv_enc.x * fv_enc.y, dd = fv_dith.z;\n"
-    "    float row = floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5);\n"
+    "    float row = fv_dither_row();\n"
     "    float v = floor(clamp(d, 0.0, fv_enc.w) * n3 * n3 + mod(row + dd * 0.5, dd) / dd);\n"
     "    float a = floor(v / n3), b = v - a * n3;\n"
     "    hi = vec4(floor(a / fv_enc.y), mod(floor(a / n), n), mod(a, n), 0.0) * (1.0 / 255.0);\n"
@@ -5886,6 +5902,17 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     return r;
 }
 
+/* FOGVOL_SPEEDUP_ALU: PS20 and MRT encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes, no
+   lookup texture reads) unless the variant set cannot take it. */
+static void fogvol__default_alu(fogvol_context *ctx)
+{
+    unsigned v = ctx->variants | FOGVOL_VARIANT_ALU;
+    if ((ctx->tier == FOGVOL_TIER_PS20 || ctx->tier == FOGVOL_TIER_MRT) && !(ctx->speedups_off & FOGVOL_SPEEDUP_ALU) &&
+        !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
+        fogvol_combination_supported(ctx->tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
+        ctx->variants = v;
+}
+
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
 {
     fogvol_context *ctx;
@@ -5915,6 +5942,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return r;
     }
     r = fogvol__choose_tier(ctx, desc);
+    if (r == FOGVOL_SUCCESS) fogvol__default_alu(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
@@ -10482,7 +10510,10 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
                        image-space effects (depth of field, outlines, distance fog), GLES and
                        WebGL tested, float SIMD analytic kernels, engine conventions (clip
                        control, reversed-Z, G-buffers, MSAA, engine depth and occluders),
-                       overflow counted every frame; outputs last everywhere (see CHANGELOG.md)
+                       overflow counted every frame; outputs last everywhere; programs
+                       specialised per configuration, PS20/MRT encode by arithmetic by default,
+                       resolve and check passes scissored; declarations in reading order (see
+                       CHANGELOG.md)
      0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
                        colour-ramp textures, mesh validation, PS20 renderer, GL backend,
                        recording null backend.

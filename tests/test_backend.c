@@ -255,6 +255,7 @@ static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
         fogvol_shader_desc sd;
         memset(&sd, 0, sizeof sd);
         sd.tier = FOGVOL_TIER_PS20;
+        sd.variants = FOGVOL_VARIANT_ALU; /* the PS20 default (FOGVOL_SPEEDUP_ALU) */
         sd.program = (fogvol_program)p;
         sd.dialect = dialect;
         sd.specialize = specs[k / FOGVOL_PROGRAM_COUNT];
@@ -776,8 +777,8 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
        texture; extinction ramps reaching 7 / density: the exp() composite, no colour texture */
     face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY));
     comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE));
-    rg = rec_texture_sized(r, 16, 16);          /* N x N */
-    blue = rec_texture_sized(r, 16 * 32, 32);   /* (N*D) x D */
+    rg = blue = 0; /* PS20 encodes by arithmetic by default (FOGVOL_SPEEDUP_ALU): no rg or blue ramp */
+    for (i = 0; i < r->ntex; ++i) assert_true(r->tex[i].w != 16 * 32 && !(r->tex[i].w == 16 && r->tex[i].hgt == 16));
     dith = rec_texture_sized(r, 8, 8);          /* 8 x 8 */
     for (i = 0; i < r->ntex; ++i) /* the two colour ramps: 256 x 1, LINEAR, CLAMP */
         if (r->tex[i].hgt == 1) {
@@ -1586,8 +1587,9 @@ static void test_a4_bad_input(void **state)
 
 /* ---- A5: fault injection ---- */
 
-/* n-th backend create call failing during context creation: 3 lookup textures (rg, blue,
-   dither index) and 3 programs (encode, face, composite) = 6 creates, so n = 1..6 fail and n = 7 succeeds. */
+/* n-th backend create call failing during context creation: PS20 encodes by arithmetic by default
+   (FOGVOL_SPEEDUP_ALU): 1 lookup texture (dither index) and 3 programs (encode, face, composite) = 4
+   creates, so n = 1..4 fail and n = 5 succeeds. */
 static void test_a5_backend_create_faults(void **state)
 {
     int n;
@@ -1610,14 +1612,14 @@ static void test_a5_backend_create_faults(void **state)
         cd.allocator = cnt_allocator(&cnt);
         res = fogvol_create_context(&cd, &fv);
         if (res == FOGVOL_SUCCESS) {
-            assert_int_equal(n, 7);
-            assert_int_equal(r.nb.creates, 6);
+            assert_int_equal(n, 5);
+            assert_int_equal(r.nb.creates, 4);
             fogvol_destroy_context(fv);
             assert_int_equal(r.nb.creates, r.nb.destroys);
             assert_int_equal(cnt.live, 0);
             break;
         }
-        assert_true(n <= 6);
+        assert_true(n <= 4);
         assert_int_equal(res, FOGVOL_ERROR_BACKEND);
         assert_null(fv);
         assert_true(log_error_has(&lc, NULL));

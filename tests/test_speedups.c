@@ -1,6 +1,6 @@
 /* test_speedups.c - the speed-ups fogvol turns on by default (FOGVOL_SPEEDUP_*):
    SKIP_OPAQUE, TEXEL_FETCH, SCISSOR (composite, resolve and overflow check passes) and SPECIALIZE
-   (programs built per configuration) give the same pixels as with them off, frame after frame
+   (programs built per configuration) and ALU (PS20 encodes by arithmetic) give the same pixels as with them off, frame after frame
    while occluders come and go (O kept from an earlier frame must be the far plane, and redrawn
    when occluders return); SKIP_OPAQUE draws one pass less from the second frame on;
    EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
@@ -134,7 +134,7 @@ static const fogvol_tier g_tiers[] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20, FOGVO
 static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
-     FOGVOL_SPEEDUP_SPECIALIZE)
+     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU)
 
 static void test_same_pixels_and_exp(void **state)
 {
@@ -153,7 +153,7 @@ static void test_same_pixels_and_exp(void **state)
             run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
             for (f = 0; f < NFRAMES; ++f) {
                 int m;
-                /* SKIP_OPAQUE, TEXEL_FETCH, SCISSOR, SPECIALIZE: the same bytes as with every speed-up off */
+                /* SKIP_OPAQUE, TEXEL_FETCH, SCISSOR, SPECIALIZE, ALU: the same bytes as with every speed-up off */
                 assert_int_equal(max_diff(noexp.px[f], off.px[f], &n), 0);
                 m = max_diff(def.px[f], noexp.px[f], &n);
                 if (m > exp_max) exp_max = m;
