@@ -1557,14 +1557,32 @@ static void print_summary(const result *rs, int n)
         pf(pm >= 6.0));
 }
 
+/* The analytic fog's figures: the end of the "summary: analytic ..." line that bench_analytic
+   wrote to the file named by FOGVOL_BENCH_ANALYTIC (make bench runs it first), else "analytic n/a". */
+static void analytic_figures(char *buf, size_t size)
+{
+    const char *path = getenv("FOGVOL_BENCH_ANALYTIC");
+    char line[256];
+    FILE *f = path ? fopen(path, "r") : NULL;
+    snprintf(buf, size, "analytic n/a");
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "summary: analytic", 17) == 0) {
+            line[strcspn(line, "\r\n")] = 0;
+            snprintf(buf, size, "%s", line + 9);
+        }
+    if (f) fclose(f);
+}
+
 /* the last line of the output: the figures to compare between runs */
 static void print_summary_line(const result *rs, int n)
 {
     const char *w;
+    char an[256];
+    analytic_figures(an, sizeof an);
     out("\nsummary: FLOAT worst %.2fx floor, FLOAT occluders %.2fx occluder floor, PS20 worst %.2fx, MRT worst %.2fx, "
-        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, analytic n/a\n",
+        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, %s\n",
         worst_ratio(rs, n, 3, 0, &w), worst_ratio(rs, n, 3, 1, &w), worst_ratio(rs, n, 1, -1, &w),
-        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n));
+        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n), an);
 }
 
 /* ---- 16 coloured volumes: per-ramp groups against one pass (FOGVOL_VARIANT_COLORS) ------ */
