@@ -797,8 +797,9 @@ typedef struct fogvol_analytic_set {
    broken by volume order), only the time the sorts take; any bytes are safe
    (orders that are not permutations are replaced). Only the DOUBLE kernel
    (fogvol_analytic_kernel) reads and writes the orders: the float kernels
-   sort the few events of the volumes on each ray from volume order; they
-   still fill sorted_vertices and moves. */
+   sort the few events of the volumes on each ray, starting from the order of
+   the previous sorted vertex of the same call; they still fill
+   sorted_vertices and moves. */
 typedef struct fogvol_analytic_order {
     unsigned char *vertex_orders; /* optional */
     size_t vertex_orders_size;    /* bytes */
@@ -3865,74 +3866,151 @@ FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const flo
     }
 }
 
-/* fogvol__an_walk in float over the hit events ev[0..h) (sorted by key) */
-static void fogvol__an_fwalk(const fogvol__an_fvol *fv, int law, int mix, float len, const float *key,
-                             const unsigned char *ev, int h, fogvol__an_fstate *st)
+/* exp(-x) and 1 - exp(-x) for x >= 0 without branches (the order-free EXP fog
+   of a block, the sorted walk's stretches): fogvol__an_fexpn's arithmetic
+   with x clamped to [0, 87]; below ln2 / 2 (n = 0) 1 - exp(-x) is -(r + r^2 P)
+   itself, which keeps its digits where 1 - e would cancel. */
+FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
 {
-    int k, c;
-    if (mix == FOGVOL_MIX_SEPARATE) {
-        for (k = 0; k < h && !st->done; ++k) {
-            int e = ev[k];
-            const fogvol__an_fvol *f = &fv[e >> 1];
-            float cs[3];
+    float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
+    int n = (int)(xc * 1.44269504f + 0.5f);
+    uint32_t bits = (uint32_t)(127 - n) << 23;
+    r = (float)n * 0.693145751953125f - xc + (float)n * 1.42860677e-6f;
+    r2 = r * r;
+    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
+        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
+    p = r + r2 * p; /* exp(r) - 1 */
+    memcpy(&scale, &bits, sizeof scale);
+    *om = n == 0 ? -p : 1.0f - (1.0f + p) * scale;
+    return (1.0f + p) * scale;
+}
+
+#define FOGVOL__AN_EVENTS (2 * FOGVOL_ANALYTIC_CAPACITY)
+
+/* The event order of the last sorted vertex of a call: the next one starts
+   from it (neighbouring vertices mostly see their volumes in the same order,
+   so the insertion sort then only compares). */
+typedef struct fogvol__an_fcarry {
+    unsigned char ev[FOGVOL__AN_EVENTS];
+    unsigned int hit[FOGVOL__AN_MASKS]; /* the volumes in ev */
+    int m;
+} fogvol__an_fcarry;
+
+/* The stretches between a ray's sorted events, front to back: the summed
+   colour * density (rgb) and density (sig) of the volumes a stretch is in,
+   and its length in world units (INTERPENETRATING, the paper's event list;
+   the sums restart from exact zeros whenever no volume is open, so rounding
+   never leaves a ghost density behind), or each volume whole at its entry
+   (SEPARATE). Stretches outside every volume get sig 0. Returns the count. */
+static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *tev,
+                                 int m, float (*rgb)[3], float *sig, float *l)
+{
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
+    int k, open = 0, n = 0;
+    for (k = 0; k < m; ++k) {
+        int e = (int)(key[k] & 0xffu);
+        const fogvol__an_fvol *f = &fv[e >> 1];
+        float t = tev[e], sd = (e & 1) ? -f->dens : f->dens;
+        if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
-            for (c = 0; c < 3; ++c) cs[c] = f->col[c] * f->dens;
-            fogvol__an_fadd(st, law, cs, f->dens, len * (key[e + 1] - key[e]));
+            rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
+            sig[n] = f->dens;
+            l[n++] = len * (tev[e + 1] - t);
+            continue;
         }
-    } else {
-        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, last = 0.0f;
-        int open = 0;
-        for (k = 0; k < h && !st->done; ++k) {
-            int e = ev[k];
-            const fogvol__an_fvol *f = &fv[e >> 1];
-            float t = key[e], sd = (e & 1) ? -f->dens : f->dens;
-            if (open > 0 && t > last) fogvol__an_fadd(st, law, acc, acc[3], (t - last) * len);
-            for (c = 0; c < 3; ++c) acc[c] += sd * f->col[c];
-            acc[3] += sd;
-            open += (e & 1) ? -1 : 1;
-            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0f;
-            last = t;
-        }
+        rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
+        sig[n] = ad;
+        l[n++] = (t - last) * len;
+        open += (e & 1) ? -1 : 1;
+        ar += sd * f->col[0], ag += sd * f->col[1], ab += sd * f->col[2], ad += sd;
+        if (open == 0) ar = ag = ab = ad = 0.0f;
+        last = t;
     }
+    return n;
+}
+
+/* The EXP law over n stretches: each stretch of optical depth tau covers
+   T (1 - exp(-tau)) of the pixel (T: the transmittance in front of it) with
+   the mean colour rgb / sig; done once T < FOGVOL__AN_CUTOFF. */
+static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const float *l, int n, float *fog,
+                                 float col[3])
+{
+    float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS], f = 1.0f, w = 0.0f, num[3] = {0.0f, 0.0f, 0.0f}, inv;
+    int k, c;
+    for (k = 0; k < n; ++k) {
+        float tau = sig[k] * l[k], om;
+        ex[k] = fogvol__an_fexp2(tau, &om);
+        q[k] = tau > 0.0f ? om / sig[k] : 0.0f;
+    }
+    for (k = 0; k < n && f >= (float)FOGVOL__AN_CUTOFF; ++k) {
+        float a = f * q[k];
+        for (c = 0; c < 3; ++c) num[c] += rgb[k][c] * a;
+        w += sig[k] * a;
+        f *= ex[k];
+    }
+    inv = w > 1e-30f ? 1.0f / w : 0.0f;
+    *fog = f;
+    for (c = 0; c < 3; ++c) col[c] = num[c] * inv;
 }
 
 /* The sorted walk of the float kernels: only the events of the volumes on
    the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
-   are sorted, by insertion from volume order (cheaper than filtering a
-   carried order of all the events). */
+   are sorted, by insertion from the order of the previous sorted vertex
+   (carry): its events still on the ray in that order, then those of the
+   volumes new to the ray in volume order. The keys are t bits << 32 | event
+   index (t >= 0, so the integer order is the order of t, ties by event index). */
 static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol__an_fvol *fv, int law, int mix,
                                       float len, const float *t1, const float *t2, const unsigned int *hit,
-                                      int64_t *moves, float *fog, float col[3])
+                                      fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
-    float key[2 * FOGVOL_ANALYTIC_CAPACITY], inv;
-    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY];
+    uint64_t key[FOGVOL__AN_EVENTS];
+    float tev[FOGVOL__AN_EVENTS], rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
     fogvol__an_fstate st;
-    int h = 0, w, k, j, c;
-    int64_t mv = 0;
-    for (w = 0; w < (s->count + 31) / 32; ++w) {
+    float inv;
+    int m = 0, n, w, k, j, c, nw = (s->count + 31) / 32;
+    for (w = 0; w < nw; ++w) {
         unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
         while (bits) {
             int v = 32 * w + fogvol__an_ctz(bits);
             bits &= bits - 1u;
-            key[2 * v] = t1[v * FOGVOL__AN_BLOCK];
-            key[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK];
-            ev[h++] = (unsigned char)(2 * v);
-            ev[h++] = (unsigned char)(2 * v + 1);
+            tev[2 * v] = t1[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
+            tev[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK] + 0.0f;
         }
     }
-    for (k = 1; k < h; ++k) {
-        unsigned char x = ev[k];
-        float kx = key[x];
-        for (j = k; j > 0 && (key[ev[j - 1]] > kx || (key[ev[j - 1]] == kx && ev[j - 1] > x)); --j) {
-            ev[j] = ev[j - 1];
-            ++mv;
-        }
-        ev[j] = x;
+    for (k = 0; k < carry->m; ++k) {
+        int e = carry->ev[k], v = e >> 1;
+        if ((hit[(v >> 5) * FOGVOL__AN_BLOCK] >> (v & 31)) & 1u) key[m++] = (uint64_t)e;
     }
-    *moves += mv;
+    for (w = 0; w < nw; ++w) {
+        unsigned int bits = hit[w * FOGVOL__AN_BLOCK] & ~carry->hit[w];
+        carry->hit[w] = hit[w * FOGVOL__AN_BLOCK];
+        while (bits) {
+            int v = 32 * w + fogvol__an_ctz(bits);
+            bits &= bits - 1u;
+            key[m++] = (uint64_t)(2 * v);
+            key[m++] = (uint64_t)(2 * v + 1);
+        }
+    }
+    for (k = 0; k < m; ++k) {
+        uint32_t u;
+        memcpy(&u, &tev[key[k]], sizeof u);
+        key[k] |= (uint64_t)u << 32;
+    }
+    for (k = 1; k < m; ++k) {
+        uint64_t x = key[k];
+        for (j = k; j > 0 && key[j - 1] > x; --j) key[j] = key[j - 1], ++*moves;
+        key[j] = x;
+    }
+    for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
+    carry->m = m;
+    n = fogvol__an_fstretches(fv, mix, len, key, tev, m, rgb, sig, l);
+    if (law == FOGVOL_FOG_EXP) {
+        fogvol__an_fexp_walk((const float (*)[3])rgb, sig, l, n, fog, col);
+        return;
+    }
     memset(&st, 0, sizeof st);
     st.f = 1.0f;
-    fogvol__an_fwalk(fv, law, mix, len, key, ev, h, &st);
+    for (k = 0; k < n && !st.done; ++k) fogvol__an_fadd(&st, law, rgb[k], sig[k], l[k]);
     inv = st.w > 1e-30f ? 1.0f / st.w : 0.0f;
     *fog = st.f;
     for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
@@ -3951,6 +4029,7 @@ typedef struct fogvol__an_call {
     float dlim; /* |vertex - eye| coordinates beyond this go to double (fogvol__an_fvols) */
     int eye_ok, law, mix, count, stride, fog_stride, color_stride, bad, sorted;
     int64_t moves;
+    fogvol__an_fcarry fcarry; /* the float kernels' event order, from sorted vertex to sorted vertex */
 } fogvol__an_call;
 
 /* Gathers block `base` (checked: x - x is 0 for finite x only), padded with
@@ -4004,7 +4083,7 @@ static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
                 fogvol__an_fsorted_vertex(c->set, fv, c->law, c->mix, blk.len[i],
                                           (const float *)(const void *)blk.t1 + i,
                                           (const float *)(const void *)blk.t2 + i,
-                                          (const unsigned int *)(const void *)blk.hit + i, &c->moves, &f, col);
+                                          (const unsigned int *)(const void *)blk.hit + i, &c->fcarry, &c->moves, &f, col);
                 ++c->sorted;
             } else {
                 f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
