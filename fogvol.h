@@ -3527,6 +3527,25 @@ FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
 #endif
 }
 
+/* exp(-x) and 1 - exp(-x) for x >= 0 without branches (the order-free EXP fog
+   of a block, the sorted walk's stretches): fogvol__an_fexpn's arithmetic
+   with x clamped to [0, 87]; below ln2 / 2 (n = 0) 1 - exp(-x) is -(r + r^2 P)
+   itself, which keeps its digits where 1 - e would cancel. */
+FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
+{
+    float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
+    int n = (int)(xc * 1.44269504f + 0.5f);
+    uint32_t bits = (uint32_t)(127 - n) << 23;
+    r = (float)n * 0.693145751953125f - xc + (float)n * 1.42860677e-6f;
+    r2 = r * r;
+    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
+        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
+    p = r + r2 * p; /* exp(r) - 1 */
+    memcpy(&scale, &bits, sizeof scale);
+    *om = n == 0 ? -p : 1.0f - (1.0f + p) * scale;
+    return (1.0f + p) * scale;
+}
+
 /* one volume as the float kernels read it, the eye already in its unit space */
 typedef struct fogvol__an_fvol {
     float m[12], o[3], c0, dens, col[3];
@@ -3575,8 +3594,8 @@ FOGVOL__AN_INLINE void fogvol__an_fhalf(const float *m, float s0, float dx, floa
 
 FOGVOL__AN_INLINE void fogvol__an_fslab(float o, float v, float *lo, float *hi)
 {
-    float vs = v + (float)(v == 0.0f);
-    float ta = (-1.0f - o) / vs, tb = (1.0f - o) / vs;
+    float iv = 1.0f / (v + (float)(v == 0.0f)); /* one division for both planes */
+    float ta = (-1.0f - o) * iv, tb = (1.0f - o) * iv;
     float mn = fogvol__an_fmin(ta, tb), mx = fogvol__an_fmax(ta, tb);
     float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
     float l = v == 0.0f ? 0.0f : mn, h = v == 0.0f ? par : mx;
@@ -3673,7 +3692,7 @@ FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_s
 /* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
    and which vertices need the sorted walk. Inlined into one function per level. */
 FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
-                                              const double e[3], const fogvol__an_fvol *fv, float limit,
+                                              const double e[3], const fogvol__an_fvol *fv, float limit, int law,
                                               fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
 {
     int v, i;
@@ -3717,8 +3736,9 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
     }
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
         /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
-        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f;
-        k->fog[i] = fogvol__an_fmax(1.0f - tau, 0.0f);
+        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f, om;
+        float ex = fogvol__an_fexp2(tau, &om);
+        k->fog[i] = law == FOGVOL_FOG_EXP ? ex : fogvol__an_fmax(1.0f - tau, 0.0f);
         k->r[i] *= inv;
         k->g[i] *= inv;
         k->bl[i] *= inv;
@@ -3727,12 +3747,12 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
 }
 
 typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                     const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k);
+                                     const fogvol__an_fvol *fv, float limit, int law, fogvol__an_fblock *k);
 
 static void fogvol__an_fblock_c(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k)
+                                const fogvol__an_fvol *fv, float limit, int law, fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_c, k);
+    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_c, k);
 }
 
 #if FOGVOL__AN_X86
@@ -3743,10 +3763,10 @@ __attribute__((target("sse2"))) static void fogvol__an_sqrt_sse2(float *out, con
 }
 __attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_analytic_set *set,
                                                                     const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    const fogvol__an_fvol *fv, float limit, int law,
                                                                     fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_sse2, k);
+    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_sse2, k);
 }
 __attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, const float *in)
 {
@@ -3755,10 +3775,10 @@ __attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, con
 }
 __attribute__((target("avx2"))) static void fogvol__an_fblock_avx2(const fogvol_analytic_set *set,
                                                                     const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    const fogvol__an_fvol *fv, float limit, int law,
                                                                     fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_avx2, k);
+    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_avx2, k);
 }
 #endif
 
@@ -3864,25 +3884,6 @@ FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const flo
             st->done = 1;
         }
     }
-}
-
-/* exp(-x) and 1 - exp(-x) for x >= 0 without branches (the order-free EXP fog
-   of a block, the sorted walk's stretches): fogvol__an_fexpn's arithmetic
-   with x clamped to [0, 87]; below ln2 / 2 (n = 0) 1 - exp(-x) is -(r + r^2 P)
-   itself, which keeps its digits where 1 - e would cancel. */
-FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
-{
-    float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
-    int n = (int)(xc * 1.44269504f + 0.5f);
-    uint32_t bits = (uint32_t)(127 - n) << 23;
-    r = (float)n * 0.693145751953125f - xc + (float)n * 1.42860677e-6f;
-    r2 = r * r;
-    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
-        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
-    p = r + r2 * p; /* exp(r) - 1 */
-    memcpy(&scale, &bits, sizeof scale);
-    *om = n == 0 ? -p : 1.0f - (1.0f + p) * scale;
-    return (1.0f + p) * scale;
 }
 
 #define FOGVOL__AN_EVENTS (2 * FOGVOL_ANALYTIC_CAPACITY)
@@ -4070,7 +4071,7 @@ static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         fogvol__an_fgather(c, base, nb, valid, &blk);
-        fn(c->set, c->pe, c->e, fv, limit, &blk);
+        fn(c->set, c->pe, c->e, fv, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
             float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
@@ -4086,8 +4087,7 @@ static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
                                           (const unsigned int *)(const void *)blk.hit + i, &c->fcarry, &c->moves, &f, col);
                 ++c->sorted;
             } else {
-                f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
-                    : blk.tau[i] > 0.0f ? (float)FOGVOL_EXP(-(double)blk.tau[i]) : 1.0f;
+                f = blk.fog[i];
                 col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
             }
             if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;
