@@ -3502,7 +3502,7 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
    further than FOGVOL__AN_FAR_EYE from its centre (the cross product o x v
    loses digits there). */
 
-#define FOGVOL__AN_GRAZE 0.0625f
+#define FOGVOL__AN_GRAZE 0.015625f
 #define FOGVOL__AN_FAR_EYE 64.0
 #define FOGVOL__AN_MASKS ((FOGVOL_ANALYTIC_CAPACITY + 31) / 32)
 
@@ -3660,6 +3660,21 @@ static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye
     }
 }
 
+/* fogvol__an_redo for the lanes base + i of volume v whose bit i is set in mask. */
+static void fogvol__an_redo_lanes(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3], int v,
+                                  int mask, int base, fogvol__an_fblock *k)
+{
+    while (mask) {
+        int i = base + fogvol__an_ctz((unsigned int)mask);
+        double dx = (double)k->px[i] - e[0], dy = (double)k->py[i] - e[1], dz = (double)k->pz[i] - e[2], lo, hi;
+        mask &= mask - 1;
+        fogvol__an_ray(set, pe, v, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
+        k->lo[i] = (float)lo;
+        k->hi[i] = (float)hi;
+        k->ch[i] = (float)(hi > lo ? hi - lo : 0.0);
+    }
+}
+
 /* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block;
    returns whether some lanes graze it (marked in redo, for fogvol__an_redo). */
 FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
@@ -3687,6 +3702,22 @@ FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_s
     if (kind == 1)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) fogvol__an_fslab(o[2], k->vz[i], &k->lo[i], &k->hi[i]);
     return any;
+}
+
+/* The order-free answer of a block (fogvol__an_sort_limit) and which vertices need the sorted walk. */
+FOGVOL__AN_INLINE void fogvol__an_ffinish(float limit, int law, fogvol__an_fblock *k)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
+        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f, om;
+        float ex = fogvol__an_fexp2(tau, &om);
+        k->fog[i] = law == FOGVOL_FOG_EXP ? ex : fogvol__an_fmax(1.0f - tau, 0.0f);
+        k->r[i] *= inv;
+        k->g[i] *= inv;
+        k->bl[i] *= inv;
+        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
+    }
 }
 
 /* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
@@ -3734,16 +3765,7 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
             k->t2[v][i] = lo + d;
         }
     }
-    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
-        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
-        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f, om;
-        float ex = fogvol__an_fexp2(tau, &om);
-        k->fog[i] = law == FOGVOL_FOG_EXP ? ex : fogvol__an_fmax(1.0f - tau, 0.0f);
-        k->r[i] *= inv;
-        k->g[i] *= inv;
-        k->bl[i] *= inv;
-        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
-    }
+    fogvol__an_ffinish(limit, law, k);
 }
 
 typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
@@ -3768,17 +3790,175 @@ __attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_
 {
     fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_sse2, k);
 }
-__attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, const float *in)
+#endif
+
+#if FOGVOL__AN_X86
+/* ---- the AVX2 kernel ----
+   The block body above written with AVX2 intrinsics, one pass per volume and
+   group of 8 vertices (entry/exit, the sums, the hit mask and t1/t2 at once,
+   where the C loops go through memory between the steps), the square roots
+   in the same pass. The per-shape maths runs the same operations in the same
+   order as the C kernels (the results are the same bit for bit). */
+#define FOGVOL__AN_AVX2_FN __attribute__((target("avx2"))) static
+#define FOGVOL__AN_AVX2_INL static __inline__ __attribute__((always_inline, target("avx2")))
+#define FOGVOL__AN_V8(x) _mm256_set1_ps(x)
+
+/* where is m set, a else b */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_sel8(__m256 m, __m256 a, __m256 b) { return _mm256_blendv_ps(b, a, m); }
+/* x + (x == 0): a divisor that is never 0 */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_nz8(__m256 x)
 {
-    int i;
-    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) _mm256_storeu_ps(out + i, _mm256_sqrt_ps(_mm256_loadu_ps(in + i)));
+    return _mm256_add_ps(x, _mm256_and_ps(_mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_EQ_OQ), FOGVOL__AN_V8(1.0f)));
 }
-__attribute__((target("avx2"))) static void fogvol__an_fblock_avx2(const fogvol_analytic_set *set,
-                                                                    const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit, int law,
-                                                                    fogvol__an_fblock *k)
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_dot8(const float *m, __m256 dx, __m256 dy, __m256 dz)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_avx2, k);
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(FOGVOL__AN_V8(m[0]), dx), _mm256_mul_ps(FOGVOL__AN_V8(m[1]), dy)),
+                         _mm256_mul_ps(FOGVOL__AN_V8(m[2]), dz));
+}
+
+/* fogvol__an_fslab on 8 lanes */
+FOGVOL__AN_AVX2_INL void fogvol__an_slab8(float o, __m256 v, __m256 *lo, __m256 *hi)
+{
+    __m256 z = _mm256_cmp_ps(v, _mm256_setzero_ps(), _CMP_EQ_OQ);
+    __m256 iv = _mm256_div_ps(FOGVOL__AN_V8(1.0f), fogvol__an_nz8(v));
+    __m256 ta = _mm256_mul_ps(FOGVOL__AN_V8(-1.0f - o), iv), tb = _mm256_mul_ps(FOGVOL__AN_V8(1.0f - o), iv);
+    float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
+    __m256 l = fogvol__an_sel8(z, _mm256_setzero_ps(), _mm256_min_ps(ta, tb));
+    __m256 h = fogvol__an_sel8(z, FOGVOL__AN_V8(par), _mm256_max_ps(ta, tb));
+    *lo = _mm256_max_ps(*lo, l);
+    *hi = _mm256_min_ps(*hi, h);
+}
+
+/* fogvol__an_fdistance, fogvol__an_fhalf and fogvol__an_fbox on 8 lanes */
+FOGVOL__AN_AVX2_INL void fogvol__an_flat8(const fogvol__an_fvol *f, __m256 dx, __m256 dy, __m256 dz, __m256 len,
+                                          __m256 *lo, __m256 *hi)
+{
+    const float *m = f->m;
+    __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f);
+    if (f->shape == FOGVOL_SHAPE_DISTANCE) {
+        __m256 ls = fogvol__an_nz8(len);
+        __m256 h = m[1] > 0.0f ? _mm256_min_ps(_mm256_div_ps(FOGVOL__AN_V8(m[1]), ls), one) : one;
+        *lo = _mm256_div_ps(FOGVOL__AN_V8(m[0]), ls);
+        *hi = fogvol__an_sel8(_mm256_cmp_ps(len, zero, _CMP_GT_OQ), h, FOGVOL__AN_V8(-1.0f));
+    } else if (f->shape == FOGVOL_SHAPE_HALF_SPACE) {
+        __m256 s1 = fogvol__an_dot8(m, dx, dy, dz), tx = _mm256_div_ps(FOGVOL__AN_V8(-f->o[0]), fogvol__an_nz8(s1));
+        __m256 up = _mm256_cmp_ps(s1, zero, _CMP_GT_OQ), down = _mm256_cmp_ps(s1, zero, _CMP_LT_OQ);
+        __m256 h = fogvol__an_sel8(up, one, FOGVOL__AN_V8(f->o[0] >= 0.0f ? 1.0f : -1.0f));
+        *lo = fogvol__an_sel8(up, _mm256_max_ps(tx, zero), zero);
+        *hi = fogvol__an_sel8(down, _mm256_min_ps(tx, one), h);
+    } else { /* BOX */
+        *lo = zero, *hi = one;
+        fogvol__an_slab8(f->o[0], fogvol__an_dot8(m, dx, dy, dz), lo, hi);
+        fogvol__an_slab8(f->o[1], fogvol__an_dot8(m + 4, dx, dy, dz), lo, hi);
+        fogvol__an_slab8(f->o[2], fogvol__an_dot8(m + 8, dx, dy, dz), lo, hi);
+    }
+}
+
+/* fogvol__an_fquad1, the graze test and fogvol__an_fquad2 (and the
+   cylinder's slab) on 8 lanes; returns the lanes that graze (a bit each) */
+FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx, __m256 dy, __m256 dz, __m256 *lo,
+                                            __m256 *hi)
+{
+    const float *m = f->m, *o = f->o;
+    __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f), o0 = FOGVOL__AN_V8(o[0]), o1 = FOGVOL__AN_V8(o[1]);
+    __m256 v0, v1, v2, w2, o2, cx, cy, cz, a, b, disc, s, sg, q, r1, r2, l, h, pos, ga;
+    int cyl = f->shape == FOGVOL_SHAPE_CYLINDER, graze;
+    if (f->shape == FOGVOL_SHAPE_SPHERE) {
+        __m256 sc = FOGVOL__AN_V8(m[0]);
+        v0 = _mm256_mul_ps(sc, dx), v1 = _mm256_mul_ps(sc, dy), v2 = _mm256_mul_ps(sc, dz);
+    } else {
+        v0 = fogvol__an_dot8(m, dx, dy, dz), v1 = fogvol__an_dot8(m + 4, dx, dy, dz);
+        v2 = fogvol__an_dot8(m + 8, dx, dy, dz);
+    }
+    w2 = cyl ? zero : v2, o2 = FOGVOL__AN_V8(cyl ? 0.0f : o[2]);
+    cx = _mm256_sub_ps(_mm256_mul_ps(o1, w2), _mm256_mul_ps(o2, v1));
+    cy = _mm256_sub_ps(_mm256_mul_ps(o2, v0), _mm256_mul_ps(o0, w2));
+    cz = _mm256_sub_ps(_mm256_mul_ps(o0, v1), _mm256_mul_ps(o1, v0));
+    a = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(v0, v0), _mm256_mul_ps(v1, v1)), _mm256_mul_ps(w2, w2));
+    b = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(o0, v0), _mm256_mul_ps(o1, v1)), _mm256_mul_ps(o2, w2));
+    disc = _mm256_sub_ps(
+        a, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(cx, cx), _mm256_mul_ps(cy, cy)), _mm256_mul_ps(cz, cz)));
+    pos = _mm256_cmp_ps(a, zero, _CMP_GT_OQ);
+    ga = _mm256_mul_ps(FOGVOL__AN_V8(FOGVOL__AN_GRAZE), a);
+    graze = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(pos, _mm256_cmp_ps(disc, ga, _CMP_LT_OQ)),
+                                             _mm256_cmp_ps(disc, _mm256_mul_ps(FOGVOL__AN_V8(-FOGVOL__AN_GRAZE), a),
+                                                           _CMP_GT_OQ)));
+    s = _mm256_sqrt_ps(_mm256_max_ps(disc, zero));
+    sg = fogvol__an_sel8(_mm256_cmp_ps(b, zero, _CMP_GE_OQ), s, _mm256_xor_ps(s, FOGVOL__AN_V8(-0.0f)));
+    q = _mm256_xor_ps(_mm256_add_ps(b, sg), FOGVOL__AN_V8(-0.0f)); /* -(b + sg), signed zeros included */
+    r1 = _mm256_div_ps(q, fogvol__an_nz8(a)), r2 = _mm256_div_ps(FOGVOL__AN_V8(f->c0), fogvol__an_nz8(q));
+    l = _mm256_max_ps(_mm256_min_ps(r1, r2), zero), h = _mm256_min_ps(_mm256_max_ps(r1, r2), one);
+    h = fogvol__an_sel8(_mm256_cmp_ps(disc, zero, _CMP_GT_OQ), h, FOGVOL__AN_V8(-1.0f));
+    *lo = fogvol__an_sel8(pos, l, zero);
+    *hi = fogvol__an_sel8(pos, h, FOGVOL__AN_V8(f->c0 <= 0.0f ? 1.0f : -1.0f));
+    if (cyl) fogvol__an_slab8(o[2], v2, lo, hi);
+    return graze;
+}
+
+/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit, the
+   sums and the hit mask, accumulated where fogvol__an_fblock_body keeps them. */
+FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                         const fogvol__an_fvol *f, int v, int base, fogvol__an_fblock *k)
+{
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base), dz = _mm256_loadu_ps(k->dz + base);
+    __m256 len = _mm256_loadu_ps(k->len + base), lo = zero, hi = zero, ch, tv, hm;
+    unsigned int *hw = k->hit[v >> 5] + base;
+    int redo = 0xff;
+    if (f->dbl) { /* every lane in double */
+    } else if (f->shape == FOGVOL_SHAPE_DISTANCE || f->shape == FOGVOL_SHAPE_HALF_SPACE ||
+               f->shape == FOGVOL_SHAPE_BOX) {
+        fogvol__an_flat8(f, dx, dy, dz, len, &lo, &hi);
+        redo = 0;
+    } else {
+        redo = fogvol__an_quadric8(f, dx, dy, dz, &lo, &hi);
+    }
+    ch = _mm256_max_ps(_mm256_sub_ps(hi, lo), zero);
+    if (redo) {
+        _mm256_storeu_ps(k->lo + base, lo), _mm256_storeu_ps(k->hi + base, hi), _mm256_storeu_ps(k->ch + base, ch);
+        fogvol__an_redo_lanes(set, pe, e, v, redo, base, k);
+        lo = _mm256_loadu_ps(k->lo + base), hi = _mm256_loadu_ps(k->hi + base), ch = _mm256_loadu_ps(k->ch + base);
+    }
+    lo = _mm256_min_ps(lo, hi);
+    tv = _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
+    hm = _mm256_cmp_ps(tv, zero, _CMP_GT_OQ);
+    _mm256_storeu_ps(k->tau + base, _mm256_add_ps(_mm256_loadu_ps(k->tau + base), tv));
+    _mm256_storeu_ps(k->r + base, _mm256_add_ps(_mm256_loadu_ps(k->r + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv)));
+    _mm256_storeu_ps(k->g + base, _mm256_add_ps(_mm256_loadu_ps(k->g + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv)));
+    _mm256_storeu_ps(k->bl + base,
+                     _mm256_add_ps(_mm256_loadu_ps(k->bl + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv)));
+    _mm256_storeu_ps(k->hits + base,
+                     _mm256_add_ps(_mm256_loadu_ps(k->hits + base), _mm256_and_ps(hm, FOGVOL__AN_V8(1.0f))));
+    _mm256_storeu_si256((__m256i *)(void *)hw,
+                        _mm256_or_si256(_mm256_loadu_si256((const __m256i *)(const void *)hw),
+                                        _mm256_and_si256(_mm256_castps_si256(hm),
+                                                         _mm256_set1_epi32((int)(1u << (v & 31))))));
+    _mm256_storeu_ps(k->t1[v] + base, lo);
+    _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
+}
+
+/* The volumes outside, the block's 4 groups of 8 inside: the groups' long
+   chains (square root, then division) are independent and overlap. */
+FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                                const double e[3], const fogvol__an_fvol *fv, float limit, int law,
+                                                fogvol__an_fblock *k)
+{
+    int base, v, i;
+    for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) {
+        __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base);
+        __m256 dz = _mm256_loadu_ps(k->dz + base), zero = _mm256_setzero_ps();
+        _mm256_storeu_ps(k->len + base, _mm256_sqrt_ps(_mm256_add_ps(
+                                            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                            _mm256_mul_ps(dz, dz))));
+        _mm256_storeu_ps(k->tau + base, zero), _mm256_storeu_ps(k->r + base, zero);
+        _mm256_storeu_ps(k->g + base, zero), _mm256_storeu_ps(k->bl + base, zero);
+        _mm256_storeu_ps(k->hits + base, zero);
+    }
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
+    for (v = 0; v < set->count; ++v)
+        for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
+    fogvol__an_ffinish(limit, law, k);
 }
 #endif
 
