@@ -3529,8 +3529,8 @@ FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
 
 /* exp(-x) and 1 - exp(-x) for x >= 0 without branches (the order-free EXP fog
    of a block, the sorted walk's stretches): fogvol__an_fexpn's arithmetic
-   with x clamped to [0, 87]; below ln2 / 2 (n = 0) 1 - exp(-x) is -(r + r^2 P)
-   itself, which keeps its digits where 1 - e would cancel. */
+   with x clamped to [0, 87]; 1 - exp(-x) as (1 - 2^-n) - (r + r^2 P) 2^-n,
+   which keeps its digits where 1 - e would cancel (n = 0 below ln2 / 2). */
 FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
 {
     float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
@@ -3542,7 +3542,7 @@ FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
         (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
     p = r + r2 * p; /* exp(r) - 1 */
     memcpy(&scale, &bits, sizeof scale);
-    *om = n == 0 ? -p : 1.0f - (1.0f + p) * scale;
+    *om = (1.0f - scale) - p * scale; /* n = 0: -p exactly */
     return (1.0f + p) * scale;
 }
 
@@ -3820,7 +3820,7 @@ FOGVOL__AN_AVX2_INL __m256 fogvol__an_dot8(const float *m, __m256 dx, __m256 dy,
 FOGVOL__AN_AVX2_INL void fogvol__an_slab8(float o, __m256 v, __m256 *lo, __m256 *hi)
 {
     __m256 z = _mm256_cmp_ps(v, _mm256_setzero_ps(), _CMP_EQ_OQ);
-    __m256 iv = _mm256_div_ps(FOGVOL__AN_V8(1.0f), fogvol__an_nz8(v));
+    __m256 iv = _mm256_div_ps(FOGVOL__AN_V8(1.0f), v); /* v = 0: infinite, those lanes are replaced below */
     __m256 ta = _mm256_mul_ps(FOGVOL__AN_V8(-1.0f - o), iv), tb = _mm256_mul_ps(FOGVOL__AN_V8(1.0f - o), iv);
     float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
     __m256 l = fogvol__an_sel8(z, _mm256_setzero_ps(), _mm256_min_ps(ta, tb));
@@ -3861,7 +3861,7 @@ FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx,
 {
     const float *m = f->m, *o = f->o;
     __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f), o0 = FOGVOL__AN_V8(o[0]), o1 = FOGVOL__AN_V8(o[1]);
-    __m256 v0, v1, v2, w2, o2, cx, cy, cz, a, b, disc, s, sg, q, r1, r2, l, h, pos, ga;
+    __m256 v0, v1, v2, w2, o2, cx, cy, cz, a, b, disc, s, sg, q, r1, r2, l, h, pos;
     int cyl = f->shape == FOGVOL_SHAPE_CYLINDER, graze;
     if (f->shape == FOGVOL_SHAPE_SPHERE) {
         __m256 sc = FOGVOL__AN_V8(m[0]);
@@ -3879,14 +3879,14 @@ FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx,
     disc = _mm256_sub_ps(
         a, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(cx, cx), _mm256_mul_ps(cy, cy)), _mm256_mul_ps(cz, cz)));
     pos = _mm256_cmp_ps(a, zero, _CMP_GT_OQ);
-    ga = _mm256_mul_ps(FOGVOL__AN_V8(FOGVOL__AN_GRAZE), a);
-    graze = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(pos, _mm256_cmp_ps(disc, ga, _CMP_LT_OQ)),
-                                             _mm256_cmp_ps(disc, _mm256_mul_ps(FOGVOL__AN_V8(-FOGVOL__AN_GRAZE), a),
-                                                           _CMP_GT_OQ)));
+    /* |disc| < GRAZE a (false where a = 0: a >= 0) */
+    graze = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_andnot_ps(FOGVOL__AN_V8(-0.0f), disc),
+                                             _mm256_mul_ps(FOGVOL__AN_V8(FOGVOL__AN_GRAZE), a), _CMP_LT_OQ));
     s = _mm256_sqrt_ps(_mm256_max_ps(disc, zero));
     sg = fogvol__an_sel8(_mm256_cmp_ps(b, zero, _CMP_GE_OQ), s, _mm256_xor_ps(s, FOGVOL__AN_V8(-0.0f)));
     q = _mm256_xor_ps(_mm256_add_ps(b, sg), FOGVOL__AN_V8(-0.0f)); /* -(b + sg), signed zeros included */
-    r1 = _mm256_div_ps(q, fogvol__an_nz8(a)), r2 = _mm256_div_ps(FOGVOL__AN_V8(f->c0), fogvol__an_nz8(q));
+    /* a = 0 (those lanes take the blends below) and q = 0 (then disc <= 0: a miss) need no guard here */
+    r1 = _mm256_div_ps(q, a), r2 = _mm256_div_ps(FOGVOL__AN_V8(f->c0), q);
     l = _mm256_max_ps(_mm256_min_ps(r1, r2), zero), h = _mm256_min_ps(_mm256_max_ps(r1, r2), one);
     h = fogvol__an_sel8(_mm256_cmp_ps(disc, zero, _CMP_GT_OQ), h, FOGVOL__AN_V8(-1.0f));
     *lo = fogvol__an_sel8(pos, l, zero);
@@ -3927,8 +3927,6 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
     _mm256_storeu_ps(k->g + base, _mm256_add_ps(_mm256_loadu_ps(k->g + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv)));
     _mm256_storeu_ps(k->bl + base,
                      _mm256_add_ps(_mm256_loadu_ps(k->bl + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv)));
-    _mm256_storeu_ps(k->hits + base,
-                     _mm256_add_ps(_mm256_loadu_ps(k->hits + base), _mm256_and_ps(hm, FOGVOL__AN_V8(1.0f))));
     _mm256_storeu_si256((__m256i *)(void *)hw,
                         _mm256_or_si256(_mm256_loadu_si256((const __m256i *)(const void *)hw),
                                         _mm256_and_si256(_mm256_castps_si256(hm),
@@ -3952,12 +3950,15 @@ FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, c
                                             _mm256_mul_ps(dz, dz))));
         _mm256_storeu_ps(k->tau + base, zero), _mm256_storeu_ps(k->r + base, zero);
         _mm256_storeu_ps(k->g + base, zero), _mm256_storeu_ps(k->bl + base, zero);
-        _mm256_storeu_ps(k->hits + base, zero);
     }
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
     for (v = 0; v < set->count; ++v)
         for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hits[i] = 0.0f; /* 2: two volumes or more on the ray */
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            k->hits[i] += (float)(k->hit[v][i] != 0u) + (float)((k->hit[v][i] & (k->hit[v][i] - 1u)) != 0u);
     fogvol__an_ffinish(limit, law, k);
 }
 #endif
@@ -4119,9 +4120,9 @@ static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const 
     float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS], f = 1.0f, w = 0.0f, num[3] = {0.0f, 0.0f, 0.0f}, inv;
     int k, c;
     for (k = 0; k < n; ++k) {
-        float tau = sig[k] * l[k], om;
-        ex[k] = fogvol__an_fexp2(tau, &om);
-        q[k] = tau > 0.0f ? om / sig[k] : 0.0f;
+        float s = sig[k], om;
+        ex[k] = fogvol__an_fexp2(s * l[k], &om);
+        q[k] = om / (s + (float)(s == 0.0f)); /* tau = 0: om = 0 */
     }
     for (k = 0; k < n && f >= (float)FOGVOL__AN_CUTOFF; ++k) {
         float a = f * q[k];
@@ -4186,7 +4187,7 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
     carry->m = m;
     n = fogvol__an_fstretches(fv, mix, len, key, tev, m, rgb, sig, l);
     if (law == FOGVOL_FOG_EXP) {
-        fogvol__an_fexp_walk((const float (*)[3])rgb, sig, l, n, fog, col);
+        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, l, n, fog, col);
         return;
     }
     memset(&st, 0, sizeof st);
