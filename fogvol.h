@@ -3546,6 +3546,21 @@ FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
     return (1.0f + p) * scale;
 }
 
+/* exp(-tau) and (1 - exp(-tau)) / sig of the n stretches of a sorted walk
+   (tau = sig * l; n a multiple of 8, the arrays padded with zeros), one
+   function per SIMD level */
+typedef void (*fogvol__an_fexps_fn)(const float *sig, const float *l, int n, float *ex, float *q);
+
+static void fogvol__an_fexps_c(const float *sig, const float *l, int n, float *ex, float *q)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        float s = sig[k], om;
+        ex[k] = fogvol__an_fexp2(s * l[k], &om);
+        q[k] = om / (s + (float)(s == 0.0f)); /* tau = 0: om = 0 */
+    }
+}
+
 /* one volume as the float kernels read it, the eye already in its unit space */
 typedef struct fogvol__an_fvol {
     float m[12], o[3], c0, dens, col[3];
@@ -3935,6 +3950,33 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
     _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
 }
 
+/* fogvol__an_fexps_c on 8 lanes, the same operations in the same order */
+FOGVOL__AN_AVX2_FN void fogvol__an_fexps_avx2(const float *sig, const float *l, int n, float *ex, float *q)
+{
+    int k;
+    for (k = 0; k < n; k += 8) {
+        __m256 s = _mm256_loadu_ps(sig + k), zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f);
+        __m256 xc = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(s, _mm256_loadu_ps(l + k)), zero), FOGVOL__AN_V8(87.0f));
+        __m256i n8 = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(xc, FOGVOL__AN_V8(1.44269504f)), FOGVOL__AN_V8(0.5f)));
+        __m256 fn = _mm256_cvtepi32_ps(n8), r, r2, p, scale;
+        r = _mm256_add_ps(_mm256_sub_ps(_mm256_mul_ps(fn, FOGVOL__AN_V8(0.693145751953125f)), xc),
+                          _mm256_mul_ps(fn, FOGVOL__AN_V8(1.42860677e-6f)));
+        r2 = _mm256_mul_ps(r, r);
+        p = _mm256_add_ps(
+            _mm256_add_ps(
+                _mm256_add_ps(FOGVOL__AN_V8(5.0000001201e-1f), _mm256_mul_ps(FOGVOL__AN_V8(1.6666665459e-1f), r)),
+                _mm256_mul_ps(r2, _mm256_add_ps(FOGVOL__AN_V8(4.1665795894e-2f),
+                                                _mm256_mul_ps(FOGVOL__AN_V8(8.3334519073e-3f), r)))),
+            _mm256_mul_ps(_mm256_mul_ps(r2, r2), _mm256_add_ps(FOGVOL__AN_V8(1.3981999507e-3f),
+                                                               _mm256_mul_ps(FOGVOL__AN_V8(1.9875691500e-4f), r))));
+        p = _mm256_add_ps(r, _mm256_mul_ps(r2, p));
+        scale = _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), n8), 23));
+        _mm256_storeu_ps(ex + k, _mm256_mul_ps(_mm256_add_ps(one, p), scale));
+        _mm256_storeu_ps(q + k, _mm256_div_ps(_mm256_sub_ps(_mm256_sub_ps(one, scale), _mm256_mul_ps(p, scale)),
+                                              _mm256_add_ps(s, _mm256_and_ps(_mm256_cmp_ps(s, zero, _CMP_EQ_OQ), one))));
+    }
+}
+
 /* The volumes outside, the block's 4 groups of 8 inside: the groups' long
    chains (square root, then division) are independent and overlap. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
@@ -4076,28 +4118,34 @@ typedef struct fogvol__an_fcarry {
     unsigned char ev[FOGVOL__AN_EVENTS];
     unsigned int hit[FOGVOL__AN_MASKS]; /* the volumes in ev */
     int m;
+    fogvol__an_fexps_fn exps; /* the level's exponentials */
 } fogvol__an_fcarry;
 
-/* The stretches between a ray's sorted events, front to back: the summed
-   colour * density (rgb) and density (sig) of the volumes a stretch is in,
-   and its length in world units (INTERPENETRATING, the paper's event list;
-   the sums restart from exact zeros whenever no volume is open, so rounding
-   never leaves a ghost density behind), or each volume whole at its entry
-   (SEPARATE). Stretches outside every volume get sig 0. Returns the count. */
-static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *tev,
-                                 int m, float (*rgb)[3], float *sig, float *l)
+/* The stretches between a ray's sorted events key[0..m) (t bits << 32 |
+   event index), front to back: the summed colour * density (rgb) and density
+   (sig) of the volumes a stretch is in, and its length in world units
+   (INTERPENETRATING, the paper's event list; the sums restart from exact
+   zeros whenever no volume is open, so rounding never leaves a ghost density
+   behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
+   volume every FOGVOL__AN_BLOCK). Stretches outside every volume get sig 0.
+   Writes the event order to ev; returns the stretch count. */
+static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
+                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l)
 {
     float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
     for (k = 0; k < m; ++k) {
         int e = (int)(key[k] & 0xffu);
         const fogvol__an_fvol *f = &fv[e >> 1];
-        float t = tev[e], sd = (e & 1) ? -f->dens : f->dens;
+        uint32_t u = (uint32_t)(key[k] >> 32);
+        float t, sd = (e & 1) ? -f->dens : f->dens;
+        memcpy(&t, &u, sizeof t);
+        ev[k] = (unsigned char)e;
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
             rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
             sig[n] = f->dens;
-            l[n++] = len * (tev[e + 1] - t);
+            l[n++] = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
             continue;
         }
         rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
@@ -4114,18 +4162,17 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
 /* The EXP law over n stretches: each stretch of optical depth tau covers
    T (1 - exp(-tau)) of the pixel (T: the transmittance in front of it) with
    the mean colour rgb / sig; done once T < FOGVOL__AN_CUTOFF. */
-static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const float *l, int n, float *fog,
+static void fogvol__an_fexp_walk(float (*rgb)[3], float *sig, float *l, int n, fogvol__an_fexps_fn exps, float *fog,
                                  float col[3])
 {
-    float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS], f = 1.0f, w = 0.0f, num[3] = {0.0f, 0.0f, 0.0f}, inv;
-    int k, c;
-    for (k = 0; k < n; ++k) {
-        float s = sig[k], om;
-        ex[k] = fogvol__an_fexp2(s * l[k], &om);
-        q[k] = om / (s + (float)(s == 0.0f)); /* tau = 0: om = 0 */
-    }
-    for (k = 0; k < n && f >= (float)FOGVOL__AN_CUTOFF; ++k) {
+    float ex[FOGVOL__AN_EVENTS + 8], q[FOGVOL__AN_EVENTS + 8], f = 1.0f, w = 0.0f, num[3] = {0.0f, 0.0f, 0.0f}, inv;
+    int k, c, n8 = (n + 7) & ~7;
+    /* padded to 8 with stretches that add nothing (fixed counts: predictable loops, no memset call) */
+    for (k = 0; k < 8; ++k) sig[n + k] = l[n + k] = rgb[n + k][0] = rgb[n + k][1] = rgb[n + k][2] = 0.0f;
+    exps(sig, l, n8, ex, q);
+    for (k = 0; k < n8; ++k) {
         float a = f * q[k];
+        if (f < (float)FOGVOL__AN_CUTOFF) break;
         for (c = 0; c < 3; ++c) num[c] += rgb[k][c] * a;
         w += sig[k] * a;
         f *= ex[k];
@@ -4146,48 +4193,40 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
                                       fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
     uint64_t key[FOGVOL__AN_EVENTS];
-    float tev[FOGVOL__AN_EVENTS], rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
+    float rgb[FOGVOL__AN_EVENTS + 8][3], sig[FOGVOL__AN_EVENTS + 8], l[FOGVOL__AN_EVENTS + 8], inv;
     fogvol__an_fstate st;
-    float inv;
     int m = 0, n, w, k, j, c, nw = (s->count + 31) / 32;
-    for (w = 0; w < nw; ++w) {
-        unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
-        while (bits) {
-            int v = 32 * w + fogvol__an_ctz(bits);
-            bits &= bits - 1u;
-            tev[2 * v] = t1[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
-            tev[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK] + 0.0f;
-        }
-    }
-    for (k = 0; k < carry->m; ++k) {
+    for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
         int e = carry->ev[k], v = e >> 1;
-        if ((hit[(v >> 5) * FOGVOL__AN_BLOCK] >> (v & 31)) & 1u) key[m++] = (uint64_t)e;
+        float t = ((e & 1) ? t2 : t1)[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
+        uint32_t u;
+        memcpy(&u, &t, sizeof u);
+        key[m] = (uint64_t)u << 32 | (uint64_t)e;
+        m += (int)((hit[(v >> 5) * FOGVOL__AN_BLOCK] >> (v & 31)) & 1u);
     }
     for (w = 0; w < nw; ++w) {
         unsigned int bits = hit[w * FOGVOL__AN_BLOCK] & ~carry->hit[w];
         carry->hit[w] = hit[w * FOGVOL__AN_BLOCK];
         while (bits) {
             int v = 32 * w + fogvol__an_ctz(bits);
+            float a = t1[v * FOGVOL__AN_BLOCK] + 0.0f, b = t2[v * FOGVOL__AN_BLOCK] + 0.0f;
+            uint32_t ua, ub;
             bits &= bits - 1u;
-            key[m++] = (uint64_t)(2 * v);
-            key[m++] = (uint64_t)(2 * v + 1);
+            memcpy(&ua, &a, sizeof ua);
+            memcpy(&ub, &b, sizeof ub);
+            key[m++] = (uint64_t)ua << 32 | (uint64_t)(2 * v);
+            key[m++] = (uint64_t)ub << 32 | (uint64_t)(2 * v + 1);
         }
-    }
-    for (k = 0; k < m; ++k) {
-        uint32_t u;
-        memcpy(&u, &tev[key[k]], sizeof u);
-        key[k] |= (uint64_t)u << 32;
     }
     for (k = 1; k < m; ++k) {
         uint64_t x = key[k];
         for (j = k; j > 0 && key[j - 1] > x; --j) key[j] = key[j - 1], ++*moves;
         key[j] = x;
     }
-    for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, tev, m, rgb, sig, l);
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l);
     if (law == FOGVOL_FOG_EXP) {
-        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, l, n, fog, col);
+        fogvol__an_fexp_walk(rgb, sig, l, n, carry->exps, fog, col);
         return;
     }
     memset(&st, 0, sizeof st);
@@ -4399,6 +4438,10 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
     c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
     c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
+    c.fcarry.exps = fogvol__an_fexps_c;
+#if FOGVOL__AN_X86
+    if (kern == FOGVOL_ANALYTIC_KERNEL_AVX2) c.fcarry.exps = fogvol__an_fexps_avx2;
+#endif
     if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
         c.bad = c.sorted = 0;
         c.moves = 0;
