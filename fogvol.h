@@ -3527,10 +3527,13 @@ FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
 #endif
 }
 
-/* exp(-x) and 1 - exp(-x) for x >= 0 without branches (the order-free EXP fog
-   of a block, the sorted walk's stretches): fogvol__an_fexpn's arithmetic
-   with x clamped to [0, 87]; 1 - exp(-x) as (1 - 2^-n) - (r + r^2 P) 2^-n,
-   which keeps its digits where 1 - e would cancel (n = 0 below ln2 / 2). */
+/* exp(-x) and 1 - exp(-x) for x >= 0 in float, without the C library and
+   without branches (the order-free EXP fog of a block, the sorted walk's
+   stretches): x clamped to [0, 87], x = n ln2 - r, |r| <= ln2 / 2,
+   exp(r) = 1 + r + r^2 P(r) with the minimax P of Cephes' expf (about 1 ulp)
+   in Estrin's order (short dependency chains), times 2^-n; 1 - exp(-x) as
+   (1 - 2^-n) - (r + r^2 P) 2^-n, which keeps its digits where 1 - e would
+   cancel (n = 0 below ln2 / 2). */
 FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
 {
     float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
@@ -3544,21 +3547,6 @@ FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
     memcpy(&scale, &bits, sizeof scale);
     *om = (1.0f - scale) - p * scale; /* n = 0: -p exactly */
     return (1.0f + p) * scale;
-}
-
-/* exp(-tau) and (1 - exp(-tau)) / sig of the n stretches of a sorted walk
-   (tau = sig * l; n a multiple of 8, the arrays padded with zeros), one
-   function per SIMD level */
-typedef void (*fogvol__an_fexps_fn)(const float *sig, const float *l, int n, float *ex, float *q);
-
-static void fogvol__an_fexps_c(const float *sig, const float *l, int n, float *ex, float *q)
-{
-    int k;
-    for (k = 0; k < n; ++k) {
-        float s = sig[k], om;
-        ex[k] = fogvol__an_fexp2(s * l[k], &om);
-        q[k] = om / (s + (float)(s == 0.0f)); /* tau = 0: om = 0 */
-    }
 }
 
 /* one volume as the float kernels read it, the eye already in its unit space */
@@ -3950,33 +3938,6 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
     _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
 }
 
-/* fogvol__an_fexps_c on 8 lanes, the same operations in the same order */
-FOGVOL__AN_AVX2_FN void fogvol__an_fexps_avx2(const float *sig, const float *l, int n, float *ex, float *q)
-{
-    int k;
-    for (k = 0; k < n; k += 8) {
-        __m256 s = _mm256_loadu_ps(sig + k), zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f);
-        __m256 xc = _mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(s, _mm256_loadu_ps(l + k)), zero), FOGVOL__AN_V8(87.0f));
-        __m256i n8 = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(xc, FOGVOL__AN_V8(1.44269504f)), FOGVOL__AN_V8(0.5f)));
-        __m256 fn = _mm256_cvtepi32_ps(n8), r, r2, p, scale;
-        r = _mm256_add_ps(_mm256_sub_ps(_mm256_mul_ps(fn, FOGVOL__AN_V8(0.693145751953125f)), xc),
-                          _mm256_mul_ps(fn, FOGVOL__AN_V8(1.42860677e-6f)));
-        r2 = _mm256_mul_ps(r, r);
-        p = _mm256_add_ps(
-            _mm256_add_ps(
-                _mm256_add_ps(FOGVOL__AN_V8(5.0000001201e-1f), _mm256_mul_ps(FOGVOL__AN_V8(1.6666665459e-1f), r)),
-                _mm256_mul_ps(r2, _mm256_add_ps(FOGVOL__AN_V8(4.1665795894e-2f),
-                                                _mm256_mul_ps(FOGVOL__AN_V8(8.3334519073e-3f), r)))),
-            _mm256_mul_ps(_mm256_mul_ps(r2, r2), _mm256_add_ps(FOGVOL__AN_V8(1.3981999507e-3f),
-                                                               _mm256_mul_ps(FOGVOL__AN_V8(1.9875691500e-4f), r))));
-        p = _mm256_add_ps(r, _mm256_mul_ps(r2, p));
-        scale = _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), n8), 23));
-        _mm256_storeu_ps(ex + k, _mm256_mul_ps(_mm256_add_ps(one, p), scale));
-        _mm256_storeu_ps(q + k, _mm256_div_ps(_mm256_sub_ps(_mm256_sub_ps(one, scale), _mm256_mul_ps(p, scale)),
-                                              _mm256_add_ps(s, _mm256_and_ps(_mm256_cmp_ps(s, zero, _CMP_EQ_OQ), one))));
-    }
-}
-
 /* The volumes outside, the block's 4 groups of 8 inside: the groups' long
    chains (square root, then division) are independent and overlap. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
@@ -4050,65 +4011,6 @@ static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_e
     return mmax > 1e12 ? 0.0f : (float)(1e15 / mmax);
 }
 
-/* exp(-x) for x >= 0 in float without the C library (the walk calls it once
-   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) = 1 + r + r^2 P(r) with
-   the minimax P of Cephes' expf (about 1 ulp), evaluated in Estrin's order
-   (short dependency chains), times 2^-n. */
-FOGVOL__AN_INLINE float fogvol__an_fexpn(float x)
-{
-    float t, r, r2, p, scale;
-    unsigned int bits;
-    int n;
-    if (!(x < 87.0f)) return x >= 87.0f ? 0.0f : 1.0f; /* NaN: 1 */
-    t = x * 1.44269504f;
-    n = (int)(t + 0.5f);
-    r = (float)n * 0.693145751953125f - x + (float)n * 1.42860677e-6f; /* ln2 in two parts */
-    r2 = r * r;
-    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
-        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
-    p = 1.0f + r + r2 * p;
-    bits = (unsigned int)(127 - n) << 23;
-    memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
-}
-
-/* fogvol__an_state and fogvol__an_add in float, for the float kernels' walk */
-typedef struct fogvol__an_fstate {
-    float f, w, num[3];
-    int done;
-} fogvol__an_fstate;
-
-FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const float cs[3], float sig, float l)
-{
-    float tau = sig * l, k;
-    int c;
-    if (!(tau > 0.0f) || st->done) return;
-    if (law == FOGVOL_FOG_EXP) {
-        float e = fogvol__an_fexpn(tau);
-        /* (1 - e) / tau, by its series where 1 - e would cancel (error < tau^6 / 5040) */
-        float ps = 1.0f - tau * (0.5f - tau * (1.0f / 6.0f - tau * (1.0f / 24.0f - tau * (1.0f / 120.0f - tau / 720.0f))));
-        float phi = tau < 0.25f ? ps : (1.0f - e) / tau;
-        k = l * phi * st->f;
-        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * k;
-        st->w += sig * k;
-        st->f *= e;
-        if (st->f < (float)FOGVOL__AN_CUTOFF) st->done = 1;
-    } else if (law == FOGVOL_FOG_LINEAR) {
-        k = tau >= st->f ? st->f / tau : 1.0f;
-        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * (l * k);
-        st->w += tau * k;
-        st->f = tau >= st->f ? 0.0f : st->f - tau;
-        st->done = st->f == 0.0f;
-    } else {
-        for (c = 0; c < 3; ++c) st->num[c] = cs[c] / sig * st->f + st->num[c] * (1.0f - st->f);
-        st->f -= tau < 1.0f ? tau : 1.0f;
-        if (st->f <= 0.0f) {
-            st->f = 0.0f;
-            st->done = 1;
-        }
-    }
-}
-
 #define FOGVOL__AN_EVENTS (2 * FOGVOL_ANALYTIC_CAPACITY)
 
 /* The event order of the last sorted vertex of a call: the next one starts
@@ -4118,7 +4020,6 @@ typedef struct fogvol__an_fcarry {
     unsigned char ev[FOGVOL__AN_EVENTS];
     unsigned int hit[FOGVOL__AN_MASKS]; /* the volumes in ev */
     int m;
-    fogvol__an_fexps_fn exps; /* the level's exponentials */
 } fogvol__an_fcarry;
 
 /* The stretches between a ray's sorted events key[0..m) (t bits << 32 |
@@ -4128,9 +4029,11 @@ typedef struct fogvol__an_fcarry {
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume get sig 0.
-   Writes the event order to ev; returns the stretch count. */
+   Writes the event order to ev; returns the stretch count. With ex != NULL
+   (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
+   here where they hang off no chain of the walk (tau = 0: q = 0). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l)
+                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l, float *ex, float *q)
 {
     float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
@@ -4138,23 +4041,28 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
         int e = (int)(key[k] & 0xffu);
         const fogvol__an_fvol *f = &fv[e >> 1];
         uint32_t u = (uint32_t)(key[k] >> 32);
-        float t, sd = (e & 1) ? -f->dens : f->dens;
+        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
         memcpy(&t, &u, sizeof t);
         ev[k] = (unsigned char)e;
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
             rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
-            sig[n] = f->dens;
-            l[n++] = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
-            continue;
+            sg = f->dens, ln = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
+        } else {
+            rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
+            sg = ad, ln = (t - last) * len;
+            open += (e & 1) ? -1 : 1;
+            ar += sd * f->col[0], ag += sd * f->col[1], ab += sd * f->col[2], ad += sd;
+            if (open == 0) ar = ag = ab = ad = 0.0f;
+            last = t;
         }
-        rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
-        sig[n] = ad;
-        l[n++] = (t - last) * len;
-        open += (e & 1) ? -1 : 1;
-        ar += sd * f->col[0], ag += sd * f->col[1], ab += sd * f->col[2], ad += sd;
-        if (open == 0) ar = ag = ab = ad = 0.0f;
-        last = t;
+        sig[n] = sg, l[n] = ln;
+        if (ex) {
+            float om;
+            ex[n] = fogvol__an_fexp2(sg * ln, &om);
+            q[n] = om / (sg + (float)(sg == 0.0f));
+        }
+        ++n;
     }
     return n;
 }
@@ -4162,24 +4070,50 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
 /* The EXP law over n stretches: each stretch of optical depth tau covers
    T (1 - exp(-tau)) of the pixel (T: the transmittance in front of it) with
    the mean colour rgb / sig; done once T < FOGVOL__AN_CUTOFF. */
-static void fogvol__an_fexp_walk(float (*rgb)[3], float *sig, float *l, int n, fogvol__an_fexps_fn exps, float *fog,
-                                 float col[3])
+static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const float *ex, const float *q, int n,
+                                 float *fog, float col[3])
 {
-    float ex[FOGVOL__AN_EVENTS + 8], q[FOGVOL__AN_EVENTS + 8], f = 1.0f, w = 0.0f, num[3] = {0.0f, 0.0f, 0.0f}, inv;
-    int k, c, n8 = (n + 7) & ~7;
-    /* padded to 8 with stretches that add nothing (fixed counts: predictable loops, no memset call) */
-    for (k = 0; k < 8; ++k) sig[n + k] = l[n + k] = rgb[n + k][0] = rgb[n + k][1] = rgb[n + k][2] = 0.0f;
-    exps(sig, l, n8, ex, q);
-    for (k = 0; k < n8; ++k) {
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
+    int k;
+    for (k = 0; k < n && f >= (float)FOGVOL__AN_CUTOFF; ++k) {
         float a = f * q[k];
-        if (f < (float)FOGVOL__AN_CUTOFF) break;
-        for (c = 0; c < 3; ++c) num[c] += rgb[k][c] * a;
+        n0 += rgb[k][0] * a, n1 += rgb[k][1] * a, n2 += rgb[k][2] * a;
         w += sig[k] * a;
         f *= ex[k];
     }
     inv = w > 1e-30f ? 1.0f / w : 0.0f;
     *fog = f;
-    for (c = 0; c < 3; ++c) col[c] = num[c] * inv;
+    col[0] = n0 * inv, col[1] = n1 * inv, col[2] = n2 * inv;
+}
+
+/* The LINEAR law (each stretch takes tau = sig * l of the fog until none is
+   left; colour weighted by the fog taken) and the paper's LINEAR_SEED colour
+   formula over n stretches, in float (fogvol__an_add's arithmetic). */
+static void fogvol__an_flinear_walk(const float (*rgb)[3], const float *sig, const float *l, int n, int law,
+                                    float *fog, float col[3])
+{
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
+    int k;
+    for (k = 0; k < n && f > 0.0f; ++k) {
+        float sg = sig[k], ln = l[k], tau = sg * ln, a;
+        if (!(tau > 0.0f)) continue;
+        if (law == FOGVOL_FOG_LINEAR_SEED) {
+            n0 = rgb[k][0] / sg * f + n0 * (1.0f - f);
+            n1 = rgb[k][1] / sg * f + n1 * (1.0f - f);
+            n2 = rgb[k][2] / sg * f + n2 * (1.0f - f);
+            f -= tau < 1.0f ? tau : 1.0f;
+            f = f > 0.0f ? f : 0.0f;
+            continue;
+        }
+        a = tau >= f ? f / tau : 1.0f;
+        n0 += rgb[k][0] * (ln * a), n1 += rgb[k][1] * (ln * a), n2 += rgb[k][2] * (ln * a);
+        w += tau * a;
+        f = tau >= f ? 0.0f : f - tau;
+    }
+    inv = w > 1e-30f ? 1.0f / w : 0.0f;
+    *fog = f;
+    if (law == FOGVOL_FOG_LINEAR_SEED) inv = 1.0f;
+    col[0] = n0 * inv, col[1] = n1 * inv, col[2] = n2 * inv;
 }
 
 /* The sorted walk of the float kernels: only the events of the volumes on
@@ -4193,9 +4127,9 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
                                       fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
     uint64_t key[FOGVOL__AN_EVENTS];
-    float rgb[FOGVOL__AN_EVENTS + 8][3], sig[FOGVOL__AN_EVENTS + 8], l[FOGVOL__AN_EVENTS + 8], inv;
-    fogvol__an_fstate st;
-    int m = 0, n, w, k, j, c, nw = (s->count + 31) / 32;
+    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
+    float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS];
+    int m = 0, n, w, k, j, nw = (s->count + 31) / 32;
     for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
         int e = carry->ev[k], v = e >> 1;
         float t = ((e & 1) ? t2 : t1)[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
@@ -4224,17 +4158,12 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
         key[j] = x;
     }
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l);
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q);
     if (law == FOGVOL_FOG_EXP) {
-        fogvol__an_fexp_walk(rgb, sig, l, n, carry->exps, fog, col);
+        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
         return;
     }
-    memset(&st, 0, sizeof st);
-    st.f = 1.0f;
-    for (k = 0; k < n && !st.done; ++k) fogvol__an_fadd(&st, law, rgb[k], sig[k], l[k]);
-    inv = st.w > 1e-30f ? 1.0f / st.w : 0.0f;
-    *fog = st.f;
-    for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
+    fogvol__an_flinear_walk((const float(*)[3])rgb, sig, l, n, law, fog, col);
 }
 
 /* What a batch call works on, for the float kernels' loop. */
@@ -4438,10 +4367,6 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
     c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
     c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
-    c.fcarry.exps = fogvol__an_fexps_c;
-#if FOGVOL__AN_X86
-    if (kern == FOGVOL_ANALYTIC_KERNEL_AVX2) c.fcarry.exps = fogvol__an_fexps_avx2;
-#endif
     if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
         c.bad = c.sorted = 0;
         c.moves = 0;
