@@ -3553,6 +3553,11 @@ FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
 typedef struct fogvol__an_fvol {
     float m[12], o[3], c0, dens, col[3];
     int shape, dbl; /* dbl: every ray of this volume in double */
+    /* a sphere around the volume (bounded: 0 for DISTANCE, HALF_SPACE and an
+       eye inside it): centre - eye, its distance, sine and cosine of the
+       half angle it subtends from the eye (fogvol__an_fcull) */
+    float bd[3], bdist, bsin, bcos;
+    int bounded;
 } fogvol__an_fvol;
 
 typedef struct fogvol__an_fblock {
@@ -3726,8 +3731,8 @@ FOGVOL__AN_INLINE void fogvol__an_ffinish(float limit, int law, fogvol__an_fbloc
 /* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
    and which vertices need the sorted walk. Inlined into one function per level. */
 FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
-                                              const double e[3], const fogvol__an_fvol *fv, float limit, int law,
-                                              fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
+                                              const double e[3], const fogvol__an_fvol *fv, const unsigned char *skip,
+                                              float limit, int law, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
 {
     int v, i;
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
@@ -3735,7 +3740,7 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0f;
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
-    for (v = 0; v < set->count; ++v) {
+    for (v = 0; v < set->count; ++v) if (!skip[v]) { /* (skip: fogvol__an_fcull) */
         const int w = v >> 5, bit = v & 31;
         const fogvol__an_fvol fl = fv[v], *f = &fl; /* a local copy: the block's stores cannot alias it */
         const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
@@ -3772,12 +3777,14 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
 }
 
 typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                     const fogvol__an_fvol *fv, float limit, int law, fogvol__an_fblock *k);
+                                     const fogvol__an_fvol *fv, const unsigned char *skip, float limit, int law,
+                                     fogvol__an_fblock *k);
 
 static void fogvol__an_fblock_c(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                const fogvol__an_fvol *fv, float limit, int law, fogvol__an_fblock *k)
+                                const fogvol__an_fvol *fv, const unsigned char *skip, float limit, int law,
+                                fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_c, k);
+    fogvol__an_fblock_body(set, pe, e, fv, skip, limit, law, fogvol__an_sqrt_c, k);
 }
 
 #if FOGVOL__AN_X86
@@ -3788,10 +3795,11 @@ __attribute__((target("sse2"))) static void fogvol__an_sqrt_sse2(float *out, con
 }
 __attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_analytic_set *set,
                                                                     const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit, int law,
+                                                                    const fogvol__an_fvol *fv,
+                                                                    const unsigned char *skip, float limit, int law,
                                                                     fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, law, fogvol__an_sqrt_sse2, k);
+    fogvol__an_fblock_body(set, pe, e, fv, skip, limit, law, fogvol__an_sqrt_sse2, k);
 }
 #endif
 
@@ -3941,8 +3949,8 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
 /* The volumes outside, the block's 4 groups of 8 inside: the groups' long
    chains (square root, then division) are independent and overlap. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
-                                                const double e[3], const fogvol__an_fvol *fv, float limit, int law,
-                                                fogvol__an_fblock *k)
+                                                const double e[3], const fogvol__an_fvol *fv,
+                                                const unsigned char *skip, float limit, int law, fogvol__an_fblock *k)
 {
     int base, v, i;
     for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) {
@@ -3957,7 +3965,8 @@ FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, c
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
     for (v = 0; v < set->count; ++v)
-        for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
+        if (!skip[v]) /* fogvol__an_fcull */
+            for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hits[i] = 0.0f; /* 2: two volumes or more on the ray */
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
@@ -3980,13 +3989,66 @@ FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic
     return FOGVOL_ANALYTIC_KERNEL_FLOAT;
 }
 
+/* A sphere around volume v (world space, radius inflated by 1e-4 for the
+   float tests): the unit shape's centre mapped back, the radius from the
+   Gram matrix G of the inverse map's columns (|M u|^2 = u^T G u), bounded by
+   Gershgorin's rows for the unit ball (largest eigenvalue), by the sum of
+   |G| over the unit cube's corners, and by disc + axis for the cylinder.
+   Returns 0 for the unbounded shapes and a singular map. */
+static int fogvol__an_bound(const fogvol_analytic_set *set, int v, double c[3], double *r)
+{
+    const double *m = set->map[v];
+    double inv[9], g[3][3], det, r2 = 0.0;
+    int i, j;
+    if (set->shape[v] < FOGVOL_SHAPE_SPHERE) return 0;
+    inv[0] = m[5] * m[10] - m[6] * m[9], inv[1] = m[2] * m[9] - m[1] * m[10], inv[2] = m[1] * m[6] - m[2] * m[5];
+    inv[3] = m[6] * m[8] - m[4] * m[10], inv[4] = m[0] * m[10] - m[2] * m[8], inv[5] = m[2] * m[4] - m[0] * m[6];
+    inv[6] = m[4] * m[9] - m[5] * m[8], inv[7] = m[1] * m[8] - m[0] * m[9], inv[8] = m[0] * m[5] - m[1] * m[4];
+    det = m[0] * inv[0] + m[1] * inv[3] + m[2] * inv[6];
+    if (!(FOGVOL_FABS(det) > 0.0)) return 0;
+    for (i = 0; i < 9; ++i) inv[i] /= det; /* row-major: world = inv (unit - t) */
+    for (i = 0; i < 3; ++i) c[i] = -(inv[i * 3] * m[3] + inv[i * 3 + 1] * m[7] + inv[i * 3 + 2] * m[11]);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            g[i][j] = inv[i] * inv[j] + inv[3 + i] * inv[3 + j] + inv[6 + i] * inv[6 + j];
+    if (set->shape[v] == FOGVOL_SHAPE_BOX) {
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) r2 += FOGVOL_FABS(g[i][j]);
+        *r = FOGVOL_SQRT(r2);
+    } else if (set->shape[v] == FOGVOL_SHAPE_CYLINDER) {
+        r2 = fogvol__an_max(g[0][0], g[1][1]) + FOGVOL_FABS(g[0][1]);
+        *r = FOGVOL_SQRT(r2) + FOGVOL_SQRT(g[2][2]);
+    } else {
+        for (i = 0; i < 3; ++i)
+            r2 = fogvol__an_max(r2, FOGVOL_FABS(g[i][0]) + FOGVOL_FABS(g[i][1]) + FOGVOL_FABS(g[i][2]));
+        *r = FOGVOL_SQRT(r2);
+    }
+    *r = *r * 1.0001 + 1e-6;
+    return *r < 1e18;
+}
+
+/* fogvol__an_fvol's bounding sphere as seen from the eye e */
+static void fogvol__an_fbound(const fogvol_analytic_set *set, const double e[3], int v, fogvol__an_fvol *f)
+{
+    double c[3], r, d;
+    f->bounded = fogvol__an_bound(set, v, c, &r);
+    if (!f->bounded) return;
+    c[0] -= e[0], c[1] -= e[1], c[2] -= e[2];
+    d = FOGVOL_SQRT(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    f->bounded = d > r * 1.0001 && d < 1e18; /* the eye clearly outside */
+    if (!f->bounded) return;
+    f->bd[0] = (float)c[0], f->bd[1] = (float)c[1], f->bd[2] = (float)c[2];
+    f->bdist = (float)d, f->bsin = (float)(r / d), f->bcos = (float)FOGVOL_SQRT(1.0 - (r / d) * (r / d));
+}
+
 /* The float kernels' per-call volume table: the eye in each unit space
    (from the double one), and which volumes go to double whole. Returns the
    largest |vertex - eye| coordinate the float loops take (further vertices
    go to double one by one), or 0 when a volume's numbers could overflow
    float sums (density or colour beyond 1e6, an eye 1e12 units away in a
    unit space, a map entry beyond 1e12): the call then runs the DOUBLE kernel. */
-static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
+static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                              fogvol__an_fvol *fv)
 {
     double mmax = 1.0;
     int v, j;
@@ -4007,6 +4069,7 @@ static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_e
         fv[v].dens = (float)set->density[v];
         fv[v].shape = set->shape[v];
         fv[v].dbl = set->shape[v] >= FOGVOL_SHAPE_SPHERE && !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
+        fogvol__an_fbound(set, e, v, &fv[v]);
     }
     return mmax > 1e12 ? 0.0f : (float)(1e15 / mmax);
 }
@@ -4207,20 +4270,58 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
     }
 }
 
+/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
+   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
+   does not evaluate) lie in a cone around their sum A, of half angle theta
+   and length at most lmax. A volume whose bounding sphere (fogvol__an_fvol)
+   is further than lmax or outside that cone widened by the sphere's half
+   angle alpha (the angle between A and the sphere's centre above
+   theta + alpha) is missed by every ray, and so is a volume of density 0.
+   The float tests keep margins of 1e-4. */
+static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol__an_fblock *k, unsigned char *skip)
+{
+    float ax = 0.0f, ay = 0.0f, az = 0.0f, aa, ia, c2min = 1.0f, l2max = 0.0f, cth, sth, lmax;
+    int i, v;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) ax += k->dx[i], ay += k->dy[i], az += k->dz[i];
+    aa = ax * ax + ay * ay + az * az;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        float d2 = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
+        float da = k->dx[i] * ax + k->dy[i] * ay + k->dz[i] * az, q = d2 * aa;
+        float c2 = da > 0.0f ? da * da / (q + (float)(q == 0.0f)) : -1.0f; /* cos^2 of the angle to A */
+        c2min = fogvol__an_fmin(c2min, d2 > 0.0f ? c2 : 1.0f);
+        l2max = fogvol__an_fmax(l2max, d2);
+    }
+    cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f;
+    sth = (float)FOGVOL_SQRT(1.0 - (double)cth * cth);
+    lmax = (float)FOGVOL_SQRT((double)l2max) * 1.0001f + 1e-6f;
+    ia = aa > 0.0f ? 1.0f / (float)FOGVOL_SQRT((double)aa) : 0.0f;
+    for (v = 0; v < count; ++v) {
+        const fogvol__an_fvol *f = &fv[v];
+        int miss = !(f->dens > 0.0f);
+        if (!miss && f->bounded) {
+            float cosa = (ax * f->bd[0] + ay * f->bd[1] + az * f->bd[2]) * ia / f->bdist;
+            miss = f->bdist - f->bdist * f->bsin > lmax ||
+                   (cth > 0.0f && cosa < cth * f->bcos - sth * f->bsin - 1e-4f);
+        }
+        skip[v] = (unsigned char)miss;
+    }
+}
+
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
 static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
-    unsigned char valid[FOGVOL__AN_BLOCK];
+    unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
     int base, i;
     float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
-    c->dlim = fogvol__an_fvols(c->set, c->pe, fv);
+    c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         fogvol__an_fgather(c, base, nb, valid, &blk);
-        fn(c->set, c->pe, c->e, fv, limit, c->law, &blk);
+        fogvol__an_fcull(c->set->count, fv, &blk, skip);
+        fn(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
             float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
