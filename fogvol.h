@@ -3554,9 +3554,10 @@ typedef struct fogvol__an_fvol {
     float m[12], o[3], c0, dens, col[3];
     int shape, dbl; /* dbl: every ray of this volume in double */
     /* a sphere around the volume (bounded: 0 for DISTANCE, HALF_SPACE and an
-       eye inside it): centre - eye, its distance, sine and cosine of the
-       half angle it subtends from the eye (fogvol__an_fcull) */
-    float bd[3], bdist, bsin, bcos;
+       eye inside it): the unit direction from the eye to its centre, the
+       distance from the eye to its surface, sine and cosine of the half angle
+       it subtends from the eye (fogvol__an_fcull) */
+    float bu[3], bnear, bsin, bcos;
     int bounded;
 } fogvol__an_fvol;
 
@@ -4037,8 +4038,8 @@ static void fogvol__an_fbound(const fogvol_analytic_set *set, const double e[3],
     d = FOGVOL_SQRT(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     f->bounded = d > r * 1.0001 && d < 1e18; /* the eye clearly outside */
     if (!f->bounded) return;
-    f->bd[0] = (float)c[0], f->bd[1] = (float)c[1], f->bd[2] = (float)c[2];
-    f->bdist = (float)d, f->bsin = (float)(r / d), f->bcos = (float)FOGVOL_SQRT(1.0 - (r / d) * (r / d));
+    f->bu[0] = (float)(c[0] / d), f->bu[1] = (float)(c[1] / d), f->bu[2] = (float)(c[2] / d);
+    f->bnear = (float)(d - r), f->bsin = (float)(r / d), f->bcos = (float)FOGVOL_SQRT(1.0 - (r / d) * (r / d));
 }
 
 /* The float kernels' per-call volume table: the eye in each unit space
@@ -4272,38 +4273,44 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
 
 /* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
    the eye to the block's vertices (k->dx..dz; zero for the lanes the block
-   does not evaluate) lie in a cone around their sum A, of half angle theta
-   and length at most lmax. A volume whose bounding sphere (fogvol__an_fvol)
-   is further than lmax or outside that cone widened by the sphere's half
-   angle alpha (the angle between A and the sphere's centre above
-   theta + alpha) is missed by every ray, and so is a volume of density 0.
-   The float tests keep margins of 1e-4. */
+   does not evaluate, which can only be in a volume around the eye, never
+   skipped) lie in a cone around their sum A, of half angle theta, and are at
+   most lmax long. A volume whose bounding sphere (fogvol__an_fvol) is further
+   than lmax or outside that cone widened by the sphere's half angle alpha
+   (the angle between A and the sphere's centre above theta + alpha) is
+   missed by every ray, and so is a volume of density 0. The float tests keep
+   margins of 1e-4. */
 static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol__an_fblock *k, unsigned char *skip)
 {
-    float ax = 0.0f, ay = 0.0f, az = 0.0f, aa, ia, c2min = 1.0f, l2max = 0.0f, cth, sth, lmax;
-    int i, v;
-    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) ax += k->dx[i], ay += k->dy[i], az += k->dz[i];
+    /* the lane loops keep 8 partial sums / minima / maxima (vectorisable without reassociation) */
+    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa, ia, c2min, l2max, cth, sth, lmax;
+    int i, j, v;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (j = 0; j < 8; ++j) px[j] += k->dx[i + j], py[j] += k->dy[i + j], pz[j] += k->dz[i + j];
+    ax = ((px[0] + px[1]) + (px[2] + px[3])) + ((px[4] + px[5]) + (px[6] + px[7]));
+    ay = ((py[0] + py[1]) + (py[2] + py[3])) + ((py[4] + py[5]) + (py[6] + py[7]));
+    az = ((pz[0] + pz[1]) + (pz[2] + pz[3])) + ((pz[4] + pz[5]) + (pz[6] + pz[7]));
     aa = ax * ax + ay * ay + az * az;
-    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
-        float d2 = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
-        float da = k->dx[i] * ax + k->dy[i] * ay + k->dz[i] * az, q = d2 * aa;
-        float c2 = da > 0.0f ? da * da / (q + (float)(q == 0.0f)) : -1.0f; /* cos^2 of the angle to A */
-        c2min = fogvol__an_fmin(c2min, d2 > 0.0f ? c2 : 1.0f);
-        l2max = fogvol__an_fmax(l2max, d2);
-    }
-    cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f;
+    for (j = 0; j < 8; ++j) pc[j] = 1.0f;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (j = 0; j < 8; ++j) {
+            float x = k->dx[i + j], y = k->dy[i + j], z = k->dz[i + j], d2 = x * x + y * y + z * z;
+            float da = x * ax + y * ay + z * az, q = d2 * aa;
+            float c2 = (da > 0.0f ? da * da : -q) / (q + (float)(q == 0.0f)); /* cos^2 to A; -1: beyond 90 degrees */
+            pc[j] = fogvol__an_fmin(pc[j], d2 > 0.0f ? c2 : 1.0f);
+            pl[j] = fogvol__an_fmax(pl[j], d2);
+        }
+    c2min = pc[0], l2max = pl[0];
+    for (j = 1; j < 8; ++j) c2min = fogvol__an_fmin(c2min, pc[j]), l2max = fogvol__an_fmax(l2max, pl[j]);
+    cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f; /* cos(theta), widened */
     sth = (float)FOGVOL_SQRT(1.0 - (double)cth * cth);
     lmax = (float)FOGVOL_SQRT((double)l2max) * 1.0001f + 1e-6f;
     ia = aa > 0.0f ? 1.0f / (float)FOGVOL_SQRT((double)aa) : 0.0f;
-    for (v = 0; v < count; ++v) {
+    for (v = 0; v < count; ++v) { /* without branches on the data */
         const fogvol__an_fvol *f = &fv[v];
-        int miss = !(f->dens > 0.0f);
-        if (!miss && f->bounded) {
-            float cosa = (ax * f->bd[0] + ay * f->bd[1] + az * f->bd[2]) * ia / f->bdist;
-            miss = f->bdist - f->bdist * f->bsin > lmax ||
-                   (cth > 0.0f && cosa < cth * f->bcos - sth * f->bsin - 1e-4f);
-        }
-        skip[v] = (unsigned char)miss;
+        float cosa = (ax * f->bu[0] + ay * f->bu[1] + az * f->bu[2]) * ia;
+        int far = f->bnear > lmax, out = cosa < cth * f->bcos - sth * f->bsin - 1e-4f, none = f->dens > 0.0f ? 0 : 1;
+        skip[v] = (unsigned char)(none | (f->bounded & (far | ((cth > 0.0f) & out))));
     }
 }
 
