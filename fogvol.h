@@ -754,12 +754,13 @@ typedef enum fogvol_fog_mix {
 } fogvol_fog_mix;
 
 /* How fogvol_analytic_batch evaluates its vertices (fogvol_analytic_set.kernel).
-   The float kernels work on blocks of vertices in structure-of-arrays float
-   loops (8 lanes with AVX2, 4 with SSE2), redo grazing rays of spheres,
+   The float kernels work on blocks of 32 vertices in structure-of-arrays float
+   loops (8 lanes with AVX2, 4 with SSE2), skip the volumes whose bounding
+   sphere no ray of a block can reach, redo grazing rays of spheres,
    ellipsoids and cylinders (and every ray of such a volume seen from further
    than 64 radii) in double, and sort only the events of the volumes a ray
    hits; they stay within 1.2e-5 of the double kernel in fog and in colour x
-   (1 - fog). AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
+   (1 - fog), and give the same results bit for bit among themselves. AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
    CPU is asked with __builtin_cpu_supports); a level the compiler or the CPU
    lacks falls back to the next one down (fogvol_analytic_kernel_resolve). */
 typedef enum fogvol_analytic_kernel {
