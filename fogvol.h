@@ -4093,7 +4093,7 @@ typedef struct fogvol__an_fcarry {
    (INTERPENETRATING, the paper's event list; the sums restart from exact
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
-   volume every FOGVOL__AN_BLOCK). Stretches outside every volume get sig 0.
+   volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
    Writes the event order to ev; returns the stretch count. With ex != NULL
    (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
    here where they hang off no chain of the walk (tau = 0: q = 0). */
@@ -4114,12 +4114,14 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
             sg = f->dens, ln = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
         } else {
+            int was = open;
             rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
             sg = ad, ln = (t - last) * len;
             open += (e & 1) ? -1 : 1;
             ar += sd * f->col[0], ag += sd * f->col[1], ab += sd * f->col[2], ad += sd;
             if (open == 0) ar = ag = ab = ad = 0.0f;
             last = t;
+            if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
         }
         sig[n] = sg, l[n] = ln;
         if (ex) {
