@@ -4096,11 +4096,14 @@ typedef struct fogvol__an_fcarry {
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
    Writes the event order to ev; returns the stretch count. With ex != NULL
    (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
-   here where they hang off no chain of the walk (tau = 0: q = 0). */
+   here where they hang off no chain of the walk (tau = 0: q = 0); with
+   linear != 0 (the LINEAR law) it stops at the stretch that leaves no fog
+   (fogvol__an_flinear_walk's f, the same arithmetic). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l, float *ex, float *q)
+                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l, float *ex, float *q,
+                                 int linear)
 {
-    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f, fl = 1.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
     for (k = 0; k < m; ++k) {
         int e = (int)(key[k] & 0xffu);
@@ -4130,7 +4133,12 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             q[n] = om / (sg + (float)(sg == 0.0f));
         }
         ++n;
+        if (linear && sg * ln > 0.0f) {
+            fl = sg * ln >= fl ? 0.0f : fl - sg * ln;
+            if (fl == 0.0f) break; /* the events after it change nothing */
+        }
     }
+    for (++k; k < m; ++k) ev[k] = (unsigned char)(key[k] & 0xffu);
     return n;
 }
 
@@ -4225,7 +4233,8 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
         key[j] = x;
     }
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q);
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
+                              law == FOGVOL_FOG_LINEAR);
     if (law == FOGVOL_FOG_EXP) {
         fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
         return;
