@@ -4094,14 +4094,13 @@ typedef struct fogvol__an_fcarry {
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
-   Writes the event order to ev; returns the stretch count. With ex != NULL
+   Returns the stretch count. With ex != NULL
    (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
    here where they hang off no chain of the walk (tau = 0: q = 0); with
    linear != 0 (the LINEAR law) it stops at the stretch that leaves no fog
    (fogvol__an_flinear_walk's f, the same arithmetic). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, unsigned char *ev, float (*rgb)[3], float *sig, float *l, float *ex, float *q,
-                                 int linear)
+                                 int m, float (*rgb)[3], float *sig, float *l, float *ex, float *q, int linear)
 {
     float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f, fl = 1.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
@@ -4111,7 +4110,6 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
         uint32_t u = (uint32_t)(key[k] >> 32);
         float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
         memcpy(&t, &u, sizeof t);
-        ev[k] = (unsigned char)e;
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
             rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
@@ -4138,7 +4136,6 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             if (fl == 0.0f) break; /* the events after it change nothing */
         }
     }
-    for (++k; k < m; ++k) ev[k] = (unsigned char)(key[k] & 0xffu);
     return n;
 }
 
@@ -4232,8 +4229,9 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
         for (j = k; j > 0 && key[j - 1] > x; --j) key[j] = key[j - 1], ++*moves;
         key[j] = x;
     }
+    for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, carry->ev, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
                               law == FOGVOL_FOG_LINEAR);
     if (law == FOGVOL_FOG_EXP) {
         fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
