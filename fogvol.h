@@ -1551,12 +1551,13 @@ typedef enum fogvol_fog_mix {
 } fogvol_fog_mix;
 
 /* How fogvol_analytic_batch evaluates its vertices (fogvol_analytic_set.kernel).
-   The float kernels work on blocks of vertices in structure-of-arrays float
-   loops (8 lanes with AVX2, 4 with SSE2), redo grazing rays of spheres,
+   The float kernels work on blocks of 32 vertices in structure-of-arrays float
+   loops (8 lanes with AVX2, 4 with SSE2), skip the volumes whose bounding
+   sphere no ray of a block can reach, redo grazing rays of spheres,
    ellipsoids and cylinders (and every ray of such a volume seen from further
    than 64 radii) in double, and sort only the events of the volumes a ray
    hits; they stay within 1.2e-5 of the double kernel in fog and in colour x
-   (1 - fog). AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
+   (1 - fog), and give the same results bit for bit among themselves. AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
    CPU is asked with __builtin_cpu_supports); a level the compiler or the CPU
    lacks falls back to the next one down (fogvol_analytic_kernel_resolve). */
 typedef enum fogvol_analytic_kernel {
@@ -1594,8 +1595,9 @@ typedef struct fogvol_analytic_set {
    broken by volume order), only the time the sorts take; any bytes are safe
    (orders that are not permutations are replaced). Only the DOUBLE kernel
    (fogvol_analytic_kernel) reads and writes the orders: the float kernels
-   sort the few events of the volumes on each ray from volume order; they
-   still fill sorted_vertices and moves. */
+   sort the few events of the volumes on each ray, starting from the order of
+   the previous sorted vertex of the same call; they still fill
+   sorted_vertices and moves. */
 typedef struct fogvol_analytic_order {
     unsigned char *vertex_orders; /* optional */
     size_t vertex_orders_size;    /* bytes */
@@ -3563,7 +3565,7 @@ static void fogvol__an_block_eval(const fogvol_analytic_set *set, const fogvol__
    further than FOGVOL__AN_FAR_EYE from its centre (the cross product o x v
    loses digits there). */
 
-#define FOGVOL__AN_GRAZE 0.0625f
+#define FOGVOL__AN_GRAZE 0.015625f
 #define FOGVOL__AN_FAR_EYE 64.0
 #define FOGVOL__AN_MASKS ((FOGVOL_ANALYTIC_CAPACITY + 31) / 32)
 
@@ -3588,10 +3590,38 @@ FOGVOL__AN_INLINE int fogvol__an_ctz(unsigned int x)
 #endif
 }
 
+/* exp(-x) and 1 - exp(-x) for x >= 0 in float, without the C library and
+   without branches (the order-free EXP fog of a block, the sorted walk's
+   stretches): x clamped to [0, 87], x = n ln2 - r, |r| <= ln2 / 2,
+   exp(r) = 1 + r + r^2 P(r) with the minimax P of Cephes' expf (about 1 ulp)
+   in Estrin's order (short dependency chains), times 2^-n; 1 - exp(-x) as
+   (1 - 2^-n) - (r + r^2 P) 2^-n, which keeps its digits where 1 - e would
+   cancel (n = 0 below ln2 / 2). */
+FOGVOL__AN_INLINE float fogvol__an_fexp2(float x, float *om)
+{
+    float xc = fogvol__an_fmin(fogvol__an_fmax(x, 0.0f), 87.0f), r, r2, p, scale;
+    int n = (int)(xc * 1.44269504f + 0.5f);
+    uint32_t bits = (uint32_t)(127 - n) << 23;
+    r = (float)n * 0.693145751953125f - xc + (float)n * 1.42860677e-6f;
+    r2 = r * r;
+    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
+        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
+    p = r + r2 * p; /* exp(r) - 1 */
+    memcpy(&scale, &bits, sizeof scale);
+    *om = (1.0f - scale) - p * scale; /* n = 0: -p exactly */
+    return (1.0f + p) * scale;
+}
+
 /* one volume as the float kernels read it, the eye already in its unit space */
 typedef struct fogvol__an_fvol {
     float m[12], o[3], c0, dens, col[3];
     int shape, dbl; /* dbl: every ray of this volume in double */
+    /* a sphere around the volume (bounded: 0 for DISTANCE, HALF_SPACE and an
+       eye inside it): the unit direction from the eye to its centre, the
+       distance from the eye to its surface, sine and cosine of the half angle
+       it subtends from the eye (fogvol__an_fcull) */
+    float bu[3], bnear, bsin, bcos;
+    int bounded;
 } fogvol__an_fvol;
 
 typedef struct fogvol__an_fblock {
@@ -3636,8 +3666,8 @@ FOGVOL__AN_INLINE void fogvol__an_fhalf(const float *m, float s0, float dx, floa
 
 FOGVOL__AN_INLINE void fogvol__an_fslab(float o, float v, float *lo, float *hi)
 {
-    float vs = v + (float)(v == 0.0f);
-    float ta = (-1.0f - o) / vs, tb = (1.0f - o) / vs;
+    float iv = 1.0f / (v + (float)(v == 0.0f)); /* one division for both planes */
+    float ta = (-1.0f - o) * iv, tb = (1.0f - o) * iv;
     float mn = fogvol__an_fmin(ta, tb), mx = fogvol__an_fmax(ta, tb);
     float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
     float l = v == 0.0f ? 0.0f : mn, h = v == 0.0f ? par : mx;
@@ -3702,6 +3732,21 @@ static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye
     }
 }
 
+/* fogvol__an_redo for the lanes base + i of volume v whose bit i is set in mask. */
+static void fogvol__an_redo_lanes(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3], int v,
+                                  int mask, int base, fogvol__an_fblock *k)
+{
+    while (mask) {
+        int i = base + fogvol__an_ctz((unsigned int)mask);
+        double dx = (double)k->px[i] - e[0], dy = (double)k->py[i] - e[1], dz = (double)k->pz[i] - e[2], lo, hi;
+        mask &= mask - 1;
+        fogvol__an_ray(set, pe, v, dx, dy, dz, FOGVOL_SQRT(dx * dx + dy * dy + dz * dz), &lo, &hi);
+        k->lo[i] = (float)lo;
+        k->hi[i] = (float)hi;
+        k->ch[i] = (float)(hi > lo ? hi - lo : 0.0);
+    }
+}
+
 /* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block;
    returns whether some lanes graze it (marked in redo, for fogvol__an_redo). */
 FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
@@ -3731,11 +3776,27 @@ FOGVOL__AN_INLINE int fogvol__an_fquadric(const fogvol__an_fvol *f, fogvol__an_s
     return any;
 }
 
+/* The order-free answer of a block (fogvol__an_sort_limit) and which vertices need the sorted walk. */
+FOGVOL__AN_INLINE void fogvol__an_ffinish(float limit, int law, fogvol__an_fblock *k)
+{
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
+        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
+        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f, om;
+        float ex = fogvol__an_fexp2(tau, &om);
+        k->fog[i] = law == FOGVOL_FOG_EXP ? ex : fogvol__an_fmax(1.0f - tau, 0.0f);
+        k->r[i] *= inv;
+        k->g[i] *= inv;
+        k->bl[i] *= inv;
+        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
+    }
+}
+
 /* One block: entry/exit per volume, the order-free sums (fogvol__an_sort_limit)
    and which vertices need the sorted walk. Inlined into one function per level. */
 FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
-                                              const double e[3], const fogvol__an_fvol *fv, float limit,
-                                              fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
+                                              const double e[3], const fogvol__an_fvol *fv, const unsigned char *skip,
+                                              float limit, int law, fogvol__an_sqrt_fn sq, fogvol__an_fblock *k)
 {
     int v, i;
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->len[i] = k->dx[i] * k->dx[i] + k->dy[i] * k->dy[i] + k->dz[i] * k->dz[i];
@@ -3743,7 +3804,7 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->tau[i] = k->r[i] = k->g[i] = k->bl[i] = k->hits[i] = 0.0f;
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
-    for (v = 0; v < set->count; ++v) {
+    for (v = 0; v < set->count; ++v) if (!skip[v]) { /* (skip: fogvol__an_fcull) */
         const int w = v >> 5, bit = v & 31;
         const fogvol__an_fvol fl = fv[v], *f = &fl; /* a local copy: the block's stores cannot alias it */
         const float *m = f->m, *o = f->o, dens = f->dens, cr = f->col[0], cg = f->col[1], cb = f->col[2];
@@ -3776,24 +3837,18 @@ FOGVOL__AN_INLINE void fogvol__an_fblock_body(const fogvol_analytic_set *set, co
             k->t2[v][i] = lo + d;
         }
     }
-    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) {
-        /* (a denormal sum would make 1 / tau infinite: no colour then, fog 1 anyway) */
-        float tau = k->tau[i], inv = tau > 1e-30f ? 1.0f / (tau + (float)(tau <= 1e-30f)) : 0.0f;
-        k->fog[i] = fogvol__an_fmax(1.0f - tau, 0.0f);
-        k->r[i] *= inv;
-        k->g[i] *= inv;
-        k->bl[i] *= inv;
-        k->need[i] = (k->hits[i] > 1.0f && tau > limit) ? 1.0f : 0.0f;
-    }
+    fogvol__an_ffinish(limit, law, k);
 }
 
 typedef void (*fogvol__an_fblock_fn)(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                     const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k);
+                                     const fogvol__an_fvol *fv, const unsigned char *skip, float limit, int law,
+                                     fogvol__an_fblock *k);
 
 static void fogvol__an_fblock_c(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                const fogvol__an_fvol *fv, float limit, fogvol__an_fblock *k)
+                                const fogvol__an_fvol *fv, const unsigned char *skip, float limit, int law,
+                                fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_c, k);
+    fogvol__an_fblock_body(set, pe, e, fv, skip, limit, law, fogvol__an_sqrt_c, k);
 }
 
 #if FOGVOL__AN_X86
@@ -3804,22 +3859,183 @@ __attribute__((target("sse2"))) static void fogvol__an_sqrt_sse2(float *out, con
 }
 __attribute__((target("sse2"))) static void fogvol__an_fblock_sse2(const fogvol_analytic_set *set,
                                                                     const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit,
+                                                                    const fogvol__an_fvol *fv,
+                                                                    const unsigned char *skip, float limit, int law,
                                                                     fogvol__an_fblock *k)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_sse2, k);
+    fogvol__an_fblock_body(set, pe, e, fv, skip, limit, law, fogvol__an_sqrt_sse2, k);
 }
-__attribute__((target("avx2"))) static void fogvol__an_sqrt_avx2(float *out, const float *in)
+#endif
+
+#if FOGVOL__AN_X86
+/* ---- the AVX2 kernel ----
+   The block body above written with AVX2 intrinsics, one pass per volume and
+   group of 8 vertices (entry/exit, the sums, the hit mask and t1/t2 at once,
+   where the C loops go through memory between the steps), the square roots
+   in the same pass. The per-shape maths runs the same operations in the same
+   order as the C kernels (the results are the same bit for bit). */
+#define FOGVOL__AN_AVX2_FN __attribute__((target("avx2"))) static
+#define FOGVOL__AN_AVX2_INL static __inline__ __attribute__((always_inline, target("avx2")))
+#define FOGVOL__AN_V8(x) _mm256_set1_ps(x)
+
+/* where is m set, a else b */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_sel8(__m256 m, __m256 a, __m256 b) { return _mm256_blendv_ps(b, a, m); }
+/* x + (x == 0): a divisor that is never 0 */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_nz8(__m256 x)
 {
-    int i;
-    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) _mm256_storeu_ps(out + i, _mm256_sqrt_ps(_mm256_loadu_ps(in + i)));
+    return _mm256_add_ps(x, _mm256_and_ps(_mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_EQ_OQ), FOGVOL__AN_V8(1.0f)));
 }
-__attribute__((target("avx2"))) static void fogvol__an_fblock_avx2(const fogvol_analytic_set *set,
-                                                                    const fogvol__an_eye *pe, const double e[3],
-                                                                    const fogvol__an_fvol *fv, float limit,
-                                                                    fogvol__an_fblock *k)
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_dot8(const float *m, __m256 dx, __m256 dy, __m256 dz)
 {
-    fogvol__an_fblock_body(set, pe, e, fv, limit, fogvol__an_sqrt_avx2, k);
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(FOGVOL__AN_V8(m[0]), dx), _mm256_mul_ps(FOGVOL__AN_V8(m[1]), dy)),
+                         _mm256_mul_ps(FOGVOL__AN_V8(m[2]), dz));
+}
+
+/* fogvol__an_fslab on 8 lanes */
+FOGVOL__AN_AVX2_INL void fogvol__an_slab8(float o, __m256 v, __m256 *lo, __m256 *hi)
+{
+    __m256 z = _mm256_cmp_ps(v, _mm256_setzero_ps(), _CMP_EQ_OQ);
+    __m256 iv = _mm256_div_ps(FOGVOL__AN_V8(1.0f), v); /* v = 0: infinite, those lanes are replaced below */
+    __m256 ta = _mm256_mul_ps(FOGVOL__AN_V8(-1.0f - o), iv), tb = _mm256_mul_ps(FOGVOL__AN_V8(1.0f - o), iv);
+    float par = ((o >= -1.0f) & (o <= 1.0f)) ? 1.0f : -1.0f;
+    __m256 l = fogvol__an_sel8(z, _mm256_setzero_ps(), _mm256_min_ps(ta, tb));
+    __m256 h = fogvol__an_sel8(z, FOGVOL__AN_V8(par), _mm256_max_ps(ta, tb));
+    *lo = _mm256_max_ps(*lo, l);
+    *hi = _mm256_min_ps(*hi, h);
+}
+
+/* fogvol__an_fdistance, fogvol__an_fhalf and fogvol__an_fbox on 8 lanes */
+FOGVOL__AN_AVX2_INL void fogvol__an_flat8(const fogvol__an_fvol *f, __m256 dx, __m256 dy, __m256 dz, __m256 len,
+                                          __m256 *lo, __m256 *hi)
+{
+    const float *m = f->m;
+    __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f);
+    if (f->shape == FOGVOL_SHAPE_DISTANCE) {
+        __m256 ls = fogvol__an_nz8(len);
+        __m256 h = m[1] > 0.0f ? _mm256_min_ps(_mm256_div_ps(FOGVOL__AN_V8(m[1]), ls), one) : one;
+        *lo = _mm256_div_ps(FOGVOL__AN_V8(m[0]), ls);
+        *hi = fogvol__an_sel8(_mm256_cmp_ps(len, zero, _CMP_GT_OQ), h, FOGVOL__AN_V8(-1.0f));
+    } else if (f->shape == FOGVOL_SHAPE_HALF_SPACE) {
+        __m256 s1 = fogvol__an_dot8(m, dx, dy, dz), tx = _mm256_div_ps(FOGVOL__AN_V8(-f->o[0]), fogvol__an_nz8(s1));
+        __m256 up = _mm256_cmp_ps(s1, zero, _CMP_GT_OQ), down = _mm256_cmp_ps(s1, zero, _CMP_LT_OQ);
+        __m256 h = fogvol__an_sel8(up, one, FOGVOL__AN_V8(f->o[0] >= 0.0f ? 1.0f : -1.0f));
+        *lo = fogvol__an_sel8(up, _mm256_max_ps(tx, zero), zero);
+        *hi = fogvol__an_sel8(down, _mm256_min_ps(tx, one), h);
+    } else { /* BOX */
+        *lo = zero, *hi = one;
+        fogvol__an_slab8(f->o[0], fogvol__an_dot8(m, dx, dy, dz), lo, hi);
+        fogvol__an_slab8(f->o[1], fogvol__an_dot8(m + 4, dx, dy, dz), lo, hi);
+        fogvol__an_slab8(f->o[2], fogvol__an_dot8(m + 8, dx, dy, dz), lo, hi);
+    }
+}
+
+/* fogvol__an_fquad1, the graze test and fogvol__an_fquad2 (and the
+   cylinder's slab) on 8 lanes; returns the lanes that graze (a bit each) */
+FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx, __m256 dy, __m256 dz, __m256 *lo,
+                                            __m256 *hi)
+{
+    const float *m = f->m, *o = f->o;
+    __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f), o0 = FOGVOL__AN_V8(o[0]), o1 = FOGVOL__AN_V8(o[1]);
+    __m256 v0, v1, v2, w2, o2, cx, cy, cz, a, b, disc, s, sg, q, r1, r2, l, h, pos;
+    int cyl = f->shape == FOGVOL_SHAPE_CYLINDER, graze;
+    if (f->shape == FOGVOL_SHAPE_SPHERE) {
+        __m256 sc = FOGVOL__AN_V8(m[0]);
+        v0 = _mm256_mul_ps(sc, dx), v1 = _mm256_mul_ps(sc, dy), v2 = _mm256_mul_ps(sc, dz);
+    } else {
+        v0 = fogvol__an_dot8(m, dx, dy, dz), v1 = fogvol__an_dot8(m + 4, dx, dy, dz);
+        v2 = fogvol__an_dot8(m + 8, dx, dy, dz);
+    }
+    w2 = cyl ? zero : v2, o2 = FOGVOL__AN_V8(cyl ? 0.0f : o[2]);
+    cx = _mm256_sub_ps(_mm256_mul_ps(o1, w2), _mm256_mul_ps(o2, v1));
+    cy = _mm256_sub_ps(_mm256_mul_ps(o2, v0), _mm256_mul_ps(o0, w2));
+    cz = _mm256_sub_ps(_mm256_mul_ps(o0, v1), _mm256_mul_ps(o1, v0));
+    a = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(v0, v0), _mm256_mul_ps(v1, v1)), _mm256_mul_ps(w2, w2));
+    b = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(o0, v0), _mm256_mul_ps(o1, v1)), _mm256_mul_ps(o2, w2));
+    disc = _mm256_sub_ps(
+        a, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(cx, cx), _mm256_mul_ps(cy, cy)), _mm256_mul_ps(cz, cz)));
+    pos = _mm256_cmp_ps(a, zero, _CMP_GT_OQ);
+    /* |disc| < GRAZE a (false where a = 0: a >= 0) */
+    graze = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_andnot_ps(FOGVOL__AN_V8(-0.0f), disc),
+                                             _mm256_mul_ps(FOGVOL__AN_V8(FOGVOL__AN_GRAZE), a), _CMP_LT_OQ));
+    s = _mm256_sqrt_ps(_mm256_max_ps(disc, zero));
+    sg = fogvol__an_sel8(_mm256_cmp_ps(b, zero, _CMP_GE_OQ), s, _mm256_xor_ps(s, FOGVOL__AN_V8(-0.0f)));
+    q = _mm256_xor_ps(_mm256_add_ps(b, sg), FOGVOL__AN_V8(-0.0f)); /* -(b + sg), signed zeros included */
+    /* a = 0 (those lanes take the blends below) and q = 0 (then disc <= 0: a miss) need no guard here */
+    r1 = _mm256_div_ps(q, a), r2 = _mm256_div_ps(FOGVOL__AN_V8(f->c0), q);
+    l = _mm256_max_ps(_mm256_min_ps(r1, r2), zero), h = _mm256_min_ps(_mm256_max_ps(r1, r2), one);
+    h = fogvol__an_sel8(_mm256_cmp_ps(disc, zero, _CMP_GT_OQ), h, FOGVOL__AN_V8(-1.0f));
+    *lo = fogvol__an_sel8(pos, l, zero);
+    *hi = fogvol__an_sel8(pos, h, FOGVOL__AN_V8(f->c0 <= 0.0f ? 1.0f : -1.0f));
+    if (cyl) fogvol__an_slab8(o[2], v2, lo, hi);
+    return graze;
+}
+
+/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit, the
+   sums and the hit mask, accumulated where fogvol__an_fblock_body keeps them. */
+FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                                         const fogvol__an_fvol *f, int v, int base, fogvol__an_fblock *k)
+{
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base), dz = _mm256_loadu_ps(k->dz + base);
+    __m256 len = _mm256_loadu_ps(k->len + base), lo = zero, hi = zero, ch, tv, hm;
+    unsigned int *hw = k->hit[v >> 5] + base;
+    int redo = 0xff;
+    if (f->dbl) { /* every lane in double */
+    } else if (f->shape == FOGVOL_SHAPE_DISTANCE || f->shape == FOGVOL_SHAPE_HALF_SPACE ||
+               f->shape == FOGVOL_SHAPE_BOX) {
+        fogvol__an_flat8(f, dx, dy, dz, len, &lo, &hi);
+        redo = 0;
+    } else {
+        redo = fogvol__an_quadric8(f, dx, dy, dz, &lo, &hi);
+    }
+    ch = _mm256_max_ps(_mm256_sub_ps(hi, lo), zero);
+    if (redo) {
+        _mm256_storeu_ps(k->lo + base, lo), _mm256_storeu_ps(k->hi + base, hi), _mm256_storeu_ps(k->ch + base, ch);
+        fogvol__an_redo_lanes(set, pe, e, v, redo, base, k);
+        lo = _mm256_loadu_ps(k->lo + base), hi = _mm256_loadu_ps(k->hi + base), ch = _mm256_loadu_ps(k->ch + base);
+    }
+    lo = _mm256_min_ps(lo, hi);
+    tv = _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
+    hm = _mm256_cmp_ps(tv, zero, _CMP_GT_OQ);
+    _mm256_storeu_ps(k->tau + base, _mm256_add_ps(_mm256_loadu_ps(k->tau + base), tv));
+    _mm256_storeu_ps(k->r + base, _mm256_add_ps(_mm256_loadu_ps(k->r + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv)));
+    _mm256_storeu_ps(k->g + base, _mm256_add_ps(_mm256_loadu_ps(k->g + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv)));
+    _mm256_storeu_ps(k->bl + base,
+                     _mm256_add_ps(_mm256_loadu_ps(k->bl + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv)));
+    _mm256_storeu_si256((__m256i *)(void *)hw,
+                        _mm256_or_si256(_mm256_loadu_si256((const __m256i *)(const void *)hw),
+                                        _mm256_and_si256(_mm256_castps_si256(hm),
+                                                         _mm256_set1_epi32((int)(1u << (v & 31))))));
+    _mm256_storeu_ps(k->t1[v] + base, lo);
+    _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
+}
+
+/* The volumes outside, the block's 4 groups of 8 inside: the groups' long
+   chains (square root, then division) are independent and overlap. */
+FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                                const double e[3], const fogvol__an_fvol *fv,
+                                                const unsigned char *skip, float limit, int law, fogvol__an_fblock *k)
+{
+    int base, v, i;
+    for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) {
+        __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base);
+        __m256 dz = _mm256_loadu_ps(k->dz + base), zero = _mm256_setzero_ps();
+        _mm256_storeu_ps(k->len + base, _mm256_sqrt_ps(_mm256_add_ps(
+                                            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                            _mm256_mul_ps(dz, dz))));
+        _mm256_storeu_ps(k->tau + base, zero), _mm256_storeu_ps(k->r + base, zero);
+        _mm256_storeu_ps(k->g + base, zero), _mm256_storeu_ps(k->bl + base, zero);
+    }
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
+    for (v = 0; v < set->count; ++v)
+        if (!skip[v]) /* fogvol__an_fcull */
+            for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
+    for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hits[i] = 0.0f; /* 2: two volumes or more on the ray */
+    for (v = 0; v < (set->count + 31) / 32; ++v)
+        for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
+            k->hits[i] += (float)(k->hit[v][i] != 0u) + (float)((k->hit[v][i] & (k->hit[v][i] - 1u)) != 0u);
+    fogvol__an_ffinish(limit, law, k);
 }
 #endif
 
@@ -3837,13 +4053,66 @@ FOGVOL_API fogvol_analytic_kernel fogvol_analytic_kernel_resolve(fogvol_analytic
     return FOGVOL_ANALYTIC_KERNEL_FLOAT;
 }
 
+/* A sphere around volume v (world space, radius inflated by 1e-4 for the
+   float tests): the unit shape's centre mapped back, the radius from the
+   Gram matrix G of the inverse map's columns (|M u|^2 = u^T G u), bounded by
+   Gershgorin's rows for the unit ball (largest eigenvalue), by the sum of
+   |G| over the unit cube's corners, and by disc + axis for the cylinder.
+   Returns 0 for the unbounded shapes and a singular map. */
+static int fogvol__an_bound(const fogvol_analytic_set *set, int v, double c[3], double *r)
+{
+    const double *m = set->map[v];
+    double inv[9], g[3][3], det, r2 = 0.0;
+    int i, j;
+    if (set->shape[v] < FOGVOL_SHAPE_SPHERE) return 0;
+    inv[0] = m[5] * m[10] - m[6] * m[9], inv[1] = m[2] * m[9] - m[1] * m[10], inv[2] = m[1] * m[6] - m[2] * m[5];
+    inv[3] = m[6] * m[8] - m[4] * m[10], inv[4] = m[0] * m[10] - m[2] * m[8], inv[5] = m[2] * m[4] - m[0] * m[6];
+    inv[6] = m[4] * m[9] - m[5] * m[8], inv[7] = m[1] * m[8] - m[0] * m[9], inv[8] = m[0] * m[5] - m[1] * m[4];
+    det = m[0] * inv[0] + m[1] * inv[3] + m[2] * inv[6];
+    if (!(FOGVOL_FABS(det) > 0.0)) return 0;
+    for (i = 0; i < 9; ++i) inv[i] /= det; /* row-major: world = inv (unit - t) */
+    for (i = 0; i < 3; ++i) c[i] = -(inv[i * 3] * m[3] + inv[i * 3 + 1] * m[7] + inv[i * 3 + 2] * m[11]);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            g[i][j] = inv[i] * inv[j] + inv[3 + i] * inv[3 + j] + inv[6 + i] * inv[6 + j];
+    if (set->shape[v] == FOGVOL_SHAPE_BOX) {
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) r2 += FOGVOL_FABS(g[i][j]);
+        *r = FOGVOL_SQRT(r2);
+    } else if (set->shape[v] == FOGVOL_SHAPE_CYLINDER) {
+        r2 = fogvol__an_max(g[0][0], g[1][1]) + FOGVOL_FABS(g[0][1]);
+        *r = FOGVOL_SQRT(r2) + FOGVOL_SQRT(g[2][2]);
+    } else {
+        for (i = 0; i < 3; ++i)
+            r2 = fogvol__an_max(r2, FOGVOL_FABS(g[i][0]) + FOGVOL_FABS(g[i][1]) + FOGVOL_FABS(g[i][2]));
+        *r = FOGVOL_SQRT(r2);
+    }
+    *r = *r * 1.0001 + 1e-6;
+    return *r < 1e18;
+}
+
+/* fogvol__an_fvol's bounding sphere as seen from the eye e */
+static void fogvol__an_fbound(const fogvol_analytic_set *set, const double e[3], int v, fogvol__an_fvol *f)
+{
+    double c[3], r, d;
+    f->bounded = fogvol__an_bound(set, v, c, &r);
+    if (!f->bounded) return;
+    c[0] -= e[0], c[1] -= e[1], c[2] -= e[2];
+    d = FOGVOL_SQRT(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    f->bounded = d > r * 1.0001 && d < 1e18; /* the eye clearly outside */
+    if (!f->bounded) return;
+    f->bu[0] = (float)(c[0] / d), f->bu[1] = (float)(c[1] / d), f->bu[2] = (float)(c[2] / d);
+    f->bnear = (float)(d - r), f->bsin = (float)(r / d), f->bcos = (float)FOGVOL_SQRT(1.0 - (r / d) * (r / d));
+}
+
 /* The float kernels' per-call volume table: the eye in each unit space
    (from the double one), and which volumes go to double whole. Returns the
    largest |vertex - eye| coordinate the float loops take (further vertices
    go to double one by one), or 0 when a volume's numbers could overflow
    float sums (density or colour beyond 1e6, an eye 1e12 units away in a
    unit space, a map entry beyond 1e12): the call then runs the DOUBLE kernel. */
-static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, fogvol__an_fvol *fv)
+static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
+                              fogvol__an_fvol *fv)
 {
     double mmax = 1.0;
     int v, j;
@@ -3864,140 +4133,173 @@ static float fogvol__an_fvols(const fogvol_analytic_set *set, const fogvol__an_e
         fv[v].dens = (float)set->density[v];
         fv[v].shape = set->shape[v];
         fv[v].dbl = set->shape[v] >= FOGVOL_SHAPE_SPHERE && !(oo <= FOGVOL__AN_FAR_EYE * FOGVOL__AN_FAR_EYE);
+        fogvol__an_fbound(set, e, v, &fv[v]);
     }
     return mmax > 1e12 ? 0.0f : (float)(1e15 / mmax);
 }
 
-/* exp(-x) for x >= 0 in float without the C library (the walk calls it once
-   per stretch): x = n ln2 - r, |r| <= ln2 / 2, exp(r) = 1 + r + r^2 P(r) with
-   the minimax P of Cephes' expf (about 1 ulp), evaluated in Estrin's order
-   (short dependency chains), times 2^-n. */
-FOGVOL__AN_INLINE float fogvol__an_fexpn(float x)
-{
-    float t, r, r2, p, scale;
-    unsigned int bits;
-    int n;
-    if (!(x < 87.0f)) return x >= 87.0f ? 0.0f : 1.0f; /* NaN: 1 */
-    t = x * 1.44269504f;
-    n = (int)(t + 0.5f);
-    r = (float)n * 0.693145751953125f - x + (float)n * 1.42860677e-6f; /* ln2 in two parts */
-    r2 = r * r;
-    p = (5.0000001201e-1f + 1.6666665459e-1f * r) + r2 * (4.1665795894e-2f + 8.3334519073e-3f * r) +
-        (r2 * r2) * (1.3981999507e-3f + 1.9875691500e-4f * r);
-    p = 1.0f + r + r2 * p;
-    bits = (unsigned int)(127 - n) << 23;
-    memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
-}
+#define FOGVOL__AN_EVENTS (2 * FOGVOL_ANALYTIC_CAPACITY)
 
-/* fogvol__an_state and fogvol__an_add in float, for the float kernels' walk */
-typedef struct fogvol__an_fstate {
-    float f, w, num[3];
-    int done;
-} fogvol__an_fstate;
+/* The event order of the last sorted vertex of a call: the next one starts
+   from it (neighbouring vertices mostly see their volumes in the same order,
+   so the insertion sort then only compares). */
+typedef struct fogvol__an_fcarry {
+    unsigned char ev[FOGVOL__AN_EVENTS];
+    unsigned int hit[FOGVOL__AN_MASKS]; /* the volumes in ev */
+    int m;
+} fogvol__an_fcarry;
 
-FOGVOL__AN_INLINE void fogvol__an_fadd(fogvol__an_fstate *st, int law, const float cs[3], float sig, float l)
+/* The stretches between a ray's sorted events key[0..m) (t bits << 32 |
+   event index), front to back: the summed colour * density (rgb) and density
+   (sig) of the volumes a stretch is in, and its length in world units
+   (INTERPENETRATING, the paper's event list; the sums restart from exact
+   zeros whenever no volume is open, so rounding never leaves a ghost density
+   behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
+   volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
+   Returns the stretch count. With ex != NULL
+   (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
+   here where they hang off no chain of the walk (tau = 0: q = 0); with
+   linear != 0 (the LINEAR law) it stops at the stretch that leaves no fog
+   (fogvol__an_flinear_walk's f, the same arithmetic). */
+static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
+                                 int m, float (*rgb)[3], float *sig, float *l, float *ex, float *q, int linear)
 {
-    float tau = sig * l, k;
-    int c;
-    if (!(tau > 0.0f) || st->done) return;
-    if (law == FOGVOL_FOG_EXP) {
-        float e = fogvol__an_fexpn(tau);
-        /* (1 - e) / tau, by its series where 1 - e would cancel (error < tau^6 / 5040) */
-        float ps = 1.0f - tau * (0.5f - tau * (1.0f / 6.0f - tau * (1.0f / 24.0f - tau * (1.0f / 120.0f - tau / 720.0f))));
-        float phi = tau < 0.25f ? ps : (1.0f - e) / tau;
-        k = l * phi * st->f;
-        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * k;
-        st->w += sig * k;
-        st->f *= e;
-        if (st->f < (float)FOGVOL__AN_CUTOFF) st->done = 1;
-    } else if (law == FOGVOL_FOG_LINEAR) {
-        k = tau >= st->f ? st->f / tau : 1.0f;
-        for (c = 0; c < 3; ++c) st->num[c] += cs[c] * (l * k);
-        st->w += tau * k;
-        st->f = tau >= st->f ? 0.0f : st->f - tau;
-        st->done = st->f == 0.0f;
-    } else {
-        for (c = 0; c < 3; ++c) st->num[c] = cs[c] / sig * st->f + st->num[c] * (1.0f - st->f);
-        st->f -= tau < 1.0f ? tau : 1.0f;
-        if (st->f <= 0.0f) {
-            st->f = 0.0f;
-            st->done = 1;
-        }
-    }
-}
-
-/* fogvol__an_walk in float over the hit events ev[0..h) (sorted by key) */
-static void fogvol__an_fwalk(const fogvol__an_fvol *fv, int law, int mix, float len, const float *key,
-                             const unsigned char *ev, int h, fogvol__an_fstate *st)
-{
-    int k, c;
-    if (mix == FOGVOL_MIX_SEPARATE) {
-        for (k = 0; k < h && !st->done; ++k) {
-            int e = ev[k];
-            const fogvol__an_fvol *f = &fv[e >> 1];
-            float cs[3];
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f, fl = 1.0f; /* scalars: kept in registers */
+    int k, open = 0, n = 0;
+    for (k = 0; k < m; ++k) {
+        int e = (int)(key[k] & 0xffu);
+        const fogvol__an_fvol *f = &fv[e >> 1];
+        uint32_t u = (uint32_t)(key[k] >> 32);
+        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
+        memcpy(&t, &u, sizeof t);
+        if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
-            for (c = 0; c < 3; ++c) cs[c] = f->col[c] * f->dens;
-            fogvol__an_fadd(st, law, cs, f->dens, len * (key[e + 1] - key[e]));
-        }
-    } else {
-        float acc[4] = {0.0f, 0.0f, 0.0f, 0.0f}, last = 0.0f;
-        int open = 0;
-        for (k = 0; k < h && !st->done; ++k) {
-            int e = ev[k];
-            const fogvol__an_fvol *f = &fv[e >> 1];
-            float t = key[e], sd = (e & 1) ? -f->dens : f->dens;
-            if (open > 0 && t > last) fogvol__an_fadd(st, law, acc, acc[3], (t - last) * len);
-            for (c = 0; c < 3; ++c) acc[c] += sd * f->col[c];
-            acc[3] += sd;
+            rgb[n][0] = f->col[0] * f->dens, rgb[n][1] = f->col[1] * f->dens, rgb[n][2] = f->col[2] * f->dens;
+            sg = f->dens, ln = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
+        } else {
+            int was = open;
+            rgb[n][0] = ar, rgb[n][1] = ag, rgb[n][2] = ab;
+            sg = ad, ln = (t - last) * len;
             open += (e & 1) ? -1 : 1;
-            if (open == 0) acc[0] = acc[1] = acc[2] = acc[3] = 0.0f;
+            ar += sd * f->col[0], ag += sd * f->col[1], ab += sd * f->col[2], ad += sd;
+            if (open == 0) ar = ag = ab = ad = 0.0f;
             last = t;
+            if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
+        }
+        sig[n] = sg, l[n] = ln;
+        if (ex) {
+            float om;
+            ex[n] = fogvol__an_fexp2(sg * ln, &om);
+            q[n] = om / (sg + (float)(sg == 0.0f));
+        }
+        ++n;
+        if (linear && sg * ln > 0.0f) {
+            fl = sg * ln >= fl ? 0.0f : fl - sg * ln;
+            if (fl == 0.0f) break; /* the events after it change nothing */
         }
     }
+    return n;
+}
+
+/* The EXP law over n stretches: each stretch of optical depth tau covers
+   T (1 - exp(-tau)) of the pixel (T: the transmittance in front of it) with
+   the mean colour rgb / sig; done once T < FOGVOL__AN_CUTOFF. */
+static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const float *ex, const float *q, int n,
+                                 float *fog, float col[3])
+{
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
+    int k;
+    for (k = 0; k < n && f >= (float)FOGVOL__AN_CUTOFF; ++k) {
+        float a = f * q[k];
+        n0 += rgb[k][0] * a, n1 += rgb[k][1] * a, n2 += rgb[k][2] * a;
+        w += sig[k] * a;
+        f *= ex[k];
+    }
+    inv = w > 1e-30f ? 1.0f / w : 0.0f;
+    *fog = f;
+    col[0] = n0 * inv, col[1] = n1 * inv, col[2] = n2 * inv;
+}
+
+/* The LINEAR law (each stretch takes tau = sig * l of the fog until none is
+   left; colour weighted by the fog taken) and the paper's LINEAR_SEED colour
+   formula over n stretches, in float (fogvol__an_add's arithmetic). */
+static void fogvol__an_flinear_walk(const float (*rgb)[3], const float *sig, const float *l, int n, int law,
+                                    float *fog, float col[3])
+{
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
+    int k;
+    for (k = 0; k < n && f > 0.0f; ++k) {
+        float sg = sig[k], ln = l[k], tau = sg * ln, a;
+        if (!(tau > 0.0f)) continue;
+        if (law == FOGVOL_FOG_LINEAR_SEED) {
+            n0 = rgb[k][0] / sg * f + n0 * (1.0f - f);
+            n1 = rgb[k][1] / sg * f + n1 * (1.0f - f);
+            n2 = rgb[k][2] / sg * f + n2 * (1.0f - f);
+            f -= tau < 1.0f ? tau : 1.0f;
+            f = f > 0.0f ? f : 0.0f;
+            continue;
+        }
+        a = tau >= f ? f / tau : 1.0f;
+        n0 += rgb[k][0] * (ln * a), n1 += rgb[k][1] * (ln * a), n2 += rgb[k][2] * (ln * a);
+        w += tau * a;
+        f = tau >= f ? 0.0f : f - tau;
+    }
+    inv = w > 1e-30f ? 1.0f / w : 0.0f;
+    *fog = f;
+    if (law == FOGVOL_FOG_LINEAR_SEED) inv = 1.0f;
+    col[0] = n0 * inv, col[1] = n1 * inv, col[2] = n2 * inv;
 }
 
 /* The sorted walk of the float kernels: only the events of the volumes on
    the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
-   are sorted, by insertion from volume order (cheaper than filtering a
-   carried order of all the events). */
+   are sorted, by insertion from the order of the previous sorted vertex
+   (carry): its events still on the ray in that order, then those of the
+   volumes new to the ray in volume order. The keys are t bits << 32 | event
+   index (t >= 0, so the integer order is the order of t, ties by event index). */
 static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol__an_fvol *fv, int law, int mix,
                                       float len, const float *t1, const float *t2, const unsigned int *hit,
-                                      int64_t *moves, float *fog, float col[3])
+                                      fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
-    float key[2 * FOGVOL_ANALYTIC_CAPACITY], inv;
-    unsigned char ev[2 * FOGVOL_ANALYTIC_CAPACITY];
-    fogvol__an_fstate st;
-    int h = 0, w, k, j, c;
-    int64_t mv = 0;
-    for (w = 0; w < (s->count + 31) / 32; ++w) {
-        unsigned int bits = hit[w * FOGVOL__AN_BLOCK];
+    uint64_t key[FOGVOL__AN_EVENTS];
+    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
+    float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS];
+    int m = 0, n, w, k, j, nw = (s->count + 31) / 32;
+    for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
+        int e = carry->ev[k], v = e >> 1;
+        float t = ((e & 1) ? t2 : t1)[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
+        uint32_t u;
+        memcpy(&u, &t, sizeof u);
+        key[m] = (uint64_t)u << 32 | (uint64_t)e;
+        m += (int)((hit[(v >> 5) * FOGVOL__AN_BLOCK] >> (v & 31)) & 1u);
+    }
+    for (w = 0; w < nw; ++w) {
+        unsigned int bits = hit[w * FOGVOL__AN_BLOCK] & ~carry->hit[w];
+        carry->hit[w] = hit[w * FOGVOL__AN_BLOCK];
         while (bits) {
             int v = 32 * w + fogvol__an_ctz(bits);
+            float a = t1[v * FOGVOL__AN_BLOCK] + 0.0f, b = t2[v * FOGVOL__AN_BLOCK] + 0.0f;
+            uint32_t ua, ub;
             bits &= bits - 1u;
-            key[2 * v] = t1[v * FOGVOL__AN_BLOCK];
-            key[2 * v + 1] = t2[v * FOGVOL__AN_BLOCK];
-            ev[h++] = (unsigned char)(2 * v);
-            ev[h++] = (unsigned char)(2 * v + 1);
+            memcpy(&ua, &a, sizeof ua);
+            memcpy(&ub, &b, sizeof ub);
+            key[m++] = (uint64_t)ua << 32 | (uint64_t)(2 * v);
+            key[m++] = (uint64_t)ub << 32 | (uint64_t)(2 * v + 1);
         }
     }
-    for (k = 1; k < h; ++k) {
-        unsigned char x = ev[k];
-        float kx = key[x];
-        for (j = k; j > 0 && (key[ev[j - 1]] > kx || (key[ev[j - 1]] == kx && ev[j - 1] > x)); --j) {
-            ev[j] = ev[j - 1];
-            ++mv;
-        }
-        ev[j] = x;
+    for (k = 1; k < m; ++k) {
+        uint64_t x = key[k];
+        for (j = k; j > 0 && key[j - 1] > x; --j) key[j] = key[j - 1], ++*moves;
+        key[j] = x;
     }
-    *moves += mv;
-    memset(&st, 0, sizeof st);
-    st.f = 1.0f;
-    fogvol__an_fwalk(fv, law, mix, len, key, ev, h, &st);
-    inv = st.w > 1e-30f ? 1.0f / st.w : 0.0f;
-    *fog = st.f;
-    for (c = 0; c < 3; ++c) col[c] = law == FOGVOL_FOG_LINEAR_SEED ? st.num[c] : st.num[c] * inv;
+    for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
+    carry->m = m;
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
+                              law == FOGVOL_FOG_LINEAR);
+    if (law == FOGVOL_FOG_EXP) {
+        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
+        return;
+    }
+    fogvol__an_flinear_walk((const float(*)[3])rgb, sig, l, n, law, fog, col);
 }
 
 /* What a batch call works on, for the float kernels' loop. */
@@ -4013,6 +4315,7 @@ typedef struct fogvol__an_call {
     float dlim; /* |vertex - eye| coordinates beyond this go to double (fogvol__an_fvols) */
     int eye_ok, law, mix, count, stride, fog_stride, color_stride, bad, sorted;
     int64_t moves;
+    fogvol__an_fcarry fcarry; /* the float kernels' event order, from sorted vertex to sorted vertex */
 } fogvol__an_call;
 
 /* Gathers block `base` (checked: x - x is 0 for finite x only), padded with
@@ -4040,20 +4343,64 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
     }
 }
 
+/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
+   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
+   does not evaluate, which can only be in a volume around the eye, never
+   skipped) lie in a cone around their sum A, of half angle theta, and are at
+   most lmax long. A volume whose bounding sphere (fogvol__an_fvol) is further
+   than lmax or outside that cone widened by the sphere's half angle alpha
+   (the angle between A and the sphere's centre above theta + alpha) is
+   missed by every ray, and so is a volume of density 0. The float tests keep
+   margins of 1e-4. */
+static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol__an_fblock *k, unsigned char *skip)
+{
+    /* the lane loops keep 8 partial sums / minima / maxima (vectorisable without reassociation) */
+    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa, ia, c2min, l2max, cth, sth, lmax;
+    int i, j, v;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (j = 0; j < 8; ++j) px[j] += k->dx[i + j], py[j] += k->dy[i + j], pz[j] += k->dz[i + j];
+    ax = ((px[0] + px[1]) + (px[2] + px[3])) + ((px[4] + px[5]) + (px[6] + px[7]));
+    ay = ((py[0] + py[1]) + (py[2] + py[3])) + ((py[4] + py[5]) + (py[6] + py[7]));
+    az = ((pz[0] + pz[1]) + (pz[2] + pz[3])) + ((pz[4] + pz[5]) + (pz[6] + pz[7]));
+    aa = ax * ax + ay * ay + az * az;
+    for (j = 0; j < 8; ++j) pc[j] = 1.0f;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (j = 0; j < 8; ++j) {
+            float x = k->dx[i + j], y = k->dy[i + j], z = k->dz[i + j], d2 = x * x + y * y + z * z;
+            float da = x * ax + y * ay + z * az, q = d2 * aa;
+            float c2 = (da > 0.0f ? da * da : -q) / (q + (float)(q == 0.0f)); /* cos^2 to A; -1: beyond 90 degrees */
+            pc[j] = fogvol__an_fmin(pc[j], d2 > 0.0f ? c2 : 1.0f);
+            pl[j] = fogvol__an_fmax(pl[j], d2);
+        }
+    c2min = pc[0], l2max = pl[0];
+    for (j = 1; j < 8; ++j) c2min = fogvol__an_fmin(c2min, pc[j]), l2max = fogvol__an_fmax(l2max, pl[j]);
+    cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f; /* cos(theta), widened */
+    sth = (float)FOGVOL_SQRT(1.0 - (double)cth * cth);
+    lmax = (float)FOGVOL_SQRT((double)l2max) * 1.0001f + 1e-6f;
+    ia = aa > 0.0f ? 1.0f / (float)FOGVOL_SQRT((double)aa) : 0.0f;
+    for (v = 0; v < count; ++v) { /* without branches on the data */
+        const fogvol__an_fvol *f = &fv[v];
+        float cosa = (ax * f->bu[0] + ay * f->bu[1] + az * f->bu[2]) * ia;
+        int far = f->bnear > lmax, out = cosa < cth * f->bcos - sth * f->bsin - 1e-4f, none = f->dens > 0.0f ? 0 : 1;
+        skip[v] = (unsigned char)(none | (f->bounded & (far | ((cth > 0.0f) & out))));
+    }
+}
+
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
 static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
-    unsigned char valid[FOGVOL__AN_BLOCK];
+    unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
     int base, i;
     float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
-    c->dlim = fogvol__an_fvols(c->set, c->pe, fv);
+    c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         fogvol__an_fgather(c, base, nb, valid, &blk);
-        fn(c->set, c->pe, c->e, fv, limit, &blk);
+        fogvol__an_fcull(c->set->count, fv, &blk, skip);
+        fn(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
             float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
@@ -4066,11 +4413,10 @@ static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
                 fogvol__an_fsorted_vertex(c->set, fv, c->law, c->mix, blk.len[i],
                                           (const float *)(const void *)blk.t1 + i,
                                           (const float *)(const void *)blk.t2 + i,
-                                          (const unsigned int *)(const void *)blk.hit + i, &c->moves, &f, col);
+                                          (const unsigned int *)(const void *)blk.hit + i, &c->fcarry, &c->moves, &f, col);
                 ++c->sorted;
             } else {
-                f = c->law != FOGVOL_FOG_EXP ? blk.fog[i]
-                    : blk.tau[i] > 0.0f ? (float)FOGVOL_EXP(-(double)blk.tau[i]) : 1.0f;
+                f = blk.fog[i];
                 col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
             }
             if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;

@@ -30,6 +30,8 @@
  *     than sorting from scratch; the carried per-batch order likewise.
  *  6b the batch kernels (double, float C, SSE2, AVX2; each forced) on edge cases
  *     against hand-computed chords (test_kernel_edges, see there); <= 1.2e-5.
+ *  6c the float kernels' per-block culling: fans of rays just inside / outside each
+ *     volume where its bounding sphere is tightest, against ground-truth chords.
  *   7 degenerate input: zero-size volumes, singular / non-affine matrices, NaN and
  *     infinite fields, zero normal, too many volumes, NaN / infinite vertices and eye,
  *     vertex at the eye, huge coordinates; result codes, never NaN.
@@ -1217,6 +1219,78 @@ static void test_kernel_edges(void **state)
 
 /* ==== 7: degenerate input ======================================================= */
 
+/* The float kernels skip, per block of 32 vertices, the volumes whose bounding
+   sphere lies outside the cone of the block's rays. Fans of 32 rays whose first
+   ray passes just inside a volume near the point furthest from its centre (where
+   the bounding sphere is tightest: 0.999 of the way out, or 1.001: just outside)
+   and whose other rays turn away from it by up to 40 degrees; every shape with a
+   bounding sphere, rotated/scaled and sheared transforms, eyes all around. The
+   first ray's fog against the ground-truth chord (the test's inside predicate and
+   bisection): |dfog| <= 1.2e-5 for every float kernel (a volume skipped wrongly
+   would leave fog 1 there, about 0.1 away). */
+static void test_block_culling(void **state)
+{
+    static float pos[KN * 3], fog[KN], col[KN * 3];
+    double worst[4] = {0, 0, 0, 0};
+    int shape, trial, j, i, k, hits = 0;
+    (void)state;
+    for (shape = FOGVOL_SHAPE_SPHERE; shape <= FOGVOL_SHAPE_CYLINDER; ++shape)
+        for (trial = 0; trial < 40; ++trial) {
+            tvol t = rand_volume(shape);
+            fogvol_analytic_set set;
+            float ext[3], c[3], eye[3], x[3];
+            double want[2], best = -1, y[3] = {0, 0, 0}, u[3], dir[3], w[3], rl = 0, wl = 0, dot = 0, far, len;
+            t.v.density = 1.0f;
+            tv_to_world(&t, y, c);
+            for (k = 0; k < 256; ++k) { /* the unit shape's boundary point furthest from the centre */
+                float q[3];
+                double d = 0;
+                rnd_unit(u);
+                if (shape == FOGVOL_SHAPE_BOX) u[0] = u[0] < 0 ? -1 : 1, u[1] = u[1] < 0 ? -1 : 1, u[2] = u[2] < 0 ? -1 : 1;
+                if (shape == FOGVOL_SHAPE_CYLINDER) {
+                    double r = sqrt(u[0] * u[0] + u[1] * u[1]);
+                    u[0] /= r, u[1] /= r, u[2] = u[2] < 0 ? -1 : 1;
+                }
+                tv_to_world(&t, u, q);
+                for (i = 0; i < 3; ++i) d += (q[i] - c[i]) * (q[i] - c[i]);
+                if (d > best) best = d, ext[0] = q[0], ext[1] = q[1], ext[2] = q[2];
+            }
+            far = sqrt(best);
+            rnd_unit(u);
+            for (i = 0; i < 3; ++i) eye[i] = (float)(c[i] + u[i] * far * rnd_range(1.5, 6));
+            assert_int_equal(fogvol_analytic_prepare(&t.v, 1, &set), FOGVOL_SUCCESS);
+            for (k = 0; k < 2; ++k) { /* block k: the first ray 0.999 / 1.001 of the way out */
+                double s = k == 0 ? 0.999 : 1.001, a = 0, b = 0, seeds[256];
+                for (i = 0; i < 3; ++i) x[i] = (float)(c[i] + s * (ext[i] - c[i]));
+                for (i = 0; i < 3; ++i) dir[i] = 1.5 * (x[i] - eye[i]), rl += dir[i] * dir[i];
+                rl = sqrt(rl);
+                for (i = 0; i < 3; ++i) dot += (x[i] - c[i]) * dir[i] / rl;
+                for (i = 0; i < 3; ++i) w[i] = (x[i] - c[i]) - dot * dir[i] / rl, wl += w[i] * w[i];
+                wl = sqrt(wl) + 1e-30;
+                for (j = 0; j < 32; ++j)
+                    for (i = 0; i < 3; ++i)
+                        pos[3 * (32 * k + j) + i] = (float)(eye[i] + dir[i] + w[i] / wl * rl * tan(0.7 * j / 31.0));
+                len = 0;
+                for (i = 0; i < 3; ++i) len += ((double)pos[96 * k + i] - eye[i]) * ((double)pos[96 * k + i] - eye[i]);
+                for (i = 0; i < 256; ++i) seeds[i] = 1 / 1.5 + (i - 128) * 2e-5; /* around the point 1.5 from the eye */
+                want[k] = gt_segment(&t, eye, &pos[96 * k], seeds, 256, &a, &b) ? exp(-sqrt(len) * (b - a)) : 1.0;
+                hits += want[k] < 0.999;
+                rl = wl = dot = 0;
+            }
+            for (j = 1; j < 4; ++j) {
+                if (!kernel_there(j)) continue;
+                kern_batch(&set, j, eye, pos, FOGVOL_FOG_EXP, fog, col);
+                for (k = 0; k < 2; ++k) worst[j] = fmax(worst[j], fabs(fog[32 * k] - want[k]));
+            }
+        }
+    for (j = 1; j < 4; ++j)
+        if (kernel_there(j))
+            print_message("# %-7s fans of rays at the volumes' furthest points (%d of 320 hit): max |dfog| %.2e\n",
+                          kernel_name[j], hits, worst[j]);
+    assert_true(hits >= 100);
+    for (j = 1; j < 4; ++j) assert_true(worst[j] <= 1.2e-5);
+}
+
 static void test_degenerate(void **state)
 {
     fogvol_analytic_volume v[40], ok;
@@ -1846,6 +1920,7 @@ int main(void)
         TIMED(test_batch_matches_eval),
         TIMED(test_order_coherence),
         TIMED(test_kernel_edges),
+        TIMED(test_block_culling),
         TIMED(test_degenerate),
         TIMED(test_fold),
         TIMED(test_pack_uniforms),
