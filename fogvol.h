@@ -6371,7 +6371,7 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
 static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3])
 {
     float f[3];
-    size_t stride = desc->stride ? (size_t)desc->stride : 12u;
+    size_t stride = (size_t)fogvol__mesh_stride(desc);
     memcpy(f, (const unsigned char *)desc->positions + desc->offset + (size_t)i * stride, sizeof f);
     p[0] = f[0];
     p[1] = f[1];
@@ -6919,6 +6919,13 @@ static int fogvol__all_zero(const float *v, int n)
 
 /* fogvol_add_volume: the density texture needs a tier that can weight faces; one colour
    texture (and map) per colour-ramp group. */
+/* fogvol_volume_desc.color_map with its default (all zero: s = x, t = y). */
+static void fogvol__color_map(const fogvol_volume_desc *desc, float map[6])
+{
+    memcpy(map, desc->color_map, 6 * sizeof(float));
+    if (fogvol__all_zero(map, 6)) map[0] = map[4] = 1.0f;
+}
+
 static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
     int i;
@@ -6934,8 +6941,7 @@ static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_vo
     for (i = 0; desc->color && i < ctx->nvol; ++i) {
         const fogvol__volume *v = &ctx->vols[i];
         float map[6];
-        memcpy(map, desc->color_map, sizeof map);
-        if (fogvol__all_zero(map, 6)) map[0] = map[4] = 1.0f;
+        fogvol__color_map(desc, map);
         if (v->ramp == desc->ramp && v->color && (v->color != desc->color || memcmp(v->color_map, map, sizeof map))) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volumes of one ramp share one colour texture and "
                         "map (volume %d of this frame has another)", i);
@@ -6950,9 +6956,8 @@ static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *de
     v->density = desc->density;
     v->color = desc->color;
     memcpy(v->density_map, desc->density_map, sizeof v->density_map);
-    memcpy(v->color_map, desc->color_map, sizeof v->color_map);
     if (fogvol__all_zero(v->density_map, 8)) v->density_map[0] = v->density_map[5] = 1.0f; /* s = x, t = y */
-    if (fogvol__all_zero(v->color_map, 6)) v->color_map[0] = v->color_map[4] = 1.0f;
+    fogvol__color_map(desc, v->color_map);
 }
 
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
