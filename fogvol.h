@@ -3732,7 +3732,8 @@ static void fogvol__an_redo(const fogvol_analytic_set *set, const fogvol__an_eye
     }
 }
 
-/* fogvol__an_redo for the lanes base + i of volume v whose bit i is set in mask. */
+#if FOGVOL__AN_X86
+/* fogvol__an_redo for the lanes base + i of volume v whose bit i is set in mask (the AVX2 kernel). */
 static void fogvol__an_redo_lanes(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3], int v,
                                   int mask, int base, fogvol__an_fblock *k)
 {
@@ -3746,6 +3747,7 @@ static void fogvol__an_redo_lanes(const fogvol_analytic_set *set, const fogvol__
         k->ch[i] = (float)(hi > lo ? hi - lo : 0.0);
     }
 }
+#endif
 
 /* Entry/exit of one quadric (sphere, ellipsoid, cylinder) for the block;
    returns whether some lanes graze it (marked in redo, for fogvol__an_redo). */
