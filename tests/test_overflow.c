@@ -566,6 +566,8 @@ static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned 
     assert_int_equal(fogvol_create_ramp(n->fv, &rd, &n->ramp), FOGVOL_SUCCESS);
 }
 
+static int g_vp_x0, g_vp_y0; /* the viewport's origin in null_frame (0, 0 unless a test moves it) */
+
 static fogvol_result null_frame(nullrig *n, int show_overflow, int volumes, fogvol_frame_stats *st)
 {
     fogvol_frame_desc fd;
@@ -575,6 +577,8 @@ static fogvol_result null_frame(nullrig *n, int show_overflow, int volumes, fogv
     glu_perspective(fd.projection, 60, 1, 0.5, 10);
     fd.znear = 0.5f;
     fd.zfar = 10;
+    fd.viewport[0] = g_vp_x0;
+    fd.viewport[1] = g_vp_y0;
     fd.viewport[2] = 16;
     fd.viewport[3] = 16;
     fd.show_overflow = show_overflow;
@@ -615,6 +619,31 @@ static void test_null_plumbing(void **state)
     assert_int_equal(n.nb.passes[3].textures[0], n.nb.passes[1].target); /* reads B ... */
     assert_int_equal(n.nb.passes[3].textures[1], n.nb.passes[2].target); /* ... and F */
     assert_int_equal(n.nb.passes[4].target, 0);                          /* then the composite */
+    { /* check and composite scissored to the volume's rectangle: window coordinates for the composite,
+         fogvol's target (window - viewport origin) for the check; the tetrahedron at distance 3 covers
+         part of the 16 x 16 view only */
+        const int *cs = n.nb.passes[3].scissor, *ws = n.nb.passes[4].scissor;
+        assert_int_equal(cs[0], ws[0]);
+        assert_int_equal(cs[1], ws[1]);
+        assert_int_equal(cs[2], ws[2]);
+        assert_int_equal(cs[3], ws[3]);
+        assert_true(ws[2] > 0 && ws[3] > 0 && ws[2] * ws[3] < 16 * 16);
+        null_close(&n);
+        g_vp_x0 = 5;
+        g_vp_y0 = 3;
+        null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_WARN_ONCE);
+        assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+        g_vp_x0 = g_vp_y0 = 0;
+        assert_int_equal(cs[0], ws[0] - 5);
+        assert_int_equal(cs[1], ws[1] - 3);
+        assert_int_equal(cs[2], ws[2]);
+        assert_int_equal(cs[3], ws[3]);
+        assert_true(ws[0] >= 5 && ws[1] >= 3 && ws[0] + ws[2] <= 21 && ws[1] + ws[3] <= 19);
+        null_close(&n);
+        null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_WARN_ONCE);
+        n.nb.query_samples = 1234;
+        assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+    }
     assert_int_equal(n.nb.queries_begun, 1);
     assert_int_equal(n.nb.queries_ended, 1);
     assert_int_equal(st.overflow_pixels_late, -1);
