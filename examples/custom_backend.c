@@ -27,6 +27,7 @@
 #include "tests/gl_util.h"
 #include <GL/glext.h>
 #include "tests/shapes.h"
+#include "examples/example_mesh.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -394,34 +395,18 @@ static void engine_init(engine *e)
 static void engine_draw(engine *e, const shp_mesh *m, const float model[16], const float vp[16], float r, float g,
                         float b)
 {
-    float *v = (float *)malloc(sizeof(float) * 6 * (size_t)m->icount), mvp[16];
-    int t, k;
-    for (t = 0; t < m->icount / 3; ++t) {
-        const float *p[3];
-        float e1[3], e2[3];
-        for (k = 0; k < 3; ++k) p[k] = m->pos + 3 * m->idx[3 * t + k];
-        for (k = 0; k < 3; ++k) e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
-        for (k = 0; k < 3; ++k) {
-            float *o = v + 18 * t + 6 * k;
-            memcpy(o, p[k], 12);
-            o[3] = e1[1] * e2[2] - e1[2] * e2[1];
-            o[4] = e1[2] * e2[0] - e1[0] * e2[2];
-            o[5] = e1[0] * e2[1] - e1[1] * e2[0];
-        }
-    }
+    float mvp[16];
     shp_mat_mul(mvp, vp, model);
     glUseProgram(e->prog);
     glUniformMatrix4fv(e->u_mvp, 1, GL_FALSE, mvp);
     glUniform3f(e->u_color, r, g, b);
     glBindVertexArray(e->vao);
-    glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 6 * (size_t)m->icount), v, GL_STREAM_DRAW);
+    exm_upload_flat(e->vbo, m, NULL, GL_STREAM_DRAW);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 24, (void *)12);
     glEnableVertexAttribArray(0);
     glEnableVertexAttribArray(1);
     glDrawArrays(GL_TRIANGLES, 0, m->icount);
-    free(v);
 }
 
 /* ---- the scene, rendered through a given context ---------------------------------- */
@@ -431,25 +416,13 @@ typedef struct scene {
 
 static const float k_pillars[3][2] = {{-2.0f, -0.5f}, {0.6f, -1.8f}, {2.2f, 0.6f}};
 
-static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m)
-{
-    fogvol_mesh_desc md;
-    fogvol_mesh *out = NULL;
-    memset(&md, 0, sizeof md);
-    md.positions = m->pos;
-    md.vertex_count = m->vcount;
-    md.indices = (const uint32_t *)m->idx;
-    md.index_count = m->icount;
-    if (fogvol_create_mesh(fv, &md, &out, NULL) != FOGVOL_SUCCESS) fprintf(stderr, "mesh refused\n");
-    return out;
-}
-
 /* Draws the opaque scene, then the fog through fv; returns fogvol_end_frame's result. */
 static fogvol_result render(engine *e, const scene *s, fogvol_context *fv, fogvol_frame_stats *st)
 {
-    fogvol_mesh *floor_v = upload(fv, &s->floor), *pillar_v = upload(fv, &s->pillar), *sphere_v = upload(fv, &s->sphere);
-    fogvol_mesh *torus_v = upload(fv, &s->torus), *bank_v = upload(fv, &s->bank), *hole_v = upload(fv, &s->hole);
-    fogvol_mesh *beam_v = upload(fv, &s->beam);
+    fogvol_mesh *floor_v = exm_fog_mesh(fv, &s->floor, 0), *pillar_v = exm_fog_mesh(fv, &s->pillar, 0);
+    fogvol_mesh *sphere_v = exm_fog_mesh(fv, &s->sphere, 0), *torus_v = exm_fog_mesh(fv, &s->torus, 0);
+    fogvol_mesh *bank_v = exm_fog_mesh(fv, &s->bank, 0), *hole_v = exm_fog_mesh(fv, &s->hole, 0);
+    fogvol_mesh *beam_v = exm_fog_mesh(fv, &s->beam, 0);
     fogvol_ramp *fog, *bank, *light;
     fogvol_ramp_desc rd;
     fogvol_frame_desc fd;

@@ -36,6 +36,7 @@
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 #include "examples/demo_scene.h"
+#include "examples/example_mesh.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <stdio.h>
@@ -78,19 +79,6 @@ static fogvol_gl_proc get_proc(const char *name, void *user)
 {
     (void)user;
     return glfwGetProcAddress(name); /* GLFWglproc and fogvol_gl_proc are both void (*)(void) */
-}
-
-static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m)
-{
-    fogvol_mesh_desc md;
-    fogvol_mesh *out = NULL;
-    memset(&md, 0, sizeof md);
-    md.positions = m->pos;
-    md.vertex_count = m->vcount;
-    md.indices = (const uint32_t *)m->idx;
-    md.index_count = m->icount;
-    if (fogvol_create_mesh(fv, &md, &out, NULL) != FOGVOL_SUCCESS) fprintf(stderr, "fogvol: mesh refused\n");
-    return out;
 }
 
 /* The main group's colour ramp: the model R cycles, the blend L toggles. */
@@ -144,7 +132,7 @@ static int build_fog(app *a, fogvol_tier tier, int bits)
         if (k_tiers[i] == fogvol_context_tier(fv, NULL)) a->tier_i = i;
     for (i = 0; i < 4; ++i)
         if (k_bits[i] == fogvol_context_encoding(fv)->bits) a->bits_i = i;
-    for (i = 0; i < a->scene.mesh_count; ++i) a->vol[i] = upload(fv, &a->scene.mesh[i]);
+    for (i = 0; i < a->scene.mesh_count; ++i) a->vol[i] = exm_fog_mesh(fv, &a->scene.mesh[i], 0);
     make_main_ramp(a);
     memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.74f, rd.color[1] = 0.80f, rd.color[2] = 0.86f, rd.density = 0.35f;
@@ -297,7 +285,7 @@ static fogvol_frame_stats render(app *a, int w, int h)
        (fogvol_destroy_mesh inside an open frame would take it out of the frame) */
     if (!a->paused || !a->vol[a->scene.blob_mesh]) {
         fogvol_destroy_mesh(a->fv, a->vol[a->scene.blob_mesh]);
-        a->vol[a->scene.blob_mesh] = upload(a->fv, &a->scene.mesh[a->scene.blob_mesh]);
+        a->vol[a->scene.blob_mesh] = exm_fog_mesh(a->fv, &a->scene.mesh[a->scene.blob_mesh], 0);
     }
 
     memset(&fd, 0, sizeof fd);

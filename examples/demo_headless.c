@@ -25,6 +25,7 @@
 #include "tests/gl_util.h"
 #include <GL/glext.h>
 #include "examples/demo_scene.h"
+#include "examples/example_mesh.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -33,22 +34,11 @@
 #define DW 640
 #define DH 360
 
-static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m, int occluder)
+/* the demo's volumes must all be accepted: exit on a refused mesh */
+static fogvol_mesh *upload(fogvol_context *fv, const shp_mesh *m)
 {
-    fogvol_mesh_desc md;
-    fogvol_mesh *out = NULL;
-    fogvol_result r;
-    memset(&md, 0, sizeof md);
-    md.positions = m->pos;
-    md.vertex_count = m->vcount;
-    md.indices = (const uint32_t *)m->idx;
-    md.index_count = m->icount;
-    md.allow_open = occluder;
-    r = fogvol_create_mesh(fv, &md, &out, NULL);
-    if (r != FOGVOL_SUCCESS) {
-        fprintf(stderr, "mesh: %s\n", fogvol_result_string(r));
-        exit(1);
-    }
+    fogvol_mesh *out = exm_fog_mesh(fv, m, 0);
+    if (!out) exit(1);
     return out;
 }
 
@@ -165,7 +155,7 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
         return 0;
     }
     out->tier = fogvol_context_tier(fv, NULL);
-    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
     make_ramps(fv, s, ramp);
 
     captures = with_fog ? 3 : 1; /* one frame per group whose thickness is read back, the first one timed */
@@ -299,7 +289,7 @@ static void scene_to_textures(demo *d, fogvol_context *fv, const float v[16], co
     fd.zfar = 40.0f;
     fd.viewport[2] = DW;
     fd.viewport[3] = DH;
-    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
     fogvol_begin_frame(fv, &fd);
     add_scene(fv, &d->scene, fm, ramp);
     fogvol_end_frame(fv, NULL);
@@ -455,7 +445,7 @@ static fogvol_mesh *demo_tl_lights(fogvol_context *fv)
     fogvol_light_desc ld;
     float r[16], t[16];
     shp_mesh sm = demo_shaft();
-    shaft = upload(fv, &sm, 0);
+    shaft = upload(fv, &sm);
     shp_free(&sm);
     memset(&ld, 0, sizeof ld);
     ld.mesh = shaft;
@@ -539,7 +529,7 @@ static void demo_texlight(demo *d, const char *dir, int lights)
         glu_destroy(&d->g);
         return;
     }
-    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i], 0);
+    for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
     for (i = 0; i < 3; ++i) tex[i] = demo_volume_texture(fv, i, i == 1 ? 32 : 64);
     memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.9f, rd.color[1] = 0.92f, rd.color[2] = 0.97f, rd.density = 0.9f;

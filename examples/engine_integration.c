@@ -31,6 +31,7 @@
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 #include "tests/shapes.h"
+#include "examples/example_mesh.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <math.h>
@@ -105,32 +106,14 @@ static GLuint compile_program(const char *vs, const char *fs)
 static gpu_mesh upload_mesh(const shp_mesh *m)
 {
     gpu_mesh g;
-    float *v = (float *)malloc(sizeof(float) * 6 * (size_t)m->icount);
-    int t, k;
-    for (t = 0; t < m->icount / 3; ++t) {
-        const float *p[3];
-        float e1[3], e2[3], n[3];
-        for (k = 0; k < 3; ++k) p[k] = m->pos + 3 * m->idx[3 * t + k];
-        for (k = 0; k < 3; ++k) e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        for (k = 0; k < 3; ++k) {
-            memcpy(v + 18 * t + 6 * k, p[k], 12);
-            memcpy(v + 18 * t + 6 * k + 3, n, 12);
-        }
-    }
-    g.count = m->icount;
     glGenVertexArrays(1, &g.vao);
     glBindVertexArray(g.vao);
     glGenBuffers(1, &g.vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 6 * (size_t)m->icount), v, GL_STATIC_DRAW);
+    g.count = exm_upload_flat(g.vbo, m, NULL, GL_STATIC_DRAW);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 24, (void *)12);
     glEnableVertexAttribArray(0);
     glEnableVertexAttribArray(1);
-    free(v);
     return g;
 }
 

@@ -339,6 +339,40 @@ SHP__FN void shp_flip(shp_mesh *m) {
   }
 }
 
+/* Flat-shaded vertex stream for an engine's opaque pass: for every triangle corner its
+   position (3 floats) and the triangle's normal (3 floats), 6 floats a corner, 18 a
+   triangle, m->icount corners in all. With model == NULL the normal is the unnormalised
+   object-space cross product (b-a) x (c-a); with a model matrix it is that normal carried
+   by the matrix's upper 3x3 and normalised (world space, for rigid and uniform-scale
+   models). Returns a malloc'd array (free() it), NULL on allocation failure or no mesh. */
+SHP__FN float *shp_flat_vertices(const shp_mesh *m, const float *model) {
+  float *v;
+  int t, k;
+  if (!m || !m->pos || !m->idx || m->icount < 3) return NULL;
+  v = (float *)malloc(sizeof(float) * 6 * (size_t)m->icount);
+  if (!v) return NULL;
+  for (t = 0; t < m->icount / 3; ++t) {
+    const float *p[3];
+    float e1[3], e2[3], n[3];
+    for (k = 0; k < 3; ++k) p[k] = m->pos + 3 * m->idx[3 * t + k];
+    for (k = 0; k < 3; ++k) e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (model) {
+      float w[3], l;
+      for (k = 0; k < 3; ++k) w[k] = model[k] * n[0] + model[4 + k] * n[1] + model[8 + k] * n[2];
+      l = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) + 1e-20f;
+      for (k = 0; k < 3; ++k) n[k] = w[k] / l;
+    }
+    for (k = 0; k < 3; ++k) {
+      memcpy(v + 18 * t + 6 * k, p[k], 3 * sizeof(float));
+      memcpy(v + 18 * t + 6 * k + 3, n, 3 * sizeof(float));
+    }
+  }
+  return v;
+}
+
 /* Append b to a (vertices and re-based indices). Returns 1 on success, 0 on allocation
    failure (a is left unchanged). Handy for building one mesh out of several pieces. */
 SHP__FN int shp_append(shp_mesh *a, const shp_mesh *b) {

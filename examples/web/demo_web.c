@@ -25,6 +25,7 @@
 #include <emscripten/html5.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
+#include "examples/example_mesh.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
 #include <stb_image_write.h>
@@ -111,31 +112,11 @@ static void engine_init(web *w)
     w->u_color = glGetUniformLocation(w->prog, "color");
 }
 
-/* expand a mesh into flat triangles with world-space face normals, into its own buffer */
+/* the mesh as flat triangles with world-space face normals, into its own buffer */
 static void engine_upload(object *o)
 {
-    int nt = o->mesh.icount / 3, t, k;
-    float *buf = (float *)malloc(sizeof(float) * 18 * (size_t)nt);
-    for (t = 0; t < nt; ++t) {
-        const float *v[3];
-        float e1[3], e2[3], n[3], wn[3], l;
-        for (k = 0; k < 3; ++k) v[k] = o->mesh.pos + 3 * o->mesh.idx[3 * t + k];
-        for (k = 0; k < 3; ++k) e1[k] = v[1][k] - v[0][k], e2[k] = v[2][k] - v[0][k];
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        for (k = 0; k < 3; ++k) wn[k] = o->model[k] * n[0] + o->model[4 + k] * n[1] + o->model[8 + k] * n[2];
-        l = sqrtf(wn[0] * wn[0] + wn[1] * wn[1] + wn[2] * wn[2]) + 1e-20f;
-        for (k = 0; k < 3; ++k) {
-            float *d = buf + 18 * t + 6 * k;
-            memcpy(d, v[k], 3 * sizeof(float));
-            d[3] = wn[0] / l, d[4] = wn[1] / l, d[5] = wn[2] / l;
-        }
-    }
     glGenBuffers(1, &o->vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, o->vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 18 * (size_t)nt), buf, GL_STATIC_DRAW);
-    free(buf);
+    exm_upload_flat(o->vbo, &o->mesh, o->model, GL_STATIC_DRAW);
 }
 
 /* the engine's opaque pass into the canvas */
