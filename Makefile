@@ -127,14 +127,14 @@ test: deps-test deps-run
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
 
 # --- demo --------------------------------------------------------------------------
-$(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h examples/example_mesh.h $(TEST_DEPS) | $(BUILD)
+$(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h examples/example_gl.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ $(GL_LIBS)
 
 demo: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/demo_headless
 	@$(BUILD)/demo_headless $(BUILD)/demo
 
-$(BUILD)/demo_glfw: examples/demo_glfw.c examples/demo_scene.h examples/example_mesh.h $(TEST_DEPS) | $(BUILD)
+$(BUILD)/demo_glfw: examples/demo_glfw.c examples/demo_scene.h examples/example_gl.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) $< -o $@ -lglfw -lGL -lm
 
 # the interactive demo; without a display: 120 frames under Xvfb into $(BUILD)/demo_glfw.png
@@ -193,7 +193,7 @@ images: demo
 # NODE_PATH: Debian's emscripten finds its node modules (acorn) there even under a node from elsewhere
 WEB_FLAGS = -std=c99 -O2 $(WARN) $(INC) -I/usr/include/stb -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 \
             -sSINGLE_FILE=1 -sWASM_ASYNC_COMPILATION=0 -sALLOW_MEMORY_GROWTH=1 -sMINIFY_HTML=0
-$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/shell.html fogvol.h examples/example_mesh.h tests/raycast.h tests/shapes.h
+$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/shell.html fogvol.h examples/example_gl.h tests/raycast.h tests/shapes.h
 	@mkdir -p $(BUILD)/web
 	NODE_PATH=/usr/share/nodejs $(EMCC) $(WEB_FLAGS) $< --shell-file examples/web/shell.html -o $@
 

@@ -27,7 +27,7 @@
 #include "tests/gl_util.h"
 #include <GL/glext.h>
 #include "tests/shapes.h"
-#include "examples/example_mesh.h"
+#include "examples/example_gl.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -376,16 +376,8 @@ static void engine_init(engine *e)
     static const char *fs = "#version 330 core\nin vec3 vn; uniform vec3 color; out vec4 o;\n"
                             "void main() { o = vec4(color * (0.4 + 0.6 * max(dot(normalize(vn), "
                             "normalize(vec3(0.4, 0.8, 0.45))), 0.0)), 1.0); }\n";
-    GLuint s[2];
-    int i;
-    e->prog = glCreateProgram();
-    for (i = 0; i < 2; ++i) {
-        s[i] = glCreateShader(i ? GL_FRAGMENT_SHADER : GL_VERTEX_SHADER);
-        glShaderSource(s[i], 1, i ? &fs : &vs, NULL);
-        glCompileShader(s[i]);
-        glAttachShader(e->prog, s[i]);
-    }
-    glLinkProgram(e->prog);
+    e->prog = exm_program("engine", vs, &fs, 1, NULL);
+    if (!e->prog) exit(1);
     e->u_mvp = glGetUniformLocation(e->prog, "mvp");
     e->u_color = glGetUniformLocation(e->prog, "color");
     glGenVertexArrays(1, &e->vao);

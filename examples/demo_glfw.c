@@ -36,7 +36,7 @@
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 #include "examples/demo_scene.h"
-#include "examples/example_mesh.h"
+#include "examples/example_gl.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <stdio.h>

@@ -25,7 +25,7 @@
 #include "tests/gl_util.h"
 #include <GL/glext.h>
 #include "examples/demo_scene.h"
-#include "examples/example_mesh.h"
+#include "examples/example_gl.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>

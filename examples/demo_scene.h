@@ -26,6 +26,7 @@
 #define DEMO_SCENE_H
 
 #include "tests/shapes.h"
+#include "examples/example_gl.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -392,26 +393,11 @@ static const char *const ds__sky_fs = "in vec3 dir; out vec4 o;\n"
 
 static inline GLuint ds__program(const char *vs, const char *fs_a, const char *fs_b, const char *fs_c)
 {
-    const char *fsrc[3];
-    GLuint p = glCreateProgram(), v = glCreateShader(GL_VERTEX_SHADER), f = glCreateShader(GL_FRAGMENT_SHADER);
-    GLint ok = 0;
-    char log[2048];
-    fsrc[0] = fs_a, fsrc[1] = fs_b, fsrc[2] = fs_c;
-    glShaderSource(v, 1, &vs, NULL);
-    glCompileShader(v);
-    glShaderSource(f, fs_c ? 3 : 2, fsrc, NULL);
-    glCompileShader(f);
-    glAttachShader(p, v);
-    glAttachShader(p, f);
-    glLinkProgram(p);
-    glDeleteShader(v);
-    glDeleteShader(f);
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        glGetShaderInfoLog(f, sizeof log, NULL, log);
-        fprintf(stderr, "demo scene: shader: %s\n", log);
-        exit(1);
-    }
+    const char *fs[3];
+    GLuint p;
+    fs[0] = fs_a, fs[1] = fs_b, fs[2] = fs_c;
+    p = exm_program("demo scene", vs, fs, fs_c ? 3 : 2, NULL);
+    if (!p) exit(1);
     return p;
 }
 

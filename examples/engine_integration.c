@@ -31,7 +31,7 @@
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 #include "tests/shapes.h"
-#include "examples/example_mesh.h"
+#include "examples/example_gl.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <math.h>
@@ -78,30 +78,6 @@ typedef struct engine {
     int debug_ramp;         /* --check: which fog group it reports (0 mist, 1 glow) */
     fogvol_context *fv; fogvol_mesh *fv_box, *fv_ball; fogvol_ramp *mist, *glow; int engine_depth; /* fogvol */
 } engine;
-
-static GLuint compile_program(const char *vs, const char *fs)
-{
-    GLuint p = glCreateProgram(), s[2];
-    GLint ok = 0;
-    int i;
-    for (i = 0; i < 2; ++i) {
-        s[i] = glCreateShader(i ? GL_FRAGMENT_SHADER : GL_VERTEX_SHADER);
-        glShaderSource(s[i], 1, i ? &fs : &vs, NULL);
-        glCompileShader(s[i]);
-        glAttachShader(p, s[i]);
-    }
-    glLinkProgram(p);
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[1024];
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        fprintf(stderr, "engine: program: %s\n", log);
-        exit(1);
-    }
-    glDeleteShader(s[0]);
-    glDeleteShader(s[1]);
-    return p;
-}
 
 static gpu_mesh upload_mesh(const shp_mesh *m)
 {
@@ -177,8 +153,9 @@ static void engine_init(engine *e)
         unsigned h = (unsigned)i * 2654435761u;
         detail[4 * i] = detail[4 * i + 1] = detail[4 * i + 2] = (unsigned char)(h >> 24), detail[4 * i + 3] = 255;
     }
-    e->lit_prog = compile_program(lit_vs, lit_fs);
-    e->post_prog = compile_program(post_vs, post_fs);
+    e->lit_prog = exm_program("engine", lit_vs, &lit_fs, 1, NULL);
+    e->post_prog = exm_program("engine", post_vs, &post_fs, 1, NULL);
+    if (!e->lit_prog || !e->post_prog) exit(1);
     e->u_mvp = glGetUniformLocation(e->lit_prog, "u_mvp");
     e->u_model = glGetUniformLocation(e->lit_prog, "u_model");
     e->u_albedo = glGetUniformLocation(e->lit_prog, "u_albedo");

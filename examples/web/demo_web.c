@@ -25,7 +25,7 @@
 #include <emscripten/html5.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
-#include "examples/example_mesh.h"
+#include "examples/example_gl.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
 #include <stb_image_write.h>
@@ -79,21 +79,6 @@ static void log_cb(void *user, fogvol_log_level level, const char *msg)
     if (level <= FOGVOL_LOG_WARNING) printf("# fogvol: %s\n", msg);
 }
 
-static GLuint compile(GLenum type, const char *src)
-{
-    GLuint s = glCreateShader(type);
-    GLint ok = 0;
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[512];
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        printf("# shader: %s\n", log);
-    }
-    return s;
-}
-
 /* the engine: flat-shaded opaque meshes, GLSL ES 1.00 (valid in WebGL1 and WebGL2) */
 static void engine_init(web *w)
 {
@@ -102,12 +87,8 @@ static void engine_init(web *w)
     static const char *fs = "precision mediump float; varying vec3 vn; uniform vec4 color;\n"
                             "void main(){ float l = 0.35 + 0.65 * max(dot(normalize(vn), vec3(0.38, 0.83, 0.41)), 0.0);\n"
                             " gl_FragColor = vec4(color.rgb * l, 1.0); }\n";
-    w->prog = glCreateProgram();
-    glAttachShader(w->prog, compile(GL_VERTEX_SHADER, vs));
-    glAttachShader(w->prog, compile(GL_FRAGMENT_SHADER, fs));
-    glBindAttribLocation(w->prog, 0, "p");
-    glBindAttribLocation(w->prog, 1, "n");
-    glLinkProgram(w->prog);
+    static const char *const attribs[] = {"p", "n", NULL};
+    w->prog = exm_program("engine", vs, &fs, 1, attribs);
     w->u_mvp = glGetUniformLocation(w->prog, "mvp");
     w->u_color = glGetUniformLocation(w->prog, "color");
 }
