@@ -215,15 +215,8 @@ static void render_fog(web *w)
     memcpy(rd.color, k_fog, sizeof k_fog);
     rd.density = (float)DENSITY;
     r = fogvol_create_ramp(fv, &rd, &ramp);
-    for (i = 0; i < w->n && r == FOGVOL_SUCCESS; ++i) {
-        fogvol_mesh_desc md;
-        memset(&md, 0, sizeof md);
-        md.positions = w->obj[i].mesh.pos;
-        md.vertex_count = w->obj[i].mesh.vcount;
-        md.indices = (const uint32_t *)w->obj[i].mesh.idx;
-        md.index_count = w->obj[i].mesh.icount;
-        r = fogvol_create_mesh(fv, &md, &fm[i], NULL);
-    }
+    for (i = 0; i < w->n && r == FOGVOL_SUCCESS; ++i)
+        if (!(fm[i] = exm_fog_mesh(fv, &w->obj[i].mesh, 0))) r = FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!check(w, r == FOGVOL_SUCCESS, "ramp and meshes created")) return;
     engine_draw(w);
     memset(&fd, 0, sizeof fd);
