@@ -986,7 +986,8 @@ typedef uintptr_t fogvol_handle;
    end. fogvol_uniform_name gives the name.
    ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
    DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
-   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   SCREEN   fv_screen:  (1/w, 1/h, -x0, -y0): gl_FragCoord + zw = pixel of fogvol's targets,
+                        (gl_FragCoord + zw) * xy in [0,1]
    DECODE   fv_dec:     decode weights (world units)
    RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
    MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
@@ -4893,10 +4894,10 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
-    "vec2 fv_st() { return gl_FragCoord.xy * fv_screen.xy + fv_screen.zw; }\n"
+    "vec2 fv_st() { return (gl_FragCoord.xy + fv_screen.zw) * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
-    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw / fv_screen.xy), 0)\n"
+    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw), 0)\n"
     "#else\n"
     "#define FV_SCREEN(s) FV_TEXTURE(s, fv_st())\n"
     "#endif\n"
@@ -4915,7 +4916,21 @@ static const char fogvol__fs_common[] =
     "uniform sampler2D fv_rg;\n"
     "uniform sampler2D fv_blue;\n"
     "#endif\n"
-    "#ifdef FV_ALU\n"                           /* the row of fogvol_make_dither_index, by arithmetic */
+    /* FV_IALU: the ALU encode in integers where the dialect has floatBitsToInt and bit operations
+       (GLSL 330+, 300 es): N and D are powers of two, so every division is a shift, every mod a mask
+       (the same bytes as the float arithmetic below, with about a third of its operations) */
+    "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
+    "#define FV_IALU\n"
+    "highp int fv_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n"
+    "highp int fv_dither_row_i() {\n"
+    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
+    "    highp int x = p.x ^ p.y, dd = int(fv_dith.z);\n"
+    "    highp int v = ((x & 1) << 5) | ((p.y & 1) << 4) | ((x & 2) << 2) | ((p.y & 2) << 1) | ((x & 4) >> 1) |\n"
+    "                  ((p.y & 4) >> 2);\n"
+    "    return fv_dith.x > 0.5 ? (((v * dd) >> 6) + (dd >> 1)) & (dd - 1) : 0;\n"
+    "}\n"
+    "float fv_dither_row() { return float(fv_dither_row_i()); }\n"
+    "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
     "float fv_dither_row() {\n"
     "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
     "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
@@ -4929,6 +4944,14 @@ static const char fogvol__fs_common[] =
     "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
+    "#ifdef FV_IALU\n"                          /* T: the blue-ramp texel count floor(u N^3 D) */
+    "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln, dd = 1 << ld;\n"
+    "    highp int T = int(u * fv_enc.y * fv_enc.x * fv_dith.z);\n"
+    "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
+    "    highp int q = ((x + ((fv_dither_row_i() + (dd >> 1)) & (dd - 1))) >> ld) - 1;\n"
+    "    highp int a = q < 0 ? 1 : 0;\n"
+    "    return vec4(ivec4((h >> ln) & (n - 1), h & (n - 1), q + a * n, a)) * (1.0 / 255.0);\n"
+    "#else\n"
     "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
     "    float n = fv_enc.x, dd = fv_dith.z;\n"
@@ -4942,6 +4965,7 @@ static const char fogvol__fs_common[] =
     "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n"
     "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n"
     "    return rg + b;\n"
+    "#endif\n"
     "#endif\n"
     "}\n"
     "#if defined(FV_PS13) || defined(FV_COUNT)\n"
@@ -7950,8 +7974,8 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
     bp.cull = FOGVOL_CULL_FRONT;
     bp.blend = FOGVOL_PASS_BLEND_LIGHT;
     memcpy(bp.viewport, fd->viewport, sizeof bp.viewport);
-    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
     bp.draw_buffer = fd->draw_buffer;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
@@ -8211,8 +8235,8 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->clear = 0;
     memcpy(ps->viewport, fd->viewport, sizeof ps->viewport);
     memcpy(ps->scissor, run->rect, sizeof ps->scissor);
-    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
@@ -8303,8 +8327,8 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     ps.textures[FOGVOL__UNIT_BACK] = ctx->tgt_c;
     ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_c2;
     memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
-    ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps.draw_buffer = fd->draw_buffer;
     ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
     if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__color_rect(ctx, ps.scissor);
@@ -8450,7 +8474,7 @@ static const char fogvol__fs_post_common[] =
     "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
     "float fv_view_depth(vec2 o) {\n"
     "    vec2 p = fv_ppix(o);\n"
-    "    vec4 q = vec4(p * fv_screen.xy + fv_screen.zw, FV_TEXTURE(fv_pdepth, p * fv_ptexel.xy).r, 1.0);\n"
+    "    vec4 q = vec4((p + fv_screen.zw) * fv_screen.xy, FV_TEXTURE(fv_pdepth, p * fv_ptexel.xy).r, 1.0);\n"
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
     "}\n";
 
@@ -8652,8 +8676,8 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ps->draw_buffer = fd->draw_buffer;
     ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)vp[2];
     ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)vp[3];
-    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)vp[0] / (float)vp[2];
-    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1] / (float)vp[3];
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)vp[0];
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1];
     ps->uniforms[FOGVOL_U_POST_TEXEL][0] = 1.0f / (float)tw;
     ps->uniforms[FOGVOL_U_POST_TEXEL][1] = 1.0f / (float)th;
     ps->uniforms[FOGVOL_U_POST_TEXEL][2] = ctx->wscale > 0.0 ? 1.0f : 0.0f;
