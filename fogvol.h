@@ -417,8 +417,9 @@ typedef enum fogvol_msaa {
 /* What fogvol does when its per-frame overflow count (fogvol_frame_stats.overflow_pixels_late)
    reports pixels with more faces along the ray than the encoding sums. The count needs the backend's
    occlusion queries (GL 1.5+, GLES 3.0; else it stays -1); FLOAT cannot overflow. Its cost: one
-   full-screen check pass per colour-ramp group (two with SINGLE_TARGET), about what the composite
-   costs; FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
+   check pass per colour-ramp group (two with SINGLE_TARGET) over an eighth of the group's screen
+   rectangle (FOGVOL_SPEEDUP_OVERFLOW_BANDS; over all of it, about what the composite costs, without
+   it); FOGVOL_OVERFLOW_OFF removes them (SINGLE_TARGET keeps one for show_overflow). */
 typedef enum fogvol_overflow_policy {
     FOGVOL_OVERFLOW_WARN_ONCE = 0,  /* count every frame; log a warning the first time only */
     FOGVOL_OVERFLOW_COUNT_ONLY = 1, /* count every frame; never log */
@@ -456,15 +457,22 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  uniforms; built on first use (same pixels).
    ALU           PS20 and MRT (not WIDE) take FOGVOL_VARIANT_ALU: the depth is encoded and the dither
                  row computed by arithmetic instead of three lookup texture reads per face fragment
-                 (same bytes; fogvol_context_tier reports the variant). */
+                 (same bytes; fogvol_context_tier reports the variant).
+   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
+                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
+                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
+                 newest count of each band: the whole picture over 8 frames, the same count while
+                 the picture holds still. Not with show_overflow (same pixels). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
     FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
     FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
     FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
-    FOGVOL_SPEEDUP_ALU = 1u << 5
+    FOGVOL_SPEEDUP_ALU = 1u << 5,
+    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6
 };
+#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
@@ -635,9 +643,13 @@ typedef struct fogvol_frame_stats {
        colour-ramp group (two with SINGLE_TARGET: after the additions and after the subtractions)
        discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
        result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
-       that finds all 4 still waiting, or with more than 32 check passes, is not counted). overflow_pixels_late: pixels with a saturated sum in frame overflow_frame,
-       summed over the colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries
-       (FOGVOL_OVERFLOW_OFF, or a backend without them); FLOAT: always 0 for this frame. */
+       that finds all 4 still waiting, or with more than 32 check passes, is not counted).
+       overflow_pixels_late: pixels with a saturated sum in frame overflow_frame, summed over the
+       colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries (FOGVOL_OVERFLOW_OFF,
+       or a backend without them); FLOAT: always 0 for this frame. With FOGVOL_SPEEDUP_OVERFLOW_BANDS
+       (the default) a frame checks one of FOGVOL_OVERFLOW_BANDS horizontal bands of each group's
+       rectangle, in turn, and the count is the sum of each band's newest count (frame
+       overflow_frame holds the newest band): the whole picture once every 8 frames. */
     int overflow_pixels_late;
     int64_t overflow_frame;  /* the frame overflow_pixels_late counts (-1 = none) */
     int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
@@ -974,7 +986,8 @@ typedef uintptr_t fogvol_handle;
    end. fogvol_uniform_name gives the name.
    ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
    DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
-   SCREEN   fv_screen:  (1/w, 1/h, -x0/w, -y0/h): gl_FragCoord -> [0,1]
+   SCREEN   fv_screen:  (1/w, 1/h, -x0, -y0): gl_FragCoord + zw = pixel of fogvol's targets,
+                        (gl_FragCoord + zw) * xy in [0,1]
    DECODE   fv_dec:     decode weights (world units)
    RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
    MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
@@ -4881,10 +4894,10 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
-    "vec2 fv_st() { return gl_FragCoord.xy * fv_screen.xy + fv_screen.zw; }\n"
+    "vec2 fv_st() { return (gl_FragCoord.xy + fv_screen.zw) * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
-    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw / fv_screen.xy), 0)\n"
+    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw), 0)\n"
     "#else\n"
     "#define FV_SCREEN(s) FV_TEXTURE(s, fv_st())\n"
     "#endif\n"
@@ -4903,7 +4916,21 @@ static const char fogvol__fs_common[] =
     "uniform sampler2D fv_rg;\n"
     "uniform sampler2D fv_blue;\n"
     "#endif\n"
-    "#ifdef FV_ALU\n"                           /* the row of fogvol_make_dither_index, by arithmetic */
+    /* FV_IALU: the ALU encode in integers where the dialect has floatBitsToInt and bit operations
+       (GLSL 330+, 300 es): N and D are powers of two, so every division is a shift, every mod a mask
+       (the same bytes as the float arithmetic below, with about a third of its operations) */
+    "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
+    "#define FV_IALU\n"
+    "highp int fv_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n"
+    "highp int fv_dither_row_i() {\n"
+    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
+    "    highp int x = p.x ^ p.y, dd = int(fv_dith.z);\n"
+    "    highp int v = ((x & 1) << 5) | ((p.y & 1) << 4) | ((x & 2) << 2) | ((p.y & 2) << 1) | ((x & 4) >> 1) |\n"
+    "                  ((p.y & 4) >> 2);\n"
+    "    return fv_dith.x > 0.5 ? (((v * dd) >> 6) + (dd >> 1)) & (dd - 1) : 0;\n"
+    "}\n"
+    "float fv_dither_row() { return float(fv_dither_row_i()); }\n"
+    "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
     "float fv_dither_row() {\n"
     "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
     "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
@@ -4917,6 +4944,14 @@ static const char fogvol__fs_common[] =
     "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
+    "#ifdef FV_IALU\n"                          /* T: the blue-ramp texel count floor(u N^3 D) */
+    "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln, dd = 1 << ld;\n"
+    "    highp int T = int(u * fv_enc.y * fv_enc.x * fv_dith.z);\n"
+    "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
+    "    highp int q = ((x + ((fv_dither_row_i() + (dd >> 1)) & (dd - 1))) >> ld) - 1;\n"
+    "    highp int a = q < 0 ? 1 : 0;\n"
+    "    return vec4(ivec4((h >> ln) & (n - 1), h & (n - 1), q + a * n, a)) * (1.0 / 255.0);\n"
+    "#else\n"
     "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
     "    float n = fv_enc.x, dd = fv_dith.z;\n"
@@ -4930,6 +4965,7 @@ static const char fogvol__fs_common[] =
     "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n"
     "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n"
     "    return rg + b;\n"
+    "#endif\n"
     "#endif\n"
     "}\n"
     "#if defined(FV_PS13) || defined(FV_COUNT)\n"
@@ -5768,6 +5804,7 @@ typedef struct fogvol__qframe {
     fogvol_handle q[FOGVOL__QPER]; /* created on first use, reused */
     int64_t frame;
     int used, ok, pending;
+    int band; /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: the band checked, 0 .. FOGVOL_OVERFLOW_BANDS-1; -1: all */
 } fogvol__qframe;
 
 struct fogvol_context {
@@ -5812,6 +5849,7 @@ struct fogvol_context {
     int counting, overflow_late, overflow_warned, qcur;
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
+    int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
     fogvol_handle post_prog[FOGVOL__POST_PROGRAMS]; /* image-space effects, built on first use */
     fogvol__light *lights;  /* fogvol_add_light, this frame */
     int nlight, caplight;
@@ -7581,6 +7619,27 @@ static int fogvol__count_near_cut(const fogvol_context *ctx)
 
 /* >>overflow checks ======================================================= */
 
+/* One fogvol_end_frame: what its passes share. */
+typedef struct fogvol__run {
+    fogvol_frame_stats st;
+    fogvol_frame_info info;
+    fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
+    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    int w, h, single, count, rgba8;
+    int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
+    int captured, overflow;     /* debug read-back done; its overflow pixel count */
+    fogvol_result r;            /* the last error that did not stop the frame */
+    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
+    int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
+} fogvol__run;
+
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: no band counted (at the start, and when L changes) */
+static void fogvol__bands_forget(fogvol_context *ctx)
+{
+    int i;
+    for (i = 0; i < FOGVOL_OVERFLOW_BANDS; ++i) ctx->band_count[i] = ctx->band_frame[i] = -1;
+}
+
 /* Counting needs the five query entries and one query that can be created. */
 static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy)
 {
@@ -7589,6 +7648,7 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
     ctx->overflow_late = -1;
     ctx->overflow_frame = -1;
     ctx->qcur = -1;
+    fogvol__bands_forget(ctx);
     if (ctx->tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
     if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
         b->create_query(b->user_data, &ctx->qf[0].q[0]) != FOGVOL_SUCCESS) {
@@ -7599,6 +7659,24 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
         return;
     }
     ctx->counting = 1;
+}
+
+/* A frame's count arrived (sum: its check passes' samples). Whole-picture checks give the count;
+   a band's count replaces that band's older one and the count is the sum over the bands counted. */
+static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f, uint64_t sum)
+{
+    int k;
+    if (f->band >= 0) {
+        if (f->frame <= ctx->band_frame[f->band]) return 0;
+        ctx->band_frame[f->band] = f->frame;
+        ctx->band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
+        for (sum = 0, k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k)
+            if (ctx->band_count[k] > 0) sum += (uint64_t)ctx->band_count[k];
+    }
+    if (f->frame <= ctx->overflow_frame) return 0;
+    ctx->overflow_frame = f->frame;
+    ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
+    return 1;
 }
 
 /* Reads the queries of earlier frames without waiting; a frame counts when all its queries are
@@ -7616,17 +7694,14 @@ static int fogvol__overflow_poll(fogvol_context *ctx)
         }
         if (k < f->used) continue;
         f->pending = 0;
-        if (f->frame > ctx->overflow_frame) {
-            ctx->overflow_frame = f->frame;
-            ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
-            fresh = 1;
-        }
+        fresh |= fogvol__overflow_arrived(ctx, f, sum);
     }
     return fresh;
 }
 
 /* Picks a free record for this frame's queries; 0 when every record still waits for the GPU
-   (the frame is then not counted: nothing ever waits). */
+   (the frame is then not counted: nothing ever waits). Checks one band of the picture with
+   FOGVOL_SPEEDUP_OVERFLOW_BANDS, unless show_overflow wants the whole mask. */
 static int fogvol__overflow_open(fogvol_context *ctx)
 {
     int i;
@@ -7638,6 +7713,9 @@ static int fogvol__overflow_open(fogvol_context *ctx)
             ctx->qf[i].used = 0;
             ctx->qf[i].ok = 1;
             ctx->qf[i].frame = ctx->frame_no;
+            ctx->qf[i].band = (ctx->speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->frame.show_overflow
+                                  ? -1
+                                  : (int)(ctx->frame_no % FOGVOL_OVERFLOW_BANDS);
             return 1;
         }
     return 0;
@@ -7664,7 +7742,7 @@ static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
 }
 
 /* After the frame's passes: its queries wait for the GPU; a frame without check passes drew no
-   volume and counts 0 now. */
+   volume (or its band holds no pixel) and counts 0 now. */
 static void fogvol__overflow_close(fogvol_context *ctx)
 {
     fogvol__qframe *f;
@@ -7672,12 +7750,8 @@ static void fogvol__overflow_close(fogvol_context *ctx)
     f = &ctx->qf[ctx->qcur];
     ctx->qcur = -1;
     if (!f->ok) return;
-    if (f->used > 0) {
-        f->pending = 1;
-    } else if (f->frame > ctx->overflow_frame) {
-        ctx->overflow_frame = f->frame;
-        ctx->overflow_late = 0;
-    }
+    if (f->used > 0) f->pending = 1;
+    else fogvol__overflow_arrived(ctx, f, 0);
 }
 
 /* The program and the mask target of the check passes, made on first use. */
@@ -7701,15 +7775,36 @@ static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
     return r;
 }
 
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: scissor (target space, w = 0: the whole w x h target) narrowed
+   to rows [h b / B, h (b + 1) / B) of its rectangle, B = FOGVOL_OVERFLOW_BANDS; band -1: unchanged.
+   Returns 0 when the band holds no row. */
+static int fogvol__band_scissor(const fogvol__run *run, int band, int scissor[4])
+{
+    int y0, y1;
+    if (band < 0) return 1;
+    if (scissor[2] <= 0 || scissor[3] <= 0) {
+        scissor[0] = scissor[1] = 0;
+        scissor[2] = run->w;
+        scissor[3] = run->h;
+    }
+    y0 = (int)((int64_t)scissor[3] * band / FOGVOL_OVERFLOW_BANDS);
+    y1 = (int)((int64_t)scissor[3] * (band + 1) / FOGVOL_OVERFLOW_BANDS);
+    scissor[1] += y0;
+    scissor[3] = y1 - y0;
+    return y1 > y0 && scissor[2] > 0;
+}
+
 /* One check pass into the mask V: pixels with a saturated sum are written (and counted by a query),
    the rest discarded. base: the pass state of the composite (target space). SINGLE runs it after the
    additions (first: clears V and its depth) and after the subtractions, whose depth test skips the
    pixels already marked, so each pixel counts once. */
-static void fogvol__check_pass(fogvol_context *ctx, const fogvol_pass *base, int first, fogvol_frame_stats *st)
+static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base, int first,
+                               fogvol_frame_stats *st)
 {
     fogvol_pass cp = *base;
     fogvol_handle q;
     int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    if (ctx->qcur >= 0 && !fogvol__band_scissor(run, ctx->qf[ctx->qcur].band, cp.scissor)) return;
     cp.target = ctx->tgt_v;
     cp.clear = first;
     memset(cp.clear_color, 0, sizeof cp.clear_color);
@@ -7770,6 +7865,7 @@ static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
     if (ctx->overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
         fogvol_result r = fogvol__lower_bits(ctx);
         if (r == FOGVOL_SUCCESS) {
+            fogvol__bands_forget(ctx);
             fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                         "fogvol: %d pixels of frame %lld have more than %d faces along the ray: encoding_bits "
                         "lowered from %d to %d (%d faces) from frame %lld on",
@@ -7788,19 +7884,6 @@ static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
                 ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
 }
 
-/* One fogvol_end_frame: what its passes share. */
-typedef struct fogvol__run {
-    fogvol_frame_stats st;
-    fogvol_frame_info info;
-    fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
-    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
-    int w, h, single, count, rgba8;
-    int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
-    int captured, overflow;     /* debug read-back done; its overflow pixel count */
-    fogvol_result r;            /* the last error that did not stop the frame */
-    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
-    int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
-} fogvol__run;
 
 /* >>texlight (volume light by compare) ====================================== */
 
@@ -7891,8 +7974,8 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
     bp.cull = FOGVOL_CULL_FRONT;
     bp.blend = FOGVOL_PASS_BLEND_LIGHT;
     memcpy(bp.viewport, fd->viewport, sizeof bp.viewport);
-    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
     bp.draw_buffer = fd->draw_buffer;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
@@ -8085,7 +8168,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
         run->st.passes +=
             fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
-        if (run->checks) fogvol__check_pass(ctx, &ps, 1, &run->st); /* saturation at the peak of the sum */
+        if (run->checks) fogvol__check_pass(ctx, run, &ps, 1, &run->st); /* saturation at the peak of the sum */
         if (fogvol__want_debug(ctx, ramp, run->captured)) {
             peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)run->w * (size_t)run->h);
             r = peak ? fogvol__single_peak(ctx, peak) : FOGVOL_ERROR_OUT_OF_MEMORY;
@@ -8152,8 +8235,8 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->clear = 0;
     memcpy(ps->viewport, fd->viewport, sizeof ps->viewport);
     memcpy(ps->scissor, run->rect, sizeof ps->scissor);
-    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
@@ -8244,8 +8327,8 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     ps.textures[FOGVOL__UNIT_BACK] = ctx->tgt_c;
     ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_c2;
     memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
-    ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0] / (float)run->w;
-    ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1] / (float)run->h;
+    ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps.draw_buffer = fd->draw_buffer;
     ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
     if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__color_rect(ctx, ps.scissor);
@@ -8298,7 +8381,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     for (i = g; i < ctx->nvol; ++i) run->st.volumes += ctx->vols[i].ramp == ramp;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
-    if (run->counted) fogvol__check_pass(ctx, &ps, !run->single, &run->st);
+    if (run->counted) fogvol__check_pass(ctx, run, &ps, !run->single, &run->st);
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
@@ -8391,7 +8474,7 @@ static const char fogvol__fs_post_common[] =
     "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
     "float fv_view_depth(vec2 o) {\n"
     "    vec2 p = fv_ppix(o);\n"
-    "    vec4 q = vec4(p * fv_screen.xy + fv_screen.zw, FV_TEXTURE(fv_pdepth, p * fv_ptexel.xy).r, 1.0);\n"
+    "    vec4 q = vec4((p + fv_screen.zw) * fv_screen.xy, FV_TEXTURE(fv_pdepth, p * fv_ptexel.xy).r, 1.0);\n"
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
     "}\n";
 
@@ -8593,8 +8676,8 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ps->draw_buffer = fd->draw_buffer;
     ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)vp[2];
     ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)vp[3];
-    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)vp[0] / (float)vp[2];
-    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1] / (float)vp[3];
+    ps->uniforms[FOGVOL_U_SCREEN][2] = -(float)vp[0];
+    ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1];
     ps->uniforms[FOGVOL_U_POST_TEXEL][0] = 1.0f / (float)tw;
     ps->uniforms[FOGVOL_U_POST_TEXEL][1] = 1.0f / (float)th;
     ps->uniforms[FOGVOL_U_POST_TEXEL][2] = ctx->wscale > 0.0 ? 1.0f : 0.0f;

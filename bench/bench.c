@@ -49,7 +49,7 @@
 #define NMETH (NTIER + 4)
 #define SPEEDUPS_ALL                                                                                              \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
-     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU)
+     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS)
 #define MAXI 32 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96

@@ -546,8 +546,8 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->tex[2] = ramp_tex;
     x->screen[0] = 1.0f / A_W;
     x->screen[1] = 1.0f / A_H;
-    x->screen[2] = -(float)A_X0 / A_W;
-    x->screen[3] = -(float)A_Y0 / A_H;
+    x->screen[2] = -(float)A_X0;
+    x->screen[3] = -(float)A_Y0;
     x->fullscreen = 1;
 }
 

@@ -151,12 +151,14 @@ typedef struct outcome {
 static outcome g_out[NCOMBO][3];
 
 /* A frame of the shells; MRT: the engine's part is a cleared O ("far": no occluders). */
+static int g_show_overflow = 1; /* shell_frame's fogvol_frame_desc.show_overflow */
+
 static fogvol_result shell_frame(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp,
                                  float *thick, fogvol_frame_stats *st)
 {
     fogvol_frame_desc fd;
     fx_frame_desc(&fd, &s->cam, W, H);
-    fd.show_overflow = 1;
+    fd.show_overflow = g_show_overflow;
     fd.debug_thickness = thick;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glClearColor(0, 0, 0, 1);
@@ -426,6 +428,71 @@ static void test_warn_once(void **state)
     }
 }
 
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS (the default, without show_overflow): each frame checks one band
+   of the picture; once every band has been counted, the count of the still picture is the debug
+   read-back's count of saturated pixels, and never more before that. */
+static void test_bands(void **state)
+{
+    const truth *t = get_truth(20, 0);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    glu_ctx g;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_stats st;
+    int frame, i, readback, last = -1, passes = 0;
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = watch_proc;
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    upload_meshes(fv, t->s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    g_show_overflow = 0;
+    g_blocking_reads = 0;
+    assert_int_equal(shell_frame(fv, t->s, meshes, ramp, thick, &st), FOGVOL_ERROR_DEPTH_OVERFLOW);
+    readback = st.overflow_pixels;
+    assert_true(readback > 100);
+    passes += st.overflow_passes;
+    for (frame = 1; frame < 2 * FOGVOL_OVERFLOW_BANDS + 2; ++frame) {
+        unsigned char px[4];
+        assert_int_equal(shell_frame(fv, t->s, meshes, ramp, NULL, &st), FOGVOL_SUCCESS);
+        glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px); /* what an engine's swap would do */
+        passes += st.overflow_passes;
+        if (st.overflow_frame < 0) continue;
+        assert_true(st.overflow_pixels_late >= last); /* bands add up */
+        assert_true(st.overflow_pixels_late <= readback);
+        if (st.overflow_pixels_late != last)
+            print_message("  bands: frame %d reads the count up to frame %lld: %d\n", frame, (long long)st.overflow_frame,
+                          st.overflow_pixels_late);
+        last = st.overflow_pixels_late;
+    }
+    g_show_overflow = 1;
+    print_message("  bands: read-back %d saturated pixels, sum of the %d bands %d (frame %lld), %d check passes in "
+                  "%d frames\n",
+                  readback, FOGVOL_OVERFLOW_BANDS, st.overflow_pixels_late, (long long)st.overflow_frame, passes, frame);
+    assert_true(st.overflow_frame >= FOGVOL_OVERFLOW_BANDS);
+    assert_int_equal(st.overflow_pixels_late, readback);
+    assert_true(passes <= frame); /* one check pass a frame at most (none where a band holds no row) */
+    assert_int_equal(g_blocking_reads, 0);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free(thick);
+}
+
 /* An engine's own occlusion query running across fogvol's frame: fogvol does not start its own
    (GL would refuse it), the frame is not counted, no GL error reaches the engine. */
 static void test_engine_query_active(void **state)
@@ -536,6 +603,8 @@ typedef struct nullrig {
     logcap lc;
 } nullrig;
 
+static unsigned g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS; /* null_open: whole-picture checks */
+
 static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned caps, int queries,
                       fogvol_overflow_policy policy)
 {
@@ -552,6 +621,7 @@ static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned 
     cd.tier = tier;
     cd.variants = variants;
     cd.overflow_policy = policy;
+    cd.disable_speedups = g_null_speedups_off;
     cd.logger.func = logger;
     cd.logger.user_data = &n->lc;
     assert_int_equal(fogvol_create_context(&cd, &n->fv), FOGVOL_SUCCESS);
@@ -740,6 +810,70 @@ static void test_null_plumbing(void **state)
     null_close(&n);
 }
 
+/* The bands on the null backend: frame f checks band f mod 8 of the composite's rectangle (rows
+   [h b / 8, h (b + 1) / 8), the same columns); the 8 bands tile it; the count is the sum of each
+   band's newest count; a band without rows draws no check pass and counts 0; show_overflow checks
+   the whole rectangle; lowering L forgets the bands counted before. */
+static void test_null_bands(void **state)
+{
+    nullrig n;
+    fogvol_frame_stats st;
+    int f, rows = 0, nonempty = 0, ws[4];
+    (void)state;
+    g_null_speedups_off = 0;
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
+    n.nb.query_samples = 3;
+    for (f = 0; f < FOGVOL_OVERFLOW_BANDS; ++f) {
+        const fogvol_pass *check, *comp;
+        int y0, y1;
+        assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+        comp = &n.nb.passes[n.nb.pass_count - 1];
+        memcpy(ws, comp->scissor, sizeof ws);
+        assert_true(ws[2] > 0 && ws[3] > 0);
+        y0 = ws[3] * f / FOGVOL_OVERFLOW_BANDS;
+        y1 = ws[3] * (f + 1) / FOGVOL_OVERFLOW_BANDS;
+        assert_int_equal(st.overflow_passes, y1 > y0);
+        if (y1 == y0) continue;
+        check = &n.nb.passes[n.nb.pass_count - 2];
+        assert_int_equal(check->blend, FOGVOL_PASS_BLEND_NONE);
+        assert_int_equal(check->scissor[0], ws[0]);
+        assert_int_equal(check->scissor[1], ws[1] + y0);
+        assert_int_equal(check->scissor[2], ws[2]);
+        assert_int_equal(check->scissor[3], y1 - y0);
+        rows += y1 - y0;
+        nonempty++;
+    }
+    assert_int_equal(rows, ws[3]); /* the bands tile the rectangle */
+    null_frame(&n, 0, 1, &st);    /* reads frame 7's query */
+    print_message("  null bands: rectangle %d x %d, %d bands with rows, count %d\n", ws[2], ws[3], nonempty,
+                  st.overflow_pixels_late);
+    assert_int_equal(st.overflow_frame, FOGVOL_OVERFLOW_BANDS - 1);
+    assert_int_equal(st.overflow_pixels_late, 3 * nonempty);
+    n.nb.query_samples = 10; /* band 0 again (frame 8): its count replaces the old one */
+    null_frame(&n, 0, 1, &st);
+    assert_int_equal(st.overflow_frame, FOGVOL_OVERFLOW_BANDS);
+    assert_int_equal(st.overflow_pixels_late, 3 * nonempty + (ws[3] / FOGVOL_OVERFLOW_BANDS > 0 ? 7 : 0));
+    /* show_overflow: the whole rectangle, counted as such */
+    assert_int_equal(null_frame(&n, 1, 1, &st), FOGVOL_SUCCESS);
+    assert_int_equal(memcmp(n.nb.passes[n.nb.pass_count - 2].scissor, ws, sizeof ws), 0);
+    null_frame(&n, 0, 1, &st);
+    assert_int_equal(st.overflow_pixels_late, 10);
+    null_close(&n);
+
+    /* LOWER_BITS: a count lowers L once; the bands counted before it do not lower it again */
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_LOWER_BITS);
+    n.nb.query_samples = 5;
+    null_frame(&n, 0, 1, &st);
+    null_frame(&n, 0, 1, &st);
+    assert_int_equal(fogvol_context_encoding(n.fv)->bits, 3);
+    n.nb.query_samples = 0;
+    for (f = 0; f < 2 * FOGVOL_OVERFLOW_BANDS; ++f) null_frame(&n, 0, 1, &st);
+    assert_int_equal(fogvol_context_encoding(n.fv)->bits, 3);
+    assert_int_equal(st.overflow_pixels_late, 0);
+    null_close(&n);
+    g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS;
+}
+
 static void test_bad_policy(void **state)
 {
     fogvol_null_backend nb;
@@ -781,7 +915,8 @@ int main(void)
         }
     {
         const struct CMUnitTest more[] = {
-            cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_bad_policy),
+            cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_null_bands),
+            cmocka_unit_test(test_bands),           cmocka_unit_test(test_bad_policy),
             cmocka_unit_test(test_lower_bits),      cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
         };
