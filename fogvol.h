@@ -7662,16 +7662,20 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
 }
 
 /* A frame's count arrived (sum: its check passes' samples). Whole-picture checks give the count;
-   a band's count replaces that band's older one and the count is the sum over the bands counted. */
+   a band's count replaces that band's older one and the count is the sum over the bands counted.
+   A band drawn before the last change of L (an older encoding) is not kept. */
 static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f, uint64_t sum)
 {
     int k;
     if (f->band >= 0) {
-        if (f->frame <= ctx->band_frame[f->band]) return 0;
+        if (f->frame <= ctx->band_frame[f->band] || f->frame < ctx->overflow_epoch) return 0;
         ctx->band_frame[f->band] = f->frame;
         ctx->band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
         for (sum = 0, k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k)
             if (ctx->band_count[k] > 0) sum += (uint64_t)ctx->band_count[k];
+        ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum; /* even from a late older frame */
+        if (f->frame > ctx->overflow_frame) ctx->overflow_frame = f->frame;
+        return 1;
     }
     if (f->frame <= ctx->overflow_frame) return 0;
     ctx->overflow_frame = f->frame;

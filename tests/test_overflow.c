@@ -860,11 +860,14 @@ static void test_null_bands(void **state)
     assert_int_equal(st.overflow_pixels_late, 10);
     null_close(&n);
 
-    /* LOWER_BITS: a count lowers L once; the bands counted before it do not lower it again */
+    /* LOWER_BITS: a count lowers L once; the bands counted before it, and the band of the frame
+       drawn with the old L whose count arrives after the change, do not lower it again */
     null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_LOWER_BITS);
     n.nb.query_samples = 5;
-    null_frame(&n, 0, 1, &st);
-    null_frame(&n, 0, 1, &st);
+    null_frame(&n, 0, 1, &st); /* frame 0 */
+    null_frame(&n, 0, 1, &st); /* frame 1 reads frame 0's 5: L 4 -> 3 from frame 2 on */
+    assert_int_equal(fogvol_context_encoding(n.fv)->bits, 3);
+    null_frame(&n, 0, 1, &st); /* frame 2 reads frame 1's 5, drawn at L = 4: not kept */
     assert_int_equal(fogvol_context_encoding(n.fv)->bits, 3);
     n.nb.query_samples = 0;
     for (f = 0; f < 2 * FOGVOL_OVERFLOW_BANDS; ++f) null_frame(&n, 0, 1, &st);
