@@ -306,46 +306,73 @@ static void test_combo(void **state)
 }
 
 /* ---- policies on the GPU -------------------------------------------------- */
+/* The policy tests' rig: a W x H OSMesa context, fogvol (PS20 unless cd says otherwise) with the 20
+   shells (they overflow at L = 4) and a ramp; cd may hold what a test changes (policy, bits ...). */
+typedef struct shellrig {
+    const truth *t;
+    glu_ctx g;
+    logcap lc;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+} shellrig;
+
+static void rig_open(shellrig *r, fogvol_context_desc *cd)
+{
+    fogvol_ramp_desc rd;
+    memset(r, 0, sizeof *r);
+    r->t = get_truth(20, 0);
+    assert_true(glu_create(&r->g, W, H, 1));
+    if (!cd->gl.get_proc_address) cd->gl.get_proc_address = watch_proc;
+    if (!cd->tier) cd->tier = FOGVOL_TIER_PS20;
+    cd->logger.func = logger;
+    cd->logger.user_data = &r->lc;
+    assert_int_equal(fogvol_create_context(cd, &r->fv), FOGVOL_SUCCESS);
+    upload_meshes(r->fv, r->t->s, r->meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(r->fv, &rd, &r->ramp), FOGVOL_SUCCESS);
+}
+
+static fogvol_result rig_frame(shellrig *r, float *thick, fogvol_frame_stats *st)
+{
+    return shell_frame(r->fv, r->t->s, r->meshes, r->ramp, thick, st);
+}
+
+static void rig_close(shellrig *r)
+{
+    int i;
+    for (i = 0; i < r->t->s->n; ++i) fogvol_destroy_mesh(r->fv, r->meshes[i]);
+    fogvol_destroy_ramp(r->fv, r->ramp);
+    fogvol_destroy_context(r->fv);
+    glu_destroy(&r->g);
+}
 /* LOWER_BITS: 20 shells at L = 4 overflow; the count arrives, L drops to 3 once (frames drawn
    before the change report overflow too, and must not lower it again), and the next frames are
    within the bound of the new encoding. */
 static void test_lower_bits(void **state)
 {
-    const truth *t = get_truth(20, 0);
-    const tscene *s = t->s;
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
-    glu_ctx g;
-    logcap lc;
+    shellrig rig;
+    const truth *t;
     fogvol_context_desc cd;
-    fogvol_context *fv;
-    fogvol_mesh *meshes[MAX_OBJ];
-    fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
     fogvol_frame_stats st;
     fogvol_result r;
-    double range = s->cam.zfar - s->cam.znear, max_before = 0, max_after = 0;
+    double range, max_before = 0, max_after = 0;
     int frame, i, lowered_at = -1, bad_after = 0;
     (void)state;
-    memset(&lc, 0, sizeof lc);
-    assert_true(glu_create(&g, W, H, 1));
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = watch_proc;
-    cd.logger.func = logger;
-    cd.logger.user_data = &lc;
-    cd.tier = FOGVOL_TIER_PS20;
     cd.encoding_bits = 4;
     cd.disable_dither = 1;
     cd.overflow_policy = FOGVOL_OVERFLOW_LOWER_BITS;
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    upload_meshes(fv, s, meshes);
-    memset(&rd, 0, sizeof rd);
-    rd.density = 0.4f;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    rig_open(&rig, &cd);
+    t = rig.t;
+    range = t->s->cam.zfar - t->s->cam.znear;
     for (frame = 0; frame < 6; ++frame) {
-        int bits = fogvol_context_encoding(fv)->bits;
+        int bits = fogvol_context_encoding(rig.fv)->bits;
         double lsb = range / pow(2.0, 3.0 * bits), max = 0;
         unsigned char px[4];
-        r = shell_frame(fv, s, meshes, ramp, thick, &st);
+        r = rig_frame(&rig, thick, &st);
         glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
         for (i = 0; i < W * H; ++i) {
             double err;
@@ -365,66 +392,45 @@ static void test_lower_bits(void **state)
             assert_int_equal(st.overflow_pixels, 0);
             if (max > max_after) max_after = max;
         }
-        if (lowered_at < 0 && fogvol_context_encoding(fv)->bits == 3) lowered_at = frame;
+        if (lowered_at < 0 && fogvol_context_encoding(rig.fv)->bits == 3) lowered_at = frame;
     }
     print_message("  lower_bits: lowered after frame %d; max error %.1f LSB (L=4) -> %.2f LSB (L=3); %d warnings\n",
-                  lowered_at, max_before, max_after, lc.warnings);
+                  lowered_at, max_before, max_after, rig.lc.warnings);
     assert_true(lowered_at >= 0 && lowered_at <= 2);
-    assert_int_equal(fogvol_context_encoding(fv)->bits, 3); /* once, not again for the frames drawn at L = 4 */
+    assert_int_equal(fogvol_context_encoding(rig.fv)->bits, 3); /* once, not again for the frames drawn at L = 4 */
     assert_int_equal(bad_after, 0);
     assert_int_equal(st.overflow_pixels_late, 0); /* the GPU agrees: frames at L = 3 fit */
     assert_true(max_before > 16);
     assert_int_equal(glGetError(), GL_NO_ERROR);
-    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
-    glu_destroy(&g);
+    rig_close(&rig);
     free(thick);
 }
 
 /* WARN_ONCE (the default): one warning however many frames overflow; COUNT_ONLY: none. */
 static void test_warn_once(void **state)
 {
-    const truth *t = get_truth(20, 0);
-    glu_ctx g;
     int policy;
     (void)state;
     for (policy = 0; policy < 2; ++policy) {
-        logcap lc;
+        shellrig rig;
         fogvol_context_desc cd;
-        fogvol_context *fv;
-        fogvol_mesh *meshes[MAX_OBJ];
-        fogvol_ramp *ramp;
-        fogvol_ramp_desc rd;
         fogvol_frame_stats st;
-        int frame, i;
-        memset(&lc, 0, sizeof lc);
-        assert_true(glu_create(&g, W, H, 1));
+        int frame;
         memset(&cd, 0, sizeof cd);
         cd.gl.get_proc_address = glu_proc;
-        cd.logger.func = logger;
-        cd.logger.user_data = &lc;
-        cd.tier = FOGVOL_TIER_PS20;
         cd.overflow_policy = policy ? FOGVOL_OVERFLOW_COUNT_ONLY : FOGVOL_OVERFLOW_WARN_ONCE;
-        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-        upload_meshes(fv, t->s, meshes);
-        memset(&rd, 0, sizeof rd);
-        rd.density = 0.4f;
-        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        rig_open(&rig, &cd);
         for (frame = 0; frame < 5; ++frame) {
             unsigned char px[4];
-            assert_int_equal(shell_frame(fv, t->s, meshes, ramp, NULL, &st), FOGVOL_SUCCESS); /* no read-back */
+            assert_int_equal(rig_frame(&rig, NULL, &st), FOGVOL_SUCCESS); /* no read-back */
             glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
         }
         assert_true(st.overflow_pixels_late > 0);
         assert_int_equal(st.overflow_frame, 3);
-        assert_int_equal(lc.warnings, policy ? 0 : 1);
-        if (!policy) assert_non_null(strstr(lc.last, "logged once"));
-        assert_int_equal(fogvol_context_encoding(fv)->bits, 4);
-        for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-        fogvol_destroy_ramp(fv, ramp);
-        fogvol_destroy_context(fv);
-        glu_destroy(&g);
+        assert_int_equal(rig.lc.warnings, policy ? 0 : 1);
+        if (!policy) assert_non_null(strstr(rig.lc.last, "logged once"));
+        assert_int_equal(fogvol_context_encoding(rig.fv)->bits, 4);
+        rig_close(&rig);
     }
 }
 
@@ -433,40 +439,24 @@ static void test_warn_once(void **state)
    read-back's count of saturated pixels, and never more before that. */
 static void test_bands(void **state)
 {
-    const truth *t = get_truth(20, 0);
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
-    glu_ctx g;
-    logcap lc;
+    shellrig rig;
     fogvol_context_desc cd;
-    fogvol_context *fv;
-    fogvol_mesh *meshes[MAX_OBJ];
-    fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
     fogvol_frame_stats st;
-    int frame, i, readback, last = -1, passes = 0;
+    int frame, readback, last = -1, passes = 0;
     (void)state;
-    memset(&lc, 0, sizeof lc);
-    assert_true(glu_create(&g, W, H, 1));
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = watch_proc;
-    cd.logger.func = logger;
-    cd.logger.user_data = &lc;
-    cd.tier = FOGVOL_TIER_PS20;
     cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    upload_meshes(fv, t->s, meshes);
-    memset(&rd, 0, sizeof rd);
-    rd.density = 0.4f;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    rig_open(&rig, &cd);
     g_show_overflow = 0;
     g_blocking_reads = 0;
-    assert_int_equal(shell_frame(fv, t->s, meshes, ramp, thick, &st), FOGVOL_ERROR_DEPTH_OVERFLOW);
+    assert_int_equal(rig_frame(&rig, thick, &st), FOGVOL_ERROR_DEPTH_OVERFLOW);
     readback = st.overflow_pixels;
     assert_true(readback > 100);
     passes += st.overflow_passes;
     for (frame = 1; frame < 2 * FOGVOL_OVERFLOW_BANDS + 2; ++frame) {
         unsigned char px[4];
-        assert_int_equal(shell_frame(fv, t->s, meshes, ramp, NULL, &st), FOGVOL_SUCCESS);
+        assert_int_equal(rig_frame(&rig, NULL, &st), FOGVOL_SUCCESS);
         glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px); /* what an engine's swap would do */
         passes += st.overflow_passes;
         if (st.overflow_frame < 0) continue;
@@ -486,10 +476,7 @@ static void test_bands(void **state)
     assert_true(passes <= frame); /* one check pass a frame at most (none where a band holds no row) */
     assert_int_equal(g_blocking_reads, 0);
     assert_int_equal(glGetError(), GL_NO_ERROR);
-    for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
-    glu_destroy(&g);
+    rig_close(&rig);
     free(thick);
 }
 
@@ -497,51 +484,33 @@ static void test_bands(void **state)
    (GL would refuse it), the frame is not counted, no GL error reaches the engine. */
 static void test_engine_query_active(void **state)
 {
-    const truth *t = get_truth(20, 0);
-    glu_ctx g;
-    logcap lc;
+    shellrig rig;
     fogvol_context_desc cd;
-    fogvol_context *fv;
-    fogvol_mesh *meshes[MAX_OBJ];
-    fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
     fogvol_frame_stats st;
     GLuint q;
     GLint cur = 0;
-    int i, frame;
+    int frame;
     (void)state;
-    memset(&lc, 0, sizeof lc);
-    assert_true(glu_create(&g, W, H, 1));
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = logger;
-    cd.logger.user_data = &lc;
-    cd.tier = FOGVOL_TIER_PS20;
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    upload_meshes(fv, t->s, meshes);
-    memset(&rd, 0, sizeof rd);
-    rd.density = 0.4f;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    rig_open(&rig, &cd);
     glGenQueries(1, &q);
     for (frame = 0; frame < 3; ++frame) {
         glBeginQuery(GL_SAMPLES_PASSED, q);
-        shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+        rig_frame(&rig, NULL, &st);
         glGetQueryiv(GL_SAMPLES_PASSED, GL_CURRENT_QUERY, &cur);
         assert_int_equal((GLuint)cur, q); /* still the engine's */
         glEndQuery(GL_SAMPLES_PASSED);
         assert_int_equal(glGetError(), GL_NO_ERROR);
     }
     assert_int_equal(st.overflow_pixels_late, -1);
-    shell_frame(fv, t->s, meshes, ramp, NULL, &st); /* the engine's query ended: counted again */
+    rig_frame(&rig, NULL, &st); /* the engine's query ended: counted again */
     glFinish();
-    shell_frame(fv, t->s, meshes, ramp, NULL, &st);
+    rig_frame(&rig, NULL, &st);
     assert_int_equal(st.overflow_frame, 3);
     assert_true(st.overflow_pixels_late > 0);
     glDeleteQueries(1, &q);
-    for (i = 0; i < t->s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
-    glu_destroy(&g);
+    rig_close(&rig);
 }
 
 /* GLES 3 (a desktop context treated as GLES 3.0, GLSL 300 es): ANY_SAMPLES_PASSED reports 1 for
