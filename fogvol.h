@@ -453,8 +453,10 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  overflow check passes likewise.
    SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
                  no O read without occluders, no density texture outside textured volumes, exp or
-                 ramp composite, no colour texture) instead of one program that switches on
-                 uniforms; built on first use (same pixels).
+                 ramp composite, no colour texture, no overflow test without show_overflow,
+                 target reads without the viewport offset where the pass's viewport starts at the
+                 window origin) instead of one program that switches on uniforms; built on first
+                 use (same pixels).
    ALU           PS20 and MRT (not WIDE) take FOGVOL_VARIANT_ALU: the depth is encoded and the dither
                  row computed by arithmetic instead of three lookup texture reads per face fragment
                  (same bytes; fogvol_context_tier reports the variant).
@@ -462,7 +464,11 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  horizontal bands of the group's rectangle, in turn, instead of all of it (an
                  eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
                  newest count of each band: the whole picture over 8 frames, the same count while
-                 the picture holds still. Not with show_overflow (same pixels). */
+                 the picture holds still. Not with show_overflow (same pixels).
+   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
+                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
+                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
+                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -470,7 +476,8 @@ enum {
     FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
     FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
     FOGVOL_SPEEDUP_ALU = 1u << 5,
-    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6
+    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
+    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -1405,14 +1412,21 @@ typedef struct fogvol_shader_desc {
    opaque depth O is the far plane and not read: FLOAT without ENGINE_DEPTH, PS20, PS13, MRT; no
    effect on COUNT, WIDE or ENGINE_DEPTH, which read other sources), NO_DENSITY (no density texture).
    COMPOSITE and COMPOSITE_MESH: EXP (alpha = 1 - exp(-density t) from fv_speed, no ramp texture) or
-   RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex). Other bits, EXP with RAMP, or bits
-   for another program: FOGVOL_ERROR_UNSUPPORTED. */
+   RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
+   for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
+   dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). Every program: ORIGIN (fogvol's targets are read at
+   gl_FragCoord, without fv_screen.zw: for passes whose viewport starts at the window origin, which
+   passes into fogvol's own targets always do). Other bits, EXP with RAMP, or bits for another
+   program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
     FOGVOL_SPECIALIZE_EXP = 1u << 2,
     FOGVOL_SPECIALIZE_RAMP = 1u << 3,
-    FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE = 1u << 4
+    FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE = 1u << 4,
+    FOGVOL_SPECIALIZE_ORIGIN = 1u << 5,
+    FOGVOL_SPECIALIZE_NO_OVERFLOW = 1u << 6,
+    FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7
 };
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -4894,10 +4908,13 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
-    "vec2 fv_st() { return (gl_FragCoord.xy + fv_screen.zw) * fv_screen.xy; }\n"
+    /* FV_PIXEL: the pixel of fogvol's targets; FV_ORIGIN (SPECIALIZE_ORIGIN): zw = 0, left out */
+    "#ifdef FV_ORIGIN\n#define FV_PIXEL gl_FragCoord.xy\n#else\n"
+    "#define FV_PIXEL (gl_FragCoord.xy + fv_screen.zw)\n#endif\n"
+    "vec2 fv_st() { return FV_PIXEL * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
-    "#define FV_SCREEN(s) texelFetch(s, ivec2(gl_FragCoord.xy + fv_screen.zw), 0)\n"
+    "#define FV_SCREEN(s) texelFetch(s, ivec2(FV_PIXEL), 0)\n"
     "#else\n"
     "#define FV_SCREEN(s) FV_TEXTURE(s, fv_st())\n"
     "#endif\n"
@@ -5120,6 +5137,17 @@ static const char fogvol__fs_resolve[] =
    brought them down. FV_CHECK (the check pass) keeps only saturated pixels. */
 static const char fogvol__fs_composite[] =
     "uniform vec4 fv_rampmap;\n"
+    /* exp(-x), x >= 0; FV_FAST_EXP (FOGVOL_SPEEDUP_FAST_EXP): 2^y = 2^n (1 + g (a + (1 - a) g)),
+       n = floor(y), g = y - n, the minimax a with p(0) = 1, p(1) = 2 (relative error 0.0027) */
+    "float fv_transmit(float x) {\n"
+    "#if defined(FV_FAST_EXP) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
+    "    float y = max(x * -1.442695, -126.0), n = floor(y), g = y - n;\n"
+    "    highp int e = int(n) * 8388608;\n"
+    "    return intBitsToFloat(floatBitsToInt(1.0 + g * (0.6602 + g * 0.3398)) + e);\n"
+    "#else\n"
+    "    return exp(-x);\n"
+    "#endif\n"
+    "}\n"
     "uniform FV_TARGET_SAMPLER fv_back;\n"
     "uniform FV_TARGET_SAMPLER fv_front;\n"
     "uniform sampler2D fv_colors;\n"
@@ -5179,18 +5207,22 @@ static const char fogvol__fs_composite[] =
     "#else\n"
     "    vec4 c;\n"
     "#if defined(FV_EXP)\n"
-    "    c = vec4(fv_speed.rgb, 1.0 - exp(-fv_speed.w * max(t, 0.0)));\n"
+    "    c = vec4(fv_speed.rgb, 1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
     "#elif defined(FV_RAMP)\n"
     "    c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
     "#else\n"
-    "    if (fv_speed.w > 0.0) c = vec4(fv_speed.rgb, 1.0 - exp(-fv_speed.w * max(t, 0.0)));\n"
+    "    if (fv_speed.w > 0.0) c = vec4(fv_speed.rgb, 1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
     "    else c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
     "#endif\n"
     "#ifndef FV_NO_CTEX\n"
     "    if (fv_ctex_u.w > 0.5)\n"
     "        c.rgb *= FV_TEXTURE(fv_ctex, vec2(dot(fv_ctex_u.xyz, vec3(st, 1.0)), dot(fv_ctex_v.xyz, vec3(st, 1.0)))).rgb;\n"
     "#endif\n"
+    "#ifdef FV_NO_SAT\n"                         /* SPECIALIZE_NO_OVERFLOW: show_overflow off */
+    "    FV_FRAGCOLOR = c;\n"
+    "#else\n"
     "    FV_FRAGCOLOR = fv_rampmap.z * sat > 0.5 ? vec4(1.0, 0.0, 1.0, 1.0) : c;\n"
+    "#endif\n"
     "#endif\n"
     "}\n";
 
@@ -5429,15 +5461,18 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
 {
     unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY;
-    unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
+    unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                    FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
+    bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program */
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
 }
 
-/* The one string of #defines for fogvol_shader_desc.specialize (NO_DENSITY leaves FV_DENSITY out). */
-static const char *fogvol__specialize_define(const fogvol_shader_desc *d)
+/* The #define strings of fogvol_shader_desc.specialize (NO_DENSITY leaves FV_DENSITY out), appended
+   at strings[n]; returns the new count. */
+static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **strings, int n)
 {
     static const char *const comp[8] = {"",
                                         "#define FV_EXP\n",
@@ -5447,10 +5482,15 @@ static const char *fogvol__specialize_define(const fogvol_shader_desc *d)
                                         "#define FV_EXP\n#define FV_NO_CTEX\n",
                                         "#define FV_RAMP\n#define FV_NO_CTEX\n",
                                         ""};
-    if (d->stage != FOGVOL_STAGE_FRAGMENT) return "";
-    if (d->program == FOGVOL_PROGRAM_FACE)
-        return (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE) ? "#define FV_NO_OPAQUE\n" : "";
-    return comp[(d->specialize >> 2) & 7u];
+    if (d->stage != FOGVOL_STAGE_FRAGMENT) return n;
+    if (d->specialize & FOGVOL_SPECIALIZE_ORIGIN) strings[n++] = "#define FV_ORIGIN\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_NO_OVERFLOW) strings[n++] = "#define FV_NO_SAT\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_FAST_EXP) strings[n++] = "#define FV_FAST_EXP\n";
+    if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
+        strings[n++] = "#define FV_NO_OPAQUE\n";
+    if (d->program != FOGVOL_PROGRAM_FACE && comp[(d->specialize >> 2) & 7u][0])
+        strings[n++] = comp[(d->specialize >> 2) & 7u];
+    return n;
 }
 
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
@@ -5487,7 +5527,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants) &&
         !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
-    if (fogvol__specialize_define(d)[0]) strings[n++] = fogvol__specialize_define(d);
+    n = fogvol__specialize_defines(d, strings, n);
     n = fogvol__program_strings(d, strings, n);
     FOGVOL_ASSERT(n <= FOGVOL_MAX_SHADER_STRINGS);
     *count = n;
@@ -5747,7 +5787,7 @@ static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
 
 /* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
    it failed to build and the general program stands in. */
-#define FOGVOL__SPEC_MAX 16
+#define FOGVOL__SPEC_MAX 32
 typedef struct fogvol__spec_program {
     fogvol_program program;
     unsigned bits;
@@ -7103,6 +7143,8 @@ static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume
     return (float)(d > 1.0 ? 1.0 : d);
 }
 
+static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits);
+
 /* After a sum pass (its state in *base): each density-textured volume of the group in a pass of
    its own with its texture and texture-coordinate rows (negative as in fogvol__draw_group).
    Returns the passes issued. */
@@ -7116,7 +7158,7 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
-        ps.program = ctx->prog[FOGVOL_PROGRAM_FACE]; /* the general program: density texture */
+        ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_ORIGIN); /* density texture */
         ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
@@ -7816,7 +7858,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
     cp.cull = FOGVOL_CULL_NONE;
     cp.depth_test = cp.depth_write = single;
     cp.stencil_guard = 0;
-    cp.program = ctx->prog[FOGVOL_PROGRAM_CHECK];
+    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, FOGVOL_SPECIALIZE_ORIGIN);
     memset(cp.native_textures, 0, sizeof cp.native_textures);
     if (single) { /* the one sum target; V is the target here, not a texture */
         memset(cp.textures, 0, sizeof cp.textures);
@@ -8150,7 +8192,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_pass ps = run->base;
     unsigned char *peak = NULL;
     fogvol_result r;
-    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY; /* textured volumes: the general program */
+    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN; /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
@@ -8220,7 +8262,7 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
     if (ctx->tier != FOGVOL_TIER_PS13) return;
     ps->target = ctx->tgt_t;
-    ps->program = ctx->prog[FOGVOL_PROGRAM_RESOLVE];
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, FOGVOL_SPECIALIZE_ORIGIN);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
@@ -8252,7 +8294,11 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
     fogvol__group_color(ctx, ramp, ps);
     spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
+    if (spec == FOGVOL_SPECIALIZE_EXP && !(ctx->speedups_off & FOGVOL_SPEEDUP_FAST_EXP))
+        spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
+    if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
+    if (fd->viewport[0] == 0 && fd->viewport[1] == 0) spec |= FOGVOL_SPECIALIZE_ORIGIN;
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;

@@ -241,15 +241,8 @@ typedef struct rec {
 #define KIND(p, spec) ((int)(p) | (int)(spec) << 8)
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
-    static const unsigned specs[] = {0,
-                                     FOGVOL_SPECIALIZE_NO_DENSITY,
-                                     FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE,
-                                     FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
-                                     FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
-                                     FOGVOL_SPECIALIZE_EXP,
-                                     FOGVOL_SPECIALIZE_RAMP};
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * (int)(sizeof specs / sizeof specs[0]); ++k) {
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 256; ++k) { /* every program, every set of specialize bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
@@ -258,7 +251,7 @@ static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
         sd.variants = FOGVOL_VARIANT_ALU; /* the PS20 default (FOGVOL_SPEEDUP_ALU) */
         sd.program = (fogvol_program)p;
         sd.dialect = dialect;
-        sd.specialize = specs[k / FOGVOL_PROGRAM_COUNT];
+        sd.specialize = (unsigned)(k / FOGVOL_PROGRAM_COUNT);
         if (fogvol_shader_strings(&sd, vs, &nv) != FOGVOL_SUCCESS) continue;
         sd.stage = FOGVOL_STAGE_FRAGMENT;
         if (fogvol_shader_strings(&sd, fs, &nf) != FOGVOL_SUCCESS) continue;
@@ -774,9 +767,13 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     /* resources identified by what they are, not by creation order */
     enc = rec_program(r, FOGVOL_PROGRAM_ENCODE);
     /* the passes run programs built for their configuration: occluders, so the faces read O, no density
-       texture; extinction ramps reaching 7 / density: the exp() composite, no colour texture */
-    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY));
-    comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE));
+       texture, target space (ORIGIN); extinction ramps reaching 7 / density: the exp() composite
+       (FAST_EXP), no colour texture, no show_overflow; the viewport starts at (A_X0, A_Y0): target reads
+       with the offset (no ORIGIN) */
+    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN));
+    comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
+                                                             FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                                             FOGVOL_SPECIALIZE_NO_OVERFLOW));
     rg = blue = 0; /* PS20 encodes by arithmetic by default (FOGVOL_SPEEDUP_ALU): no rg or blue ramp */
     for (i = 0; i < r->ntex; ++i) assert_true(r->tex[i].w != 16 * 32 && !(r->tex[i].w == 16 && r->tex[i].hgt == 16));
     dith = rec_texture_sized(r, 8, 8);          /* 8 x 8 */

@@ -4,7 +4,8 @@
    while occluders come and go (O kept from an earlier frame must be the far plane, and redrawn
    when occluders return); SKIP_OPAQUE draws one pass less from the second frame on;
    EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
-   differs from the ramp by at most 1/255 per channel. Accuracy against ray-cast ground truth
+   differs from the ramp by at most 1/255 per channel, and FAST_EXP (its exp() by a polynomial) from
+   exp() by at most 1/255. Accuracy against ray-cast ground truth
    with the defaults is tested in test_render.c, test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -134,11 +135,11 @@ static const fogvol_tier g_tiers[] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20, FOGVO
 static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
-     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS)
+     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP)
 
 static void test_same_pixels_and_exp(void **state)
 {
-    static run_out def, noexp, off;
+    static run_out def, exact, noexp, off;
     const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
     glu_ctx g;
     int ti, si, f, n;
@@ -147,17 +148,22 @@ static void test_same_pixels_and_exp(void **state)
     for (ti = 0; ti < 3; ++ti)
         for (si = 0; si < 2; ++si) {
             const tscene *s = &g_scenes[scene_index(names[si])];
-            int exp_max = 0, exp_n = 0, occluded = 0;
+            int exp_max = 0, exp_n = 0, fast_max = 0, fast_n = 0, occluded = 0;
             run_frames(s, g_tiers[ti], 0, &g, &def);
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP, &g, &exact);
             run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_EXP_COMPOSITE, &g, &noexp);
             run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
             for (f = 0; f < NFRAMES; ++f) {
                 int m;
                 /* SKIP_OPAQUE, TEXEL_FETCH, SCISSOR, SPECIALIZE, ALU: the same bytes as with every speed-up off */
                 assert_int_equal(max_diff(noexp.px[f], off.px[f], &n), 0);
-                m = max_diff(def.px[f], noexp.px[f], &n);
+                m = max_diff(exact.px[f], noexp.px[f], &n);
                 if (m > exp_max) exp_max = m;
                 exp_n += n;
+                /* FAST_EXP: the transmittance within 0.27% of exp(): at most 0.69/255 + rounding */
+                m = max_diff(def.px[f], exact.px[f], &n);
+                if (m > fast_max) fast_max = m;
+                fast_n += n;
                 /* one O pass drawn with speed-ups off in every frame; on: only in the first frame
                    and where occluders come (or leave: O must become the far plane again) */
                 assert_int_equal(def.passes[f], off.passes[f] - (f == 1 ? 1 : 0));
@@ -173,10 +179,13 @@ static void test_same_pixels_and_exp(void **state)
             assert_true(occluded > 8);
             assert_int_equal(max_diff(def.px[3], def.px[0], &n), 0);
             print_message("# %-5s %-22s exp() composite vs 8-bit ramp: max %d/255 over %d channel values of %d "
-                          "frames; other speed-ups: identical bytes; passes %d %d %d %d (off: %d %d %d %d)\n",
-                          g_tier_names[ti], names[si], exp_max, exp_n, NFRAMES, def.passes[0], def.passes[1],
-                          def.passes[2], def.passes[3], off.passes[0], off.passes[1], off.passes[2], off.passes[3]);
+                          "frames; fast exp vs exp(): max %d/255 over %d; other speed-ups: identical bytes; "
+                          "passes %d %d %d %d (off: %d %d %d %d)\n",
+                          g_tier_names[ti], names[si], exp_max, exp_n, NFRAMES, fast_max, fast_n, def.passes[0],
+                          def.passes[1], def.passes[2], def.passes[3], off.passes[0], off.passes[1], off.passes[2],
+                          off.passes[3]);
             assert_true(exp_max <= 1);
+            assert_true(fast_max <= 1);
         }
     glu_destroy(&g);
 }
