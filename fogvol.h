@@ -4947,6 +4947,14 @@ static const char fogvol__fs_common[] =
     "    return fv_dith.x > 0.5 ? (((v * dd) >> 6) + (dd >> 1)) & (dd - 1) : 0;\n"
     "}\n"
     "float fv_dither_row() { return float(fv_dither_row_i()); }\n"
+    /* the encode's offset (row + D/2) mod D = (v D) >> 6 (v: the 8x8 index above; the dither off:
+       D/2); v's bits spread in two multiplies: (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2 */
+    "highp int fv_dither_offset_i() {\n"
+    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
+    "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n"
+    "    highp int dd = int(fv_dith.z);\n"
+    "    return fv_dith.x > 0.5 ? (((s.x << 1) | s.y) * dd) >> 8 : dd >> 1;\n"
+    "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
     "float fv_dither_row() {\n"
     "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n"
@@ -4962,10 +4970,10 @@ static const char fogvol__fs_common[] =
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
     "#ifdef FV_IALU\n"                          /* T: the blue-ramp texel count floor(u N^3 D) */
-    "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln, dd = 1 << ld;\n"
-    "    highp int T = int(u * fv_enc.y * fv_enc.x * fv_dith.z);\n"
+    "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln;\n"
+    "    highp int T = int(u * (fv_enc.y * fv_enc.x * fv_dith.z));\n" /* powers of two: exact either way */
     "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
-    "    highp int q = ((x + ((fv_dither_row_i() + (dd >> 1)) & (dd - 1))) >> ld) - 1;\n"
+    "    highp int q = ((x + fv_dither_offset_i()) >> ld) - 1;\n"
     "    highp int a = q < 0 ? 1 : 0;\n"
     "    return vec4(ivec4((h >> ln) & (n - 1), h & (n - 1), q + a * n, a)) * (1.0 / 255.0);\n"
     "#else\n"
