@@ -1414,10 +1414,10 @@ typedef struct fogvol_shader_desc {
    COMPOSITE and COMPOSITE_MESH: EXP (alpha = 1 - exp(-density t) from fv_speed, no ramp texture) or
    RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
    for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
-   dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). Every program: ORIGIN (fogvol's targets are read at
-   gl_FragCoord, without fv_screen.zw: for passes whose viewport starts at the window origin, which
-   passes into fogvol's own targets always do). Other bits, EXP with RAMP, or bits for another
-   program: FOGVOL_ERROR_UNSUPPORTED. */
+   dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). Every program:
+   ORIGIN (fogvol's targets are read at gl_FragCoord, without fv_screen.zw: for passes whose
+   viewport starts at the window origin, which passes into fogvol's own targets always do). Other
+   bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,

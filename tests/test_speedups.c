@@ -5,8 +5,9 @@
    when occluders return); SKIP_OPAQUE draws one pass less from the second frame on;
    EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
    differs from the ramp by at most 1/255 per channel, and FAST_EXP (its exp() by a polynomial) from
-   exp() by at most 1/255; the sums themselves (debug_thickness) are bit-identical throughout. Accuracy against ray-cast ground truth
-   with the defaults is tested in test_render.c, test_tiers.c and test_engine_depth.c. */
+   exp() by at most 1/255; the sums themselves (debug_thickness) are bit-identical throughout.
+   Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
+   test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
