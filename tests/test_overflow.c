@@ -180,6 +180,12 @@ static fogvol_result shell_frame(fogvol_context *fv, const tscene *s, fogvol_mes
 }
 
 static int is_magenta(const unsigned char *p) { return p[0] == 255 && p[1] == 0 && p[2] == 255; }
+static int count_magenta(const unsigned char *px)
+{
+    int i, n = 0;
+    for (i = 0; i < W * H; ++i) n += is_magenta(px + 4 * i);
+    return n;
+}
 
 static void write_png(const char *name, int k, const unsigned char *px)
 {
@@ -436,14 +442,15 @@ static void test_warn_once(void **state)
 
 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS (the default, without show_overflow): each frame checks one band
    of the picture; once every band has been counted, the count of the still picture is the debug
-   read-back's count of saturated pixels, and never more before that. */
+   read-back's count of saturated pixels, and never more before that. Then show_overflow in the
+   same context marks exactly those pixels (the composite built with the overflow test again). */
 static void test_bands(void **state)
 {
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
     shellrig rig;
     fogvol_context_desc cd;
     fogvol_frame_stats st;
-    int frame, readback, last = -1, passes = 0, partial = 0;
+    int frame, readback, last = -1, passes = 0, partial = 0, magenta_off, magenta_on;
     (void)state;
     memset(&cd, 0, sizeof cd);
     cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
@@ -468,10 +475,18 @@ static void test_bands(void **state)
         last = st.overflow_pixels_late;
         partial += last < readback; /* not every band counted yet */
     }
-    g_show_overflow = 1;
+    glFinish();
+    magenta_off = count_magenta(rig.g.pixels); /* the composite built without the overflow test */
+    g_show_overflow = 1; /* the same context: the composite with it, this frame */
+    assert_int_equal(rig_frame(&rig, NULL, &st), FOGVOL_SUCCESS);
+    glFinish();
+    magenta_on = count_magenta(rig.g.pixels);
     print_message("  bands: read-back %d saturated pixels, sum of the %d bands %d (frame %lld), %d check passes in "
-                  "%d frames\n",
-                  readback, FOGVOL_OVERFLOW_BANDS, st.overflow_pixels_late, (long long)st.overflow_frame, passes, frame);
+                  "%d frames; magenta pixels %d without show_overflow, %d with it\n",
+                  readback, FOGVOL_OVERFLOW_BANDS, st.overflow_pixels_late, (long long)st.overflow_frame, passes, frame,
+                  magenta_off, magenta_on);
+    assert_int_equal(magenta_off, 0);
+    assert_int_equal(magenta_on, readback); /* the program switched back to the overflow test */
     assert_true(st.overflow_frame >= FOGVOL_OVERFLOW_BANDS);
     assert_int_equal(st.overflow_pixels_late, readback);
     assert_true(partial > 0); /* whole-picture checks would give the full count at once */
