@@ -6,6 +6,8 @@
    EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
    differs from the ramp by at most 1/255 per channel, and FAST_EXP (its exp() by a polynomial) from
    exp() by at most 1/255; the sums themselves (debug_thickness) are bit-identical throughout.
+   A viewport away from the window origin gives the same pixels, shifted, as one at the origin (the
+   composite reads fogvol's targets with the offset there, without it at the origin).
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -43,7 +45,9 @@ typedef struct run_out {
     int passes[NFRAMES];
 } run_out;
 
-/* NFRAMES frames of scene s on tier t with these speed-ups off, into out */
+/* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
+   (g_x0, g_y0) of g's buffer, whose pixels outside it must keep the clear colour */
+static int g_x0, g_y0;
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
 {
     fogvol_context_desc cd;
@@ -52,7 +56,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp;
     fogvol_frame_stats st;
-    int f, i;
+    int f, i, x, y;
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = logger;
@@ -72,6 +76,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         rc_camera_matrices(&s->cam, fd.view, fd.projection);
         fd.znear = (float)s->cam.znear;
         fd.zfar = (float)s->cam.zfar;
+        fd.viewport[0] = g_x0;
+        fd.viewport[1] = g_y0;
         fd.viewport[2] = W;
         fd.viewport[3] = H;
         fd.debug_thickness = out->th[f];
@@ -81,7 +87,14 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         add_scene(fv, s, meshes, ramp, with_occluders(f));
         assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
         glFinish();
-        memcpy(out->px[f], g->pixels, sizeof out->px[f]);
+        for (y = 0; y < g->height; ++y)
+            for (x = 0; x < g->width; ++x) {
+                const unsigned char *p = g->pixels + 4 * ((size_t)y * g->width + x);
+                if (x >= g_x0 && x < g_x0 + W && y >= g_y0 && y < g_y0 + H)
+                    memcpy(out->px[f] + 4 * ((y - g_y0) * W + (x - g_x0)), p, 4);
+                else /* outside the viewport: the clear colour (51, 128, 204) */
+                    assert_true(p[0] == 51 && p[1] == 128 && p[2] == 204);
+            }
         out->passes[f] = st.passes;
     }
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
@@ -198,9 +211,41 @@ static void test_same_pixels_and_exp(void **state)
     glu_destroy(&g);
 }
 
+/* A viewport away from the window origin (an editor pane, split screen): the composite reads
+   fogvol's targets with the offset (the program without SPECIALIZE_ORIGIN) and must give the same
+   pixels, shifted, as the viewport at the origin; nothing outside the viewport changes. */
+static void test_viewport_offset(void **state)
+{
+    static run_out at0, moved;
+    const tscene *s = &g_scenes[scene_index("layers_opaque_between")];
+    glu_ctx g;
+    int ti, f, n, fogged;
+    (void)state;
+    assert_true(glu_create(&g, W + 13, H + 7, 1));
+    for (ti = 0; ti < 3; ++ti) {
+        g_x0 = g_y0 = 0;
+        run_frames(s, g_tiers[ti], 0, &g, &at0);
+        g_x0 = 13;
+        g_y0 = 7;
+        run_frames(s, g_tiers[ti], 0, &g, &moved);
+        g_x0 = g_y0 = 0;
+        for (f = 0; f < NFRAMES; ++f) {
+            assert_int_equal(max_diff(moved.px[f], at0.px[f], &n), 0);
+            assert_memory_equal(moved.th[f], at0.th[f], sizeof at0.th[f]);
+        }
+        fogged = 0;
+        for (n = 0; n < W * H; ++n) fogged += at0.px[2][4 * n] != 51 || at0.px[2][4 * n + 2] != 204;
+        print_message("# %-5s viewport at (13, 7): the same pixels as at (0, 0), %d of them fogged\n",
+                      g_tier_names[ti], fogged);
+        assert_true(fogged > W * H / 8);
+    }
+    glu_destroy(&g);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
+                                       cmocka_unit_test(test_viewport_offset)};
     int r;
     build_scenes();
     r = cmocka_run_group_tests(tests, NULL, NULL);
