@@ -4185,21 +4185,20 @@ typedef struct fogvol__an_fcarry {
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
-   Returns the stretch count. With ex != NULL
-   (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
-   here where they hang off no chain of the walk (tau = 0: q = 0); with
-   linear != 0 (the LINEAR law) it stops at the stretch that leaves no fog
-   (fogvol__an_flinear_walk's f, the same arithmetic). */
+   Returns the stretch count; also each stretch's exp(-tau) and
+   (1 - exp(-tau)) / sig (q), here where they hang off no chain of the walk
+   (tau = 0: q = 0). The EXP law's; the LINEAR laws walk the events
+   themselves (fogvol__an_flinear_events). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, float (*rgb)[3], float *sig, float *l, float *ex, float *q, int linear)
+                                 int m, float (*rgb)[3], float *sig, float *ex, float *q)
 {
-    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f, fl = 1.0f; /* scalars: kept in registers */
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
     for (k = 0; k < m; ++k) {
         int e = (int)(key[k] & 0xffu);
         const fogvol__an_fvol *f = &fv[e >> 1];
         uint32_t u = (uint32_t)(key[k] >> 32);
-        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
+        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln, om;
         memcpy(&t, &u, sizeof t);
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
@@ -4215,17 +4214,10 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             last = t;
             if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
         }
-        sig[n] = sg, l[n] = ln;
-        if (ex) {
-            float om;
-            ex[n] = fogvol__an_fexp2(sg * ln, &om);
-            q[n] = om / (sg + (float)(sg == 0.0f));
-        }
+        sig[n] = sg;
+        ex[n] = fogvol__an_fexp2(sg * ln, &om);
+        q[n] = om / (sg + (float)(sg == 0.0f));
         ++n;
-        if (linear && sg * ln > 0.0f) {
-            fl = sg * ln >= fl ? 0.0f : fl - sg * ln;
-            if (fl == 0.0f) break; /* the events after it change nothing */
-        }
     }
     return n;
 }
@@ -4251,25 +4243,47 @@ static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const 
 
 /* The LINEAR law (each stretch takes tau = sig * l of the fog until none is
    left; colour weighted by the fog taken) and the paper's LINEAR_SEED colour
-   formula over n stretches, in float (fogvol__an_add's arithmetic). */
-static void fogvol__an_flinear_walk(const float (*rgb)[3], const float *sig, const float *l, int n, int law,
-                                    float *fog, float col[3])
+   formula, in float (fogvol__an_add's arithmetic), over the stretches of the
+   sorted events key[0..m) as fogvol__an_fstretches forms them, in the same
+   pass: it stops at the stretch that leaves no fog. */
+static void fogvol__an_flinear_events(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key,
+                                      const float *t2, int m, int law, float *fog, float col[3])
 {
-    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
-    int k;
-    for (k = 0; k < n && f > 0.0f; ++k) {
-        float sg = sig[k], ln = l[k], tau = sg * ln, a;
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv;
+    int k, open = 0;
+    for (k = 0; k < m && f > 0.0f; ++k) {
+        int e = (int)(key[k] & 0xffu);
+        const fogvol__an_fvol *fl = &fv[e >> 1];
+        uint32_t u = (uint32_t)(key[k] >> 32);
+        float t, sd = (e & 1) ? -fl->dens : fl->dens, sr, sgr, sb, sg, ln, tau, a;
+        memcpy(&t, &u, sizeof t);
+        if (mix == FOGVOL_MIX_SEPARATE) {
+            if (e & 1) continue;
+            sr = fl->col[0] * fl->dens, sgr = fl->col[1] * fl->dens, sb = fl->col[2] * fl->dens;
+            sg = fl->dens, ln = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
+        } else {
+            int was = open;
+            sr = ar, sgr = ag, sb = ab;
+            sg = ad, ln = (t - last) * len;
+            open += (e & 1) ? -1 : 1;
+            ar += sd * fl->col[0], ag += sd * fl->col[1], ab += sd * fl->col[2], ad += sd;
+            if (open == 0) ar = ag = ab = ad = 0.0f;
+            last = t;
+            if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
+        }
+        tau = sg * ln;
         if (!(tau > 0.0f)) continue;
         if (law == FOGVOL_FOG_LINEAR_SEED) {
-            n0 = rgb[k][0] / sg * f + n0 * (1.0f - f);
-            n1 = rgb[k][1] / sg * f + n1 * (1.0f - f);
-            n2 = rgb[k][2] / sg * f + n2 * (1.0f - f);
+            n0 = sr / sg * f + n0 * (1.0f - f);
+            n1 = sgr / sg * f + n1 * (1.0f - f);
+            n2 = sb / sg * f + n2 * (1.0f - f);
             f -= tau < 1.0f ? tau : 1.0f;
             f = f > 0.0f ? f : 0.0f;
             continue;
         }
         a = tau >= f ? f / tau : 1.0f;
-        n0 += rgb[k][0] * (ln * a), n1 += rgb[k][1] * (ln * a), n2 += rgb[k][2] * (ln * a);
+        n0 += sr * (ln * a), n1 += sgr * (ln * a), n2 += sb * (ln * a);
         w += tau * a;
         f = tau >= f ? 0.0f : f - tau;
     }
@@ -4290,7 +4304,7 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
                                       fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
     uint64_t key[FOGVOL__AN_EVENTS];
-    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
+    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS];
     float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS];
     int m = 0, n, w, k, j, nw = (s->count + 31) / 32;
     for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
@@ -4322,13 +4336,12 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
     }
     for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
-                              law == FOGVOL_FOG_LINEAR);
-    if (law == FOGVOL_FOG_EXP) {
-        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
+    if (law != FOGVOL_FOG_EXP) {
+        fogvol__an_flinear_events(fv, mix, len, key, t2, m, law, fog, col);
         return;
     }
-    fogvol__an_flinear_walk((const float(*)[3])rgb, sig, l, n, law, fog, col);
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, ex, q);
+    fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
 }
 
 /* What a batch call works on, for the float kernels' loop. */
