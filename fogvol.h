@@ -3999,15 +3999,14 @@ FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx,
     return graze;
 }
 
-/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit, the
-   sums and the hit mask, accumulated where fogvol__an_fblock_body keeps them. */
-FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                         const fogvol__an_fvol *f, int v, int base, fogvol__an_fblock *k)
+/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit into
+   t1/t2; returns the optical depth dens * len * chord (tv). */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                           const double e[3], const fogvol__an_fvol *f, int v, int base, __m256 dx,
+                                           __m256 dy, __m256 dz, __m256 len, fogvol__an_fblock *k)
 {
     const __m256 zero = _mm256_setzero_ps();
-    __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base), dz = _mm256_loadu_ps(k->dz + base);
-    __m256 len = _mm256_loadu_ps(k->len + base), lo = zero, hi = zero, ch, tv, hm;
-    unsigned int *hw = k->hit[v >> 5] + base;
+    __m256 lo = zero, hi = zero, ch;
     int redo = 0xff;
     if (f->dbl) { /* every lane in double */
     } else if (f->shape == FOGVOL_SHAPE_DISTANCE || f->shape == FOGVOL_SHAPE_HALF_SPACE ||
@@ -4024,23 +4023,13 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
         lo = _mm256_loadu_ps(k->lo + base), hi = _mm256_loadu_ps(k->hi + base), ch = _mm256_loadu_ps(k->ch + base);
     }
     lo = _mm256_min_ps(lo, hi);
-    tv = _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
-    hm = _mm256_cmp_ps(tv, zero, _CMP_GT_OQ);
-    _mm256_storeu_ps(k->tau + base, _mm256_add_ps(_mm256_loadu_ps(k->tau + base), tv));
-    _mm256_storeu_ps(k->r + base, _mm256_add_ps(_mm256_loadu_ps(k->r + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv)));
-    _mm256_storeu_ps(k->g + base, _mm256_add_ps(_mm256_loadu_ps(k->g + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv)));
-    _mm256_storeu_ps(k->bl + base,
-                     _mm256_add_ps(_mm256_loadu_ps(k->bl + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv)));
-    _mm256_storeu_si256((__m256i *)(void *)hw,
-                        _mm256_or_si256(_mm256_loadu_si256((const __m256i *)(const void *)hw),
-                                        _mm256_and_si256(_mm256_castps_si256(hm),
-                                                         _mm256_set1_epi32((int)(1u << (v & 31))))));
     _mm256_storeu_ps(k->t1[v] + base, lo);
     _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
+    return _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
 }
 
-/* The volumes outside, the block's 4 groups of 8 inside: the groups' long
-   chains (square root, then division) are independent and overlap. */
+/* The block's 4 groups of 8 outside, the volumes inside: a group's sums and
+   hit mask stay in registers. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
                                                 const double e[3], const fogvol__an_fvol *fv,
                                                 const unsigned char *skip, float limit, int law, fogvol__an_fblock *k)
@@ -4049,17 +4038,30 @@ FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, c
     for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) {
         __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base);
         __m256 dz = _mm256_loadu_ps(k->dz + base), zero = _mm256_setzero_ps();
-        _mm256_storeu_ps(k->len + base, _mm256_sqrt_ps(_mm256_add_ps(
-                                            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                                            _mm256_mul_ps(dz, dz))));
-        _mm256_storeu_ps(k->tau + base, zero), _mm256_storeu_ps(k->r + base, zero);
-        _mm256_storeu_ps(k->g + base, zero), _mm256_storeu_ps(k->bl + base, zero);
+        __m256 len = _mm256_sqrt_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz)));
+        __m256 tau = zero, r = zero, g = zero, bl = zero;
+        __m256i hw = _mm256_setzero_si256();
+        _mm256_storeu_ps(k->len + base, len);
+        for (v = 0; v < set->count; ++v) {
+            if (!skip[v]) { /* fogvol__an_fcull */
+                const fogvol__an_fvol *f = &fv[v];
+                __m256 tv = fogvol__an_vol8(set, pe, e, f, v, base, dx, dy, dz, len, k);
+                __m256i bit = _mm256_set1_epi32((int)(1u << (v & 31)));
+                tau = _mm256_add_ps(tau, tv);
+                r = _mm256_add_ps(r, _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv));
+                g = _mm256_add_ps(g, _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv));
+                bl = _mm256_add_ps(bl, _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv));
+                hw = _mm256_or_si256(hw, _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps(tv, zero, _CMP_GT_OQ)), bit));
+            }
+            if ((v & 31) == 31 || v == set->count - 1) { /* a mask word done */
+                _mm256_storeu_si256((__m256i *)(void *)(k->hit[v >> 5] + base), hw);
+                hw = _mm256_setzero_si256();
+            }
+        }
+        _mm256_storeu_ps(k->tau + base, tau), _mm256_storeu_ps(k->r + base, r);
+        _mm256_storeu_ps(k->g + base, g), _mm256_storeu_ps(k->bl + base, bl);
     }
-    for (v = 0; v < (set->count + 31) / 32; ++v)
-        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
-    for (v = 0; v < set->count; ++v)
-        if (!skip[v]) /* fogvol__an_fcull */
-            for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hits[i] = 0.0f; /* 2: two volumes or more on the ray */
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
