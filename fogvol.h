@@ -4387,25 +4387,38 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
     }
 }
 
-/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
-   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
-   does not evaluate, which can only be in a volume around the eye, never
-   skipped) lie in a cone around their sum A, of half angle theta, and are at
-   most lmax long. A volume whose bounding sphere (fogvol__an_fvol) is further
-   than lmax or outside that cone widened by the sphere's half angle alpha
-   (the angle between A and the sphere's centre above theta + alpha) is
-   missed by every ray, and so is a volume of density 0. The float tests keep
-   margins of 1e-4. */
-static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol__an_fblock *k, unsigned char *skip)
+/* The lane loops of fogvol__an_fcull: the sum A of the block's rays and, over
+   the rays, the smallest cos^2 of the angle to A (-1 beyond 90 degrees) and
+   the largest squared length: out = {Ax, Ay, Az, cos^2 min, length^2 max}.
+   8 partial sums / minima / maxima, added up in one fixed order (the SIMD
+   levels below run the same operations in the same order). */
+typedef void (*fogvol__an_fcone_fn)(const fogvol__an_fblock *k, float out[5]);
+
+FOGVOL__AN_INLINE float fogvol__an_hsum8(const float *p)
 {
-    /* the lane loops keep 8 partial sums / minima / maxima (vectorisable without reassociation) */
-    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa, ia, c2min, l2max, cth, sth, lmax;
-    int i, j, v;
+    return ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]));
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fcone_end(const float *px, const float *py, const float *pz, float out[3])
+{
+    out[0] = fogvol__an_hsum8(px), out[1] = fogvol__an_hsum8(py), out[2] = fogvol__an_hsum8(pz);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fcone_min(const float *pc, const float *pl, float out[5])
+{
+    int j;
+    out[3] = pc[0], out[4] = pl[0];
+    for (j = 1; j < 8; ++j) out[3] = fogvol__an_fmin(out[3], pc[j]), out[4] = fogvol__an_fmax(out[4], pl[j]);
+}
+
+static void fogvol__an_fcone_c(const fogvol__an_fblock *k, float out[5])
+{
+    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa;
+    int i, j;
     for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
         for (j = 0; j < 8; ++j) px[j] += k->dx[i + j], py[j] += k->dy[i + j], pz[j] += k->dz[i + j];
-    ax = ((px[0] + px[1]) + (px[2] + px[3])) + ((px[4] + px[5]) + (px[6] + px[7]));
-    ay = ((py[0] + py[1]) + (py[2] + py[3])) + ((py[4] + py[5]) + (py[6] + py[7]));
-    az = ((pz[0] + pz[1]) + (pz[2] + pz[3])) + ((pz[4] + pz[5]) + (pz[6] + pz[7]));
+    fogvol__an_fcone_end(px, py, pz, out);
+    ax = out[0], ay = out[1], az = out[2];
     aa = ax * ax + ay * ay + az * az;
     for (j = 0; j < 8; ++j) pc[j] = 1.0f;
     for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
@@ -4416,8 +4429,91 @@ static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol_
             pc[j] = fogvol__an_fmin(pc[j], d2 > 0.0f ? c2 : 1.0f);
             pl[j] = fogvol__an_fmax(pl[j], d2);
         }
-    c2min = pc[0], l2max = pl[0];
-    for (j = 1; j < 8; ++j) c2min = fogvol__an_fmin(c2min, pc[j]), l2max = fogvol__an_fmax(l2max, pl[j]);
+    fogvol__an_fcone_min(pc, pl, out);
+}
+
+#if FOGVOL__AN_X86
+/* fogvol__an_fcone_c with 4 lanes (two halves of the 8 partial results) */
+__attribute__((target("sse2"))) static void fogvol__an_fcone_sse2(const fogvol__an_fblock *k, float out[5])
+{
+    __m128 px[2], py[2], pz[2], pc[2], pl[2], ax, ay, az, aa, zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    float sx[8], sy[8], sz[8], sc[8], sl[8];
+    int i, h;
+    for (h = 0; h < 2; ++h) px[h] = py[h] = pz[h] = pl[h] = zero, pc[h] = one;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (h = 0; h < 2; ++h) {
+            px[h] = _mm_add_ps(px[h], _mm_loadu_ps(k->dx + i + 4 * h));
+            py[h] = _mm_add_ps(py[h], _mm_loadu_ps(k->dy + i + 4 * h));
+            pz[h] = _mm_add_ps(pz[h], _mm_loadu_ps(k->dz + i + 4 * h));
+        }
+    for (h = 0; h < 2; ++h)
+        _mm_storeu_ps(sx + 4 * h, px[h]), _mm_storeu_ps(sy + 4 * h, py[h]), _mm_storeu_ps(sz + 4 * h, pz[h]);
+    fogvol__an_fcone_end(sx, sy, sz, out);
+    ax = _mm_set1_ps(out[0]), ay = _mm_set1_ps(out[1]), az = _mm_set1_ps(out[2]);
+    aa = _mm_set1_ps(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (h = 0; h < 2; ++h) {
+            __m128 x = _mm_loadu_ps(k->dx + i + 4 * h), y = _mm_loadu_ps(k->dy + i + 4 * h);
+            __m128 z = _mm_loadu_ps(k->dz + i + 4 * h);
+            __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
+            __m128 da = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, ax), _mm_mul_ps(y, ay)), _mm_mul_ps(z, az));
+            __m128 q = _mm_mul_ps(d2, aa), pos = _mm_cmpgt_ps(da, zero), in = _mm_cmpgt_ps(d2, zero);
+            __m128 num = _mm_or_ps(_mm_and_ps(pos, _mm_mul_ps(da, da)), _mm_andnot_ps(pos, _mm_xor_ps(q, _mm_set1_ps(-0.0f))));
+            __m128 c2 = _mm_div_ps(num, _mm_add_ps(q, _mm_and_ps(_mm_cmpeq_ps(q, zero), one)));
+            pc[h] = _mm_min_ps(pc[h], _mm_or_ps(_mm_and_ps(in, c2), _mm_andnot_ps(in, one)));
+            pl[h] = _mm_max_ps(pl[h], d2);
+        }
+    for (h = 0; h < 2; ++h) _mm_storeu_ps(sc + 4 * h, pc[h]), _mm_storeu_ps(sl + 4 * h, pl[h]);
+    fogvol__an_fcone_min(sc, sl, out);
+}
+
+/* fogvol__an_fcone_c with 8 lanes */
+FOGVOL__AN_AVX2_FN void fogvol__an_fcone_avx2(const fogvol__an_fblock *k, float out[5])
+{
+    __m256 px = _mm256_setzero_ps(), py = px, pz = px, pl = px, zero = px, one = FOGVOL__AN_V8(1.0f), pc = one;
+    __m256 ax, ay, az, aa;
+    float sx[8], sy[8], sz[8];
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) {
+        px = _mm256_add_ps(px, _mm256_loadu_ps(k->dx + i));
+        py = _mm256_add_ps(py, _mm256_loadu_ps(k->dy + i));
+        pz = _mm256_add_ps(pz, _mm256_loadu_ps(k->dz + i));
+    }
+    _mm256_storeu_ps(sx, px), _mm256_storeu_ps(sy, py), _mm256_storeu_ps(sz, pz);
+    fogvol__an_fcone_end(sx, sy, sz, out);
+    ax = FOGVOL__AN_V8(out[0]), ay = FOGVOL__AN_V8(out[1]), az = FOGVOL__AN_V8(out[2]);
+    aa = FOGVOL__AN_V8(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) {
+        __m256 x = _mm256_loadu_ps(k->dx + i), y = _mm256_loadu_ps(k->dy + i), z = _mm256_loadu_ps(k->dz + i);
+        __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+        __m256 da = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, ax), _mm256_mul_ps(y, ay)), _mm256_mul_ps(z, az));
+        __m256 q = _mm256_mul_ps(d2, aa);
+        __m256 num = fogvol__an_sel8(_mm256_cmp_ps(da, zero, _CMP_GT_OQ), _mm256_mul_ps(da, da),
+                                     _mm256_xor_ps(q, FOGVOL__AN_V8(-0.0f)));
+        __m256 c2 = _mm256_div_ps(num, fogvol__an_nz8(q));
+        pc = _mm256_min_ps(pc, fogvol__an_sel8(_mm256_cmp_ps(d2, zero, _CMP_GT_OQ), c2, one));
+        pl = _mm256_max_ps(pl, d2);
+    }
+    _mm256_storeu_ps(sx, pc), _mm256_storeu_ps(sy, pl);
+    fogvol__an_fcone_min(sx, sy, out);
+}
+#endif
+
+
+/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
+   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
+   does not evaluate, which can only be in a volume around the eye, never
+   skipped) lie in a cone around their sum A, of half angle theta, and are at
+   most lmax long (cone: fogvol__an_fcone_c's out). A volume whose bounding
+   sphere (fogvol__an_fvol) is further than lmax or outside that cone widened
+   by the sphere's half angle alpha (the angle between A and the sphere's
+   centre above theta + alpha) is missed by every ray, and so is a volume of
+   density 0. The float tests keep margins of 1e-4. */
+static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const float cone[5], unsigned char *skip)
+{
+    float ax = cone[0], ay = cone[1], az = cone[2], aa, ia, c2min = cone[3], l2max = cone[4], cth, sth, lmax;
+    int v;
+    aa = ax * ax + ay * ay + az * az;
     cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f; /* cos(theta), widened */
     sth = (float)FOGVOL_SQRT(1.0 - (double)cth * cth);
     lmax = (float)FOGVOL_SQRT((double)l2max) * 1.0001f + 1e-6f;
@@ -4431,19 +4527,20 @@ static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol_
 }
 
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
-static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
+static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn, fogvol__an_fcone_fn cone)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
     int base, i;
-    float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
+    float cn[5], limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
     c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         fogvol__an_fgather(c, base, nb, valid, &blk);
-        fogvol__an_fcull(c->set->count, fv, &blk, skip);
+        cone(&blk, cn);
+        fogvol__an_fcull(c->set->count, fv, cn, skip);
         fn(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
@@ -4483,6 +4580,18 @@ static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
     (void)k;
 #endif
     return fogvol__an_fblock_c;
+}
+
+/* The cone of fogvol__an_fcull a resolved level runs. */
+static fogvol__an_fcone_fn fogvol__an_fcone(fogvol_analytic_kernel k)
+{
+#if FOGVOL__AN_X86
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fcone_avx2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fcone_sse2;
+#else
+    (void)k;
+#endif
+    return fogvol__an_fcone_c;
 }
 
 /* The double kernel's gather of block `base` (checked: x - x is 0 for finite x only), padded with
@@ -4591,7 +4700,7 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
     c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
     c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
-    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
+    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern), fogvol__an_fcone(kern))) {
         c.bad = c.sorted = 0;
         c.moves = 0;
         fogvol__an_dbatch(&c);
