@@ -3999,15 +3999,14 @@ FOGVOL__AN_AVX2_INL int fogvol__an_quadric8(const fogvol__an_fvol *f, __m256 dx,
     return graze;
 }
 
-/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit, the
-   sums and the hit mask, accumulated where fogvol__an_fblock_body keeps them. */
-FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe, const double e[3],
-                                         const fogvol__an_fvol *f, int v, int base, fogvol__an_fblock *k)
+/* Volume v for the 8 vertices base .. base + 7 of the block: entry/exit into
+   t1/t2; returns the optical depth dens * len * chord (tv). */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_vol8(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
+                                           const double e[3], const fogvol__an_fvol *f, int v, int base, __m256 dx,
+                                           __m256 dy, __m256 dz, __m256 len, fogvol__an_fblock *k)
 {
     const __m256 zero = _mm256_setzero_ps();
-    __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base), dz = _mm256_loadu_ps(k->dz + base);
-    __m256 len = _mm256_loadu_ps(k->len + base), lo = zero, hi = zero, ch, tv, hm;
-    unsigned int *hw = k->hit[v >> 5] + base;
+    __m256 lo = zero, hi = zero, ch;
     int redo = 0xff;
     if (f->dbl) { /* every lane in double */
     } else if (f->shape == FOGVOL_SHAPE_DISTANCE || f->shape == FOGVOL_SHAPE_HALF_SPACE ||
@@ -4024,23 +4023,13 @@ FOGVOL__AN_AVX2_INL void fogvol__an_vol8(const fogvol_analytic_set *set, const f
         lo = _mm256_loadu_ps(k->lo + base), hi = _mm256_loadu_ps(k->hi + base), ch = _mm256_loadu_ps(k->ch + base);
     }
     lo = _mm256_min_ps(lo, hi);
-    tv = _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
-    hm = _mm256_cmp_ps(tv, zero, _CMP_GT_OQ);
-    _mm256_storeu_ps(k->tau + base, _mm256_add_ps(_mm256_loadu_ps(k->tau + base), tv));
-    _mm256_storeu_ps(k->r + base, _mm256_add_ps(_mm256_loadu_ps(k->r + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv)));
-    _mm256_storeu_ps(k->g + base, _mm256_add_ps(_mm256_loadu_ps(k->g + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv)));
-    _mm256_storeu_ps(k->bl + base,
-                     _mm256_add_ps(_mm256_loadu_ps(k->bl + base), _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv)));
-    _mm256_storeu_si256((__m256i *)(void *)hw,
-                        _mm256_or_si256(_mm256_loadu_si256((const __m256i *)(const void *)hw),
-                                        _mm256_and_si256(_mm256_castps_si256(hm),
-                                                         _mm256_set1_epi32((int)(1u << (v & 31))))));
     _mm256_storeu_ps(k->t1[v] + base, lo);
     _mm256_storeu_ps(k->t2[v] + base, _mm256_add_ps(lo, ch));
+    return _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
 }
 
-/* The volumes outside, the block's 4 groups of 8 inside: the groups' long
-   chains (square root, then division) are independent and overlap. */
+/* The block's 4 groups of 8 outside, the volumes inside: a group's sums and
+   hit mask stay in registers. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
                                                 const double e[3], const fogvol__an_fvol *fv,
                                                 const unsigned char *skip, float limit, int law, fogvol__an_fblock *k)
@@ -4049,17 +4038,30 @@ FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, c
     for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) {
         __m256 dx = _mm256_loadu_ps(k->dx + base), dy = _mm256_loadu_ps(k->dy + base);
         __m256 dz = _mm256_loadu_ps(k->dz + base), zero = _mm256_setzero_ps();
-        _mm256_storeu_ps(k->len + base, _mm256_sqrt_ps(_mm256_add_ps(
-                                            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                                            _mm256_mul_ps(dz, dz))));
-        _mm256_storeu_ps(k->tau + base, zero), _mm256_storeu_ps(k->r + base, zero);
-        _mm256_storeu_ps(k->g + base, zero), _mm256_storeu_ps(k->bl + base, zero);
+        __m256 len = _mm256_sqrt_ps(
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz)));
+        __m256 tau = zero, r = zero, g = zero, bl = zero;
+        __m256i hw = _mm256_setzero_si256();
+        _mm256_storeu_ps(k->len + base, len);
+        for (v = 0; v < set->count; ++v) {
+            if (!skip[v]) { /* fogvol__an_fcull */
+                const fogvol__an_fvol *f = &fv[v];
+                __m256 tv = fogvol__an_vol8(set, pe, e, f, v, base, dx, dy, dz, len, k);
+                __m256i bit = _mm256_set1_epi32((int)(1u << (v & 31)));
+                tau = _mm256_add_ps(tau, tv);
+                r = _mm256_add_ps(r, _mm256_mul_ps(FOGVOL__AN_V8(f->col[0]), tv));
+                g = _mm256_add_ps(g, _mm256_mul_ps(FOGVOL__AN_V8(f->col[1]), tv));
+                bl = _mm256_add_ps(bl, _mm256_mul_ps(FOGVOL__AN_V8(f->col[2]), tv));
+                hw = _mm256_or_si256(hw, _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps(tv, zero, _CMP_GT_OQ)), bit));
+            }
+            if ((v & 31) == 31 || v == set->count - 1) { /* a mask word done */
+                _mm256_storeu_si256((__m256i *)(void *)(k->hit[v >> 5] + base), hw);
+                hw = _mm256_setzero_si256();
+            }
+        }
+        _mm256_storeu_ps(k->tau + base, tau), _mm256_storeu_ps(k->r + base, r);
+        _mm256_storeu_ps(k->g + base, g), _mm256_storeu_ps(k->bl + base, bl);
     }
-    for (v = 0; v < (set->count + 31) / 32; ++v)
-        for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hit[v][i] = 0u;
-    for (v = 0; v < set->count; ++v)
-        if (!skip[v]) /* fogvol__an_fcull */
-            for (base = 0; base < FOGVOL__AN_BLOCK; base += 8) fogvol__an_vol8(set, pe, e, &fv[v], v, base, k);
     for (i = 0; i < FOGVOL__AN_BLOCK; ++i) k->hits[i] = 0.0f; /* 2: two volumes or more on the ray */
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
@@ -4185,21 +4187,20 @@ typedef struct fogvol__an_fcarry {
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
-   Returns the stretch count. With ex != NULL
-   (the EXP law) also each stretch's exp(-tau) and (1 - exp(-tau)) / sig (q),
-   here where they hang off no chain of the walk (tau = 0: q = 0); with
-   linear != 0 (the LINEAR law) it stops at the stretch that leaves no fog
-   (fogvol__an_flinear_walk's f, the same arithmetic). */
+   Returns the stretch count; also each stretch's exp(-tau) and
+   (1 - exp(-tau)) / sig (q), here where they hang off no chain of the walk
+   (tau = 0: q = 0). The EXP law's; the LINEAR laws walk the events
+   themselves (fogvol__an_flinear_events). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, float (*rgb)[3], float *sig, float *l, float *ex, float *q, int linear)
+                                 int m, float (*rgb)[3], float *sig, float *ex, float *q)
 {
-    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f, fl = 1.0f; /* scalars: kept in registers */
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
     for (k = 0; k < m; ++k) {
         int e = (int)(key[k] & 0xffu);
         const fogvol__an_fvol *f = &fv[e >> 1];
         uint32_t u = (uint32_t)(key[k] >> 32);
-        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
+        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln, om;
         memcpy(&t, &u, sizeof t);
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
@@ -4215,17 +4216,10 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             last = t;
             if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
         }
-        sig[n] = sg, l[n] = ln;
-        if (ex) {
-            float om;
-            ex[n] = fogvol__an_fexp2(sg * ln, &om);
-            q[n] = om / (sg + (float)(sg == 0.0f));
-        }
+        sig[n] = sg;
+        ex[n] = fogvol__an_fexp2(sg * ln, &om);
+        q[n] = om / (sg + (float)(sg == 0.0f));
         ++n;
-        if (linear && sg * ln > 0.0f) {
-            fl = sg * ln >= fl ? 0.0f : fl - sg * ln;
-            if (fl == 0.0f) break; /* the events after it change nothing */
-        }
     }
     return n;
 }
@@ -4251,25 +4245,47 @@ static void fogvol__an_fexp_walk(const float (*rgb)[3], const float *sig, const 
 
 /* The LINEAR law (each stretch takes tau = sig * l of the fog until none is
    left; colour weighted by the fog taken) and the paper's LINEAR_SEED colour
-   formula over n stretches, in float (fogvol__an_add's arithmetic). */
-static void fogvol__an_flinear_walk(const float (*rgb)[3], const float *sig, const float *l, int n, int law,
-                                    float *fog, float col[3])
+   formula, in float (fogvol__an_add's arithmetic), over the stretches of the
+   sorted events key[0..m) as fogvol__an_fstretches forms them, in the same
+   pass: it stops at the stretch that leaves no fog. */
+static void fogvol__an_flinear_events(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key,
+                                      const float *t2, int m, int law, float *fog, float col[3])
 {
-    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv; /* scalars: kept in registers */
-    int k;
-    for (k = 0; k < n && f > 0.0f; ++k) {
-        float sg = sig[k], ln = l[k], tau = sg * ln, a;
+    float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
+    float f = 1.0f, w = 0.0f, n0 = 0.0f, n1 = 0.0f, n2 = 0.0f, inv;
+    int k, open = 0;
+    for (k = 0; k < m && f > 0.0f; ++k) {
+        int e = (int)(key[k] & 0xffu);
+        const fogvol__an_fvol *fl = &fv[e >> 1];
+        uint32_t u = (uint32_t)(key[k] >> 32);
+        float t, sd = (e & 1) ? -fl->dens : fl->dens, sr, sgr, sb, sg, ln, tau, a;
+        memcpy(&t, &u, sizeof t);
+        if (mix == FOGVOL_MIX_SEPARATE) {
+            if (e & 1) continue;
+            sr = fl->col[0] * fl->dens, sgr = fl->col[1] * fl->dens, sb = fl->col[2] * fl->dens;
+            sg = fl->dens, ln = len * ((t2[(e >> 1) * FOGVOL__AN_BLOCK] + 0.0f) - t);
+        } else {
+            int was = open;
+            sr = ar, sgr = ag, sb = ab;
+            sg = ad, ln = (t - last) * len;
+            open += (e & 1) ? -1 : 1;
+            ar += sd * fl->col[0], ag += sd * fl->col[1], ab += sd * fl->col[2], ad += sd;
+            if (open == 0) ar = ag = ab = ad = 0.0f;
+            last = t;
+            if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
+        }
+        tau = sg * ln;
         if (!(tau > 0.0f)) continue;
         if (law == FOGVOL_FOG_LINEAR_SEED) {
-            n0 = rgb[k][0] / sg * f + n0 * (1.0f - f);
-            n1 = rgb[k][1] / sg * f + n1 * (1.0f - f);
-            n2 = rgb[k][2] / sg * f + n2 * (1.0f - f);
+            n0 = sr / sg * f + n0 * (1.0f - f);
+            n1 = sgr / sg * f + n1 * (1.0f - f);
+            n2 = sb / sg * f + n2 * (1.0f - f);
             f -= tau < 1.0f ? tau : 1.0f;
             f = f > 0.0f ? f : 0.0f;
             continue;
         }
         a = tau >= f ? f / tau : 1.0f;
-        n0 += rgb[k][0] * (ln * a), n1 += rgb[k][1] * (ln * a), n2 += rgb[k][2] * (ln * a);
+        n0 += sr * (ln * a), n1 += sgr * (ln * a), n2 += sb * (ln * a);
         w += tau * a;
         f = tau >= f ? 0.0f : f - tau;
     }
@@ -4290,7 +4306,7 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
                                       fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
 {
     uint64_t key[FOGVOL__AN_EVENTS];
-    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS], l[FOGVOL__AN_EVENTS];
+    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS];
     float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS];
     int m = 0, n, w, k, j, nw = (s->count + 31) / 32;
     for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
@@ -4322,13 +4338,12 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
     }
     for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
     carry->m = m;
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, l, law == FOGVOL_FOG_EXP ? ex : NULL, q,
-                              law == FOGVOL_FOG_LINEAR);
-    if (law == FOGVOL_FOG_EXP) {
-        fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
+    if (law != FOGVOL_FOG_EXP) {
+        fogvol__an_flinear_events(fv, mix, len, key, t2, m, law, fog, col);
         return;
     }
-    fogvol__an_flinear_walk((const float(*)[3])rgb, sig, l, n, law, fog, col);
+    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, ex, q);
+    fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
 }
 
 /* What a batch call works on, for the float kernels' loop. */
@@ -4372,25 +4387,80 @@ static void fogvol__an_fgather(fogvol__an_call *c, int base, int nb, unsigned ch
     }
 }
 
-/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
-   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
-   does not evaluate, which can only be in a volume around the eye, never
-   skipped) lie in a cone around their sum A, of half angle theta, and are at
-   most lmax long. A volume whose bounding sphere (fogvol__an_fvol) is further
-   than lmax or outside that cone widened by the sphere's half angle alpha
-   (the angle between A and the sphere's centre above theta + alpha) is
-   missed by every ray, and so is a volume of density 0. The float tests keep
-   margins of 1e-4. */
-static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol__an_fblock *k, unsigned char *skip)
+#if FOGVOL__AN_X86
+/* fogvol__an_fgather for a whole block with AVX2 gathers (byte offsets: a
+   stride up to 1 MB); the same tests and results. */
+FOGVOL__AN_AVX2_FN void fogvol__an_fgather_avx2(fogvol__an_call *c, int base, int nb, unsigned char *valid,
+                                                 fogvol__an_fblock *k)
 {
-    /* the lane loops keep 8 partial sums / minima / maxima (vectorisable without reassociation) */
-    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa, ia, c2min, l2max, cth, sth, lmax;
-    int i, j, v;
+    const float *src;
+    __m256 e8[3], lim = FOGVOL__AN_V8(c->dlim), nlim = FOGVOL__AN_V8(-c->dlim), zero = _mm256_setzero_ps();
+    __m256i off;
+    int g, j, d;
+    if (nb < FOGVOL__AN_BLOCK || c->stride > (1 << 20)) {
+        fogvol__an_fgather(c, base, nb, valid, k);
+        return;
+    }
+    src = (const float *)(const void *)(c->src + (size_t)base * (size_t)c->stride);
+    for (d = 0; d < 3; ++d) e8[d] = FOGVOL__AN_V8((float)c->e[d]);
+    off = _mm256_mullo_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(c->stride));
+    for (g = 0; g < FOGVOL__AN_BLOCK; g += 8) {
+        __m256 p[3], ok = c->eye_ok ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : zero, in = ok;
+        int mo, mi;
+        for (d = 0; d < 3; ++d) {
+            __m256 q;
+            p[d] = _mm256_i32gather_ps(src + d, off, 1);
+            q = _mm256_sub_ps(p[d], e8[d]);
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_sub_ps(p[d], p[d]), zero, _CMP_EQ_OQ));
+            in = _mm256_and_ps(in, _mm256_and_ps(_mm256_cmp_ps(q, lim, _CMP_LE_OQ), _mm256_cmp_ps(q, nlim, _CMP_GE_OQ)));
+        }
+        in = _mm256_and_ps(in, ok); /* valid 1: the float loops take it */
+        for (d = 0; d < 3; ++d) {
+            float *pk = d == 0 ? k->px : d == 1 ? k->py : k->pz, *dk = d == 0 ? k->dx : d == 1 ? k->dy : k->dz;
+            __m256 x = fogvol__an_sel8(in, p[d], e8[d]);
+            _mm256_storeu_ps(pk + g, x);
+            _mm256_storeu_ps(dk + g, _mm256_sub_ps(x, e8[d]));
+        }
+        mo = _mm256_movemask_ps(ok), mi = _mm256_movemask_ps(in);
+        for (j = 0; j < 8; ++j) valid[g + j] = (unsigned char)(((mo >> j) & 1) + ((mo & ~mi) >> j & 1));
+        for (j = 0; j < 8; ++j) c->bad += !((mo >> j) & 1);
+        off = _mm256_add_epi32(off, _mm256_set1_epi32(8 * c->stride));
+    }
+}
+#endif
+
+/* The lane loops of fogvol__an_fcull: the sum A of the block's rays and, over
+   the rays, the smallest cos^2 of the angle to A (-1 beyond 90 degrees) and
+   the largest squared length: out = {Ax, Ay, Az, cos^2 min, length^2 max}.
+   8 partial sums / minima / maxima, added up in one fixed order (the SIMD
+   levels below run the same operations in the same order). */
+typedef void (*fogvol__an_fcone_fn)(const fogvol__an_fblock *k, float out[5]);
+
+FOGVOL__AN_INLINE float fogvol__an_hsum8(const float *p)
+{
+    return ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]));
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fcone_end(const float *px, const float *py, const float *pz, float out[3])
+{
+    out[0] = fogvol__an_hsum8(px), out[1] = fogvol__an_hsum8(py), out[2] = fogvol__an_hsum8(pz);
+}
+
+FOGVOL__AN_INLINE void fogvol__an_fcone_min(const float *pc, const float *pl, float out[5])
+{
+    int j;
+    out[3] = pc[0], out[4] = pl[0];
+    for (j = 1; j < 8; ++j) out[3] = fogvol__an_fmin(out[3], pc[j]), out[4] = fogvol__an_fmax(out[4], pl[j]);
+}
+
+static void fogvol__an_fcone_c(const fogvol__an_fblock *k, float out[5])
+{
+    float px[8] = {0}, py[8] = {0}, pz[8] = {0}, pc[8], pl[8] = {0}, ax, ay, az, aa;
+    int i, j;
     for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
         for (j = 0; j < 8; ++j) px[j] += k->dx[i + j], py[j] += k->dy[i + j], pz[j] += k->dz[i + j];
-    ax = ((px[0] + px[1]) + (px[2] + px[3])) + ((px[4] + px[5]) + (px[6] + px[7]));
-    ay = ((py[0] + py[1]) + (py[2] + py[3])) + ((py[4] + py[5]) + (py[6] + py[7]));
-    az = ((pz[0] + pz[1]) + (pz[2] + pz[3])) + ((pz[4] + pz[5]) + (pz[6] + pz[7]));
+    fogvol__an_fcone_end(px, py, pz, out);
+    ax = out[0], ay = out[1], az = out[2];
     aa = ax * ax + ay * ay + az * az;
     for (j = 0; j < 8; ++j) pc[j] = 1.0f;
     for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
@@ -4401,8 +4471,91 @@ static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol_
             pc[j] = fogvol__an_fmin(pc[j], d2 > 0.0f ? c2 : 1.0f);
             pl[j] = fogvol__an_fmax(pl[j], d2);
         }
-    c2min = pc[0], l2max = pl[0];
-    for (j = 1; j < 8; ++j) c2min = fogvol__an_fmin(c2min, pc[j]), l2max = fogvol__an_fmax(l2max, pl[j]);
+    fogvol__an_fcone_min(pc, pl, out);
+}
+
+#if FOGVOL__AN_X86
+/* fogvol__an_fcone_c with 4 lanes (two halves of the 8 partial results) */
+__attribute__((target("sse2"))) static void fogvol__an_fcone_sse2(const fogvol__an_fblock *k, float out[5])
+{
+    __m128 px[2], py[2], pz[2], pc[2], pl[2], ax, ay, az, aa, zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    float sx[8], sy[8], sz[8], sc[8], sl[8];
+    int i, h;
+    for (h = 0; h < 2; ++h) px[h] = py[h] = pz[h] = pl[h] = zero, pc[h] = one;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (h = 0; h < 2; ++h) {
+            px[h] = _mm_add_ps(px[h], _mm_loadu_ps(k->dx + i + 4 * h));
+            py[h] = _mm_add_ps(py[h], _mm_loadu_ps(k->dy + i + 4 * h));
+            pz[h] = _mm_add_ps(pz[h], _mm_loadu_ps(k->dz + i + 4 * h));
+        }
+    for (h = 0; h < 2; ++h)
+        _mm_storeu_ps(sx + 4 * h, px[h]), _mm_storeu_ps(sy + 4 * h, py[h]), _mm_storeu_ps(sz + 4 * h, pz[h]);
+    fogvol__an_fcone_end(sx, sy, sz, out);
+    ax = _mm_set1_ps(out[0]), ay = _mm_set1_ps(out[1]), az = _mm_set1_ps(out[2]);
+    aa = _mm_set1_ps(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8)
+        for (h = 0; h < 2; ++h) {
+            __m128 x = _mm_loadu_ps(k->dx + i + 4 * h), y = _mm_loadu_ps(k->dy + i + 4 * h);
+            __m128 z = _mm_loadu_ps(k->dz + i + 4 * h);
+            __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
+            __m128 da = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, ax), _mm_mul_ps(y, ay)), _mm_mul_ps(z, az));
+            __m128 q = _mm_mul_ps(d2, aa), pos = _mm_cmpgt_ps(da, zero), in = _mm_cmpgt_ps(d2, zero);
+            __m128 num = _mm_or_ps(_mm_and_ps(pos, _mm_mul_ps(da, da)), _mm_andnot_ps(pos, _mm_xor_ps(q, _mm_set1_ps(-0.0f))));
+            __m128 c2 = _mm_div_ps(num, _mm_add_ps(q, _mm_and_ps(_mm_cmpeq_ps(q, zero), one)));
+            pc[h] = _mm_min_ps(pc[h], _mm_or_ps(_mm_and_ps(in, c2), _mm_andnot_ps(in, one)));
+            pl[h] = _mm_max_ps(pl[h], d2);
+        }
+    for (h = 0; h < 2; ++h) _mm_storeu_ps(sc + 4 * h, pc[h]), _mm_storeu_ps(sl + 4 * h, pl[h]);
+    fogvol__an_fcone_min(sc, sl, out);
+}
+
+/* fogvol__an_fcone_c with 8 lanes */
+FOGVOL__AN_AVX2_FN void fogvol__an_fcone_avx2(const fogvol__an_fblock *k, float out[5])
+{
+    __m256 px = _mm256_setzero_ps(), py = px, pz = px, pl = px, zero = px, one = FOGVOL__AN_V8(1.0f), pc = one;
+    __m256 ax, ay, az, aa;
+    float sx[8], sy[8], sz[8];
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) {
+        px = _mm256_add_ps(px, _mm256_loadu_ps(k->dx + i));
+        py = _mm256_add_ps(py, _mm256_loadu_ps(k->dy + i));
+        pz = _mm256_add_ps(pz, _mm256_loadu_ps(k->dz + i));
+    }
+    _mm256_storeu_ps(sx, px), _mm256_storeu_ps(sy, py), _mm256_storeu_ps(sz, pz);
+    fogvol__an_fcone_end(sx, sy, sz, out);
+    ax = FOGVOL__AN_V8(out[0]), ay = FOGVOL__AN_V8(out[1]), az = FOGVOL__AN_V8(out[2]);
+    aa = FOGVOL__AN_V8(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) {
+        __m256 x = _mm256_loadu_ps(k->dx + i), y = _mm256_loadu_ps(k->dy + i), z = _mm256_loadu_ps(k->dz + i);
+        __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+        __m256 da = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, ax), _mm256_mul_ps(y, ay)), _mm256_mul_ps(z, az));
+        __m256 q = _mm256_mul_ps(d2, aa);
+        __m256 num = fogvol__an_sel8(_mm256_cmp_ps(da, zero, _CMP_GT_OQ), _mm256_mul_ps(da, da),
+                                     _mm256_xor_ps(q, FOGVOL__AN_V8(-0.0f)));
+        __m256 c2 = _mm256_div_ps(num, fogvol__an_nz8(q));
+        pc = _mm256_min_ps(pc, fogvol__an_sel8(_mm256_cmp_ps(d2, zero, _CMP_GT_OQ), c2, one));
+        pl = _mm256_max_ps(pl, d2);
+    }
+    _mm256_storeu_ps(sx, pc), _mm256_storeu_ps(sy, pl);
+    fogvol__an_fcone_min(sx, sy, out);
+}
+#endif
+
+
+/* Which volumes no ray of block k can reach (skip[v] = 1): the rays from
+   the eye to the block's vertices (k->dx..dz; zero for the lanes the block
+   does not evaluate, which can only be in a volume around the eye, never
+   skipped) lie in a cone around their sum A, of half angle theta, and are at
+   most lmax long (cone: fogvol__an_fcone_c's out). A volume whose bounding
+   sphere (fogvol__an_fvol) is further than lmax or outside that cone widened
+   by the sphere's half angle alpha (the angle between A and the sphere's
+   centre above theta + alpha) is missed by every ray, and so is a volume of
+   density 0. The float tests keep margins of 1e-4. */
+static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const float cone[5], unsigned char *skip)
+{
+    float ax = cone[0], ay = cone[1], az = cone[2], aa, ia, c2min = cone[3], l2max = cone[4], cth, sth, lmax;
+    int v;
+    aa = ax * ax + ay * ay + az * az;
     cth = c2min > 0.0f ? (float)FOGVOL_SQRT((double)c2min) - 1e-4f : -1.0f; /* cos(theta), widened */
     sth = (float)FOGVOL_SQRT(1.0 - (double)cth * cth);
     lmax = (float)FOGVOL_SQRT((double)l2max) * 1.0001f + 1e-6f;
@@ -4416,19 +4569,25 @@ static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const fogvol_
 }
 
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
-static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn)
+static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn, fogvol__an_fcone_fn cone, int avx2)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
     int base, i;
-    float limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
+    float cn[5], limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
+    (void)avx2;
     c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
-        fogvol__an_fgather(c, base, nb, valid, &blk);
-        fogvol__an_fcull(c->set->count, fv, &blk, skip);
+#if FOGVOL__AN_X86
+        if (avx2) fogvol__an_fgather_avx2(c, base, nb, valid, &blk);
+        else
+#endif
+            fogvol__an_fgather(c, base, nb, valid, &blk);
+        cone(&blk, cn);
+        fogvol__an_fcull(c->set->count, fv, cn, skip);
         fn(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
@@ -4468,6 +4627,18 @@ static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
     (void)k;
 #endif
     return fogvol__an_fblock_c;
+}
+
+/* The cone of fogvol__an_fcull a resolved level runs. */
+static fogvol__an_fcone_fn fogvol__an_fcone(fogvol_analytic_kernel k)
+{
+#if FOGVOL__AN_X86
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fcone_avx2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fcone_sse2;
+#else
+    (void)k;
+#endif
+    return fogvol__an_fcone_c;
 }
 
 /* The double kernel's gather of block `base` (checked: x - x is 0 for finite x only), padded with
@@ -4576,7 +4747,8 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
     c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
     c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
-    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern))) {
+    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE ||
+        !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern), fogvol__an_fcone(kern), kern == FOGVOL_ANALYTIC_KERNEL_AVX2)) {
         c.bad = c.sorted = 0;
         c.moves = 0;
         fogvol__an_dbatch(&c);
