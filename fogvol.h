@@ -454,9 +454,9 @@ typedef struct fogvol_context_desc fogvol_context_desc;
    SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
                  no O read without occluders, no density texture outside textured volumes, exp or
                  ramp composite, no colour texture, no overflow test without show_overflow,
-                 target reads without the viewport offset where the pass's viewport starts at the
-                 window origin) instead of one program that switches on uniforms; built on first
-                 use (same pixels).
+                 target and engine-depth reads without the viewport offset where the viewport
+                 starts at the window origin) instead of one program that switches on uniforms;
+                 built on first use (same pixels).
    ALU           PS20 and MRT (not WIDE) take FOGVOL_VARIANT_ALU: the depth is encoded and the dither
                  row computed by arithmetic instead of three lookup texture reads per face fragment
                  (same bytes; fogvol_context_tier reports the variant).
@@ -1415,8 +1415,8 @@ typedef struct fogvol_shader_desc {
    RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
    for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
    dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). Every program:
-   ORIGIN (fogvol's targets are read at gl_FragCoord, without fv_screen.zw: for passes whose
-   viewport starts at the window origin, which passes into fogvol's own targets always do). Other
+   ORIGIN (the frame's viewport starts at the window origin: fogvol's targets and the engine's
+   depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). Other
    bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
@@ -5080,9 +5080,12 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
     "uniform vec4 fv_screen;\n"
     "uniform vec4 fv_dec;\n"
-    /* FV_PIXEL: the pixel of fogvol's targets; FV_ORIGIN (SPECIALIZE_ORIGIN): zw = 0, left out */
-    "#ifdef FV_ORIGIN\n#define FV_PIXEL gl_FragCoord.xy\n#else\n"
-    "#define FV_PIXEL (gl_FragCoord.xy + fv_screen.zw)\n#endif\n"
+    /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
+       texture (fv_nf.zw: the viewport's origin, declared by the programs that read it); FV_ORIGIN
+       (SPECIALIZE_ORIGIN, the viewport at the window origin): both offsets 0, left out */
+    "#ifdef FV_ORIGIN\n#define FV_PIXEL gl_FragCoord.xy\n#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy)\n#else\n"
+    "#define FV_PIXEL (gl_FragCoord.xy + fv_screen.zw)\n"
+    "#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy + fv_nf.zw)\n#endif\n"
     "vec2 fv_st() { return FV_PIXEL * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
@@ -5191,7 +5194,7 @@ static const char fogvol__fs_encode[] =
     "uniform sampler2D fv_opaque;\n"
     "uniform vec4 fv_nf;\n"
     "void main() {\n"
-    "    float depth = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float depth = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
@@ -5233,7 +5236,7 @@ static const char fogvol__fs_face[] =
     "uniform vec4 fv_speed;\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
@@ -5424,7 +5427,7 @@ static const char fogvol__fs_light[] =
     "}\n"
     "float fv_light_opaque() {\n"
     "#if defined(FV_FLOAT) && defined(FV_ENGINE_DEPTH)\n"
-    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    return fv_light_depth(FV_SCREEN(fv_opaque));\n"
@@ -5473,7 +5476,7 @@ static const char fogvol__fs_color_face[] =
     "uniform vec4 fv_emit;\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, ivec2(gl_FragCoord.xy + fv_nf.zw), 0).r;\n"
+    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
@@ -7325,6 +7328,13 @@ static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume
 
 static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits);
 
+/* SPECIALIZE_ORIGIN where the frame's viewport starts at the window origin (its offset, added to
+   every read of fogvol's targets and of the engine's depth, is 0) */
+static unsigned fogvol__origin_bit(const fogvol_context *ctx)
+{
+    return ctx->frame.viewport[0] == 0 && ctx->frame.viewport[1] == 0 ? (unsigned)FOGVOL_SPECIALIZE_ORIGIN : 0u;
+}
+
 /* After a sum pass (its state in *base): each density-textured volume of the group in a pass of
    its own with its texture and texture-coordinate rows (negative as in fogvol__draw_group).
    Returns the passes issued. */
@@ -7338,7 +7348,7 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
-        ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_ORIGIN); /* density texture */
+        ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__origin_bit(ctx)); /* density texture */
         ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
@@ -8038,7 +8048,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
     cp.cull = FOGVOL_CULL_NONE;
     cp.depth_test = cp.depth_write = single;
     cp.stencil_guard = 0;
-    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, FOGVOL_SPECIALIZE_ORIGIN);
+    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, fogvol__origin_bit(ctx));
     memset(cp.native_textures, 0, sizeof cp.native_textures);
     if (single) { /* the one sum target; V is the target here, not a texture */
         memset(cp.textures, 0, sizeof cp.textures);
@@ -8343,7 +8353,8 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
-    ps.program = ctx->prog[FOGVOL_PROGRAM_ENCODE];
+    ps.program = engine ? fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, fogvol__origin_bit(ctx))
+                        : ctx->prog[FOGVOL_PROGRAM_ENCODE];
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
@@ -8372,7 +8383,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_pass ps = run->base;
     unsigned char *peak = NULL;
     fogvol_result r;
-    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN; /* textured volumes: below */
+    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
@@ -8442,7 +8453,7 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
     if (ctx->tier != FOGVOL_TIER_PS13) return;
     ps->target = ctx->tgt_t;
-    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, FOGVOL_SPECIALIZE_ORIGIN);
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx));
     ctx->be.begin_pass(ctx->be.user_data, ps);
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
@@ -8478,7 +8489,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
-    if (fd->viewport[0] == 0 && fd->viewport[1] == 0) spec |= FOGVOL_SPECIALIZE_ORIGIN;
+    spec |= fogvol__origin_bit(ctx);
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;

@@ -767,10 +767,9 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     /* resources identified by what they are, not by creation order */
     enc = rec_program(r, FOGVOL_PROGRAM_ENCODE);
     /* the passes run programs built for their configuration: occluders, so the faces read O, no density
-       texture, target space (ORIGIN); extinction ramps reaching 7 / density: the exp() composite
-       (FAST_EXP), no colour texture, no show_overflow; the viewport starts at (A_X0, A_Y0): target reads
-       with the offset (no ORIGIN) */
-    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN));
+       texture; extinction ramps reaching 7 / density: the exp() composite (FAST_EXP), no colour
+       texture, no show_overflow; the viewport starts at (A_X0, A_Y0): reads with the offset (no ORIGIN) */
+    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY));
     comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
                                                              FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                                                              FOGVOL_SPECIALIZE_NO_OVERFLOW));
