@@ -452,7 +452,8 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
                  overflow check passes likewise.
    SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
-                 no O read without occluders, no density texture outside textured volumes, exp or
+                 no O read without occluders (and no test for it with them), no density texture
+                 outside textured volumes, exp or
                  ramp composite, no colour texture, no overflow test without show_overflow,
                  target and engine-depth reads without the viewport offset where the viewport
                  starts at the window origin) instead of one program that switches on uniforms;
@@ -1410,7 +1411,9 @@ typedef struct fogvol_shader_desc {
 
 /* fogvol_shader_desc.specialize: parts of a program left out at compile time. FACE: NO_OPAQUE (the
    opaque depth O is the far plane and not read: FLOAT without ENGINE_DEPTH, PS20, PS13, MRT; no
-   effect on COUNT, WIDE or ENGINE_DEPTH, which read other sources), NO_DENSITY (no density texture).
+   effect on COUNT, WIDE or ENGINE_DEPTH, which read other sources), OPAQUE (FLOAT: O read at every
+   fragment, without the uniform that lets the general program skip it), NO_DENSITY (no density
+   texture).
    COMPOSITE and COMPOSITE_MESH: EXP (alpha = 1 - exp(-density t) from fv_speed, no ramp texture) or
    RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
    for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
@@ -1426,7 +1429,8 @@ enum {
     FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE = 1u << 4,
     FOGVOL_SPECIALIZE_ORIGIN = 1u << 5,
     FOGVOL_SPECIALIZE_NO_OVERFLOW = 1u << 6,
-    FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7
+    FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7,
+    FOGVOL_SPECIALIZE_OPAQUE = 1u << 8
 };
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -5240,7 +5244,9 @@ static const char fogvol__fs_face[] =
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
-    "#ifndef FV_NO_OPAQUE\n"
+    "#if defined(FV_OPAQUE)\n"
+    "    o = FV_SCREEN(fv_opaque).r;\n"
+    "#elif !defined(FV_NO_OPAQUE)\n"
     "    if (fv_speed.x < 0.5) o = FV_SCREEN(fv_opaque).r;\n"
     "#endif\n"
     "#endif\n"
@@ -5643,10 +5649,11 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 /* fogvol_shader_desc.specialize: the bits a program accepts (FOGVOL_SPECIALIZE_*). */
 static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
 {
-    unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY;
+    unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE;
     unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                     FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
+    if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program */
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
@@ -5671,6 +5678,8 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_FAST_EXP) strings[n++] = "#define FV_FAST_EXP\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
+    if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
+        strings[n++] = "#define FV_OPAQUE\n";
     if (d->program != FOGVOL_PROGRAM_FACE && comp[(d->specialize >> 2) & 7u][0])
         strings[n++] = comp[(d->specialize >> 2) & 7u];
     return n;
@@ -8385,6 +8394,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_result r;
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
+    else if (ctx->tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
     ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;

@@ -15,10 +15,11 @@
 /* The documented rule of fogvol_shader_desc.specialize: which bits a program takes. */
 static int spec_applies(int p, unsigned bits)
 {
-    const unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY;
+    const unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE;
     const unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                           FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
+    if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program takes it */
     if (!bits) return 1;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
@@ -42,7 +43,9 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
                                          FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
                                      FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_OVERFLOW,
-                                     FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_NO_OPAQUE};
+                                     FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE,
+                                     FOGVOL_SPECIALIZE_OPAQUE | FOGVOL_SPECIALIZE_NO_OPAQUE};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;

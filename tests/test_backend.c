@@ -242,7 +242,7 @@ typedef struct rec {
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 256; ++k) { /* every program, every set of specialize bits */
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 512; ++k) { /* every program, every set of specialize bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
