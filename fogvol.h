@@ -1417,7 +1417,8 @@ typedef struct fogvol_shader_desc {
    COMPOSITE and COMPOSITE_MESH: EXP (alpha = 1 - exp(-density t) from fv_speed, no ramp texture) or
    RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
    for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
-   dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). Every program:
+   dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). ENCODE and FACE:
+   DITHER (the dither on, fv_dith.x = 255: the integer ALU encode without the test). Every program:
    ORIGIN (the frame's viewport starts at the window origin: fogvol's targets and the engine's
    depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). Other
    bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
@@ -1430,7 +1431,8 @@ enum {
     FOGVOL_SPECIALIZE_ORIGIN = 1u << 5,
     FOGVOL_SPECIALIZE_NO_OVERFLOW = 1u << 6,
     FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7,
-    FOGVOL_SPECIALIZE_OPAQUE = 1u << 8
+    FOGVOL_SPECIALIZE_OPAQUE = 1u << 8,
+    FOGVOL_SPECIALIZE_DITHER = 1u << 9
 };
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -5105,7 +5107,11 @@ static const char fogvol__fs_common[] =
     "float fv_engine_view_depth(vec2 st, float z) {\n"
     "    vec4 q = vec4(st, z, 1.0);\n"
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
-    "}\n"
+    "}\n";
+
+/* The RGBA8 tiers' encode (lookup textures or ALU, the dither) and the borrow fold: the second
+   string of the shared fragment code (one string would pass the 4095 characters C99 guarantees). */
+static const char fogvol__fs_encode_common[] =
     "#if !defined(FV_FLOAT)\n"
     "uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
@@ -5132,7 +5138,11 @@ static const char fogvol__fs_common[] =
     "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
     "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n"
     "    highp int dd = int(fv_dith.z);\n"
+    "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
+    "    return (((s.x << 1) | s.y) * dd) >> 8;\n"
+    "#else\n"
     "    return fv_dith.x > 0.5 ? (((s.x << 1) | s.y) * dd) >> 8 : dd >> 1;\n"
+    "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
     "float fv_dither_row() {\n"
@@ -5634,6 +5644,7 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
     }
     if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
     strings[n++] = fogvol__fs_common;
+    strings[n++] = fogvol__fs_encode_common;
     switch (d->program) {
     case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
     case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
@@ -5655,6 +5666,7 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program */
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
@@ -5676,6 +5688,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_ORIGIN) strings[n++] = "#define FV_ORIGIN\n";
     if (d->specialize & FOGVOL_SPECIALIZE_NO_OVERFLOW) strings[n++] = "#define FV_NO_SAT\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FAST_EXP) strings[n++] = "#define FV_FAST_EXP\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_DITHER) strings[n++] = "#define FV_DITHER_ON\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -7337,6 +7350,12 @@ static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume
 
 static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits);
 
+/* SPECIALIZE_DITHER where the encode computes by integer ALU with the dither on */
+static unsigned fogvol__dither_bit(const fogvol_context *ctx)
+{
+    return ctx->dither && fogvol__has(ctx, FOGVOL_VARIANT_ALU) ? (unsigned)FOGVOL_SPECIALIZE_DITHER : 0u;
+}
+
 /* SPECIALIZE_ORIGIN where the frame's viewport starts at the window origin (its offset, added to
    every read of fogvol's targets and of the engine's depth, is 0) */
 static unsigned fogvol__origin_bit(const fogvol_context *ctx)
@@ -8362,8 +8381,8 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
-    ps.program = engine ? fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, fogvol__origin_bit(ctx))
-                        : ctx->prog[FOGVOL_PROGRAM_ENCODE];
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, (engine ? fogvol__origin_bit(ctx) : 0u) |
+                                                                 fogvol__dither_bit(ctx));
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
@@ -8395,6 +8414,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     else if (ctx->tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
+    spec |= fogvol__dither_bit(ctx);
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
     ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;

@@ -4,8 +4,8 @@
    FOGVOL_ERROR_UNSUPPORTED and no strings. The per-sample fragment shaders
    (fogvol_shader_desc.samples = 4, where fogvol_msaa_supported) go to
    <tier>_v<variants>_<program>_<dialect>_ms.frag. The programs built for one configuration
-   (fogvol_shader_desc.specialize) that fogvol's renderer uses, FACE and COMPOSITE, get _s<bits>
-   before the extension; other programs must refuse those bits. */
+   (fogvol_shader_desc.specialize) get _s<bits> before the extension; a program must refuse the
+   bits it does not take (spec_applies). */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -21,6 +21,7 @@ static int spec_applies(int p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program takes it */
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
     if (!bits) return 1;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
@@ -45,7 +46,10 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_OVERFLOW,
                                      FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_NO_OPAQUE,
                                      FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE,
-                                     FOGVOL_SPECIALIZE_OPAQUE | FOGVOL_SPECIALIZE_NO_OPAQUE};
+                                     FOGVOL_SPECIALIZE_OPAQUE | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE |
+                                         FOGVOL_SPECIALIZE_DITHER};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;

@@ -242,7 +242,7 @@ typedef struct rec {
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 512; ++k) { /* every program, every set of specialize bits */
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 1024; ++k) { /* every program, every set of specialize bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
@@ -765,11 +765,11 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     assert_int_equal(r->nb.frames_begun, r->nb.frames_ended);
 
     /* resources identified by what they are, not by creation order */
-    enc = rec_program(r, FOGVOL_PROGRAM_ENCODE);
+    enc = rec_program(r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER)); /* the ALU encode, dither on */
     /* the passes run programs built for their configuration: occluders, so the faces read O, no density
        texture; extinction ramps reaching 7 / density: the exp() composite (FAST_EXP), no colour
        texture, no show_overflow; the viewport starts at (A_X0, A_Y0): reads with the offset (no ORIGIN) */
-    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY));
+    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER));
     comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
                                                              FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                                                              FOGVOL_SPECIALIZE_NO_OVERFLOW));
@@ -1157,7 +1157,7 @@ static void test_a3_frame_protocol(void **state)
     assert_int_equal(cb.calls, 1);
     assert_int_equal(cb.pass_count_at_call, 1); /* inside pass 0 ... */
     assert_int_equal(cb.in_pass_at_call, 1);
-    assert_int_equal(cb.program_at_call, rec_program(&r, FOGVOL_PROGRAM_ENCODE)); /* ... the O pass */
+    assert_int_equal(cb.program_at_call, rec_program(&r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER)));
     assert_int_equal(cb.transform_result, FOGVOL_SUCCESS);
     assert_int_equal(cb.nan_result, FOGVOL_ERROR_INVALID_ARGUMENT);
     assert_int_equal(cb.nset_after, 1); /* the transform reached the backend as set_draw */
@@ -1834,10 +1834,11 @@ static void test_a5_target_faults(void **state)
         assert_int_equal(st.passes, 4);
         assert_int_equal(st.volumes, 1);
         assert_int_equal(r.nb.pass_count, 4);
-        /* three targets, and the two programs built on first use for this configuration (faces
-           without occluders or density texture, exp() composite without colour texture) */
-        assert_int_equal(r.nb.creates - r.nb.destroys, live + 5);
-        live += 2;
+        /* three targets, and the three programs built on first use for this configuration (the O
+           pass's encode with the dither on, faces without occluders or density texture, exp()
+           composite without colour texture) */
+        assert_int_equal(r.nb.creates - r.nb.destroys, live + 6);
+        live += 3;
         assert_int_equal(r.nb.frames_begun, 2);
         assert_int_equal(r.nb.frames_ended, 2);
         /* and a target failure on a resize is handled the same way */
