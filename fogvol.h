@@ -4574,27 +4574,31 @@ static void fogvol__an_fcull(int count, const fogvol__an_fvol *fv, const float c
     }
 }
 
+/* What a resolved float level runs for each block: its gather, the cone of its culling and its kernel. */
+typedef void (*fogvol__an_fgather_fn)(fogvol__an_call *c, int base, int nb, unsigned char *valid,
+                                      fogvol__an_fblock *k);
+typedef struct fogvol__an_flevel {
+    fogvol__an_fgather_fn gather;
+    fogvol__an_fcone_fn cone;
+    fogvol__an_fblock_fn block;
+} fogvol__an_flevel;
+
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
-static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn, fogvol__an_fcone_fn cone, int avx2)
+static int fogvol__an_fbatch(fogvol__an_call *c, const fogvol__an_flevel *lv)
 {
     fogvol__an_fblock blk;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
     int base, i;
     float cn[5], limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
-    (void)avx2;
     c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
-#if FOGVOL__AN_X86
-        if (avx2) fogvol__an_fgather_avx2(c, base, nb, valid, &blk);
-        else
-#endif
-            fogvol__an_fgather(c, base, nb, valid, &blk);
-        cone(&blk, cn);
+        lv->gather(c, base, nb, valid, &blk);
+        lv->cone(&blk, cn);
         fogvol__an_fcull(c->set->count, fv, cn, skip);
-        fn(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
+        lv->block(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
             float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
@@ -4623,28 +4627,19 @@ static int fogvol__an_fbatch(fogvol__an_call *c, fogvol__an_fblock_fn fn, fogvol
     return 1;
 }
 
-/* The float kernel a resolved level runs. */
-static fogvol__an_fblock_fn fogvol__an_fkernel(fogvol_analytic_kernel k)
+/* The functions of a resolved float level (SSE2 gathers with the C loop). */
+static fogvol__an_flevel fogvol__an_flevel_of(fogvol_analytic_kernel k)
 {
+    fogvol__an_flevel lv;
+    lv.gather = fogvol__an_fgather, lv.cone = fogvol__an_fcone_c, lv.block = fogvol__an_fblock_c;
 #if FOGVOL__AN_X86
-    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fblock_avx2;
-    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fblock_sse2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2)
+        lv.gather = fogvol__an_fgather_avx2, lv.cone = fogvol__an_fcone_avx2, lv.block = fogvol__an_fblock_avx2;
+    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) lv.cone = fogvol__an_fcone_sse2, lv.block = fogvol__an_fblock_sse2;
 #else
     (void)k;
 #endif
-    return fogvol__an_fblock_c;
-}
-
-/* The cone of fogvol__an_fcull a resolved level runs. */
-static fogvol__an_fcone_fn fogvol__an_fcone(fogvol_analytic_kernel k)
-{
-#if FOGVOL__AN_X86
-    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) return fogvol__an_fcone_avx2;
-    if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) return fogvol__an_fcone_sse2;
-#else
-    (void)k;
-#endif
-    return fogvol__an_fcone_c;
+    return lv;
 }
 
 /* The double kernel's gather of block `base` (checked: x - x is 0 for finite x only), padded with
@@ -4729,6 +4724,7 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     double e[3];
     int m;
     fogvol_analytic_kernel kern;
+    fogvol__an_flevel lv;
     if (invalid) *invalid = 0;
     if (!fogvol__an_args_ok(set, law, mix)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     kern = fogvol_analytic_kernel_resolve((fogvol_analytic_kernel)set->kernel);
@@ -4753,8 +4749,8 @@ FOGVOL_API fogvol_result fogvol_analytic_batch(const fogvol_analytic_set *set, c
     c.law = (int)law, c.mix = (int)mix, c.count = count, c.stride = stride ? stride : 12;
     c.fog_out = fog_out, c.fog_stride = fog_stride ? fog_stride : 4;
     c.color_out = color_out, c.color_stride = color_stride ? color_stride : 12;
-    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE ||
-        !fogvol__an_fbatch(&c, fogvol__an_fkernel(kern), fogvol__an_fcone(kern), kern == FOGVOL_ANALYTIC_KERNEL_AVX2)) {
+    lv = fogvol__an_flevel_of(kern);
+    if (kern == FOGVOL_ANALYTIC_KERNEL_DOUBLE || !fogvol__an_fbatch(&c, &lv)) {
         c.bad = c.sorted = 0;
         c.moves = 0;
         fogvol__an_dbatch(&c);
