@@ -5120,24 +5120,24 @@ static const char fogvol__fs_encode_common[] =
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
     "#define FV_IALU\n"
     "highp int fv_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n"
-    "highp int fv_dither_row_i() {\n"
-    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
-    "    highp int x = p.x ^ p.y, dd = int(fv_dith.z);\n"
-    "    highp int v = ((x & 1) << 5) | ((p.y & 1) << 4) | ((x & 2) << 2) | ((p.y & 2) << 1) | ((x & 4) >> 1) |\n"
-    "                  ((p.y & 4) >> 2);\n"
-    "    return fv_dith.x > 0.5 ? (((v * dd) >> 6) + (dd >> 1)) & (dd - 1) : 0;\n"
-    "}\n"
-    "float fv_dither_row() { return float(fv_dither_row_i()); }\n"
-    /* the encode's offset (row + D/2) mod D = (v D) >> 6 (v: the 8x8 index above; the dither off:
-       D/2); v's bits spread in two multiplies: (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2 */
-    "highp int fv_dither_offset_i() {\n"
+    /* fv_dither_scaled_i: (v D) >> 6, v the 8x8 index of fogvol_make_dither_index (bits 5..0: x0 y0
+       x1 y1 x2 y2 of x = px ^ py, y = py); (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2, so the
+       two spread 3-bit values make 4 v */
+    "highp int fv_dither_scaled_i() {\n"
     "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
     "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n"
+    "    return (((s.x << 1) | s.y) * int(fv_dith.z)) >> 8;\n"
+    "}\n"
+    "float fv_dither_row() {\n"
     "    highp int dd = int(fv_dith.z);\n"
+    "    return fv_dith.x > 0.5 ? float((fv_dither_scaled_i() + (dd >> 1)) & (dd - 1)) : 0.0;\n"
+    "}\n"
+    /* the encode's offset (row + D/2) mod D = (v D) >> 6 (the dither off: D/2) */
+    "highp int fv_dither_offset_i() {\n"
     "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
-    "    return (((s.x << 1) | s.y) * dd) >> 8;\n"
+    "    return fv_dither_scaled_i();\n"
     "#else\n"
-    "    return fv_dith.x > 0.5 ? (((s.x << 1) | s.y) * dd) >> 8 : dd >> 1;\n"
+    "    return fv_dith.x > 0.5 ? fv_dither_scaled_i() : int(fv_dith.z) >> 1;\n"
     "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */

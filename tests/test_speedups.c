@@ -8,6 +8,8 @@
    exp() by at most 1/255; the sums themselves (debug_thickness) are bit-identical throughout.
    A viewport away from the window origin gives the same pixels, shifted, as one at the origin (the
    composite reads fogvol's targets with the offset there, without it at the origin).
+   PS20 + WIDE with FOGVOL_VARIANT_ALU gives the lookup textures' sums bit for bit (the integer
+   dither row of the wide encode).
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -48,6 +50,7 @@ typedef struct run_out {
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
    (g_x0, g_y0) of g's buffer, whose pixels outside it must keep the clear colour */
 static int g_x0, g_y0;
+static unsigned g_variants; /* fogvol_context_desc.variants */
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
 {
     fogvol_context_desc cd;
@@ -62,6 +65,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.logger.func = logger;
     cd.tier = t;
     cd.disable_speedups = off;
+    cd.variants = g_variants;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
     upload_meshes(fv, s, meshes);
     memset(&rd, 0, sizeof rd);
@@ -242,10 +246,35 @@ static void test_viewport_offset(void **state)
     glu_destroy(&g);
 }
 
+/* FOGVOL_VARIANT_ALU with WIDE (asked for explicitly; the ALU speed-up leaves WIDE alone): the
+   18-bit sums by arithmetic, the dither row included, are the lookup textures' bytes. */
+static void test_wide_alu(void **state)
+{
+    static run_out tex, alu;
+    const tscene *s = &g_scenes[scene_index("layers_opaque_between")];
+    glu_ctx g;
+    int f, n, covered = 0;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    g_variants = FOGVOL_VARIANT_WIDE;
+    run_frames(s, FOGVOL_TIER_PS20, 0, &g, &tex);
+    g_variants = FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ALU;
+    run_frames(s, FOGVOL_TIER_PS20, 0, &g, &alu);
+    g_variants = 0;
+    for (f = 0; f < NFRAMES; ++f) {
+        assert_memory_equal(alu.th[f], tex.th[f], sizeof tex.th[f]);
+        assert_int_equal(max_diff(alu.px[f], tex.px[f], &n), 0);
+    }
+    for (n = 0; n < W * H; ++n) covered += tex.th[2][n] > 0.0f;
+    print_message("# PS20+wide: ALU = lookup textures bit for bit, %d pixels with thickness\n", covered);
+    assert_true(covered > W * H / 8);
+    glu_destroy(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
-                                       cmocka_unit_test(test_viewport_offset)};
+                                       cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu)};
     int r;
     build_scenes();
     r = cmocka_run_group_tests(tests, NULL, NULL);
