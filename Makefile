@@ -23,7 +23,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test demo images fuzz run examples bench bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web
 
 all: test
@@ -64,6 +64,7 @@ test_cpu_LIBS          = -lcmocka -lm
 test_gles_LIBS         = -lcmocka -lEGL -lGLESv2 -lm
 test_engine_msaa_FLAGS = -D_POSIX_C_SOURCE=200809L
 dump_shaders_LIBS      = -lm
+gl_compile_LIBS        = -lEGL -lm
 libs_of = $(or $($(1)_LIBS),$(TEST_LIBS))
 
 $(BUILD)/%: tests/%.c $(TEST_DEPS) | $(BUILD)
@@ -86,13 +87,19 @@ TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
             $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
-            $(BUILD)/demo_headless $(BUILD)/bench
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile
+
+# every shader dump_shaders writes, compiled and linked by an EGL driver (Mesa's llvmpipe here;
+# make gl-compile on a machine with a GPU driver)
+GL_COMPILE = mkdir -p $(BUILD)/shaders_gl && rm -f $(BUILD)/shaders_gl/*.vert $(BUILD)/shaders_gl/*.frag && \
+             $(BUILD)/dump_shaders $(BUILD)/shaders_gl > /dev/null && $(BUILD)/gl_compile $(BUILD)/shaders_gl
 
 # name=command lines for tests/run.sh, besides the cmocka programs
 SCRIPT_RUNS = \
   "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
   "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
+  "gl_compile=$(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
@@ -150,6 +157,20 @@ examples: deps-demo deps-run
 
 $(BUILD)/bench: bench/bench.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+# the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
+# build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
+$(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 -O2 $(WARN) -DBENCH_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
+
+gl-compile: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/dump_shaders $(BUILD)/gl_compile
+	@$(GL_COMPILE) | grep -v '^ok '
+
+bench-egl: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/bench_egl $(BUILD)/bench_analytic
+	$(BUILD)/bench_analytic | tee $(BUILD)/bench_analytic.txt
+	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench_egl
 
 # full run, 5-6 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run); the
 # analytic fog's figures (bench_analytic, run first) join its summary line

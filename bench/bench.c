@@ -22,16 +22,23 @@
    Fog time per frame = glFinish .. fog work .. glFinish (the engine's opaque
    pass is drawn before the clock starts; for MRT it is the engine pass that
    writes O, so the MRT time is the whole frame minus the median plain engine
-   pass of the same scene). Medians of many frames after warm-up.
+   pass of the same scene). Medians of many frames after warm-up. Under OSMesa
+   the clock is the wall clock; built with -DBENCH_EGL (make bench-egl, for a
+   GPU driver through EGL) it is GPU timestamps taken at the same points.
 
    usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
                                prints only; --scene I: scene I alone, prints only)
-   full run: prints the tables, writes bench/RESULTS.md and bench/plot.png */
+   full run: prints the tables, writes bench/RESULTS.md and bench/plot.png
+   (BENCH_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
-#define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
+#define GL_GLEXT_PROTOTYPES /* libOSMesa (or, with BENCH_EGL, libOpenGL) exports the GL entry points */
 #include "tests/gl_util.h"
 #include <GL/glext.h>
+#ifdef BENCH_EGL
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#endif
 #include "tests/shapes.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
@@ -78,6 +85,142 @@ static double now_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+/* ---- the GL context: OSMesa (llvmpipe), or with BENCH_EGL any EGL device
+   (a GPU driver through glvnd; Mesa's software device here) ----------------- */
+#ifdef BENCH_EGL
+#define BENCH_MD "bench/RESULTS-gpu.md"
+#define BENCH_PNG "bench/plot-gpu.png"
+#define BENCH_FRAMES 41 /* GPU frames are short: more of them for the medians */
+#define BENCH_EGL_OR(a, b) a
+typedef struct bench_ctx {
+    EGLDisplay dpy;
+    EGLContext ctx;
+    EGLSurface surf;
+} bench_ctx;
+
+static void (*bench_proc(const char *name, void *user))(void)
+{
+    (void)user;
+    return (void (*)(void))eglGetProcAddress(name);
+}
+
+/* EGL_EXT_platform_device: device FOGVOL_BENCH_EGL_DEVICE (default 0), else
+   the default display */
+static EGLDisplay bench_display(void)
+{
+    PFNEGLQUERYDEVICESEXTPROC query = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLDeviceEXT dev[16];
+    EGLint n = 0;
+    const char *pick = getenv("FOGVOL_BENCH_EGL_DEVICE");
+    int want = pick ? atoi(pick) : 0;
+    if (query && get && query(16, dev, &n) && n > 0) {
+        EGLDisplay d = get(EGL_PLATFORM_DEVICE_EXT, dev[want >= 0 && want < n ? want : 0], NULL);
+        fprintf(stderr, "EGL: %d device(s), using device %d\n", (int)n, want >= 0 && want < n ? want : 0);
+        if (d != EGL_NO_DISPLAY) return d;
+    }
+    return eglGetDisplay(EGL_DEFAULT_DISPLAY);
+}
+
+/* a 3.3 core context current on a 64x64 pbuffer (the bench draws into its own framebuffers) */
+static int bench_create(bench_ctx *c)
+{
+    static const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                      EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
+                                      EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8, EGL_NONE};
+    static const EGLint pb_attr[] = {EGL_WIDTH, 64, EGL_HEIGHT, 64, EGL_NONE};
+    static const EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    EGLConfig cfg;
+    EGLint major, minor, n = 0;
+    memset(c, 0, sizeof *c);
+    c->dpy = bench_display();
+    if (c->dpy == EGL_NO_DISPLAY || !eglInitialize(c->dpy, &major, &minor)) return 0;
+    if (!eglBindAPI(EGL_OPENGL_API)) return 0;
+    if (!eglChooseConfig(c->dpy, cfg_attr, &cfg, 1, &n) || n < 1) return 0;
+    c->surf = eglCreatePbufferSurface(c->dpy, cfg, pb_attr);
+    if (c->surf == EGL_NO_SURFACE) return 0;
+    c->ctx = eglCreateContext(c->dpy, cfg, EGL_NO_CONTEXT, ctx_attr);
+    if (c->ctx == EGL_NO_CONTEXT) return 0;
+    return eglMakeCurrent(c->dpy, c->surf, c->surf, c->ctx) == EGL_TRUE;
+}
+
+static void bench_destroy(bench_ctx *c)
+{
+    eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (c->ctx != EGL_NO_CONTEXT) eglDestroyContext(c->dpy, c->ctx);
+    if (c->surf != EGL_NO_SURFACE) eglDestroySurface(c->dpy, c->surf);
+    eglTerminate(c->dpy);
+}
+#else
+#define BENCH_MD "bench/RESULTS.md"
+#define BENCH_PNG "bench/plot.png"
+#define BENCH_FRAMES 15
+#define BENCH_EGL_OR(a, b) b
+typedef glu_ctx bench_ctx;
+#define bench_proc glu_proc
+static int bench_create(bench_ctx *c)
+{
+    return glu_create(c, 64, 64, 1);
+}
+#define bench_destroy glu_destroy
+#endif
+
+/* The clock of the GPU work. Under OSMesa the GL runs on the CPU and a
+   reading is the wall clock after glFinish. On a GPU (g_gpu_clock) a reading
+   is a GL_TIMESTAMP query, resolved later: a start is issued after a glFinish
+   (the GPU idle), an end before one (the GPU stamps it once every command
+   before it is done), so an interval is the GPU timeline of the work between,
+   without glFinish's round trip. */
+typedef struct tick {
+    double ms;
+    GLuint q;
+} tick;
+#define NQUERY 64
+static int g_gpu_clock;
+static GLuint g_query[NQUERY];
+static unsigned g_nquery;
+
+static tick tick_at(int end)
+{
+    tick t;
+    t.q = 0;
+    if (g_gpu_clock && end) {
+        t.q = g_query[g_nquery++ % NQUERY];
+        glQueryCounter(t.q, GL_TIMESTAMP);
+    }
+    glFinish();
+    t.ms = now_ms();
+    if (g_gpu_clock && !end) {
+        t.q = g_query[g_nquery++ % NQUERY];
+        glQueryCounter(t.q, GL_TIMESTAMP);
+    }
+    return t;
+}
+#define tick_start() tick_at(0)
+#define tick_end() tick_at(1)
+
+static double tick_ms(tick a, tick b)
+{
+    GLuint64 x = 0, y = 0;
+    if (!g_gpu_clock) return b.ms - a.ms;
+    glGetQueryObjectui64v(a.q, GL_QUERY_RESULT, &x);
+    glGetQueryObjectui64v(b.q, GL_QUERY_RESULT, &y);
+    return (double)(y - x) / 1e6;
+}
+
+/* GPU timestamps where the context has them (GL_TIMESTAMP counter bits > 0), BENCH_EGL builds only */
+static void clock_init(void)
+{
+#ifdef BENCH_EGL
+    GLint bits = 0;
+    glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
+    g_gpu_clock = bits > 0 && getenv("FOGVOL_BENCH_WALL_CLOCK") == NULL;
+    if (g_gpu_clock) glGenQueries(NQUERY, g_query);
+#endif
 }
 
 static int cmp_d(const void *a, const void *b)
@@ -520,26 +663,21 @@ typedef struct pass_timer {
     void (*begin_pass)(void *, const fogvol_pass *);
     void (*end_pass)(void *);
     int on, pass;
-    double t0, ms[MAXPASS], engine_ms;
+    tick t0;
+    double ms[MAXPASS], engine_ms;
 } pass_timer;
 static pass_timer g_pt;
 
 static void pt_begin_pass(void *u, const fogvol_pass *p)
 {
-    if (g_pt.on) {
-        glFinish();
-        g_pt.t0 = now_ms();
-    }
+    if (g_pt.on) g_pt.t0 = tick_start();
     g_pt.begin_pass(u, p);
 }
 
 static void pt_end_pass(void *u)
 {
     if (g_pt.end_pass) g_pt.end_pass(u);
-    if (g_pt.on) {
-        glFinish();
-        if (g_pt.pass < MAXPASS) g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
-    }
+    if (g_pt.on && g_pt.pass < MAXPASS) g_pt.ms[g_pt.pass++] = tick_ms(g_pt.t0, tick_end());
 }
 
 typedef struct fogs {
@@ -571,15 +709,11 @@ static fogvol_result fog_frame(fogs *F, int t, const scene *s, const view *vw, c
     if ((res = fogvol_begin_frame(c, &fd)) != FOGVOL_SUCCESS) return res;
     if (mrt) {
         fogvol_mrt_info mi;
-        double t0;
+        tick t0;
         if ((res = fogvol_mrt_prepare(c, &mi)) != FOGVOL_SUCCESS) return res;
-        if (g_pt.on) glFinish();
-        t0 = now_ms();
+        if (g_pt.on) t0 = tick_start();
         engine_pass(s, vw, r, &mi);
-        if (g_pt.on) {
-            glFinish();
-            g_pt.engine_ms = now_ms() - t0;
-        }
+        if (g_pt.on) g_pt.engine_ms = tick_ms(t0, tick_end());
     }
     memset(&vd, 0, sizeof vd);
     vd.ramp = F->ramp[t];
@@ -667,9 +801,9 @@ static void floor_frame(const scene *s, const view *vw, const rt *r, int mode)
         glScissor(rc[0], rc[1], rc[2], rc[3]);
     }
     if (g_pt.on) {
-        glFinish();
-        g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
-        g_pt.t0 = now_ms();
+        g_pt.ms[g_pt.pass] = tick_ms(g_pt.t0, tick_end());
+        g_pt.pass++;
+        g_pt.t0 = tick_start();
     }
     glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -683,10 +817,7 @@ static void floor_frame(const scene *s, const view *vw, const rt *r, int mode)
     glDisable(GL_BLEND);
     glDisable(GL_SCISSOR_TEST);
     glUseProgram(0);
-    if (g_pt.on) {
-        glFinish();
-        g_pt.ms[g_pt.pass++] = now_ms() - g_pt.t0;
-    }
+    if (g_pt.on) g_pt.ms[g_pt.pass++] = tick_ms(g_pt.t0, tick_end());
 }
 
 static void bind_tex(int unit, GLuint t)
@@ -843,7 +974,7 @@ typedef struct result {
     char scene[48];
     int w, h, k, triangles;
     double ms[NMETH];      /* median fog ms per frame */
-    double first_ms[NMETH];/* first frame (shader JIT in llvmpipe) */
+    double first_ms[NMETH];/* first frame (the driver compiles shaders on first use) */
     int passes[NMETH];
     int layers;            /* peeling */
     long fogged;           /* pixels with nonzero thickness */
@@ -997,7 +1128,7 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
     make_view(&vw, s, w, h);
     for (i = 0; i < NTIER; ++i) res->cpu_us[i] = null_frame_us(s, i, w, h);
 
-    /* first frame of every method (llvmpipe compiles shader variants on first use) */
+    /* first frame of every method (drivers compile shader variants on first use: llvmpipe JITs them) */
     for (i = 0; i < NMETH; ++i) {
         double t0;
         if (i >= NTIER || g_tiers[i].tier != FOGVOL_TIER_MRT) engine_pass(s, &vw, &r, NULL);
@@ -1040,16 +1171,14 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
     for (it = 0; it < warm + frames; ++it) {
         for (mi = 0; mi < NMETH; ++mi) {
             int m = (mi + it) % NMETH, mrt = m < NTIER && g_tiers[m].tier == FOGVOL_TIER_MRT;
-            double t0, t1, e0 = 0, e1 = 0;
+            tick t0, e0, e1;
             int passes = 0;
             if (!mrt) {
-                glFinish();
-                e0 = now_ms();
+                e0 = tick_start();
                 engine_pass(s, &vw, &r, NULL);
+                e1 = tick_end();
             }
-            glFinish();
-            t0 = now_ms();
-            e1 = t0;
+            t0 = tick_start();
             if (m < NTIER) {
                 fogvol_result fr = fog_frame(F, m, s, &vw, &r, NULL, &st);
                 if (fr != FOGVOL_SUCCESS) die(fogvol_result_string(fr));
@@ -1057,12 +1186,10 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
             } else {
                 passes = ref_frame(m, s, &vw, &r, res->layers);
             }
-            glFinish();
-            t1 = now_ms();
             res->passes[m] = passes;
             if (it >= warm) {
-                t[m][nt[m]++] = t1 - t0;
-                if (!mrt) te[ne++] = e1 - e0;
+                t[m][nt[m]++] = tick_ms(t0, tick_end());
+                if (!mrt) te[ne++] = tick_ms(e0, e1);
             }
         }
     }
@@ -1082,17 +1209,15 @@ static void run_scene(fogs *F, scene *s, int w, int h, int warm, int frames, res
         res->engine_ms = median(te, ne);
         for (b = 0; b < NB; ++b)
             for (m = 0; m <= M_FLOOR; ++m) {
-                double t0;
+                tick t0;
                 if (m >= NTIER || g_tiers[m].tier != FOGVOL_TIER_MRT) engine_pass(s, &vw, &r, NULL);
                 memset(g_pt.ms, 0, sizeof g_pt.ms);
                 g_pt.pass = 0;
                 g_pt.on = 1;
-                glFinish();
-                t0 = g_pt.t0 = now_ms();
+                t0 = g_pt.t0 = tick_start();
                 if (m < NTIER) fog_frame(F, m, s, &vw, &r, NULL, &st);
                 else floor_frame(s, &vw, &r, 0);
-                glFinish();
-                bf[m][b] = now_ms() - t0;
+                bf[m][b] = tick_ms(t0, tick_end());
                 g_pt.on = 0;
                 res->bd_np[m] = g_pt.pass;
                 for (p = 0; p < MAXPASS; ++p) bt[m][p][b] = g_pt.ms[p];
@@ -1183,7 +1308,7 @@ static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
     fogvol_context *c = NULL;
     double t0;
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
+    cd.gl.get_proc_address = bench_proc;
     cd.logger.func = fv_log;
     cd.tier = g_tiers[t].tier;
     cd.variants = g_tiers[t].variants;
@@ -1276,6 +1401,7 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
                                                 {127, 127, 127}, {188, 189, 34}, {44, 160, 44}};
     static const unsigned char black[3] = {0, 0, 0}, grid[3] = {225, 225, 225};
     static const char *xlabel = "depth complexity k (back faces per ray at the centre, log2 scale)";
+    const char *renderer = (const char *)glGetString(GL_RENDERER);
     canvas c;
     const result *pts[8];
     int np = 0, i, m, L = 80, R = 40, T = 80, B = 130, lx, ly;
@@ -1316,7 +1442,8 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
     }
     line(&c, L, T, L, c.h - B, 2, black, 0);
     line(&c, L, c.h - B, c.w - R, c.h - B, 2, black, 0);
-    snprintf(s, sizeof s, "fogvol.h: fog cost vs depth complexity (nested shells, %dx%d, llvmpipe)", w, h);
+    snprintf(s, sizeof s, "fogvol.h: fog cost vs depth complexity (nested shells, %dx%d, %.*s)", w, h,
+             (int)strcspn(renderer, "/("), renderer); /* "llvmpipe", "NVIDIA H100 80GB HBM3" */
     text(&c, c.w / 2 - text_w(s, 2) / 2, 16, s, 2, black);
     text(&c, L - 60, T - 30, "ms per frame (median, log scale)", 2, black);
     text(&c, L + (c.w - L - R) / 2 - text_w(xlabel, 2) / 2, c.h - B + 38, xlabel, 2, black);
@@ -1601,7 +1728,7 @@ static void colbench_init(colbench *b, unsigned variants, const shp_mesh *m)
     int i;
     memset(b, 0, sizeof *b);
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
+    cd.gl.get_proc_address = bench_proc;
     cd.logger.func = fv_log;
     cd.tier = FOGVOL_TIER_FLOAT;
     cd.variants = variants;
@@ -1628,7 +1755,8 @@ static double colbench_frame(colbench *b, int w, int h, int *passes)
 {
     fogvol_frame_desc fd;
     fogvol_frame_stats st;
-    double t0, eye[3] = {0, 0, 7}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    double eye[3] = {0, 0, 7}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    tick t0;
     int i;
     memset(&fd, 0, sizeof fd);
     glu_look_at(fd.view, eye, at, up);
@@ -1638,8 +1766,7 @@ static double colbench_frame(colbench *b, int w, int h, int *passes)
     fd.viewport[2] = w;
     fd.viewport[3] = h;
     glClear(GL_COLOR_BUFFER_BIT);
-    glFinish();
-    t0 = now_ms();
+    t0 = tick_start();
     fogvol_begin_frame(b->ctx, &fd);
     for (i = 0; i < NCOL; ++i) {
         fogvol_volume_desc vd;
@@ -1651,9 +1778,8 @@ static double colbench_frame(colbench *b, int w, int h, int *passes)
         fogvol_add_volume(b->ctx, &vd);
     }
     if (fogvol_end_frame(b->ctx, &st) != FOGVOL_SUCCESS) die("end_frame (colours)");
-    glFinish();
     *passes = st.passes;
-    return now_ms() - t0;
+    return tick_ms(t0, tick_end());
 }
 
 static void colbench_free(colbench *b)
@@ -1707,7 +1833,7 @@ int main(int argc, char **argv)
     int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
     int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
     double t_start = now_ms(), v[5];
-    glu_ctx g;
+    bench_ctx g;
     fogs F;
     cpu_figs cpu;
     struct utsname un;
@@ -1719,7 +1845,9 @@ int main(int argc, char **argv)
     }
     /* cold shader compiles for the startup figures (no Mesa disk cache) */
     setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
-    if (!glu_create(&g, 64, 64, 1)) die("OSMesa context");
+    setenv("__GL_SHADER_DISK_CACHE", "0", 1); /* NVIDIA's driver */
+    if (!bench_create(&g)) die(BENCH_EGL_OR("EGL context (OpenGL 3.3 core on an EGL device)", "OSMesa context"));
+    clock_init();
     make_progs();
     memset(&F, 0, sizeof F);
     memset(&cpu, 0, sizeof cpu);
@@ -1739,8 +1867,8 @@ int main(int argc, char **argv)
     }
     cpu_measure(&cpu, quick);
     if (!quick && only < 0) {
-        g_md = fopen("bench/RESULTS.md", "w");
-        if (!g_md) die("cannot write bench/RESULTS.md (run from the repository root)");
+        g_md = fopen(BENCH_MD, "w");
+        if (!g_md) die("cannot write " BENCH_MD " (run from the repository root)");
     }
     uname(&un);
     cpu_info(cpu_model, sizeof cpu_model, &ncpu);
@@ -1761,7 +1889,7 @@ int main(int argc, char **argv)
             }
             build_scene(s, sc);
             scene_upload(s, &F);
-            frames = quick ? 3 : 15;
+            frames = quick ? 3 : BENCH_FRAMES;
             g_res[g_nres].bd = !quick && w > 640;
             run_scene(&F, s, w, h, warm, frames, &g_res[g_nres]);
             fprintf(stderr, "  %-24s %4dx%-4d %3d layers  %6.1f s\n", s->name, w, h, g_res[g_nres].layers,
@@ -1772,7 +1900,7 @@ int main(int argc, char **argv)
         }
     }
     out("## GPU: fog work per frame\n\nMedians over %d interleaved frames per scene after %d warm-up "
-        "frames; glFinish before the clock starts and after fogvol_end_frame. x floor: time / floor time. ours/peel: "
+        "frames; %s. x floor: time / floor time. ours/peel: "
         "time / depth-peeling time. Mpx/s: pixels with nonzero thickness (FLOAT debug read-back) per second. "
         "vs peeling: |fogvol debug thickness - peeled thickness| over pixels where both are nonzero and the 3x3 "
         "neighbourhood has one layer count (no silhouettes); LSB = (far - near) / 4096 for the RGBA8 tiers, world "
@@ -1784,7 +1912,10 @@ int main(int argc, char **argv)
         "occluder floor in scenes with occluders), PS20 and MRT <= 2.0x, PS13 <= 2.5x (against the occluder floor "
         "in scenes with occluders), depth peeling >= 6x slower at >= 6 layers. The rows \"speed-ups off\" run with "
         "fogvol_context_desc.disable_speedups = every FOGVOL_SPEEDUP_* bit (the configuration before them).\n\n",
-        quick ? 3 : 15, quick ? 1 : 3);
+        quick ? 3 : BENCH_FRAMES, quick ? 1 : 3,
+        g_gpu_clock ? "clock: GPU timestamps (GL_TIMESTAMP queries), one issued after a glFinish before the fog "
+                      "work, one after fogvol_end_frame before a glFinish"
+                    : "clock: the wall clock after a glFinish, before the fog work and after fogvol_end_frame");
     print_results(g_res, g_nres);
     print_summary(g_res, g_nres);
     print_breakdown(g_res, g_nres);
@@ -1799,7 +1930,7 @@ int main(int argc, char **argv)
         out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
             g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
     for (t = 0; t < NMETH; ++t)
-        out("| first frame of %s, %s %dx%d (target allocation + llvmpipe shader JIT) | %.1f ms |\n", g_meth_names[t],
+        out("| first frame of %s, %s %dx%d (target allocation + the driver's shader compiles on first use; wall clock) | %.1f ms |\n", g_meth_names[t],
             g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
     loadavg(load1, sizeof load1);
     out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
@@ -1808,12 +1939,12 @@ int main(int argc, char **argv)
     print_summary_line(g_res, g_nres);
     if (g_md) {
         fclose(g_md);
-        plot("bench/plot.png", g_res, g_nres, 1280, 720);
+        plot(BENCH_PNG, g_res, g_nres, 1280, 720);
     }
     for (t = 0; t < NTIER; ++t) {
         fogvol_destroy_ramp(F.ctx[t], F.ramp[t]);
         destroy_tier(F.ctx[t], &F.be[t]);
     }
-    glu_destroy(&g);
+    bench_destroy(&g);
     return 0;
 }

@@ -5,7 +5,7 @@
 # FOGVOL_NO_INSTALL=1 turns installing off (provide the packages yourself, e.g. on a non-Debian system).
 set -euo pipefail
 what=${1:-test}
-pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0"
+pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0 libopengl-dev"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
 pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth cmake pkg-config libosmesa6-dev libstb-dev"
 pkgs_web="make emscripten chromium libstb-dev"

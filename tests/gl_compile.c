@@ -1,0 +1,250 @@
+/* gl_compile.c - compiles and links every shader that dump_shaders wrote with a
+   real GL driver through EGL (glslangValidator checks the language; a driver
+   also checks its own limits and quirks). Desktop dialects (110 .. 330) go to a
+   compatibility-profile context, 100 and 300es to an OpenGL ES 3.x context, both
+   on EGL device FOGVOL_EGL_DEVICE (default 0). GL is reached only through
+   eglGetProcAddress.
+
+   usage: gl_compile DIR   (DIR as written by dump_shaders). Every X.frag is
+   linked with X.vert, or for a per-sample X_ms.frag with the vertex shader of
+   the same name without _ms. One TAP line a program (a failure with the
+   driver's log), the first logs of programs that linked with a message, and a
+   last line "N passed, M failed" (exit status 1 when M > 0). make test runs it
+   on Mesa's EGL device (llvmpipe); on a GPU machine: make gl-compile. */
+#define _POSIX_C_SOURCE 200809L
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GLC_FUNCS(X)                                                                                          \
+    X(PFNGLCREATESHADERPROC, CreateShader)                                                                    \
+    X(PFNGLSHADERSOURCEPROC, ShaderSource)                                                                    \
+    X(PFNGLCOMPILESHADERPROC, CompileShader)                                                                  \
+    X(PFNGLGETSHADERIVPROC, GetShaderiv)                                                                      \
+    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                                                            \
+    X(PFNGLDELETESHADERPROC, DeleteShader)                                                                    \
+    X(PFNGLCREATEPROGRAMPROC, CreateProgram)                                                                  \
+    X(PFNGLATTACHSHADERPROC, AttachShader)                                                                    \
+    X(PFNGLLINKPROGRAMPROC, LinkProgram)                                                                      \
+    X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                                                    \
+    X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                                                          \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram)
+
+typedef const GLubyte *(APIENTRYP glc_getstring_fn)(GLenum);
+typedef struct glc_gl {
+#define GLC_MEMBER(type, name) type name;
+    GLC_FUNCS(GLC_MEMBER)
+#undef GLC_MEMBER
+    glc_getstring_fn GetString;
+} glc_gl;
+
+typedef struct glc_ctx {
+    EGLContext ctx;
+    glc_gl gl;
+    const char *what;
+} glc_ctx;
+
+static EGLDisplay g_dpy = EGL_NO_DISPLAY;
+static EGLSurface g_surf = EGL_NO_SURFACE;
+
+static int glc_fail(const char *what)
+{
+    fprintf(stderr, "gl_compile: %s failed (EGL error 0x%x)\n", what, (unsigned)eglGetError());
+    return 0;
+}
+
+static EGLDisplay glc_display(void)
+{
+    PFNEGLQUERYDEVICESEXTPROC query = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLDeviceEXT dev[16];
+    EGLint n = 0;
+    const char *pick = getenv("FOGVOL_EGL_DEVICE");
+    int want = pick ? atoi(pick) : 0;
+    if (query && get && query(16, dev, &n) && n > 0) {
+        EGLDisplay d = get(EGL_PLATFORM_DEVICE_EXT, dev[want >= 0 && want < n ? want : 0], NULL);
+        if (d != EGL_NO_DISPLAY) return d;
+    }
+    return eglGetDisplay(EGL_DEFAULT_DISPLAY);
+}
+
+/* es: 0 = desktop GL, compatibility profile (every desktop GLSL version); 1 = OpenGL ES 3.x */
+static int glc_context(glc_ctx *c, int es, EGLConfig cfg)
+{
+    static const EGLint es_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_NONE};
+    static const EGLint gl_attr[] = {EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
+                                     EGL_NONE};
+    memset(c, 0, sizeof *c);
+    c->what = es ? "OpenGL ES" : "OpenGL (compatibility profile)";
+    if (!eglBindAPI(es ? EGL_OPENGL_ES_API : EGL_OPENGL_API)) return glc_fail("eglBindAPI");
+    c->ctx = eglCreateContext(g_dpy, cfg, EGL_NO_CONTEXT, es ? es_attr : gl_attr);
+    if (c->ctx == EGL_NO_CONTEXT) return glc_fail(c->what);
+    if (!eglMakeCurrent(g_dpy, g_surf, g_surf, c->ctx)) return glc_fail("eglMakeCurrent");
+#define GLC_LOAD(type, name)                                                          \
+    if (!(c->gl.name = (type)eglGetProcAddress("gl" #name))) {                        \
+        fprintf(stderr, "gl_compile: no gl" #name " in the %s context\n", c->what); \
+        return 0;                                                                     \
+    }
+    GLC_FUNCS(GLC_LOAD)
+    GLC_LOAD(glc_getstring_fn, GetString)
+#undef GLC_LOAD
+    printf("%s: %s, %s\n", c->what, (const char *)c->gl.GetString(GL_RENDERER),
+           (const char *)c->gl.GetString(GL_VERSION));
+    return 1;
+}
+
+static char *glc_read(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    long n;
+    char *s;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    s = (char *)malloc((size_t)n + 1);
+    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
+        free(s);
+        s = NULL;
+    }
+    if (s) s[n] = 0;
+    fclose(f);
+    return s;
+}
+
+/* compiles one stage; returns the shader (0 on failure, log in buf) */
+static GLuint glc_shader(const glc_gl *gl, GLenum stage, const char *src, char *log, int cap, int *logged)
+{
+    GLuint sh = gl->CreateShader(stage);
+    GLint ok = 0, len = 0;
+    gl->ShaderSource(sh, 1, &src, NULL);
+    gl->CompileShader(sh);
+    gl->GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    gl->GetShaderiv(sh, GL_INFO_LOG_LENGTH, &len);
+    if (len > 1) {
+        gl->GetShaderInfoLog(sh, cap, NULL, log);
+        *logged = 1;
+    }
+    if (!ok) {
+        gl->DeleteShader(sh);
+        return 0;
+    }
+    return sh;
+}
+
+/* 1 = linked; *logged = the driver said something */
+static int glc_program(const glc_gl *gl, const char *vs, const char *fs, char *log, int cap, int *logged)
+{
+    GLuint v, f, p;
+    GLint ok = 0, len = 0;
+    log[0] = 0;
+    *logged = 0;
+    if (!(v = glc_shader(gl, GL_VERTEX_SHADER, vs, log, cap, logged))) return 0;
+    if (!(f = glc_shader(gl, GL_FRAGMENT_SHADER, fs, log, cap, logged))) {
+        gl->DeleteShader(v);
+        return 0;
+    }
+    p = gl->CreateProgram();
+    gl->AttachShader(p, v);
+    gl->AttachShader(p, f);
+    gl->LinkProgram(p);
+    gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
+    gl->GetProgramiv(p, GL_INFO_LOG_LENGTH, &len);
+    if (len > 1) {
+        gl->GetProgramInfoLog(p, cap, NULL, log);
+        *logged = 1;
+    }
+    gl->DeleteProgram(p);
+    gl->DeleteShader(v);
+    gl->DeleteShader(f);
+    return ok != 0;
+}
+
+static int glc_is_es(const char *name)
+{
+    return strstr(name, "_100.") || strstr(name, "_100_") || strstr(name, "_300es");
+}
+
+/* the vertex shader of X.frag: X.vert, or without "_ms" for a per-sample program */
+static char *glc_vertex(const char *dir, const char *frag)
+{
+    char path[1024], base[512];
+    const char *ms;
+    char *s;
+    size_t n = strlen(frag) - 5; /* without ".frag" */
+    if (n >= sizeof base) return NULL;
+    memcpy(base, frag, n);
+    base[n] = 0;
+    snprintf(path, sizeof path, "%s/%s.vert", dir, base);
+    if ((s = glc_read(path)) != NULL) return s;
+    if ((ms = strstr(base, "_ms")) == NULL) return NULL;
+    snprintf(path, sizeof path, "%s/%.*s%s.vert", dir, (int)(ms - base), base, ms + 3);
+    return glc_read(path);
+}
+
+int main(int argc, char **argv)
+{
+    static const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
+                                      EGL_OPENGL_BIT | EGL_OPENGL_ES3_BIT, EGL_NONE};
+    static const EGLint pb_attr[] = {EGL_WIDTH, 16, EGL_HEIGHT, 16, EGL_NONE};
+    static char log[8192];
+    glc_ctx ctx[2];
+    EGLConfig cfg;
+    EGLint n = 0, major, minor;
+    DIR *d;
+    struct dirent *e;
+    int passed = 0, failed = 0, logs = 0, cur = -1;
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s DIR (the shaders dump_shaders wrote)\n", argv[0]);
+        return 2;
+    }
+    g_dpy = glc_display();
+    if (g_dpy == EGL_NO_DISPLAY || !eglInitialize(g_dpy, &major, &minor)) return !glc_fail("eglInitialize");
+    if (!eglChooseConfig(g_dpy, cfg_attr, &cfg, 1, &n) || n < 1) return !glc_fail("eglChooseConfig");
+    if ((g_surf = eglCreatePbufferSurface(g_dpy, cfg, pb_attr)) == EGL_NO_SURFACE)
+        return !glc_fail("eglCreatePbufferSurface");
+    if (!glc_context(&ctx[0], 0, cfg) || !glc_context(&ctx[1], 1, cfg)) return 1;
+    if (!(d = opendir(argv[1]))) {
+        fprintf(stderr, "gl_compile: cannot open %s\n", argv[1]);
+        return 1;
+    }
+    while ((e = readdir(d)) != NULL) {
+        size_t len = strlen(e->d_name);
+        char path[1024], *fs, *vs;
+        int es, logged = 0, ok;
+        if (len < 6 || strcmp(e->d_name + len - 5, ".frag") != 0) continue;
+        es = glc_is_es(e->d_name) != 0;
+        if (cur != es) {
+            eglBindAPI(es ? EGL_OPENGL_ES_API : EGL_OPENGL_API);
+            if (!eglMakeCurrent(g_dpy, g_surf, g_surf, ctx[es].ctx)) return !glc_fail("eglMakeCurrent");
+            cur = es;
+        }
+        snprintf(path, sizeof path, "%s/%s", argv[1], e->d_name);
+        fs = glc_read(path);
+        vs = glc_vertex(argv[1], e->d_name);
+        ok = fs && vs && glc_program(&ctx[es].gl, vs, fs, log, (int)sizeof log, &logged);
+        if (!fs || !vs) snprintf(log, sizeof log, "missing %s shader file", fs ? "vertex" : "fragment");
+        if (ok) {
+            printf("ok %d - %s\n", passed + failed + 1, e->d_name);
+            ++passed;
+        } else {
+            printf("not ok %d - %s (%s): %s\n", passed + failed + 1, e->d_name, ctx[es].what, log);
+            ++failed;
+        }
+        if (ok && logged && logs++ < 5) printf("log - %s: %s\n", e->d_name, log);
+        free(fs);
+        free(vs);
+    }
+    closedir(d);
+    printf("%d of the programs that linked had a non-empty driver log\n", logs);
+    printf("%d passed, %d failed\n", passed, failed);
+    eglMakeCurrent(g_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglTerminate(g_dpy);
+    return failed > 0;
+}
