@@ -9285,11 +9285,11 @@ enum {
     X(void, Enablei, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, Disablei, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, ColorMaski, (fogvol__GLuint, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean))
-/* Per-draw-buffer blend functions and equations: GL 4.0, GLES 3.2. */
+/* Per-draw-buffer blend functions and equations: GL 4.0 (3.x + ARB_draw_buffers_blend: ...iARB), GLES 3.2. */
 #define FOGVOL__GL_INDEXED_BLEND(X) \
     X(void, BlendFuncSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
     X(void, BlendEquationSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum))
-/* Pausing the engine's transform feedback: GL 4.0, GLES 3.0. */
+/* Pausing the engine's transform feedback: GL 4.0 (or 3.x + ARB_transform_feedback2, same names), GLES 3.0. */
 #define FOGVOL__GL_TF_PAUSE(X) X(void, PauseTransformFeedback, (void)) X(void, ResumeTransformFeedback, (void))
 
 /* Desktop only. */
@@ -10991,11 +10991,21 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
     return FOGVOL_SUCCESS;
 }
 
-/* Framebuffer objects (core, ARB_framebuffer_object or EXT_framebuffer_object: fbo_suffix "EXT") and
+/* Loads gl<nm><suffix> (locals: char name[64], const char *suffix: "" for the core name, "EXT" or "ARB"
+   where an extension provides the function); missing: an error. */
+#define FOGVOL__GL_LOAD_SUFFIXED(ret, nm, params) \
+    snprintf(name, sizeof name, "gl%s%s", #nm, suffix); \
+    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
+    if (!gl->nm) { \
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
+        return FOGVOL_ERROR_MISSING_FUNCTION; \
+    }
+
+/* Framebuffer objects (core, ARB_framebuffer_object or EXT_framebuffer_object: suffix "EXT") and
    what else the version has; ext: the GL 2 / GLES 2 extension string (NULL on 3.x and later). */
 static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *desc, const char **ext)
 {
-    const char *fbo_suffix = "";
+    const char *suffix = "";
     char name[64];
     gl->has_split_fbo = gl->major >= 3;
     gl->has_vao = gl->major >= 3;
@@ -11012,20 +11022,12 @@ static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *d
                         gl->minor);
             return FOGVOL_ERROR_UNSUPPORTED;
         }
-        fbo_suffix = "EXT";
+        suffix = "EXT";
     }
     if (!gl->gles && gl->major < 3) /* ARB_framebuffer_object / EXT_framebuffer_blit: separate read and draw */
         gl->has_split_fbo = fogvol__has_ext(*ext, "GL_ARB_framebuffer_object") ||
                             fogvol__has_ext(*ext, "GL_EXT_framebuffer_blit");
-#define FOGVOL__GL_LOAD_FBO(ret, nm, params) \
-    snprintf(name, sizeof name, "gl%s%s", #nm, fbo_suffix); \
-    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
-    if (!gl->nm) { \
-        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
-        return FOGVOL_ERROR_MISSING_FUNCTION; \
-    }
-    FOGVOL__GL_FBO(FOGVOL__GL_LOAD_FBO)
-#undef FOGVOL__GL_LOAD_FBO
+    FOGVOL__GL_FBO(FOGVOL__GL_LOAD_SUFFIXED)
     return FOGVOL_SUCCESS;
 }
 
@@ -11055,16 +11057,23 @@ static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_d
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_LOAD)
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_REQUIRE)
     }
+    /* GL 3.x contexts may have the GL 4.0 per-buffer blend and transform feedback pause as
+       extensions (a driver may give exactly the 3.3 asked for), and the engine may use them */
     gl->has_indexed_mask = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2) : gl->major >= 3;
-    gl->has_indexed_blend = gl->gles ? gl->has_indexed_mask : gl->major >= 4;
-    gl->has_tf_pause = gl->gles ? gl->major >= 3 : gl->major >= 4;
+    gl->has_indexed_blend = gl->gles ? gl->has_indexed_mask
+                                     : gl->major >= 4 ||
+                                           (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_draw_buffers_blend"));
+    gl->has_tf_pause = gl->gles ? gl->major >= 3
+                                : gl->major >= 4 ||
+                                      (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_transform_feedback2"));
     if (gl->has_indexed_mask) {
         FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD)
         FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_REQUIRE)
     }
-    if (gl->has_indexed_blend) {
-        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD)
-        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_REQUIRE)
+    if (gl->has_indexed_blend) { /* ARB_draw_buffers_blend names them ...iARB */
+        const char *suffix = gl->gles || gl->major >= 4 ? "" : "ARB";
+        char name[64];
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_SUFFIXED)
     }
     if (gl->has_tf_pause) {
         FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)

@@ -80,11 +80,13 @@ typedef struct eng {
     obj o[MAXOBJ];
     int n;
     fogvol_ramp *ramp[2];
-    int core, v21, es30;
+    int core, v21, es30, v33;
 } eng;
 
-/* PROF_ES30: the core context treated as OpenGL ES 3.0 (fogvol_gl_desc.gles). */
-enum { PROF_CORE = 0, PROF_COMPAT = 1, PROF_21 = 2, PROF_ES30 = 3 };
+/* PROF_ES30: the core context treated as OpenGL ES 3.0 (fogvol_gl_desc.gles). PROF_33: treated as
+   GL 3.3 core, where per-buffer blending and transform feedback pause are the extensions
+   ARB_draw_buffers_blend and ARB_transform_feedback2 (a driver may give exactly the 3.3 asked for). */
+enum { PROF_CORE = 0, PROF_COMPAT = 1, PROF_21 = 2, PROF_ES30 = 3, PROF_33 = 4 };
 
 /* glGetError that first returns a code the test queues (errors GL cannot raise on demand). */
 static GLenum g_fake_error;
@@ -117,6 +119,10 @@ static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
         cd.gl.version_major = 3;
         cd.gl.gles = 1;
     }
+    if (e->v33) {
+        cd.gl.version_major = 3;
+        cd.gl.version_minor = 3;
+    }
     return fogvol_create_context(&cd, &e->fv);
 }
 
@@ -146,9 +152,10 @@ static void make_ramp(eng *e, int i, const float rgba[4])
 static void eng_open(eng *e, int prof, fogvol_tier tier)
 {
     memset(e, 0, sizeof *e);
-    e->core = prof == PROF_CORE || prof == PROF_ES30;
+    e->core = prof == PROF_CORE || prof == PROF_ES30 || prof == PROF_33;
     e->v21 = prof == PROF_21;
     e->es30 = prof == PROF_ES30;
+    e->v33 = prof == PROF_33;
     assert_true(glu_create(&e->g, W, H, e->core));
     e->cam.eye[2] = 6.0;
     e->cam.up[1] = 1.0;
@@ -472,7 +479,7 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     }
     glBindFramebuffer(GL_FRAMEBUFFER, f.fbo);
     glDrawBuffers(4, list);
-    if (prof == PROF_CORE || prof == PROF_COMPAT) engine_blend_state();
+    if (prof == PROF_CORE || prof == PROF_COMPAT || prof == PROF_33) engine_blend_state();
     take_snap(&e, &before);
     frame_desc(&e, &fd);
     fd.draw_buffer = named;
@@ -480,6 +487,7 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
              prof == PROF_CORE     ? "core"
              : prof == PROF_COMPAT ? "compat"
              : prof == PROF_21     ? "GL 2.1 path"
+             : prof == PROF_33     ? "as GL 3.3 core"
                                    : "as ES 3.0",
              named);
     check_thickness(&e, &fd, 1.0, what);
@@ -488,7 +496,12 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     assert_int_equal(glGetError(), GL_NO_ERROR);
     for (i = 0; i < 4; ++i) tex_read(f.tex[i], post[i]);
     snprintf(png, sizeof png, "four_attachments_%s_buffer%d",
-             prof == PROF_CORE ? "core" : prof == PROF_COMPAT ? "compat" : prof == PROF_21 ? "gl21" : "es30", named);
+             prof == PROF_CORE     ? "core"
+             : prof == PROF_COMPAT ? "compat"
+             : prof == PROF_21     ? "gl21"
+             : prof == PROF_33     ? "gl33"
+                                   : "es30",
+             named);
     write_png4((const unsigned char *const *)post, png);
     /* reference: a one-attachment FBO with the same contents, default blend state */
     efbo_make(&ref, 1, GL_RGBA8);
@@ -496,7 +509,7 @@ static void drawbuffers_case(int prof, int named, const GLenum *list)
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, pre[named]);
     glBindTexture(GL_TEXTURE_2D, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, ref.fbo);
-    if (prof == PROF_CORE || prof == PROF_COMPAT) {
+    if (prof == PROF_CORE || prof == PROF_COMPAT || prof == PROF_33) {
         glDisablei(GL_BLEND, 0);
         glColorMaski(0, 1, 1, 1, 1);
     }
@@ -534,6 +547,7 @@ static void test_drawbuffers_core(void **st)
     (void)st;
     drawbuffers_case(PROF_CORE, 0, g_list4);
     drawbuffers_case(PROF_CORE, 2, g_list_gap);
+    drawbuffers_case(PROF_33, 1, g_list4);
 }
 static void test_drawbuffers_compat(void **st)
 {
@@ -678,8 +692,7 @@ static void composite_case(eng *e, const char *what)
         frame_desc(e, &fd);
         fd.composite = c ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN;
         assert_int_equal(run(e, &fd, NULL), FOGVOL_SUCCESS);
-        glFinish();
-        memcpy(col[c], e->g.pixels, NPIX * 4);
+        memcpy(col[c], glu_pixels(&e->g), NPIX * 4);
         read_stencil(st1);
         for (i = nst = 0; i < NPIX; ++i) nst += st0[i] != st1[i];
         if (nst) fail_msg("%s: %d stencil pixels changed", what, nst);
@@ -799,7 +812,7 @@ static void test_state_compat(void **st)
 }
 
 /* An active transform feedback of the engine: fogvol's draws are not captured, it stays active. */
-static void test_transform_feedback(void **st)
+static void tf_case(int prof)
 {
     static const char *vs = "#version 330 core\nin vec4 p;\nout vec4 cap;\nvoid main() { cap = p; gl_Position = p; }\n";
     static const char *varyings[] = {"cap"};
@@ -808,8 +821,7 @@ static void test_transform_feedback(void **st)
     snap before, after;
     GLuint sh, prog, buf, q, vao, written = 123;
     GLint ok = 0;
-    (void)st;
-    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    eng_open(&e, prof, FOGVOL_TIER_PS20);
     add_obj(&e, shp_sphere(2.0f, 48, 24), 0, 0, 0, 1, 1, 0);
     sh = glCreateShader(GL_VERTEX_SHADER);
     glShaderSource(sh, 1, &vs, NULL);
@@ -834,7 +846,8 @@ static void test_transform_feedback(void **st)
     take_snap(&e, &before);
     assert_true(before.tf_active && !before.tf_paused);
     frame_desc(&e, &fd);
-    check_thickness(&e, &fd, 1.0, "core: transform feedback active");
+    check_thickness(&e, &fd, 1.0, prof == PROF_33 ? "as GL 3.3: transform feedback active"
+                                                  : "core: transform feedback active");
     take_snap(&e, &after);
     check_snap(&before, &after, "transform feedback");
     assert_int_equal(glGetError(), GL_NO_ERROR);
@@ -850,6 +863,13 @@ static void test_transform_feedback(void **st)
     glDeleteProgram(prog);
     glDeleteShader(sh);
     eng_close(&e);
+}
+
+static void test_transform_feedback(void **st)
+{
+    (void)st;
+    tf_case(PROF_CORE);
+    tf_case(PROF_33); /* the pause from ARB_transform_feedback2 */
 }
 
 /* ---- 4. the engine's pending GL errors ------------------------------------ */
