@@ -23,7 +23,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web
 
 all: test
@@ -161,7 +161,18 @@ $(BUILD)/bench: bench/bench.c $(TEST_DEPS) | $(BUILD)
 # the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
 # build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
 $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
-	$(CC) -std=c99 -O2 $(WARN) -DBENCH_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
+	$(CC) -std=c99 -O2 $(WARN) -DGLU_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
+
+# the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
+# driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0)
+EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post
+$(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
+	@mkdir -p $(BUILD)/egl
+	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm
+
+gpu-test: deps-test
+	@$(MAKE) --no-print-directory -j$(JOBS) $(foreach t,$(EGL_TESTS),$(BUILD)/egl/test_$(t))
+	@LOGDIR=$(BUILD)/logs_egl JOBS=1 tests/run.sh $(foreach t,$(EGL_TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/egl/test_$(t)")
 
 gl-compile: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/dump_shaders $(BUILD)/gl_compile

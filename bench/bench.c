@@ -23,22 +23,18 @@
    pass is drawn before the clock starts; for MRT it is the engine pass that
    writes O, so the MRT time is the whole frame minus the median plain engine
    pass of the same scene). Medians of many frames after warm-up. Under OSMesa
-   the clock is the wall clock; built with -DBENCH_EGL (make bench-egl, for a
+   the clock is the wall clock; built with -DGLU_EGL (make bench-egl, for a
    GPU driver through EGL) it is GPU timestamps taken at the same points.
 
    usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
                                prints only; --scene I: scene I alone, prints only)
    full run: prints the tables, writes bench/RESULTS.md and bench/plot.png
-   (BENCH_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
+   (GLU_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
-#define GL_GLEXT_PROTOTYPES /* libOSMesa (or, with BENCH_EGL, libOpenGL) exports the GL entry points */
+#define GL_GLEXT_PROTOTYPES /* libOSMesa (or, with GLU_EGL, libOpenGL) exports the GL entry points */
 #include "tests/gl_util.h"
 #include <GL/glext.h>
-#ifdef BENCH_EGL
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
-#endif
 #include "tests/shapes.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
@@ -87,86 +83,18 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
 }
 
-/* ---- the GL context: OSMesa (llvmpipe), or with BENCH_EGL any EGL device
-   (a GPU driver through glvnd; Mesa's software device here) ----------------- */
-#ifdef BENCH_EGL
+/* output files and frames: OSMesa (llvmpipe), or built with -DGLU_EGL (tests/gl_util.h) any EGL
+   device, a GPU driver through glvnd */
+#ifdef GLU_EGL
 #define BENCH_MD "bench/RESULTS-gpu.md"
 #define BENCH_PNG "bench/plot-gpu.png"
 #define BENCH_FRAMES 41 /* GPU frames are short: more of them for the medians */
-#define BENCH_EGL_OR(a, b) a
-typedef struct bench_ctx {
-    EGLDisplay dpy;
-    EGLContext ctx;
-    EGLSurface surf;
-} bench_ctx;
-
-static void (*bench_proc(const char *name, void *user))(void)
-{
-    (void)user;
-    return (void (*)(void))eglGetProcAddress(name);
-}
-
-/* EGL_EXT_platform_device: device FOGVOL_BENCH_EGL_DEVICE (default 0), else
-   the default display */
-static EGLDisplay bench_display(void)
-{
-    PFNEGLQUERYDEVICESEXTPROC query = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
-    PFNEGLGETPLATFORMDISPLAYEXTPROC get =
-        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-    EGLDeviceEXT dev[16];
-    EGLint n = 0;
-    const char *pick = getenv("FOGVOL_BENCH_EGL_DEVICE");
-    int want = pick ? atoi(pick) : 0;
-    if (query && get && query(16, dev, &n) && n > 0) {
-        EGLDisplay d = get(EGL_PLATFORM_DEVICE_EXT, dev[want >= 0 && want < n ? want : 0], NULL);
-        fprintf(stderr, "EGL: %d device(s), using device %d\n", (int)n, want >= 0 && want < n ? want : 0);
-        if (d != EGL_NO_DISPLAY) return d;
-    }
-    return eglGetDisplay(EGL_DEFAULT_DISPLAY);
-}
-
-/* a 3.3 core context current on a 64x64 pbuffer (the bench draws into its own framebuffers) */
-static int bench_create(bench_ctx *c)
-{
-    static const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                      EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
-                                      EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8, EGL_NONE};
-    static const EGLint pb_attr[] = {EGL_WIDTH, 64, EGL_HEIGHT, 64, EGL_NONE};
-    static const EGLint ctx_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    EGLConfig cfg;
-    EGLint major, minor, n = 0;
-    memset(c, 0, sizeof *c);
-    c->dpy = bench_display();
-    if (c->dpy == EGL_NO_DISPLAY || !eglInitialize(c->dpy, &major, &minor)) return 0;
-    if (!eglBindAPI(EGL_OPENGL_API)) return 0;
-    if (!eglChooseConfig(c->dpy, cfg_attr, &cfg, 1, &n) || n < 1) return 0;
-    c->surf = eglCreatePbufferSurface(c->dpy, cfg, pb_attr);
-    if (c->surf == EGL_NO_SURFACE) return 0;
-    c->ctx = eglCreateContext(c->dpy, cfg, EGL_NO_CONTEXT, ctx_attr);
-    if (c->ctx == EGL_NO_CONTEXT) return 0;
-    return eglMakeCurrent(c->dpy, c->surf, c->surf, c->ctx) == EGL_TRUE;
-}
-
-static void bench_destroy(bench_ctx *c)
-{
-    eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    if (c->ctx != EGL_NO_CONTEXT) eglDestroyContext(c->dpy, c->ctx);
-    if (c->surf != EGL_NO_SURFACE) eglDestroySurface(c->dpy, c->surf);
-    eglTerminate(c->dpy);
-}
+#define BENCH_CONTEXT "EGL context (OpenGL 3.3 core on an EGL device)"
 #else
 #define BENCH_MD "bench/RESULTS.md"
 #define BENCH_PNG "bench/plot.png"
 #define BENCH_FRAMES 15
-#define BENCH_EGL_OR(a, b) b
-typedef glu_ctx bench_ctx;
-#define bench_proc glu_proc
-static int bench_create(bench_ctx *c)
-{
-    return glu_create(c, 64, 64, 1);
-}
-#define bench_destroy glu_destroy
+#define BENCH_CONTEXT "OSMesa context"
 #endif
 
 /* The clock of the GPU work. Under OSMesa the GL runs on the CPU and a
@@ -212,10 +140,10 @@ static double tick_ms(tick a, tick b)
     return (double)(y - x) / 1e6;
 }
 
-/* GPU timestamps where the context has them (GL_TIMESTAMP counter bits > 0), BENCH_EGL builds only */
+/* GPU timestamps where the context has them (GL_TIMESTAMP counter bits > 0), GLU_EGL builds only */
 static void clock_init(void)
 {
-#ifdef BENCH_EGL
+#ifdef GLU_EGL
     GLint bits = 0;
     glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
     g_gpu_clock = bits > 0 && getenv("FOGVOL_BENCH_WALL_CLOCK") == NULL;
@@ -1308,7 +1236,7 @@ static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
     fogvol_context *c = NULL;
     double t0;
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = bench_proc;
+    cd.gl.get_proc_address = glu_proc;
     cd.logger.func = fv_log;
     cd.tier = g_tiers[t].tier;
     cd.variants = g_tiers[t].variants;
@@ -1728,7 +1656,7 @@ static void colbench_init(colbench *b, unsigned variants, const shp_mesh *m)
     int i;
     memset(b, 0, sizeof *b);
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = bench_proc;
+    cd.gl.get_proc_address = glu_proc;
     cd.logger.func = fv_log;
     cd.tier = FOGVOL_TIER_FLOAT;
     cd.variants = variants;
@@ -1833,7 +1761,7 @@ int main(int argc, char **argv)
     int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
     int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
     double t_start = now_ms(), v[5];
-    bench_ctx g;
+    glu_ctx g;
     fogs F;
     cpu_figs cpu;
     struct utsname un;
@@ -1846,7 +1774,7 @@ int main(int argc, char **argv)
     /* cold shader compiles for the startup figures (no Mesa disk cache) */
     setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
     setenv("__GL_SHADER_DISK_CACHE", "0", 1); /* NVIDIA's driver */
-    if (!bench_create(&g)) die(BENCH_EGL_OR("EGL context (OpenGL 3.3 core on an EGL device)", "OSMesa context"));
+    if (!glu_create(&g, 64, 64, 1)) die(BENCH_CONTEXT);
     clock_init();
     make_progs();
     memset(&F, 0, sizeof F);
@@ -1945,6 +1873,6 @@ int main(int argc, char **argv)
         fogvol_destroy_ramp(F.ctx[t], F.ramp[t]);
         destroy_tier(F.ctx[t], &F.be[t]);
     }
-    bench_destroy(&g);
+    glu_destroy(&g);
     return 0;
 }

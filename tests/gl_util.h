@@ -1,9 +1,18 @@
-/* gl_util.h - OSMesa contexts, matrices and PNG output for fogvol tests and examples.
-   Header-only; link -lOSMesa (not -lGL: direct gl* calls must reach OSMesa). */
+/* gl_util.h - GL contexts, matrices and PNG output for fogvol tests and examples.
+   Header-only. Contexts come from OSMesa (llvmpipe; link -lOSMesa, not -lGL:
+   direct gl* calls must reach OSMesa) or, built with -DGLU_EGL, from any EGL
+   device through glvnd (a GPU driver; link -lEGL -lOpenGL): the same
+   glu_ctx, whose framebuffer 0 is then a pbuffer of the same size. Read the
+   framebuffer's pixels through glu_pixels, which works with both. */
 #ifndef GL_UTIL_H
 #define GL_UTIL_H
 
+#ifdef GLU_EGL
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#else
 #include <GL/osmesa.h>
+#endif
 #include <GL/gl.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,11 +20,116 @@
 #include <string.h>
 
 typedef struct glu_ctx {
+#ifdef GLU_EGL
+    EGLDisplay dpy;
+    EGLContext ctx;
+    EGLSurface surf;
+#else
     OSMesaContext ctx;
-    unsigned char *pixels; /* RGBA, first row = bottom */
+#endif
+    unsigned char *pixels; /* RGBA, first row = bottom (OSMesa renders into it; EGL: glu_pixels fills it) */
     int width, height;
 } glu_ctx;
 
+#ifdef GLU_EGL
+/* The display of EGL device FOGVOL_EGL_DEVICE (default 0; EGL_EXT_platform_device), else the
+   default display; initialised once per process and kept. */
+static inline EGLDisplay glu_egl_display(void)
+{
+    static EGLDisplay dpy = EGL_NO_DISPLAY;
+    PFNEGLQUERYDEVICESEXTPROC query;
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get;
+    EGLDeviceEXT dev[16];
+    EGLint n = 0, major, minor;
+    const char *pick = getenv("FOGVOL_EGL_DEVICE");
+    int want = pick ? atoi(pick) : 0;
+    if (dpy != EGL_NO_DISPLAY) return dpy;
+    query = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+    get = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    if (query && get && query(16, dev, &n) && n > 0)
+        dpy = get(EGL_PLATFORM_DEVICE_EXT, dev[want >= 0 && want < n ? want : 0], NULL);
+    if (dpy == EGL_NO_DISPLAY) dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    if (dpy != EGL_NO_DISPLAY && !eglInitialize(dpy, &major, &minor)) dpy = EGL_NO_DISPLAY;
+    return dpy;
+}
+
+/* core = 1: the highest core profile from 4.6 down to 3.3 (as Mesa gives 4.5 core for 3.3 where a
+   driver may give exactly 3.3); 0: compatibility profile. Framebuffer 0: a width x height pbuffer,
+   RGBA8 + depth 24 + stencil 8, single-sample, like the OSMesa buffer. */
+static inline int glu_create(glu_ctx *c, int width, int height, int core)
+{
+    static const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                      EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
+                                      EGL_DEPTH_SIZE, 24, EGL_STENCIL_SIZE, 8, EGL_SAMPLE_BUFFERS, 0, EGL_NONE};
+    static const int versions[][2] = {{4, 6}, {4, 5}, {4, 3}, {4, 1}, {4, 0}, {3, 3}};
+    EGLint core_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                          EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    int v;
+    const EGLint compat_attr[] = {EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
+                                  EGL_NONE};
+    const EGLint pb_attr[] = {EGL_WIDTH, width, EGL_HEIGHT, height, EGL_NONE};
+    EGLConfig cfg;
+    EGLint n = 0;
+    memset(c, 0, sizeof *c);
+    c->width = width;
+    c->height = height;
+    c->dpy = glu_egl_display();
+    if (c->dpy == EGL_NO_DISPLAY || !eglBindAPI(EGL_OPENGL_API)) return 0;
+    if (!eglChooseConfig(c->dpy, cfg_attr, &cfg, 1, &n) || n < 1) return 0;
+    if ((c->surf = eglCreatePbufferSurface(c->dpy, cfg, pb_attr)) == EGL_NO_SURFACE) return 0;
+    for (v = 0; v < (int)(sizeof versions / sizeof versions[0]) && c->ctx == EGL_NO_CONTEXT; ++v) {
+        core_attr[1] = versions[v][0];
+        core_attr[3] = versions[v][1];
+        c->ctx = eglCreateContext(c->dpy, cfg, EGL_NO_CONTEXT, core ? core_attr : compat_attr);
+        if (!core) break;
+    }
+    if (c->ctx == EGL_NO_CONTEXT) return 0;
+    c->pixels = (unsigned char *)calloc((size_t)width * height, 4);
+    return c->pixels && eglMakeCurrent(c->dpy, c->surf, c->surf, c->ctx);
+}
+
+static inline void glu_destroy(glu_ctx *c)
+{
+    if (c->dpy != EGL_NO_DISPLAY) {
+        eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        if (c->ctx != EGL_NO_CONTEXT) eglDestroyContext(c->dpy, c->ctx);
+        if (c->surf != EGL_NO_SURFACE) eglDestroySurface(c->dpy, c->surf);
+    }
+    free(c->pixels);
+    memset(c, 0, sizeof *c);
+}
+
+static inline void (*glu_proc(const char *name, void *user))(void)
+{
+    (void)user;
+    return (void (*)(void))eglGetProcAddress(name);
+}
+
+/* Framebuffer 0's pixels after glFinish: read back into c->pixels with the GL state the read
+   touches (read framebuffer, pack buffer, pack alignment and row length) put back as it was. */
+static inline unsigned char *glu_pixels(glu_ctx *c)
+{
+    typedef void (*bind_fn)(GLenum, GLuint);
+    bind_fn bind_fb = (bind_fn)eglGetProcAddress("glBindFramebuffer"),
+            bind_buf = (bind_fn)eglGetProcAddress("glBindBuffer");
+    GLint fb = 0, buf = 0, align = 4, row = 0;
+    glFinish();
+    glGetIntegerv(0x8CAA /* GL_READ_FRAMEBUFFER_BINDING */, &fb);
+    glGetIntegerv(0x88ED /* GL_PIXEL_PACK_BUFFER_BINDING */, &buf);
+    glGetIntegerv(GL_PACK_ALIGNMENT, &align);
+    glGetIntegerv(GL_PACK_ROW_LENGTH, &row);
+    bind_fb(0x8CA8 /* GL_READ_FRAMEBUFFER */, 0);
+    bind_buf(0x88EB /* GL_PIXEL_PACK_BUFFER */, 0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glReadPixels(0, 0, c->width, c->height, GL_RGBA, GL_UNSIGNED_BYTE, c->pixels);
+    bind_fb(0x8CA8, (GLuint)fb);
+    bind_buf(0x88EB, (GLuint)buf);
+    glPixelStorei(GL_PACK_ALIGNMENT, align);
+    glPixelStorei(GL_PACK_ROW_LENGTH, row);
+    return c->pixels;
+}
+#else
 /* core = 1: 3.3 core profile; 0: compatibility profile (Mesa gives 4.5 compat either way). */
 static inline int glu_create(glu_ctx *c, int width, int height, int core)
 {
@@ -45,6 +159,14 @@ static inline void (*glu_proc(const char *name, void *user))(void)
     (void)user;
     return (void (*)(void))OSMesaGetProcAddress(name);
 }
+
+/* Framebuffer 0's pixels after glFinish (OSMesa renders into c->pixels) */
+static inline unsigned char *glu_pixels(glu_ctx *c)
+{
+    glFinish();
+    return c->pixels;
+}
+#endif
 
 /* column-major matrices, OpenGL conventions */
 static inline void glu_identity(float m[16])

@@ -175,8 +175,7 @@ static void gpu_render(cgpu *c, const cscene *s, fogvol_composite comp, unsigned
         assert_int_equal(fogvol_add_volume(c->fv, &vd), FOGVOL_SUCCESS);
     }
     assert_int_equal(fogvol_end_frame(c->fv, st), FOGVOL_SUCCESS);
-    glFinish();
-    memcpy(out, c->g.pixels, (size_t)CW * CH * 4);
+    memcpy(out, glu_pixels(&c->g), (size_t)CW * CH * 4);
     assert_int_equal(glGetError(), GL_NO_ERROR);
 }
 

@@ -347,7 +347,7 @@ static void engine_init(engine *e)
     e->u_mrt = glGetUniformLocation(e->prog, "fogvol_mrt");
     glGenVertexArrays(1, &e->vao);
     fx_color_depth_fbo(W, H, GL_DEPTH_COMPONENT32F, GL_FLOAT, &e->color, &e->depth, &e->fbo);
-    e->clip_control = (PFNGLCLIPCONTROLPROC)OSMesaGetProcAddress("glClipControl");
+    e->clip_control = (PFNGLCLIPCONTROLPROC)glu_proc("glClipControl", NULL);
     assert_non_null(e->clip_control);
 }
 

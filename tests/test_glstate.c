@@ -187,7 +187,10 @@ static void snapshot(snap *s, int compat)
     s->cull_face = glIsEnabled(GL_CULL_FACE);
     glGetIntegerv(GL_CULL_FACE_MODE, &s->cull_mode);
     glGetIntegerv(GL_FRONT_FACE, &s->front_face);
+    s->polygon_mode[1] = -1;
     glGetIntegerv(GL_POLYGON_MODE, s->polygon_mode);
+    if (!compat && s->polygon_mode[1] == -1) /* a core profile has one mode for both sides: some GLs return one value */
+        s->polygon_mode[1] = s->polygon_mode[0];
     glGetBooleanv(GL_COLOR_WRITEMASK, b);
     for (i = 0; i < 4; ++i) s->color_mask[i] = b[i];
     s->scissor_test = glIsEnabled(GL_SCISSOR_TEST);

@@ -475,12 +475,10 @@ static void test_bands(void **state)
         last = st.overflow_pixels_late;
         partial += last < readback; /* not every band counted yet */
     }
-    glFinish();
-    magenta_off = count_magenta(rig.g.pixels); /* the composite built without the overflow test */
+    magenta_off = count_magenta(glu_pixels(&rig.g)); /* the composite built without the overflow test */
     g_show_overflow = 1; /* the same context: the composite with it, this frame */
     assert_int_equal(rig_frame(&rig, NULL, &st), FOGVOL_SUCCESS);
-    glFinish();
-    magenta_on = count_magenta(rig.g.pixels);
+    magenta_on = count_magenta(glu_pixels(&rig.g));
     print_message("  bands: read-back %d saturated pixels, sum of the %d bands %d (frame %lld), %d check passes in "
                   "%d frames; magenta pixels %d without show_overflow, %d with it\n",
                   readback, FOGVOL_OVERFLOW_BANDS, st.overflow_pixels_late, (long long)st.overflow_frame, passes, frame,
@@ -549,6 +547,14 @@ static void test_gles3_any_samples(void **state)
         int i, frame;
         memset(&lc, 0, sizeof lc);
         assert_true(glu_create(&g, W, H, 1));
+        if (!strstr((const char *)glGetString(GL_VERSION), "Mesa")) {
+            /* a desktop context passes for GLES 3 only where the driver takes the ES enums on desktop
+               too, as Mesa does; NVIDIA's 580 driver answers GL_INVALID_ENUM (test_gles covers real
+               ES contexts) */
+            print_message("  GLES 3 as desktop GL: %s is not Mesa: skipped\n", (const char *)glGetString(GL_VERSION));
+            glu_destroy(&g);
+            skip();
+        }
         memset(&cd, 0, sizeof cd);
         cd.gl.get_proc_address = watch_proc;
         cd.gl.gles = 1;

@@ -153,8 +153,7 @@ static void density_exact(fogvol_tier tier, unsigned variants, double bound, con
     vd.density_map[7] = 0.5f;
     assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
-    glFinish();
-    png(name, g.pixels);
+    png(name, glu_pixels(&g));
     for (y = 0; y < TH; ++y)
         for (x = 0; x < TW; ++x) {
             double wx = -1.5 + 3.0 * (x + 0.5) / TW, wy = -1.5 + 3.0 * (y + 0.5) / TH;
@@ -347,8 +346,7 @@ static void test_color_texture(void **state)
     assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(g_last_error, "colour texture"));
     assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
-    glFinish();
-    png("color_texture", g.pixels);
+    png("color_texture", glu_pixels(&g));
     for (y = 0; y < TH; ++y)
         for (x = 0; x < TW; ++x) {
             const unsigned char *p = g.pixels + 4 * (y * TW + x), *t;
@@ -463,8 +461,7 @@ static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect diale
     assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
     assert_int_equal(st.lights, 1);
-    glFinish();
-    png(name, g.pixels);
+    png(name, glu_pixels(&g));
     for (y = 0; y < TH; ++y)
         for (x = 0; x < TW; ++x) {
             int ref = light_reference(fd.view, fd.projection, x, y);
