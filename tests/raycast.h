@@ -674,6 +674,57 @@ RC__FN rc_result rc_trace(const rc_scene *sc, const rc_camera *cam, double sx, d
   return r;
 }
 
+/* The view depths w of sample (sx,sy) that a rasteriser's faces produce: the nearest occluder
+   crossing (if before zfar) and every volume crossing in [znear, min(zfar, opaque_w)], per
+   volume in t order. Returns the count (<= cap; -1 on allocation failure). */
+RC__FN int rc__counted_depths(const rc_scene *sc, const rc_camera *cam, double sx, double sy, double *w, int cap) {
+  rc__hitbuf buf;
+  rc__ray ray;
+  double o[3], d[3], zn = cam->znear, zf = cam->zfar, opaque = INFINITY, end;
+  int i, k, n = 0, oom = 0;
+  rc_camera_ray(cam, sx, sy, o, d);
+  rc__ray_setup(&ray, o, d);
+  rc__hitbuf_init(&buf);
+  for (i = 0; i < sc->count; i++) {
+    if (sc->objs[i].sign != 0) continue;
+    buf.n = 0;
+    rc__object_hits(&sc->objs[i], &ray, zn, INFINITY, &buf);
+    oom |= buf.oom;
+    for (k = 0; k < buf.n; k++)
+      if (buf.h[k].t < opaque) opaque = buf.h[k].t;
+  }
+  end = opaque < zf ? opaque : zf;
+  if (opaque < zf && n < cap) w[n++] = opaque;
+  for (i = 0; i < sc->count; i++) {
+    if (sc->objs[i].sign == 0) continue;
+    buf.n = 0;
+    rc__object_hits(&sc->objs[i], &ray, zn, end, &buf);
+    oom |= buf.oom;
+    rc__sort(&buf);
+    for (k = 0; k < buf.n && n < cap; k++) w[n++] = buf.h[k].t;
+  }
+  rc__hitbuf_free(&buf);
+  return oom ? -1 : n;
+}
+
+/* How fast the depths of pixel (px,py)'s centre sample move with the sample position: the sum
+   over the depths rc__counted_depths lists of |dw/dsx| + |dw/dsy| (view-depth units per pixel),
+   by differences over 1/1024 pixel; INFINITY where the crossings change within that distance.
+   A GL rasteriser snaps vertices to a grid of 2^-GL_SUBPIXEL_BITS pixels, which moves each
+   face's plane by up to about that much at the sample: delta * rc_depth_slope bounds what the
+   snapping adds to a thickness error (the GL spec leaves the rounding to the implementation). */
+RC__FN double rc_depth_slope(const rc_scene *sc, const rc_camera *cam, int px, int py) {
+  enum { CAP = 256 };
+  const double eps = 1.0 / 1024.0;
+  double w0[CAP], wx[CAP], wy[CAP], sum = 0.0;
+  int n0 = rc__counted_depths(sc, cam, px + 0.5, py + 0.5, w0, CAP), i;
+  if (n0 < 0 || n0 == CAP || rc__counted_depths(sc, cam, px + 0.5 + eps, py + 0.5, wx, CAP) != n0 ||
+      rc__counted_depths(sc, cam, px + 0.5, py + 0.5 + eps, wy, CAP) != n0)
+    return INFINITY;
+  for (i = 0; i < n0; i++) sum += fabs(wx[i] - w0[i]) + fabs(wy[i] - w0[i]);
+  return sum / eps;
+}
+
 /* 1 if pixel (px,py) is "interior": the signature at the pixel centre equals the signatures
    at the 4 pixel corners and at the 8 neighbouring pixel centres (so one-pixel silhouette
    bands, opaque/volume intersection curves and near/far-plane crossings are excluded). */

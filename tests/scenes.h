@@ -248,9 +248,11 @@ static void free_scenes(void)
 }
 
 /* Ground truth for every pixel centre: thickness, pairs of faces crossed,
-   interior mask (rc_interior), covered mask (a volume face on the ray). */
+   interior mask (rc_interior), covered mask (a volume face on the ray) and, where slope is not
+   NULL, the interior pixels' depth slopes (rc_depth_slope; 0 elsewhere): a test adds
+   slope * snap_pixels() to its bound for what the GL's vertex snapping moves the faces. */
 static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char *interior, unsigned char *covered,
-                         int *max_faces, double *tmax)
+                         int *max_faces, double *tmax, double *slope)
 {
     rc_object ro[MAX_OBJ];
     unsigned *reversed[MAX_OBJ] = {0};
@@ -290,11 +292,21 @@ static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char 
             covered[k] = r.faces_front + r.faces_back > 0;
             if (pairs[k] < 1) pairs[k] = 1;
             interior[k] = (unsigned char)rc_interior(&rs, &s->cam, x, y);
+            if (slope) slope[k] = interior[k] ? rc_depth_slope(&rs, &s->cam, x, y) : 0.0;
             if (r.faces_back > *max_faces) *max_faces = r.faces_back;
             if (r.faces_front > *max_faces) *max_faces = r.faces_front;
             if (gt[k] > *tmax) *tmax = gt[k];
         }
     rc_scene_free(&rs);
+}
+
+/* The grid the current GL context snaps vertices to, in pixels: 2^-GL_SUBPIXEL_BITS (the GL
+   minimum of 4 bits where the context reports fewer). */
+static inline double snap_pixels(void)
+{
+    GLint bits = 0;
+    glGetIntegerv(0x0D50 /* GL_SUBPIXEL_BITS */, &bits);
+    return ldexp(1.0, -(bits < 4 ? 4 : bits));
 }
 
 /* Every tier and variant combination the GL tests render (test_tiers on desktop dialects,

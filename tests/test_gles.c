@@ -558,7 +558,7 @@ static void test_overflow(void **state)
     fogvol_ramp_desc rd;
     fogvol_frame_stats st, first;
     int es3;
-    ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax);
+    ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax, NULL);
     context_up(ci, &c);
     es3 = c.major >= 3;
     engine_init(&e, es3);
@@ -616,7 +616,7 @@ static int setup_all(void **state)
         t->interior = (unsigned char *)calloc((size_t)W * H, 1);
         t->covered = (unsigned char *)calloc((size_t)W * H, 1);
         ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
-                     &t->max_faces, &t->tmax);
+                     &t->max_faces, &t->tmax, NULL);
     }
     return 0;
 }

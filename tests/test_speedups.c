@@ -138,7 +138,7 @@ static int check_ground_truth(const tscene *s, const unsigned char *px)
     static unsigned char interior[W * H], covered[W * H];
     static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
     int i, c, worst = 0, n = 0;
-    ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax);
+    ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax, NULL);
     for (i = 0; i < W * H; ++i) {
         double a = 1.0 - exp(-(double)s->density * gt[i]);
         if (!interior[i]) continue;

@@ -39,7 +39,7 @@ static const fogvol_dialect g_dialects[] = {FOGVOL_GLSL_110, FOGVOL_GLSL_120,   
 #define NDIALECT ((int)(sizeof g_dialects / sizeof g_dialects[0]))
 
 typedef struct gt_cache {
-    double *gt;
+    double *gt, *slope;
     int *pairs;
     unsigned char *interior, *covered;
     int max_faces;
@@ -155,11 +155,12 @@ static void run(int ci, int di)
     fogvol_dialect dialect = g_dialects[di];
     int core = dialect != FOGVOL_GLSL_110 && dialect != FOGVOL_GLSL_120 && dialect != FOGVOL_GLSL_130;
     int sc, i, j, bad = 0, n = 0;
-    double max_lsb = 0, sum_pp = 0, comp_max = 0;
+    double max_lsb = 0, sum_pp = 0, comp_max = 0, snap, slack_pp = 0;
     unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged = (unsigned char *)malloc((size_t)W * H * 4);
     glu_ctx g;
     engine e;
     assert_true(glu_create(&g, W, H, core));
+    snap = snap_pixels();
     engine_init(&e);
     for (sc = 0; sc < NSCENE; ++sc) {
         const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
@@ -273,13 +274,17 @@ static void run(int ci, int di)
             if (err > max_lsb) max_lsb = err;
             if (t->covered[i]) {
                 sum_pp += err / t->pairs[i];
+                slack_pp += t->slope[i] * snap / lsb / t->pairs[i];
                 ++n;
             }
-            /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits) */
-            if (err > (c->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb)) {
+            /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits);
+               + what the GL's vertex snapping may move the faces (rc_depth_slope) */
+            if (err > (c->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb) +
+                          t->slope[i] * snap / lsb) {
                 if (bad < 3)
-                    print_message("  %s/%s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units)\n", c->name,
-                                  fogvol_dialect_name(dialect), s->name, i % W, i / W, thick[i], t->gt[i], err);
+                    print_message("  %s/%s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units; %d pairs, snapping %.2f)\n",
+                                  c->name, fogvol_dialect_name(dialect), s->name, i % W, i / W, thick[i], t->gt[i], err,
+                                  t->pairs[i], t->slope[i] * snap / lsb);
                 ++bad;
             }
         }
@@ -299,7 +304,7 @@ static void run(int ci, int di)
     if (comp_max > 2.0 / 255.0)
         print_message("  %s/%s: composite off by %.2f/255\n", c->name, fogvol_dialect_name(dialect), comp_max * 255);
     assert_int_equal(bad, 0);
-    assert_true(g_mean[ci][di] <= 0.5);
+    assert_true(g_mean[ci][di] <= 0.5 + (n ? slack_pp / n : 0)); /* + the mean vertex-snapping allowance */
     assert_true(comp_max <= 2.0 / 255.0);
 }
 
@@ -548,11 +553,12 @@ static int setup_all(void **state)
     for (i = 0; i < NSCENE; ++i) {
         gt_cache *t = &g_gt[i];
         t->gt = (double *)calloc((size_t)W * H, sizeof(double));
+        t->slope = (double *)calloc((size_t)W * H, sizeof(double));
         t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
         t->interior = (unsigned char *)calloc((size_t)W * H, 1);
         t->covered = (unsigned char *)calloc((size_t)W * H, 1);
         ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
-                     &t->max_faces, &t->tmax);
+                     &t->max_faces, &t->tmax, t->slope);
     }
     return 0;
 }
