@@ -5,6 +5,7 @@
 #   make images refresh the README pictures in docs/ from the demo
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
+#   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
 #   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
 # Adding a test program: one name in TESTS (see "test programs" below). JOBS=n sets how many
 # compilers and tests run at once (default: the number of cores).

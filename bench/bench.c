@@ -1372,7 +1372,8 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
     line(&c, L, c.h - B, c.w - R, c.h - B, 2, black, 0);
     snprintf(s, sizeof s, "fogvol.h: fog cost vs depth complexity (nested shells, %dx%d, %.*s)", w, h,
              (int)strcspn(renderer, "/("), renderer); /* "llvmpipe", "NVIDIA H100 80GB HBM3" */
-    text(&c, c.w / 2 - text_w(s, 2) / 2, 16, s, 2, black);
+    i = text_w(s, 2) <= c.w - 20 ? 2 : 1; /* a long renderer name: the small font */
+    text(&c, c.w / 2 - text_w(s, i) / 2, 16, s, i, black);
     text(&c, L - 60, T - 30, "ms per frame (median, log scale)", 2, black);
     text(&c, L + (c.w - L - R) / 2 - text_w(xlabel, 2) / 2, c.h - B + 38, xlabel, 2, black);
     for (m = 0; m < NMETH; ++m) {
