@@ -2,8 +2,8 @@
    real GL driver through EGL (glslangValidator checks the language; a driver
    also checks its own limits and quirks). Desktop dialects (110 .. 330) go to a
    compatibility-profile context, 100 and 300es to an OpenGL ES 3.x context, both
-   on EGL device FOGVOL_EGL_DEVICE (default 0). GL is reached only through
-   eglGetProcAddress.
+   on EGL device FOGVOL_EGL_DEVICE (default 0, tests/gl_util.h). GL is reached
+   only through eglGetProcAddress.
 
    usage: gl_compile DIR   (DIR as written by dump_shaders). Every X.frag is
    linked with X.vert, or for a per-sample X_ms.frag with the vertex shader of
@@ -12,9 +12,8 @@
    last line "N passed, M failed" (exit status 1 when M > 0). make test runs it
    on Mesa's EGL device (llvmpipe); on a GPU machine: make gl-compile. */
 #define _POSIX_C_SOURCE 200809L
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
-#include <GL/gl.h>
+#define GLU_EGL
+#include "tests/gl_util.h" /* glu_egl_display */
 #include <GL/glext.h>
 #include <dirent.h>
 #include <stdio.h>
@@ -56,22 +55,6 @@ static int glc_fail(const char *what)
 {
     fprintf(stderr, "gl_compile: %s failed (EGL error 0x%x)\n", what, (unsigned)eglGetError());
     return 0;
-}
-
-static EGLDisplay glc_display(void)
-{
-    PFNEGLQUERYDEVICESEXTPROC query = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
-    PFNEGLGETPLATFORMDISPLAYEXTPROC get =
-        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-    EGLDeviceEXT dev[16];
-    EGLint n = 0;
-    const char *pick = getenv("FOGVOL_EGL_DEVICE");
-    int want = pick ? atoi(pick) : 0;
-    if (query && get && query(16, dev, &n) && n > 0) {
-        EGLDisplay d = get(EGL_PLATFORM_DEVICE_EXT, dev[want >= 0 && want < n ? want : 0], NULL);
-        if (d != EGL_NO_DISPLAY) return d;
-    }
-    return eglGetDisplay(EGL_DEFAULT_DISPLAY);
 }
 
 /* es: 0 = desktop GL, compatibility profile (every desktop GLSL version); 1 = OpenGL ES 3.x */
@@ -196,7 +179,7 @@ int main(int argc, char **argv)
     static char log[8192];
     glc_ctx ctx[2];
     EGLConfig cfg;
-    EGLint n = 0, major, minor;
+    EGLint n = 0;
     DIR *d;
     struct dirent *e;
     int passed = 0, failed = 0, logs = 0, cur = -1;
@@ -204,8 +187,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s DIR (the shaders dump_shaders wrote)\n", argv[0]);
         return 2;
     }
-    g_dpy = glc_display();
-    if (g_dpy == EGL_NO_DISPLAY || !eglInitialize(g_dpy, &major, &minor)) return !glc_fail("eglInitialize");
+    g_dpy = glu_egl_display();
+    if (g_dpy == EGL_NO_DISPLAY) return !glc_fail("eglInitialize");
     if (!eglChooseConfig(g_dpy, cfg_attr, &cfg, 1, &n) || n < 1) return !glc_fail("eglChooseConfig");
     if ((g_surf = eglCreatePbufferSurface(g_dpy, cfg, pb_attr)) == EGL_NO_SURFACE)
         return !glc_fail("eglCreatePbufferSurface");
