@@ -88,7 +88,7 @@ TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
             $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
-            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless
 
 # every shader dump_shaders writes, compiled and linked by an EGL driver (Mesa's llvmpipe here;
 # make gl-compile on a machine with a GPU driver)
@@ -171,9 +171,14 @@ $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
 	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm
 
+$(BUILD)/egl/demo_headless: examples/demo_headless.c examples/demo_scene.h examples/example_gl.h $(TEST_DEPS)
+	@mkdir -p $(BUILD)/egl
+	$(CC) -std=c99 -DGLU_EGL $(CFLAGS) $(WARN) $(INC) $< -o $@ -lEGL -lOpenGL -lm
+
 gpu-test: deps-test
-	@$(MAKE) --no-print-directory -j$(JOBS) $(foreach t,$(EGL_TESTS),$(BUILD)/egl/test_$(t))
-	@LOGDIR=$(BUILD)/logs_egl JOBS=1 tests/run.sh $(foreach t,$(EGL_TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/egl/test_$(t)")
+	@$(MAKE) --no-print-directory -j$(JOBS) $(foreach t,$(EGL_TESTS),$(BUILD)/egl/test_$(t)) $(BUILD)/egl/demo_headless
+	@LOGDIR=$(BUILD)/logs_egl JOBS=1 tests/run.sh $(foreach t,$(EGL_TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/egl/test_$(t)") \
+	  "demo_headless=$(BUILD)/egl/demo_headless $(BUILD)/demo_egl --check"
 
 gl-compile: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/dump_shaders $(BUILD)/gl_compile

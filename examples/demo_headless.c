@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 199309L
-/* demo_headless.c - fogvol.h without a window. OSMesa renders the demo's place
+/* demo_headless.c - fogvol.h without a window. OSMesa (built with -DGLU_EGL: any
+   EGL device, make gpu-test) renders the demo's place
    (examples/demo_scene.h: a sunlit courtyard with a cobbled path, a house,
    columns, an arch gate, rocks, pine trees and a lamp post, drawn by the demo's
    own shaders as the engine's opaque pass), and fogvol adds the fog volumes
@@ -180,12 +181,9 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
         fogvol_end_frame(fv, grp == 0 ? &out->st : NULL);
         glFinish();
         if (grp == 0) out->ms = now_ms() - t0;
-        if (grp == 0) memcpy(out->rgba, d->g.pixels, (size_t)s->w * s->h * 4);
+        if (grp == 0) memcpy(out->rgba, glu_pixels(&d->g), (size_t)s->w * s->h * 4);
     }
-    if (!with_fog) {
-        glFinish();
-        memcpy(out->rgba, d->g.pixels, (size_t)s->w * s->h * 4);
-    }
+    if (!with_fog) memcpy(out->rgba, glu_pixels(&d->g), (size_t)s->w * s->h * 4);
     for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
     for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
     fogvol_destroy_context(fv);
@@ -341,7 +339,7 @@ static int post_effect(demo *d, fogvol_context *fv, const fogvol_frame_desc *fd,
         fprintf(stderr, "%s: %s\n", names[k], fogvol_result_string(r));
         return 0;
     }
-    glFinish();
+    glu_pixels(&d->g);
     save_row(dir, names[k], &img, 1, DW, DH);
     return 1;
 }
@@ -550,8 +548,7 @@ static void demo_texlight(demo *d, const char *dir, int lights)
     demo_tl_volumes(d, fv, fm, ramp, tex, lights);
     if (lights) shaft = demo_tl_lights(fv);
     fogvol_end_frame(fv, NULL);
-    glFinish();
-    imgs[0] = d->g.pixels;
+    imgs[0] = glu_pixels(&d->g);
     save_row(dir, lights ? "light_compare.png" : "textured_fog.png", imgs, 1, DW, DH);
     printf("  %-34s tier %s\n", lights ? "light_compare.png" : "textured_fog.png",
            fogvol_tier_name(fogvol_context_tier(fv, NULL)));
