@@ -54,8 +54,9 @@ static inline EGLDisplay glu_egl_display(void)
 }
 
 /* core = 1: the highest core profile from 4.6 down to 3.3 (as Mesa gives 4.5 core for 3.3 where a
-   driver may give exactly 3.3); 0: compatibility profile. Framebuffer 0: a width x height pbuffer,
-   RGBA8 + depth 24 + stencil 8, single-sample, like the OSMesa buffer. */
+   driver may give exactly 3.3), or exactly the version FOGVOL_EGL_CORE names ("3.3": what many
+   engines ask for); 0: compatibility profile. Framebuffer 0: a width x height pbuffer, RGBA8 +
+   depth 24 + stencil 8, single-sample, like the OSMesa buffer. */
 static inline int glu_create(glu_ctx *c, int width, int height, int core)
 {
     static const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
@@ -64,7 +65,8 @@ static inline int glu_create(glu_ctx *c, int width, int height, int core)
     static const int versions[][2] = {{4, 6}, {4, 5}, {4, 3}, {4, 1}, {4, 0}, {3, 3}};
     EGLint core_attr[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
                           EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    int v;
+    const char *want = getenv("FOGVOL_EGL_CORE");
+    int v, first = 0, count = (int)(sizeof versions / sizeof versions[0]);
     const EGLint compat_attr[] = {EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
                                   EGL_NONE};
     const EGLint pb_attr[] = {EGL_WIDTH, width, EGL_HEIGHT, height, EGL_NONE};
@@ -77,7 +79,13 @@ static inline int glu_create(glu_ctx *c, int width, int height, int core)
     if (c->dpy == EGL_NO_DISPLAY || !eglBindAPI(EGL_OPENGL_API)) return 0;
     if (!eglChooseConfig(c->dpy, cfg_attr, &cfg, 1, &n) || n < 1) return 0;
     if ((c->surf = eglCreatePbufferSurface(c->dpy, cfg, pb_attr)) == EGL_NO_SURFACE) return 0;
-    for (v = 0; v < (int)(sizeof versions / sizeof versions[0]) && c->ctx == EGL_NO_CONTEXT; ++v) {
+    if (want) /* exactly this one */
+        for (v = 0; v < count; ++v)
+            if (want[0] - '0' == versions[v][0] && want[1] == '.' && want[2] - '0' == versions[v][1]) {
+                first = v;
+                count = v + 1;
+            }
+    for (v = first; v < count && c->ctx == EGL_NO_CONTEXT; ++v) {
         core_attr[1] = versions[v][0];
         core_attr[3] = versions[v][1];
         c->ctx = eglCreateContext(c->dpy, cfg, EGL_NO_CONTEXT, core ? core_attr : compat_attr);
