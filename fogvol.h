@@ -9277,15 +9277,18 @@ enum {
 #define FOGVOL__GL_DRAW_BUFFERS(X) X(void, DrawBuffers, (fogvol__GLsizei, const fogvol__GLenum *))
 #define FOGVOL__GL_3_DESKTOP(X) X(void, BindFragDataLocation, (fogvol__GLuint, fogvol__GLuint, const fogvol__GLchar *))
 
-/* Per-draw-buffer colour mask and blend enable: GL 3.0, GLES 3.2. */
+/* Per-draw-buffer colour mask and blend enable: GL 3.0, GLES 3.2 (3.0/3.1 + OES_/EXT_draw_buffers_indexed). */
 #define FOGVOL__GL_INDEXED_MASK(X) \
-    X(void, GetBooleani_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLboolean *)) \
-    X(void, GetIntegeri_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLint *)) \
     X(fogvol__GLboolean, IsEnabledi, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, Enablei, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, Disablei, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, ColorMaski, (fogvol__GLuint, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean, fogvol__GLboolean))
-/* Per-draw-buffer blend functions and equations: GL 4.0 (3.x + ARB_draw_buffers_blend: ...iARB), GLES 3.2. */
+/* The indexed queries: GL 3.0, GLES 3.0 (GetBooleani_v: GLES 3.1; on GLES 3.0 the masks are read as integers). */
+#define FOGVOL__GL_INDEXED_QUERY(X) \
+    X(void, GetBooleani_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLboolean *)) \
+    X(void, GetIntegeri_v, (fogvol__GLenum, fogvol__GLuint, fogvol__GLint *))
+/* Per-draw-buffer blend functions and equations: GL 4.0 (3.x + ARB_draw_buffers_blend: ...iARB), GLES 3.2
+   (3.0/3.1 + OES_ or EXT_draw_buffers_indexed: ...iOES, ...iEXT, like the masks above). */
 #define FOGVOL__GL_INDEXED_BLEND(X) \
     X(void, BlendFuncSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
     X(void, BlendEquationSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum))
@@ -9320,7 +9323,7 @@ enum {
 #define FOGVOL__GL_ALL(X) \
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
-            FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X) \
+            FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_QUERY(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X) \
                 FOGVOL__GL_QUERY(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
@@ -9753,7 +9756,13 @@ static void fogvol__gl_save_draw_buffers(fogvol__gl *gl, fogvol__gl_state *s)
         }
     s->n_indexed = gl->has_indexed_mask ? gl->max_draw_buffers : 0;
     for (i = 0; i < s->n_indexed; ++i) {
-        gl->GetBooleani_v(FOGVOL__GL_COLOR_WRITEMASK, (fogvol__GLuint)i, s->bi_mask[i]);
+        if (gl->GetBooleani_v) {
+            gl->GetBooleani_v(FOGVOL__GL_COLOR_WRITEMASK, (fogvol__GLuint)i, s->bi_mask[i]);
+        } else { /* GLES 3.0 */
+            fogvol__GLint m[4] = {1, 1, 1, 1}, k;
+            gl->GetIntegeri_v(FOGVOL__GL_COLOR_WRITEMASK, (fogvol__GLuint)i, m);
+            for (k = 0; k < 4; ++k) s->bi_mask[i][k] = (fogvol__GLboolean)(m[k] != 0);
+        }
         s->bi_blend[i] = gl->IsEnabledi(FOGVOL__GL_BLEND, (fogvol__GLuint)i);
         if (!gl->has_indexed_blend) continue;
         gl->GetIntegeri_v(FOGVOL__GL_BLEND_SRC_RGB, (fogvol__GLuint)i, &s->bi_src_rgb[i]);
@@ -11031,9 +11040,55 @@ static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *d
     return FOGVOL_SUCCESS;
 }
 
+/* Per-draw-buffer masks and blending, which the engine may have set and fogvol puts back, and the
+   transform feedback pause. GL 3.x and GLES 3.0/3.1 contexts may have the later versions' functions
+   as extensions (a driver may give exactly the 3.3 asked for): the masks are GL 3.0, GLES 3.2 or
+   OES_/EXT_draw_buffers_indexed (...iOES/...iEXT, blending too); the blending GL 4.0 or
+   ARB_draw_buffers_blend (...iARB); the pause GL 4.0, GLES 3.0 or ARB_transform_feedback2. */
+static fogvol_result fogvol__gl_load_indexed(fogvol__gl *gl, const fogvol_gl_desc *desc)
+{
+    const char *mask = NULL, *blend = NULL, *suffix; /* the functions' suffixes; NULL: none */
+    char name[64];
+    if (!gl->gles) {
+        mask = gl->major >= 3 ? "" : NULL;
+        blend = gl->major >= 4                                                              ? ""
+                : gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_draw_buffers_blend") ? "ARB"
+                                                                                            : NULL;
+    } else if (gl->major > 3 || (gl->major == 3 && gl->minor >= 2)) {
+        mask = blend = "";
+    } else if (gl->major == 3) {
+        mask = blend = fogvol__gl_has_ext3(gl, "GL_OES_draw_buffers_indexed")   ? "OES"
+                       : fogvol__gl_has_ext3(gl, "GL_EXT_draw_buffers_indexed") ? "EXT"
+                                                                               : NULL;
+    }
+    gl->has_indexed_mask = mask != NULL;
+    gl->has_indexed_blend = blend != NULL;
+    gl->has_tf_pause = gl->gles ? gl->major >= 3
+                                : gl->major >= 4 ||
+                                      (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_transform_feedback2"));
+    if (mask) {
+        FOGVOL__GL_INDEXED_QUERY(FOGVOL__GL_LOAD)
+        FOGVOL__GL_REQUIRE(void, GetIntegeri_v, ())
+        if (gl->gles && gl->major == 3 && gl->minor == 0) gl->GetBooleani_v = NULL; /* GLES 3.1 */
+        else FOGVOL__GL_REQUIRE(void, GetBooleani_v, ())
+        suffix = mask;
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD_SUFFIXED)
+    }
+    if (blend) {
+        suffix = blend;
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_SUFFIXED)
+    }
+    if (gl->has_tf_pause) {
+        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)
+        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_REQUIRE)
+    }
+    return FOGVOL_SUCCESS;
+}
+
 /* The functions of the later versions that the context has. */
 static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
 {
+    fogvol_result r;
     if (gl->has_vao) {
         FOGVOL__GL_VAO(FOGVOL__GL_LOAD)
         FOGVOL__GL_VAO(FOGVOL__GL_REQUIRE)
@@ -11057,28 +11112,7 @@ static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_d
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_LOAD)
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_REQUIRE)
     }
-    /* GL 3.x contexts may have the GL 4.0 per-buffer blend and transform feedback pause as
-       extensions (a driver may give exactly the 3.3 asked for), and the engine may use them */
-    gl->has_indexed_mask = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2) : gl->major >= 3;
-    gl->has_indexed_blend = gl->gles ? gl->has_indexed_mask
-                                     : gl->major >= 4 ||
-                                           (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_draw_buffers_blend"));
-    gl->has_tf_pause = gl->gles ? gl->major >= 3
-                                : gl->major >= 4 ||
-                                      (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_transform_feedback2"));
-    if (gl->has_indexed_mask) {
-        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD)
-        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_REQUIRE)
-    }
-    if (gl->has_indexed_blend) { /* ARB_draw_buffers_blend names them ...iARB */
-        const char *suffix = gl->gles || gl->major >= 4 ? "" : "ARB";
-        char name[64];
-        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_SUFFIXED)
-    }
-    if (gl->has_tf_pause) {
-        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)
-        FOGVOL__GL_TF_PAUSE(FOGVOL__GL_REQUIRE)
-    }
+    if ((r = fogvol__gl_load_indexed(gl, desc)) != FOGVOL_SUCCESS) return r;
     if (!gl->gles || gl->major >= 3) { /* optional */
         FOGVOL__GL_QUERY(FOGVOL__GL_LOAD)
 #define FOGVOL__GL_HAVE(ret, name, params) &&gl->name

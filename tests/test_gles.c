@@ -604,6 +604,148 @@ static void test_overflow(void **state)
     free(thick);
 }
 
+/* The engine's per-draw-buffer blending and masks (GLES 3.2, or OES_/EXT_draw_buffers_indexed on
+   GLES 3.0/3.1) over a frame drawn into draw buffer 0 of two: fogvol leaves buffer 1's state and
+   pixels as they were, and fogs buffer 0. */
+typedef struct es_ib {
+    void (*blend_func)(GLuint, GLenum, GLenum, GLenum, GLenum);
+    void (*blend_eq)(GLuint, GLenum, GLenum);
+    void (*color_mask)(GLuint, GLboolean, GLboolean, GLboolean, GLboolean);
+    void (*enable)(GLenum, GLuint);
+    GLboolean (*is_enabled)(GLenum, GLuint);
+} es_ib;
+
+static int es_ib_load(es_ib *f, const eglu_ctx *c)
+{
+    const char *sfx = c->major > 3 || c->minor >= 2 ? "" : NULL;
+    char n[64];
+    memset(f, 0, sizeof *f);
+    if (!sfx) { /* GLES 3.0/3.1 */
+        GLint k, count = 0;
+        glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+        for (k = 0; k < count && !sfx; ++k) {
+            const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)k);
+            if (strcmp(e, "GL_OES_draw_buffers_indexed") == 0) sfx = "OES";
+            else if (strcmp(e, "GL_EXT_draw_buffers_indexed") == 0) sfx = "EXT";
+        }
+        if (!sfx) return 0;
+    }
+#define ES_IB_LOAD(field, name, type) (snprintf(n, sizeof n, "gl%s%s", name, sfx), f->field = (type)eglu_proc(n, NULL))
+    ES_IB_LOAD(blend_func, "BlendFuncSeparatei", void (*)(GLuint, GLenum, GLenum, GLenum, GLenum));
+    ES_IB_LOAD(blend_eq, "BlendEquationSeparatei", void (*)(GLuint, GLenum, GLenum));
+    ES_IB_LOAD(color_mask, "ColorMaski", void (*)(GLuint, GLboolean, GLboolean, GLboolean, GLboolean));
+    ES_IB_LOAD(enable, "Enablei", void (*)(GLenum, GLuint));
+    ES_IB_LOAD(is_enabled, "IsEnabledi", GLboolean (*)(GLenum, GLuint));
+#undef ES_IB_LOAD
+    print_message("  per-buffer blending: %s\n", sfx[0] ? sfx : "core");
+    return f->blend_func && f->blend_eq && f->color_mask && f->enable && f->is_enabled;
+}
+
+/* buffer i's blend enable, functions, equations and mask (GetIntegeri_v: GLES 3.0) */
+static void es_ib_state(const es_ib *f, GLuint i, GLint st[11])
+{
+    static const GLenum q[6] = {GL_BLEND_SRC_RGB, GL_BLEND_DST_RGB, GL_BLEND_SRC_ALPHA, GL_BLEND_DST_ALPHA,
+                                GL_BLEND_EQUATION_RGB, GL_BLEND_EQUATION_ALPHA};
+    int k;
+    st[0] = f->is_enabled(GL_BLEND, i);
+    for (k = 0; k < 6; ++k) glGetIntegeri_v(q[k], i, &st[1 + k]);
+    glGetIntegeri_v(GL_COLOR_WRITEMASK, i, &st[7]);
+}
+
+static void test_drawbuffers(void **state)
+{
+    int ci = (int)(intptr_t)*state, i, fogged0 = 0, changed1 = 0;
+    const tscene *s = &g_scenes[scene_index("sphere")];
+    static const tier_combo cb = {FOGVOL_TIER_PS20, 0, "PS20", 0};
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    unsigned char *px[2][2];
+    GLint before[2][11], after[2][11];
+    GLuint fbo, tex[2], depth;
+    eglu_ctx c;
+    es_ib f;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_desc fd;
+    context_up(ci, &c);
+    memset(&f, 0, sizeof f);
+    if (!es_ib_load(&f, &c)) {
+        eglu_destroy(&c);
+        skip();
+    }
+    glGenTextures(2, tex);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    for (i = 0; i < 2; ++i) {
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, tex[i], 0);
+    }
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, W, H);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glDrawBuffers(2, bufs);
+    glClearColor(0.2f, 0.4f, 0.6f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    /* the engine's per-buffer state: buffer 1 blends its own way and writes red and blue only */
+    f.enable(GL_BLEND, 1);
+    f.blend_func(1, GL_DST_COLOR, GL_ZERO, GL_ONE, GL_ONE);
+    f.blend_eq(1, GL_FUNC_SUBTRACT, GL_MAX);
+    f.color_mask(1, GL_TRUE, GL_FALSE, GL_TRUE, GL_FALSE);
+    for (i = 0; i < 2; ++i) {
+        px[0][i] = (unsigned char *)malloc((size_t)W * H * 4);
+        px[1][i] = (unsigned char *)malloc((size_t)W * H * 4);
+        es_ib_state(&f, (GLuint)i, before[i]);
+        glReadBuffer(bufs[i]);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px[0][i]);
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    fv = make_context(&cb, s->bits);
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    fx_frame_desc(&fd, &s->cam, W, H);
+    fd.draw_buffer = 0;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_scene(fv, s, meshes, ramp, 1);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    for (i = 0; i < 2; ++i) {
+        es_ib_state(&f, (GLuint)i, after[i]);
+        glReadBuffer(bufs[i]);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px[1][i]);
+    }
+    for (i = 0; i < W * H * 4; ++i) {
+        fogged0 += px[0][0][i] != px[1][0][i];
+        changed1 += px[0][1][i] != px[1][1][i];
+    }
+    print_message("  %s draw buffer 0 of 2: %d channel values fogged, %d changed in buffer 1; buffer 1 blend %d, "
+                  "functions 0x%x 0x%x 0x%x 0x%x -> 0x%x 0x%x 0x%x 0x%x, mask %d%d%d%d -> %d%d%d%d\n",
+                  g_ctx[ci].name, fogged0, changed1, after[1][0], before[1][1], before[1][2], before[1][3],
+                  before[1][4], after[1][1], after[1][2], after[1][3], after[1][4], before[1][7], before[1][8],
+                  before[1][9], before[1][10], after[1][7], after[1][8], after[1][9], after[1][10]);
+    assert_memory_equal(before, after, sizeof before);
+    assert_true(fogged0 > 1000);
+    assert_int_equal(changed1, 0);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(2, tex);
+    glDeleteRenderbuffers(1, &depth);
+    for (i = 0; i < 2; ++i) {
+        free(px[0][i]);
+        free(px[1][i]);
+    }
+    eglu_destroy(&c);
+}
+
 static int setup_all(void **state)
 {
     int i;
@@ -660,8 +802,8 @@ static int print_table(void **state)
 static int run_context(int ci)
 {
     static tcase cases[NTIER_COMBO];
-    static struct CMUnitTest tests[NTIER_COMBO + 2];
-    static char names[NTIER_COMBO + 2][64], group[32];
+    static struct CMUnitTest tests[NTIER_COMBO + 3];
+    static char names[NTIER_COMBO + 3][64], group[32];
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
@@ -686,6 +828,13 @@ static int run_context(int ci)
     tests[n].test_func = test_overflow;
     tests[n].initial_state = (void *)(intptr_t)ci;
     ++n;
+    if (g_ctx[ci].major >= 3) {
+        snprintf(names[n], sizeof names[n], "%s_drawbuffers", g_ctx[ci].file);
+        tests[n].name = names[n];
+        tests[n].test_func = test_drawbuffers;
+        tests[n].initial_state = (void *)(intptr_t)ci;
+        ++n;
+    }
     snprintf(group, sizeof group, "gles_%s", g_ctx[ci].file);
     return _cmocka_run_group_tests(group, tests, (size_t)n, setup_all, print_table);
 }
