@@ -165,7 +165,8 @@ $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -O2 $(WARN) -DGLU_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
 
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
-# driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0)
+# driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with
+# test_gles (EGL's surfaceless platform, OpenGL ES) and the headless demo
 EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post
 $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
@@ -176,9 +177,10 @@ $(BUILD)/egl/demo_headless: examples/demo_headless.c examples/demo_scene.h examp
 	$(CC) -std=c99 -DGLU_EGL $(CFLAGS) $(WARN) $(INC) $< -o $@ -lEGL -lOpenGL -lm
 
 gpu-test: deps-test
-	@$(MAKE) --no-print-directory -j$(JOBS) $(foreach t,$(EGL_TESTS),$(BUILD)/egl/test_$(t)) $(BUILD)/egl/demo_headless
+	@$(MAKE) --no-print-directory -j$(JOBS) $(foreach t,$(EGL_TESTS),$(BUILD)/egl/test_$(t)) $(BUILD)/egl/demo_headless \
+	  $(BUILD)/test_gles
 	@LOGDIR=$(BUILD)/logs_egl JOBS=1 tests/run.sh $(foreach t,$(EGL_TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/egl/test_$(t)") \
-	  "demo_headless=$(BUILD)/egl/demo_headless $(BUILD)/demo_egl --check"
+	  "gles=$(TAP) $(BUILD)/test_gles" "demo_headless=$(BUILD)/egl/demo_headless $(BUILD)/demo_egl --check"
 
 gl-compile: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/dump_shaders $(BUILD)/gl_compile

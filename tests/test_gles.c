@@ -58,7 +58,7 @@ static const es_ctx g_ctx[] = {
 
 
 typedef struct gt_cache {
-    double *gt;
+    double *gt, *slope;
     int *pairs;
     unsigned char *interior, *covered;
     int max_faces;
@@ -94,6 +94,13 @@ static void context_up(int ci, eglu_ctx *c)
         fail_msg("no OpenGL ES context from Mesa's EGL surfaceless platform (%s): %s. The tests need the Debian "
                  "packages libegl-mesa0, libegl-dev and libgles-dev (tools/deps.sh test).",
                  g_ctx[ci].name, c->error);
+    if (c->major != g_ctx[ci].major && g_ctx[ci].override && !strstr((const char *)glGetString(GL_VERSION), "Mesa")) {
+        /* only Mesa gives a real ES 2.0 (MESA_GLES_VERSION_OVERRIDE); other drivers a later version */
+        print_message("  asked for %s, got ES %d.%d from a driver other than Mesa: skipped\n", g_ctx[ci].name,
+                      c->major, c->minor);
+        eglu_destroy(c);
+        skip();
+    }
     if (c->major != g_ctx[ci].major) fail_msg("asked for %s, got ES %d.%d", g_ctx[ci].name, c->major, c->minor);
     snprintf(g_version[ci][0], sizeof g_version[ci][0], "%s", (const char *)glGetString(GL_VERSION));
     snprintf(g_version[ci][1], sizeof g_version[ci][1], "%s", (const char *)glGetString(GL_SHADING_LANGUAGE_VERSION));
@@ -413,6 +420,7 @@ static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine 
 
 typedef struct scene_out {
     double max_err, sum_pp, comp_max; /* max_err: LSB per pair of faces (FLOAT: units of 3e-5 of the range) */
+    double slack_pp;                  /* the mean's vertex-snapping allowance (sum, like sum_pp) */
     int n, bad;
 } scene_out;
 
@@ -423,7 +431,8 @@ static void compare(const tier_combo *cb, const tscene *s, const gt_cache *t, co
     double range = s->cam.zfar - s->cam.znear;
     int bits = cb->bits ? cb->bits : s->bits, i, ch;
     double lsb = cb->tier == FOGVOL_TIER_FLOAT ? 3e-5 * range
-                 : range / pow(2.0, ((cb->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * bits);
+                 : range / pow(2.0, ((cb->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * bits),
+           snap = snap_pixels();
     memset(o, 0, sizeof *o);
     for (i = 0; i < W * H; ++i) {
         double err, a;
@@ -431,8 +440,9 @@ static void compare(const tier_combo *cb, const tscene *s, const gt_cache *t, co
         err = fabs(thick[i] - t->gt[i]) / lsb;
         if ((cb->tier == FOGVOL_TIER_FLOAT ? err : err / t->pairs[i]) > o->max_err)
             o->max_err = cb->tier == FOGVOL_TIER_FLOAT ? err : err / t->pairs[i];
-        /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits) */
-        if (err > (cb->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb)) {
+        /* + 1e-6 (far - near): fp32 vertex transforms move a grazing face's depth (visible at 18 bits);
+           + what the GL's vertex snapping may move the faces (rc_depth_slope, as in test_tiers) */
+        if (err > (cb->tier == FOGVOL_TIER_FLOAT ? 1.0 : t->pairs[i] + 1e-6 * range / lsb) + t->slope[i] * snap / lsb) {
             if (o->bad < 3)
                 print_message("  %s/%s pixel (%d,%d): %.5f vs %.5f (%.2f units)\n", cb->name, s->name, i % W, i / W,
                               thick[i], t->gt[i], err);
@@ -440,6 +450,7 @@ static void compare(const tier_combo *cb, const tscene *s, const gt_cache *t, co
         }
         if (!t->covered[i]) continue;
         o->sum_pp += err / t->pairs[i];
+        o->slack_pp += t->slope[i] * snap / lsb / t->pairs[i];
         ++o->n;
         a = 1.0 - exp(-(double)s->density * (t->gt[i] > 0 ? t->gt[i] : 0));
         for (ch = 0; ch < 3; ++ch) {
@@ -504,7 +515,7 @@ static void test_combo(void **state)
     const tcase *tc = (const tcase *)*state;
     const tier_combo *cb = &g_tier_combos[tc->combo];
     unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged = (unsigned char *)malloc((size_t)W * H * 4);
-    double t0 = now(), sum_pp = 0, comp = 0;
+    double t0 = now(), sum_pp = 0, comp = 0, slack_pp = 0;
     int sc, n = 0, bad = 0;
     eglu_ctx c;
     engine e;
@@ -515,6 +526,7 @@ static void test_combo(void **state)
         run_scene(tc, &c, &e, sc, base, fogged, &o);
         g_err[tc->ctx][tc->combo][sc] = o.max_err;
         sum_pp += o.sum_pp;
+        slack_pp += o.slack_pp;
         n += o.n;
         bad += o.bad;
         if (o.comp_max > comp) comp = o.comp_max;
@@ -531,7 +543,7 @@ static void test_combo(void **state)
     if (comp > 2.0 / 255.0) print_message("  %s/%s: composite off by %.2f/255\n", g_ctx[tc->ctx].name, cb->name, comp * 255);
     assert_int_equal(bad, 0);
     assert_true(n > 1000);
-    assert_true(g_mean[tc->ctx][tc->combo] <= 0.5);
+    assert_true(g_mean[tc->ctx][tc->combo] <= 0.5 + (n ? slack_pp / n : 0)); /* + the mean snapping allowance */
     assert_true(comp <= 2.0 / 255.0);
 }
 
@@ -754,11 +766,12 @@ static int setup_all(void **state)
     for (i = 0; i < NSCENE; ++i) {
         gt_cache *t = &g_gt[i];
         t->gt = (double *)calloc((size_t)W * H, sizeof(double));
+        t->slope = (double *)calloc((size_t)W * H, sizeof(double));
         t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
         t->interior = (unsigned char *)calloc((size_t)W * H, 1);
         t->covered = (unsigned char *)calloc((size_t)W * H, 1);
         ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
-                     &t->max_faces, &t->tmax, NULL);
+                     &t->max_faces, &t->tmax, t->slope);
     }
     return 0;
 }
