@@ -11061,6 +11061,24 @@ static fogvol_result fogvol__gl_load_indexed(fogvol__gl *gl, const fogvol_gl_des
                        : fogvol__gl_has_ext3(gl, "GL_EXT_draw_buffers_indexed") ? "EXT"
                                                                                : NULL;
     }
+    if (mask && *mask) { /* the extension's functions: all, or the context is taken as without them
+                            (WebGL 2 lists OES_draw_buffers_indexed without IsEnablediOES) */
+#define FOGVOL__GL_LOAD_TRY(ret, nm, params) \
+    snprintf(name, sizeof name, "gl%s%s", #nm, mask); \
+    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data);
+#define FOGVOL__GL_HAVE(ret, nm, params) &&gl->nm
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD_TRY)
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_TRY)
+        if (!(1 FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_HAVE) FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_HAVE))) {
+            fogvol__log(&gl->log, FOGVOL_LOG_INFO,
+                        "fogvol: %s_draw_buffers_indexed is listed without all its functions: per-buffer blend state "
+                        "is not saved",
+                        mask);
+            mask = blend = NULL;
+        }
+#undef FOGVOL__GL_HAVE
+#undef FOGVOL__GL_LOAD_TRY
+    }
     gl->has_indexed_mask = mask != NULL;
     gl->has_indexed_blend = blend != NULL;
     gl->has_tf_pause = gl->gles ? gl->major >= 3
