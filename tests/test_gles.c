@@ -381,6 +381,20 @@ static fogvol_context *make_context(const tier_combo *cb, int bits)
     return fv;
 }
 
+/* A context of combo cb (its bits, else the scene's) with scene s's meshes and a grey extinction ramp of
+   the scene's density. */
+static fogvol_context *scene_context(const tier_combo *cb, const tscene *s, fogvol_mesh **meshes, fogvol_ramp **ramp)
+{
+    fogvol_context *fv = make_context(cb, cb->bits ? cb->bits : s->bits);
+    fogvol_ramp_desc rd;
+    upload_meshes(fv, s, meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, ramp), FOGVOL_SUCCESS);
+    return fv;
+}
+
 /* One frame of scene s as an engine would draw it, the engine's state checked
    around fogvol_end_frame. base: the engine's picture before the fog. */
 static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine *e, const tscene *s,
@@ -471,10 +485,9 @@ static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, uns
 {
     const tier_combo *cb = &g_tier_combos[tc->combo];
     const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
-    fogvol_context *fv = make_context(cb, cb->bits ? cb->bits : s->bits);
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
+    fogvol_context *fv = scene_context(cb, s, meshes, &ramp);
     fogvol_frame_stats st;
     fogvol_tier_info ti;
     fogvol_result r;
@@ -483,12 +496,7 @@ static void run_scene(const tcase *tc, const eglu_ctx *c, engine *e, int sc, uns
     /* Baker's count needs the camera outside the volumes: inside, end_frame refuses the frame and
        leaves the engine's picture alone */
     int refused = (cb->variants & FOGVOL_VARIANT_COUNT) && strcmp(s->name, "camera_inside_sphere") == 0;
-    upload_meshes(fv, s, meshes);
     for (i = 0; i < s->n; ++i) has_neg |= s->obj[i].sign < 0;
-    memset(&rd, 0, sizeof rd);
-    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
-    rd.density = s->density;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
     r = engine_frame(fv, c, e, s, meshes, ramp, cb->tier == FOGVOL_TIER_MRT, thick, base, fogged, &st);
     memset(o, 0, sizeof *o);
     if (refused) {
@@ -567,19 +575,13 @@ static void test_overflow(void **state)
     fogvol_context *fv;
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
     fogvol_frame_stats st, first;
     int es3;
     ground_truth(s, gt, pairs, interior, covered, &max_faces, &tmax, NULL);
     context_up(ci, &c);
     es3 = c.major >= 3;
     engine_init(&e, es3);
-    fv = make_context(&cb, s->bits);
-    upload_meshes(fv, s, meshes);
-    memset(&rd, 0, sizeof rd);
-    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
-    rd.density = s->density;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    fv = scene_context(&cb, s, meshes, &ramp);
     assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 0, thick, base, fogged, &st),
                      FOGVOL_ERROR_DEPTH_OVERFLOW);
     first = st;
@@ -678,7 +680,6 @@ static void test_drawbuffers(void **state)
     fogvol_context *fv;
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp;
-    fogvol_ramp_desc rd;
     fogvol_frame_desc fd;
     context_up(ci, &c);
     memset(&f, 0, sizeof f);
@@ -715,12 +716,7 @@ static void test_drawbuffers(void **state)
         glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px[0][i]);
     }
     assert_int_equal(glGetError(), GL_NO_ERROR);
-    fv = make_context(&cb, s->bits);
-    upload_meshes(fv, s, meshes);
-    memset(&rd, 0, sizeof rd);
-    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
-    rd.density = s->density;
-    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    fv = scene_context(&cb, s, meshes, &ramp);
     fx_frame_desc(&fd, &s->cam, W, H);
     fd.draw_buffer = 0;
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
