@@ -11000,11 +11000,13 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
     return FOGVOL_SUCCESS;
 }
 
-/* Loads gl<nm><suffix> (locals: char name[64], const char *suffix: "" for the core name, "EXT" or "ARB"
-   where an extension provides the function); missing: an error. */
-#define FOGVOL__GL_LOAD_SUFFIXED(ret, nm, params) \
+/* Loads gl<nm><suffix> (locals: char name[64], const char *suffix: "" for the core name, "EXT", "ARB" or
+   "OES" where an extension provides the function); _SUFFIXED: missing is an error. */
+#define FOGVOL__GL_LOAD_NAMED(ret, nm, params) \
     snprintf(name, sizeof name, "gl%s%s", #nm, suffix); \
-    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data); \
+    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data);
+#define FOGVOL__GL_LOAD_SUFFIXED(ret, nm, params) \
+    FOGVOL__GL_LOAD_NAMED(ret, nm, params) \
     if (!gl->nm) { \
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: required GL function %s is missing", name); \
         return FOGVOL_ERROR_MISSING_FUNCTION; \
@@ -11061,40 +11063,50 @@ static fogvol_result fogvol__gl_load_indexed(fogvol__gl *gl, const fogvol_gl_des
                        : fogvol__gl_has_ext3(gl, "GL_EXT_draw_buffers_indexed") ? "EXT"
                                                                                : NULL;
     }
-    if (mask && *mask) { /* the extension's functions: all, or the context is taken as without them
-                            (WebGL 2 lists OES_draw_buffers_indexed without IsEnablediOES) */
-#define FOGVOL__GL_LOAD_TRY(ret, nm, params) \
-    snprintf(name, sizeof name, "gl%s%s", #nm, mask); \
-    gl->nm = (fogvol__PFN_##nm)desc->get_proc_address(name, desc->user_data);
-#define FOGVOL__GL_HAVE(ret, nm, params) &&gl->nm
-        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD_TRY)
-        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_TRY)
-        if (!(1 FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_HAVE) FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_HAVE))) {
-            fogvol__log(&gl->log, FOGVOL_LOG_INFO,
-                        "fogvol: %s_draw_buffers_indexed is listed without all its functions: per-buffer blend state "
-                        "is not saved",
-                        mask);
-            mask = blend = NULL;
-        }
-#undef FOGVOL__GL_HAVE
-#undef FOGVOL__GL_LOAD_TRY
+    if (mask) {
+        suffix = mask;
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD_NAMED)
     }
+    if (blend) {
+        suffix = blend;
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_NAMED)
+    }
+    /* an extension counts only with all its functions (WebGL 2 lists OES_draw_buffers_indexed without
+       IsEnablediOES): else the context is taken as without it; core functions are required */
+#define FOGVOL__GL_HAVE(ret, nm, params) &&gl->nm
+#define FOGVOL__GL_CLEAR(ret, nm, params) gl->nm = NULL;
+    if (mask && *mask && !(1 FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_HAVE) FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_HAVE))) {
+        fogvol__log(&gl->log, FOGVOL_LOG_INFO,
+                    "fogvol: %s_draw_buffers_indexed is listed without all its functions: the engine's per-buffer "
+                    "blend state is not saved", mask);
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_CLEAR)
+        mask = blend = NULL;
+    }
+    if (blend && *blend && !(1 FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_HAVE))) {
+        fogvol__log(&gl->log, FOGVOL_LOG_INFO,
+                    "fogvol: %s_draw_buffers_blend is listed without all its functions: the engine's per-buffer "
+                    "blend functions are not saved", blend);
+        blend = NULL;
+    }
+    if (!blend) {
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_CLEAR)
+    }
+#undef FOGVOL__GL_CLEAR
+#undef FOGVOL__GL_HAVE
     gl->has_indexed_mask = mask != NULL;
     gl->has_indexed_blend = blend != NULL;
     gl->has_tf_pause = gl->gles ? gl->major >= 3
                                 : gl->major >= 4 ||
                                       (gl->major == 3 && fogvol__gl_has_ext3(gl, "GL_ARB_transform_feedback2"));
     if (mask) {
+        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_REQUIRE)
         FOGVOL__GL_INDEXED_QUERY(FOGVOL__GL_LOAD)
         FOGVOL__GL_REQUIRE(void, GetIntegeri_v, ())
         if (gl->gles && gl->major == 3 && gl->minor == 0) gl->GetBooleani_v = NULL; /* GLES 3.1 */
         else FOGVOL__GL_REQUIRE(void, GetBooleani_v, ())
-        suffix = mask;
-        FOGVOL__GL_INDEXED_MASK(FOGVOL__GL_LOAD_SUFFIXED)
     }
     if (blend) {
-        suffix = blend;
-        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_LOAD_SUFFIXED)
+        FOGVOL__GL_INDEXED_BLEND(FOGVOL__GL_REQUIRE)
     }
     if (gl->has_tf_pause) {
         FOGVOL__GL_TF_PAUSE(FOGVOL__GL_LOAD)
