@@ -595,6 +595,34 @@ RC__FN unsigned rc__mix(unsigned h, unsigned v) {
   return h;
 }
 
+/* Pass 1 of a trace: the nearest occluder crossing with t >= zn (INFINITY if none) and its
+   object index in *nearest; with h, each occluder's index and whether it is crossed before zf
+   are mixed into *h (the signature). */
+RC__FN double rc__occluders(const rc_scene *sc, const rc__ray *ray, double zn, double zf, rc__hitbuf *buf,
+                            int *nearest, unsigned *h, int *oom) {
+  double opaque = INFINITY;
+  int i, k;
+  for (i = 0; i < sc->count; i++) {
+    int inrange = 0;
+    if (sc->objs[i].sign != 0) continue;
+    buf->n = 0;
+    rc__object_hits(&sc->objs[i], ray, zn, INFINITY, buf);
+    *oom |= buf->oom;
+    for (k = 0; k < buf->n; k++) {
+      if (buf->h[k].t < zf) inrange = 1;
+      if (buf->h[k].t < opaque) {
+        opaque = buf->h[k].t;
+        *nearest = i;
+      }
+    }
+    if (h) {
+      *h = rc__mix(*h, (unsigned)i);
+      *h = rc__mix(*h, (unsigned)inrange);
+    }
+  }
+  return opaque;
+}
+
 /* Trace the sample (sx,sy) (pixel units, see top of file). On allocation failure the
    thickness is NaN. */
 RC__FN rc_result rc_trace(const rc_scene *sc, const rc_camera *cam, double sx, double sy) {
@@ -609,24 +637,7 @@ RC__FN rc_result rc_trace(const rc_scene *sc, const rc_camera *cam, double sx, d
   rc_camera_ray(cam, sx, sy, o, d);
   rc__ray_setup(&ray, o, d);
   rc__hitbuf_init(&buf);
-  /* pass 1: occluders (two-sided) */
-  for (i = 0; i < sc->count; i++) {
-    const rc_scene_object *so = &sc->objs[i];
-    int inrange = 0;
-    if (so->sign != 0) continue;
-    buf.n = 0;
-    rc__object_hits(so, &ray, zn, INFINITY, &buf);
-    oom |= buf.oom;
-    for (k = 0; k < buf.n; k++) {
-      if (buf.h[k].t < zf) inrange = 1;
-      if (buf.h[k].t < r.opaque_w) {
-        r.opaque_w = buf.h[k].t;
-        nearest = i;
-      }
-    }
-    h = rc__mix(h, (unsigned)i);
-    h = rc__mix(h, (unsigned)inrange);
-  }
+  r.opaque_w = rc__occluders(sc, &ray, zn, zf, &buf, &nearest, &h, &oom); /* pass 1: occluders (two-sided) */
   end = r.opaque_w < zf ? r.opaque_w : zf;
   h = rc__mix(h, (unsigned)(r.opaque_w < zf ? nearest : -1));
   /* pass 2: volumes, whole line */
@@ -680,19 +691,12 @@ RC__FN rc_result rc_trace(const rc_scene *sc, const rc_camera *cam, double sx, d
 RC__FN int rc__counted_depths(const rc_scene *sc, const rc_camera *cam, double sx, double sy, double *w, int cap) {
   rc__hitbuf buf;
   rc__ray ray;
-  double o[3], d[3], zn = cam->znear, zf = cam->zfar, opaque = INFINITY, end;
-  int i, k, n = 0, oom = 0;
+  double o[3], d[3], zn = cam->znear, zf = cam->zfar, opaque, end;
+  int i, k, n = 0, oom = 0, nearest = -1;
   rc_camera_ray(cam, sx, sy, o, d);
   rc__ray_setup(&ray, o, d);
   rc__hitbuf_init(&buf);
-  for (i = 0; i < sc->count; i++) {
-    if (sc->objs[i].sign != 0) continue;
-    buf.n = 0;
-    rc__object_hits(&sc->objs[i], &ray, zn, INFINITY, &buf);
-    oom |= buf.oom;
-    for (k = 0; k < buf.n; k++)
-      if (buf.h[k].t < opaque) opaque = buf.h[k].t;
-  }
+  opaque = rc__occluders(sc, &ray, zn, zf, &buf, &nearest, NULL, &oom);
   end = opaque < zf ? opaque : zf;
   if (opaque < zf && n < cap) w[n++] = opaque;
   for (i = 0; i < sc->count; i++) {

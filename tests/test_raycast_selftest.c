@@ -1069,6 +1069,38 @@ static void test_perf(void) {
   shp_free(&m);
 }
 
+/* rc_depth_slope against the closed form: a unit box turned 30 degrees about y, 5 units ahead;
+   the centre ray crosses its front and back faces, planes n.p = d, where the view depth along the
+   ray dir(sx) = f + x tx r (x = 2 sx / width - 1) is w = d / (n.dir), so
+   dw/dsx = -d (n.r) tx (2 / width) / (n.dir)^2 and dw/dsy = 0 (n has no y part). */
+static void test_depth_slope(void) {
+  const int W = 64, H = 64;
+  rc_camera c = make_cam(0, 0, 0, 0, 0, -1, 0, 1, 0, 60.0, W, H, 0.1, 100.0);
+  shp_mesh box = shp_box(1.0f, 1.0f, 1.0f);
+  float model[16];
+  double tx = tan(30.0 * PI / 180.0), want = 0.0, got, cs, sn;
+  rc_object o;
+  rc_scene sc;
+  int k;
+  shp_mat_identity(model);
+  cs = (double)(float)cos(PI / 6.0);
+  sn = (double)(float)sin(PI / 6.0);
+  model[0] = (float)cs, model[2] = (float)-sn, model[8] = (float)sn, model[10] = (float)cs, model[14] = -5.0f;
+  o = make_obj(&box, model, 1);
+  check(rc_scene_init(&sc, &o, 1), "depth slope: scene");
+  for (k = -1; k <= 1; k += 2) { /* the faces z = +-1 of the box: n = R (0, 0, k), through c + n */
+    double n[3] = {sn * k, 0.0, cs * k}, d = n[2] * -5.0 + 1.0, x = 2.0 * (31 + 0.5) / W - 1.0;
+    double ndir = -n[2] + x * tx * n[0];
+    want += fabs(-d * n[0] * tx * (2.0 / W) / (ndir * ndir));
+  }
+  got = rc_depth_slope(&sc, &c, 31, 31);
+  check(fabs(got - want) <= 1e-4 * want, "depth slope at the centre %.9g != closed form %.9g", got, want);
+  check(rc_depth_slope(&sc, &c, 0, 0) == 0.0, "depth slope where nothing is crossed: %g", rc_depth_slope(&sc, &c, 0, 0));
+  printf("   rc_depth_slope: %.9g vs closed form %.9g view units per pixel\n", got, want);
+  rc_scene_free(&sc);
+  shp_free(&box);
+}
+
 int main(void) {
   test_meshes();
   test_camera();
@@ -1078,6 +1110,7 @@ int main(void) {
   test_negative();
   test_ties();
   test_winding();
+  test_depth_slope();
   test_perf();
   printf("%d passed, %d failed\n", g_pass, g_fail);
   return g_fail ? 1 : 0;
