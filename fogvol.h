@@ -469,7 +469,16 @@ typedef struct fogvol_context_desc fogvol_context_desc;
    FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
                  integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
                  exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
-                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0. */
+                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
+   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) in frames with
+                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
+                 and every volume's box either wholly between the near and far planes or wholly
+                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
+                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
+                 fragment behind an occluder is not shaded, and the composite adds the opaque
+                 depth once per missing back face. Other frames (a camera inside or near a volume)
+                 take the min compare as before. The same sums: B - F equals the min compare's
+                 bytes up to the faces that lie within depth-buffer precision of an occluder. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -478,7 +487,8 @@ enum {
     FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
     FOGVOL_SPEEDUP_ALU = 1u << 5,
     FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
-    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7
+    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
+    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -663,6 +673,8 @@ typedef struct fogvol_frame_stats {
     int64_t frame;           /* this frame's number: 0, 1, ... per context (end_frame calls) */
     int overflow_passes;     /* check passes issued this frame (not included in passes) */
     int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
+    int depth_tested;        /* 1: the faces were depth-tested against the occluders and counted (the
+                                COUNT variant, or FOGVOL_SPEEDUP_DEPTH_TEST took this frame) */
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -1418,7 +1430,10 @@ typedef struct fogvol_shader_desc {
    RAMP (the ramp texture only), NO_COLOR_TEXTURE (no fv_ctex), NO_OVERFLOW (no saturation test:
    for frames without show_overflow), FAST_EXP (the exp() of the alpha by a polynomial where the
    dialect has floatBitsToInt, see FOGVOL_SPEEDUP_FAST_EXP; not the same pixels). ENCODE and FACE:
-   DITHER (the dither on, fv_dith.x = 255: the integer ALU encode without the test). Every program:
+   DITHER (the dither on, fv_dith.x = 255: the integer ALU encode without the test). ENCODE, FACE,
+   RESOLVE and COMPOSITE of PS20 and PS13 without COUNT, SINGLE_TARGET, WIDE and ENGINE_DEPTH:
+   COUNT (the program of the COUNT variant, FACE only with NO_DENSITY; FOGVOL_SPEEDUP_DEPTH_TEST).
+   Every program:
    ORIGIN (the frame's viewport starts at the window origin: fogvol's targets and the engine's
    depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). Other
    bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
@@ -1432,7 +1447,8 @@ enum {
     FOGVOL_SPECIALIZE_NO_OVERFLOW = 1u << 6,
     FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7,
     FOGVOL_SPECIALIZE_OPAQUE = 1u << 8,
-    FOGVOL_SPECIALIZE_DITHER = 1u << 9
+    FOGVOL_SPECIALIZE_DITHER = 1u << 9,
+    FOGVOL_SPECIALIZE_COUNT = 1u << 10
 };
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -5662,6 +5678,9 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program */
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_RESOLVE ||
+        p == FOGVOL_PROGRAM_COMPOSITE)
+        bits &= ~(unsigned)FOGVOL_SPECIALIZE_COUNT; /* the tier and variants decide (fogvol__count_spec_ok) */
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
@@ -5694,10 +5713,20 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     return n;
 }
 
+/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
+   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
+static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
+{
+    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
+           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
+                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
+}
+
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
 {
     const fogvol__dialect_info *di;
     int n = 0, i, per_sample;
+    unsigned v; /* the variants the strings define: COUNT added by FOGVOL_SPECIALIZE_COUNT */
     if (!strings || !count || !d) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if (d->tier <= FOGVOL_TIER_AUTO || d->tier >= FOGVOL_TIER_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
@@ -5710,6 +5739,14 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if (d->samples > 1 && fogvol_msaa_supported(d->tier, d->variants, d->dialect) != FOGVOL_SUCCESS)
         return FOGVOL_ERROR_UNSUPPORTED;
     if (!fogvol__specialize_ok(d->program, d->specialize)) return FOGVOL_ERROR_UNSUPPORTED;
+    v = d->variants;
+    if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
+        if (!fogvol__count_spec_ok(d->tier, v) ||
+            fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
+            (d->program == FOGVOL_PROGRAM_FACE && !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))
+            return FOGVOL_ERROR_UNSUPPORTED; /* (COUNT has no density texture) */
+        v |= FOGVOL_VARIANT_COUNT;
+    }
     di = fogvol__dialect(d->dialect);
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
     strings[n++] = per_sample ? di->version_msaa : di->version;
@@ -5723,9 +5760,9 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         strings[n++] = di->fs;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
-        if (d->variants & (1u << i)) strings[n++] = fogvol__variant_define[i];
+        if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (per_sample) strings[n++] = fogvol__fs_msaa;
-    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, d->variants) &&
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, v) &&
         !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
     n = fogvol__specialize_defines(d, strings, n);
@@ -5988,7 +6025,7 @@ static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
 
 /* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
    it failed to build and the general program stands in. */
-#define FOGVOL__SPEC_MAX 32
+#define FOGVOL__SPEC_MAX 64
 typedef struct fogvol__spec_program {
     fogvol_program program;
     unsigned bits;
@@ -6097,6 +6134,9 @@ struct fogvol_context {
     fogvol_handle tgt_l;    /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
     unsigned speedups_off;  /* fogvol_context_desc.disable_speedups */
     int o_far;              /* O holds the far plane only (cleared, nothing drawn since) */
+    int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
+    unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
+    int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
 };
 
 /* column-major 4x4 helpers in double */
@@ -6224,7 +6264,8 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
         td.label = "fogvol O (opaque depth)";
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
         td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT)) td.share_depth = ctx->tgt_o; /* faces depth-tested */
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->tier, ctx->variants))
+            td.share_depth = ctx->tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
         td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
         td.label = "fogvol F (front faces)";
@@ -7487,7 +7528,7 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
     float *fl;
     fogvol_result r;
     double range = (double)ctx->frame.zfar - ctx->frame.znear;
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = ctx->count_frame;
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
     if (ctx->tgt_b2) return fogvol__debug_capture_wide(ctx, overflow);
     b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 12u);
@@ -7618,18 +7659,25 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
 
 /* The program p built for this configuration (fogvol_shader_desc.specialize = bits) in the current
    sample set, made on first use (the GL backend builds programs inside a frame without disturbing
-   it); the general program when specialising is off or the build failed (logged once). */
+   it); the general program when specialising is off or the build failed (logged once). COUNT is
+   not an option but another program: built with SPECIALIZE off too, and if it cannot be, the
+   frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged). */
 static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
 {
     fogvol__spec_program *sp;
     int i;
-    if (!bits || (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE)) return ctx->prog[p];
+    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT, and a COUNT face's NO_DENSITY */
+        bits &= (bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u;
+    if (!bits) return ctx->prog[p];
     for (i = 0; i < ctx->nspec; ++i) {
         sp = &ctx->spec[i];
         if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
             return sp->handle ? sp->handle : ctx->prog[p];
     }
-    if (ctx->nspec == FOGVOL__SPEC_MAX) return ctx->prog[p];
+    if (ctx->nspec == FOGVOL__SPEC_MAX) {
+        if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
+        return ctx->prog[p];
+    }
     sp = &ctx->spec[ctx->nspec++];
     sp->program = p;
     sp->bits = bits;
@@ -7638,7 +7686,10 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
         sp->handle = 0;
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: the specialised program (0x%x) did not build; the general program draws instead", bits);
+                    "fogvol: the specialised program (0x%x) did not build; the general program draws instead%s", bits,
+                    (bits & FOGVOL_SPECIALIZE_COUNT) ? " (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off from now on)"
+                                                     : "");
+        if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
     }
     ctx->compile_samples = 0;
     return sp->handle ? sp->handle : ctx->prog[p];
@@ -7845,6 +7896,23 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     return FOGVOL_SUCCESS;
 }
 
+/* The view depths of the 8 corners of volume v's bounds: their least and greatest. */
+static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volume *v, double *emin, double *emax)
+{
+    int c, j;
+    for (c = 0; c < 8; ++c) {
+        double p[3], e = ctx->eyerow[3];
+        p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
+        p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
+        p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
+        for (j = 0; j < 3; ++j)
+            e += ctx->eyerow[j] *
+                 (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
+        if (c == 0 || e < *emin) *emin = e;
+        if (c == 0 || e > *emax) *emax = e;
+    }
+}
+
 /* COUNT adds the opaque depth once per back face without its front face, so it
    needs every front face in front of the near plane: a volume that the near
    plane may cut (the camera inside it or within znear of it) breaks the count.
@@ -7853,24 +7921,31 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
    the first such volume, or -1. */
 static int fogvol__count_near_cut(const fogvol_context *ctx)
 {
-    int i, c, j;
+    int i;
     for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
         double emin = 0.0, emax = 0.0;
-        for (c = 0; c < 8; ++c) {
-            double p[3], e = ctx->eyerow[3];
-            p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
-            p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
-            p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
-            for (j = 0; j < 3; ++j)
-                e += ctx->eyerow[j] *
-                     (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
-            if (c == 0 || e < emin) emin = e;
-            if (c == 0 || e > emax) emax = e;
-        }
+        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
         if (emin < ctx->frame.znear && emax > 0.0) return i;
     }
     return -1;
+}
+
+/* FOGVOL_SPEEDUP_DEPTH_TEST: this frame drawn as COUNT (see the speed-up). Beyond the near-plane
+   condition of COUNT, no volume crosses the far plane either: there the min compare drops the
+   clipped faces while the count would add the far plane for them. */
+static int fogvol__depth_test_frame(const fogvol_context *ctx)
+{
+    int i;
+    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->nocc == 0 ||
+        ctx->engine_occluders || ctx->nlight > 0 || !fogvol__count_spec_ok(ctx->tier, ctx->variants))
+        return 0;
+    for (i = 0; i < ctx->nvol; ++i) {
+        double emin = 0.0, emax = 0.0;
+        if (ctx->vols[i].density) return 0;
+        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
+        if ((emin < ctx->frame.znear && emax > 0.0) || (emin < ctx->frame.zfar && emax > ctx->frame.zfar)) return 0;
+    }
+    return 1;
 }
 
 /* >>overflow checks ======================================================= */
@@ -8378,7 +8453,7 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, (engine ? fogvol__origin_bit(ctx) : 0u) |
-                                                                 fogvol__dither_bit(ctx));
+                                                                 fogvol__dither_bit(ctx) | ctx->count_bit);
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
@@ -8410,7 +8485,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     else if (ctx->tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
-    spec |= fogvol__dither_bit(ctx);
+    spec |= fogvol__dither_bit(ctx) | ctx->count_bit;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
     ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
@@ -8479,7 +8554,7 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
     if (ctx->tier != FOGVOL_TIER_PS13) return;
     ps->target = ctx->tgt_t;
-    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx));
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx) | ctx->count_bit);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
@@ -8515,7 +8590,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
-    spec |= fogvol__origin_bit(ctx);
+    spec |= fogvol__origin_bit(ctx) | ctx->count_bit;
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;
@@ -8711,7 +8786,9 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.w = ctx->frame.viewport[2];
     run.h = ctx->frame.viewport[3];
     run.single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    run.count = fogvol__has(ctx, FOGVOL_VARIANT_COUNT);
+    ctx->count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
+    run.count = ctx->count_frame = fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || ctx->count_bit;
+    run.st.depth_tested = run.count;
     run.rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {

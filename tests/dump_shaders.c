@@ -28,6 +28,24 @@ static int spec_applies(int p, unsigned bits)
     return 0;
 }
 
+/* FOGVOL_SPECIALIZE_COUNT: the COUNT variant's ENCODE, FACE (with NO_DENSITY), RESOLVE and COMPOSITE,
+   for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
+static int count_applies(int t, unsigned v, int d, int p, unsigned bits)
+{
+    const unsigned no = FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
+                        FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS;
+    if (!(bits & FOGVOL_SPECIALIZE_COUNT)) return spec_applies(p, bits);
+    if ((t != FOGVOL_TIER_PS20 && t != FOGVOL_TIER_PS13) || (v & no) ||
+        fogvol_combination_supported((fogvol_tier)t, v | FOGVOL_VARIANT_COUNT, (fogvol_dialect)d) != FOGVOL_SUCCESS)
+        return 0;
+    if (p == FOGVOL_PROGRAM_FACE && !(bits & FOGVOL_SPECIALIZE_NO_DENSITY)) return 0;
+    if (p != FOGVOL_PROGRAM_ENCODE && p != FOGVOL_PROGRAM_FACE && p != FOGVOL_PROGRAM_RESOLVE &&
+        p != FOGVOL_PROGRAM_COMPOSITE)
+        return 0;
+    return p == FOGVOL_PROGRAM_RESOLVE ? (bits & ~(unsigned)(FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN)) == 0
+                                       : spec_applies(p, bits & ~(unsigned)FOGVOL_SPECIALIZE_COUNT);
+}
+
 int main(int argc, char **argv)
 {
     static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh",
@@ -49,7 +67,15 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_OPAQUE | FOGVOL_SPECIALIZE_NO_OPAQUE,
                                      FOGVOL_SPECIALIZE_DITHER,
                                      FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE |
-                                         FOGVOL_SPECIALIZE_DITHER};
+                                         FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_COUNT,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
+                                         FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;
@@ -76,7 +102,7 @@ int main(int argc, char **argv)
                         if (ms && st == FOGVOL_STAGE_VERTEX) continue; /* the same as single-sample */
                         r = fogvol_shader_strings(&sd, s, &count);
                         if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
-                            !spec_applies(p, specs[k]) ||
+                            !count_applies(t, v, d, p, specs[k]) ||
                             !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p) ||
                             (ms && fogvol_msaa_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS)) {
                             if (r != FOGVOL_ERROR_UNSUPPORTED || count != 0) {

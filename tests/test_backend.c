@@ -242,7 +242,7 @@ typedef struct rec {
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 1024; ++k) { /* every program, every set of specialize bits */
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 2048; ++k) { /* every program, every set of specialize bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
@@ -448,12 +448,15 @@ static fogvol_handle rec_texture_sized(const rec *r, int w, int h)
     return t;
 }
 
+static unsigned g_rec_speedups_off; /* rec_context's fogvol_context_desc.disable_speedups */
+
 static fogvol_context *rec_context(rec *r, logcap *lc, counting *cnt)
 {
     fogvol_context_desc cd;
     fogvol_context *fv = NULL;
     memset(&cd, 0, sizeof cd);
     cd.backend = r->table;
+    cd.disable_speedups = g_rec_speedups_off;
     cd.tier = FOGVOL_TIER_PS20; /* the null backend reports no caps: AUTO would pick PS13 */
     if (lc) cd.logger = cap_logger(lc);
     if (cnt) cd.allocator = cnt_allocator(cnt);
@@ -585,7 +588,8 @@ static void check_pass(const rec *r, int i, const xpass *x, const char *what)
 }
 
 /* Uniforms every pass carries, from the encoding worked out by hand for L = 4. */
-static void check_common_uniforms(const fogvol_pass *p, const fogvol_constants *k, int dither, const char *what)
+static void check_common_uniforms(const fogvol_pass *p, const fogvol_constants *k, int dither, int count,
+                                  const char *what)
 {
     const double N = 16.0, D = 32.0, lsb3 = 1.0 / 4096.0, range = A_FAR - A_NEAR, scale = range * 255.0 / N;
     int j;
@@ -601,8 +605,9 @@ static void check_common_uniforms(const fogvol_pass *p, const fogvol_constants *
     assert_close(p->uniforms[FOGVOL_U_DECODE][0], scale, 1e-6, what);
     assert_close(p->uniforms[FOGVOL_U_DECODE][1], scale / N, 1e-6, what);
     assert_close(p->uniforms[FOGVOL_U_DECODE][2], scale / (N * N), 1e-6, what);
-    assert_close(p->uniforms[FOGVOL_U_DECODE][3], -scale / N, 1e-6, what);
-    for (j = 0; j < 4; ++j) assert_close(p->uniforms[FOGVOL_U_DECODE][j], k->decode[j], 1e-7, what);
+    /* alpha: the borrow of the blue digit; with face counts in alpha (COUNT) not decoded */
+    assert_close(p->uniforms[FOGVOL_U_DECODE][3], count ? 0.0 : -scale / N, 1e-6, what);
+    for (j = 0; j < 4; ++j) assert_close(p->uniforms[FOGVOL_U_DECODE][j], count && j == 3 ? 0.0 : k->decode[j], 1e-7, what);
 }
 
 static void check_depth_row(const fogvol_draw *d, const double p[3], double w, const char *what)
@@ -738,6 +743,11 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     xpass x[9];
     int i, n_depth = 0, n_plain = 0;
     fogvol_mesh *all[7];
+    /* FOGVOL_SPEEDUP_DEPTH_TEST: every box lies between the planes (w from 2 to 6, near 0.5, far 10.5), so
+       the frame is drawn as COUNT: programs with FOGVOL_SPECIALIZE_COUNT, faces depth-tested against the
+       occluders' depth, the composite reads O's counts (unit 3) */
+    int count = !(g_rec_speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST);
+    unsigned cbit = count ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
 
     for (i = 0; i < 5; ++i) all[i] = s->vol[i];
     all[5] = s->occ[0];
@@ -765,14 +775,14 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     assert_int_equal(r->nb.frames_begun, r->nb.frames_ended);
 
     /* resources identified by what they are, not by creation order */
-    enc = rec_program(r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER)); /* the ALU encode, dither on */
+    enc = rec_program(r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER | cbit)); /* the ALU encode, dither on */
     /* the passes run programs built for their configuration: occluders, so the faces read O, no density
        texture; extinction ramps reaching 7 / density: the exp() composite (FAST_EXP), no colour
        texture, no show_overflow; the viewport starts at (A_X0, A_Y0): reads with the offset (no ORIGIN) */
-    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER));
+    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER | cbit));
     comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
                                                              FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
-                                                             FOGVOL_SPECIALIZE_NO_OVERFLOW));
+                                                             FOGVOL_SPECIALIZE_NO_OVERFLOW | cbit));
     rg = blue = 0; /* PS20 encodes by arithmetic by default (FOGVOL_SPEEDUP_ALU): no rg or blue ramp */
     for (i = 0; i < r->ntex; ++i) assert_true(r->tex[i].w != 16 * 32 && !(r->tex[i].w == 16 && r->tex[i].hgt == 16));
     dith = rec_texture_sized(r, 8, 8);          /* 8 x 8 */
@@ -854,6 +864,10 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     x_add_draw(&x[7], mh(s->vol[1]));
     x_add_draw(&x[7], mh(s->vol[4]));
     x_composite(&x[8], FOGVOL_PASS_BLEND_FOG, geometry, comp, B, F, tf);
+    for (i = 1; i < 9 && count; ++i) {
+        if (i == 5 || i == 8) x[i].tex[3] = O; /* the composite: O's counts */
+        else x[i].depth_test = 1;              /* the faces: against the occluders' depth, not written */
+    }
     for (i = 0; i < 9; ++i) check_pass(r, i, &x[i], geometry ? "geometry" : "fullscreen");
     for (i = 1; i < 9; ++i) { /* B/F clear to zero */
         if (r->nb.passes[i].clear) {
@@ -872,7 +886,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     /* uniforms */
     assert_int_equal(fogvol_encoding_init(4, &e), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_compute_constants(&e, A_NEAR, A_FAR, 0.0f, &k), FOGVOL_SUCCESS);
-    for (i = 0; i < 9; ++i) check_common_uniforms(&r->nb.passes[i], &k, 1, "pass uniforms");
+    for (i = 0; i < 9; ++i) check_common_uniforms(&r->nb.passes[i], &k, 1, count, "pass uniforms");
     for (i = 5; i < 9; i += 3) {
         /* fv_rampmap: t = 0 -> centre of texel 0, t = max_thickness (7/density = 14) -> centre of the last */
         const float *rm = r->nb.passes[i].uniforms[FOGVOL_U_RAMP];
@@ -922,6 +936,19 @@ static void test_a1_pass_structure_fullscreen(void **state)
     a1_check(s, 0, 0x80);
     a1_free(s);
     free(s);
+}
+
+/* The same frame drawn with the min compare (FOGVOL_SPEEDUP_DEPTH_TEST off): the faces read O. */
+static void test_a1_pass_structure_min_compare(void **state)
+{
+    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
+    (void)state;
+    g_rec_speedups_off = FOGVOL_SPEEDUP_DEPTH_TEST;
+    a1_build(s);
+    a1_check(s, 0, 0x80);
+    a1_free(s);
+    free(s);
+    g_rec_speedups_off = 0;
 }
 
 static void test_a1_pass_structure_geometry(void **state)
@@ -1157,7 +1184,9 @@ static void test_a3_frame_protocol(void **state)
     assert_int_equal(cb.calls, 1);
     assert_int_equal(cb.pass_count_at_call, 1); /* inside pass 0 ... */
     assert_int_equal(cb.in_pass_at_call, 1);
-    assert_int_equal(cb.program_at_call, rec_program(&r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER)));
+    /* (drawn as COUNT: FOGVOL_SPEEDUP_DEPTH_TEST, the box between the planes) */
+    assert_int_equal(cb.program_at_call, rec_program(&r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER |
+                                                                                       FOGVOL_SPECIALIZE_COUNT)));
     assert_int_equal(cb.transform_result, FOGVOL_SUCCESS);
     assert_int_equal(cb.nan_result, FOGVOL_ERROR_INVALID_ARGUMENT);
     assert_int_equal(cb.nset_after, 1); /* the transform reached the backend as set_draw */
@@ -2646,6 +2675,7 @@ int main(void)
 {
     const struct CMUnitTest null_tests[] = {
         cmocka_unit_test(test_a1_pass_structure_fullscreen),
+        cmocka_unit_test(test_a1_pass_structure_min_compare),
         cmocka_unit_test(test_a1_pass_structure_geometry),
         cmocka_unit_test(test_a1_geometry_stencil_bit),
         cmocka_unit_test(test_a1_geometry_without_stencil),

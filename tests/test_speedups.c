@@ -6,6 +6,8 @@
    EXP_COMPOSITE (alpha = 1 - exp(-density t) computed instead of read from the 8-bit ramp)
    differs from the ramp by at most 1/255 per channel, and FAST_EXP (its exp() by a polynomial) from
    exp() by at most 1/255; the sums themselves (debug_thickness) are bit-identical throughout.
+   DEPTH_TEST draws the PS20 and PS13 frames with occluders as COUNT (faces depth-tested against the
+   occluders, fogvol_frame_stats.depth_tested): the same bytes and sums as the min compare.
    A viewport away from the window origin gives the same pixels, shifted, as one at the origin (the
    composite reads fogvol's targets with the offset there, without it at the origin).
    PS20 + WIDE with FOGVOL_VARIANT_ALU gives the lookup textures' sums bit for bit (the integer
@@ -45,6 +47,7 @@ typedef struct run_out {
     unsigned char px[NFRAMES][W * H * 4];
     float th[NFRAMES][W * H]; /* fogvol_frame_desc.debug_thickness: the sums read back and decoded */
     int passes[NFRAMES];
+    int depth_tested[NFRAMES]; /* fogvol_frame_stats.depth_tested */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -102,6 +105,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
                     assert_memory_equal(p, clear, 4);
             }
         out->passes[f] = st.passes;
+        out->depth_tested[f] = st.depth_tested;
     }
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_ramp(fv, ramp);
@@ -157,7 +161,8 @@ static const fogvol_tier g_tiers[] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20, FOGVO
 static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
-     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP)
+     FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
+     FOGVOL_SPEEDUP_DEPTH_TEST)
 
 static void test_same_pixels_and_exp(void **state)
 {
@@ -194,6 +199,10 @@ static void test_same_pixels_and_exp(void **state)
                 /* one O pass drawn with speed-ups off in every frame; on: only in the first frame
                    and where occluders come (or leave: O must become the far plane again) */
                 assert_int_equal(def.passes[f], off.passes[f] - (f == 1 ? 1 : 0));
+                /* DEPTH_TEST: PS20 and PS13 frames with occluders (both scenes lie between the planes)
+                   are drawn as COUNT, faces depth-tested; the bytes above are the same */
+                assert_int_equal(def.depth_tested[f], g_tiers[ti] != FOGVOL_TIER_FLOAT && with_occluders(f));
+                assert_int_equal(off.depth_tested[f], 0);
             }
             write_png(g_tier_names[ti], def.px[2]);
             if (g_tiers[ti] == FOGVOL_TIER_FLOAT) {
