@@ -478,7 +478,10 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  fragment behind an occluder is not shaded, and the composite adds the opaque
                  depth once per missing back face. Other frames (a camera inside or near a volume)
                  take the min compare as before. The same sums: B - F equals the min compare's
-                 bytes up to the faces that lie within depth-buffer precision of an occluder. */
+                 bytes up to the faces that lie within depth-buffer precision of an occluder.
+                 FLOAT keeps the min compare: there the count needs a second float channel and
+                 an O read per composite pixel, which measured slower on llvmpipe than the one O
+                 read per face fragment it saves (cut by floor+pillars: 19.7 against 18.2 ms). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,

@@ -938,6 +938,80 @@ static void test_a1_pass_structure_fullscreen(void **state)
     free(s);
 }
 
+/* FOGVOL_SPEEDUP_DEPTH_TEST takes a frame only where the face count holds: occluders drawn by fogvol,
+   and every volume's box wholly between the planes or wholly outside them, on PS20 and PS13 (FLOAT
+   keeps the min compare). The camera of part A (w = 5 - x, near 0.5, far 10.5) and a box of
+   half-size 0.5 at x = tx: w from 4.5 - tx to 5.5 - tx. */
+static void test_a1_depth_test_frames(void **state)
+{
+    static const struct {
+        float tx;
+        int occluders, off, tested;
+        const char *what;
+    } c[] = {{0.0f, 1, 0, 1, "between the planes"},
+             {7.0f, 1, 0, 1, "behind the eye (w -2.5 .. -1.5)"},
+             {-7.0f, 1, 0, 1, "beyond the far plane (w 11.5 .. 12.5)"},
+             {5.0f, 1, 0, 0, "the eye inside (w -0.5 .. 0.5)"},
+             {4.3f, 1, 0, 0, "cut by the near plane (w 0.2 .. 1.2)"},
+             {-5.3f, 1, 0, 0, "cut by the far plane (w 9.8 .. 10.8)"},
+             {0.0f, 0, 0, 0, "no occluder"},
+             {0.0f, 1, 1, 0, "FOGVOL_SPEEDUP_DEPTH_TEST off"}};
+    static const fogvol_tier tiers[3] = {FOGVOL_TIER_PS20, FOGVOL_TIER_PS13, FOGVOL_TIER_FLOAT};
+    int t, i;
+    (void)state;
+    for (t = 0; t < 3; ++t)
+        for (i = 0; i < (int)(sizeof c / sizeof c[0]); ++i) {
+            rec r;
+            fogvol_context_desc cd;
+            fogvol_context *fv = NULL;
+            fogvol_mesh *box, *plane;
+            fogvol_ramp *ramp;
+            fogvol_frame_desc fd;
+            fogvol_volume_desc vd;
+            fogvol_frame_stats st;
+            shp_mesh bm = box_mesh(), pm = shp_grid_plane(1, 1, 2);
+            float om[16];
+            int k, face_passes = 0, want = tiers[t] == FOGVOL_TIER_FLOAT ? 0 : c[i].tested;
+            rec_init(&r);
+            r.table.caps |= FOGVOL_CAP_FLOAT_BLEND;
+            memset(&cd, 0, sizeof cd);
+            cd.backend = r.table;
+            cd.tier = tiers[t];
+            cd.disable_speedups = c[i].off ? FOGVOL_SPEEDUP_DEPTH_TEST : 0u;
+            assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+            assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
+            assert_int_equal(make_mesh(fv, &pm, 1, 0, &plane), FOGVOL_SUCCESS);
+            assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+            a_frame_desc(&fd);
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            mat_ts(om, 0, 0, -2, 1, 1, 1);
+            if (c[i].occluders) assert_int_equal(fogvol_add_occluder(fv, plane, om), FOGVOL_SUCCESS);
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = box;
+            vd.ramp = ramp;
+            mat_ts(vd.model, c[i].tx, 0, 0, 1, 1, 1);
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            if (st.depth_tested != want)
+                fail_msg("%s, %s: depth_tested %d, want %d", fogvol_tier_name(tiers[t]), c[i].what, st.depth_tested,
+                         want);
+            for (k = 0; k < r.nb.pass_count; ++k) /* the face passes: depth-tested exactly then */
+                if (r.nb.passes[k].target && r.nb.passes[k].blend != FOGVOL_PASS_BLEND_NONE) {
+                    assert_int_equal(r.nb.passes[k].depth_test != 0, want);
+                    assert_int_equal(r.nb.passes[k].depth_write, 0);
+                    face_passes++;
+                }
+            assert_int_equal(face_passes, tiers[t] == FOGVOL_TIER_FLOAT ? 1 : 2);
+            fogvol_destroy_mesh(fv, box);
+            fogvol_destroy_mesh(fv, plane);
+            fogvol_destroy_ramp(fv, ramp);
+            fogvol_destroy_context(fv);
+            assert_int_equal(r.nb.creates, r.nb.destroys);
+            shp_free(&bm);
+            shp_free(&pm);
+        }
+}
+
 /* The same frame drawn with the min compare (FOGVOL_SPEEDUP_DEPTH_TEST off): the faces read O. */
 static void test_a1_pass_structure_min_compare(void **state)
 {
@@ -2676,6 +2750,7 @@ int main(void)
     const struct CMUnitTest null_tests[] = {
         cmocka_unit_test(test_a1_pass_structure_fullscreen),
         cmocka_unit_test(test_a1_pass_structure_min_compare),
+        cmocka_unit_test(test_a1_depth_test_frames),
         cmocka_unit_test(test_a1_pass_structure_geometry),
         cmocka_unit_test(test_a1_geometry_stencil_bit),
         cmocka_unit_test(test_a1_geometry_without_stencil),
