@@ -769,6 +769,15 @@ typedef struct fogvol_frame_desc {
     fogvol_depth_source engine_depth_source;
     uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
+    /* 0 or 1: fogvol's sums at the viewport's resolution. 2: at half its width and height
+       (rounded up): the O and face passes shade a quarter of the fragments and the composite
+       upsamples the thickness bilinearly (FOGVOL_SPECIALIZE_DOWNSAMPLE); debug_thickness gets
+       the same upsampled values. The edges of volumes and occluders blur over a low-resolution
+       pixel (the README's "Half resolution" gives the measured error). FLOAT tier without
+       ENGINE_DEPTH or COLORS, single-sample, no fogvol_add_light, no fogvol_occluder_prepare;
+       otherwise end_frame returns FOGVOL_ERROR_UNSUPPORTED (logged). Other values:
+       FOGVOL_ERROR_INVALID_ARGUMENT. */
+    int downsample;
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -1079,7 +1088,7 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
 #define FOGVOL_MAX_TEXTURE_UNITS 8
 
 typedef struct fogvol_target_desc {
-    int width, height;        /* colour texture, NEAREST, CLAMP */
+    int width, height;        /* colour texture, NEAREST (see linear), CLAMP */
     int color_count;          /* 0 or 1: one colour attachment; 2: two (WIDE, COLORS), drawn together,
                                  both of the format */
     fogvol_format format;
@@ -1088,6 +1097,10 @@ typedef struct fogvol_target_desc {
     int depth;                /* 1: with a depth buffer */
     fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
     const char *label;
+    int linear;               /* 1: sampled with bilinear filtering (R32F, single-sample: the sum of
+                                 fogvol_frame_desc.downsample 2). A backend that cannot filter the
+                                 format returns FOGVOL_ERROR_UNSUPPORTED, and fogvol makes the target
+                                 without it and filters in the shader (four reads) */
 } fogvol_target_desc;
 
 #define FOGVOL_MAX_SHADER_STRINGS 16
@@ -1436,7 +1449,9 @@ typedef struct fogvol_shader_desc {
    DITHER (the dither on, fv_dith.x = 255: the integer ALU encode without the test). ENCODE, FACE,
    RESOLVE and COMPOSITE of PS20 and PS13 without COUNT, SINGLE_TARGET, WIDE and ENGINE_DEPTH:
    COUNT (the program of the COUNT variant, FACE only with NO_DENSITY; FOGVOL_SPEEDUP_DEPTH_TEST).
-   Every program:
+   COMPOSITE of FLOAT (not COLORS; single-sample): DOWNSAMPLE (the sums are at half the viewport's
+   width and height: a bilinear read of fv_back at the pixel, four texels; fogvol_frame_desc.downsample),
+   with FILTERED (one read: the backend filters fv_back, fogvol_target_desc.linear). Every program:
    ORIGIN (the frame's viewport starts at the window origin: fogvol's targets and the engine's
    depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). Other
    bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
@@ -1451,7 +1466,9 @@ enum {
     FOGVOL_SPECIALIZE_FAST_EXP = 1u << 7,
     FOGVOL_SPECIALIZE_OPAQUE = 1u << 8,
     FOGVOL_SPECIALIZE_DITHER = 1u << 9,
-    FOGVOL_SPECIALIZE_COUNT = 1u << 10
+    FOGVOL_SPECIALIZE_COUNT = 1u << 10,
+    FOGVOL_SPECIALIZE_DOWNSAMPLE = 1u << 11,
+    FOGVOL_SPECIALIZE_FILTERED = 1u << 12
 };
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
@@ -5374,9 +5391,34 @@ static const char fogvol__fs_composite[] =
     "uniform sampler2D fv_back2;\n"
     "uniform sampler2D fv_front2;\n"
     "#endif\n"
+    /* FV_DOWNSAMPLE (FLOAT, GLSL 130+): the sum at half resolution, bilinear between the four
+       nearest low-resolution texel centres (low-resolution texel i covers pixels 2i and 2i + 1:
+       its centre lies at window coordinate 2i + 1), clamped at the edges */
+    "#ifdef FV_DOWNSAMPLE\n"
+    "#ifdef FV_NO_FETCH\n"
+    "#define FV_TAP(c, n) FV_TEXTURE(fv_back, (vec2(c) + 0.5) / vec2(n + 1)).r\n"
+    "#else\n"
+    "#define FV_TAP(c, n) texelFetch(fv_back, c, 0).r\n"
+    "#endif\n"
+    "float fv_half_sum() {\n"
+    "#ifdef FV_FILTERED\n"                   /* the sampler interpolates (fogvol_target_desc.linear) */
+    "    return FV_TEXTURE(fv_back, FV_PIXEL * 0.5 / vec2(textureSize(fv_back, 0))).r;\n"
+    "#else\n"
+    "    vec2 p = FV_PIXEL * 0.5 - 0.5, i = floor(p), f = p - i;\n"
+    "    ivec2 n = textureSize(fv_back, 0) - 1;\n"
+    "    ivec2 a = clamp(ivec2(i), ivec2(0), n), c = clamp(ivec2(i) + 1, ivec2(0), n);\n"
+    "    return mix(mix(FV_TAP(a, n), FV_TAP(ivec2(c.x, a.y), n), f.x),\n"
+    "               mix(FV_TAP(ivec2(a.x, c.y), n), FV_TAP(c, n), f.x), f.y);\n"
+    "#endif\n"
+    "}\n"
+    "#endif\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
+    "#ifdef FV_DOWNSAMPLE\n"
+    "    vec4 b = vec4(fv_half_sum(), 0.0, 0.0, 0.0);\n"
+    "#else\n"
     "    vec4 b = FV_SCREEN(fv_back);\n"
+    "#endif\n"
     "    float sat = 0.0, t;\n"
     "#if defined(FV_FLOAT)\n"
     "    if (b.r == 0.0) discard;\n"
@@ -5684,6 +5726,9 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_RESOLVE ||
         p == FOGVOL_PROGRAM_COMPOSITE)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_COUNT; /* the tier and variants decide (fogvol__count_spec_ok) */
+    if ((bits & FOGVOL_SPECIALIZE_FILTERED) && !(bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
+    if (p == FOGVOL_PROGRAM_COMPOSITE) /* (FLOAT: the caller) */
+        bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED);
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
@@ -5707,6 +5752,8 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_NO_OVERFLOW) strings[n++] = "#define FV_NO_SAT\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FAST_EXP) strings[n++] = "#define FV_FAST_EXP\n";
     if (d->specialize & FOGVOL_SPECIALIZE_DITHER) strings[n++] = "#define FV_DITHER_ON\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_DOWNSAMPLE) strings[n++] = "#define FV_DOWNSAMPLE\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_FILTERED) strings[n++] = "#define FV_FILTERED\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -5743,6 +5790,9 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         return FOGVOL_ERROR_UNSUPPORTED;
     if (!fogvol__specialize_ok(d->program, d->specialize)) return FOGVOL_ERROR_UNSUPPORTED;
     v = d->variants;
+    if ((d->specialize & FOGVOL_SPECIALIZE_DOWNSAMPLE) &&
+        (d->tier != FOGVOL_TIER_FLOAT || (v & FOGVOL_VARIANT_COLORS) || d->samples > 1))
+        return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__count_spec_ok(d->tier, v) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
@@ -6104,6 +6154,8 @@ struct fogvol_context {
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
     int target_w, target_h;
+    int target_half;      /* the targets are for fogvol_frame_desc.downsample 2 (FLOAT: B made linear) */
+    int target_filtered;  /* ... and B is filtered by the backend (else the composite reads four texels) */
     fogvol_msaa msaa;
     int samples, target_samples;     /* this frame's / the targets' samples per pixel (0: single-sample) */
     int prog_ms, compile_samples;    /* prog holds the per-sample set; samples for fogvol__make_program */
@@ -6231,13 +6283,16 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->variants & variant) != 0; }
 
-static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
+static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
     fogvol_result r;
-    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples)
+    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples &&
+        ctx->target_half == half)
         return FOGVOL_SUCCESS;
     fogvol__destroy_targets(ctx);
+    ctx->target_half = half;
+    ctx->target_filtered = 0;
     memset(&td, 0, sizeof td);
     td.width = w;
     td.height = h;
@@ -6252,7 +6307,16 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h)
         }
         td.depth = 0;
         td.label = "fogvol signed depth sum (float)";
+        td.linear = half; /* downsample 2: the composite reads it bilinearly */
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+        ctx->target_filtered = r == FOGVOL_SUCCESS && half;
+        if (r == FOGVOL_ERROR_UNSUPPORTED && half) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
+                                                    "the composite reads four texels instead");
+            td.linear = 0;
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+        }
+        td.linear = 0;
         if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_COLORS)) {
             td.format = FOGVOL_FORMAT_RGBA32F;
             td.color_count = 2;
@@ -7096,6 +7160,10 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (d->downsample < 0 || d->downsample > 2) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample %d is not 0, 1 or 2", d->downsample);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     if (d->engine_depth_zero_to_one < -1 || d->engine_depth_zero_to_one > 1 ||
         !fogvol__finite_n(d->engine_depth_range, 2)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_zero_to_one not -1, 0 or 1, or "
@@ -7522,6 +7590,24 @@ static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overfl
     return r;
 }
 
+/* fogvol_frame_desc.downsample 2: the viewport's debug thickness from the half-resolution float sums,
+   bilinear as the composite reads them (FV_DOWNSAMPLE) */
+static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double range)
+{
+    int w = ctx->frame.viewport[2], h = ctx->frame.viewport[3], tw = ctx->target_w, th = ctx->target_h, x, y;
+    for (y = 0; y < h; ++y) {
+        double py = (y + 0.5) * 0.5 - 0.5, iy = floor(py), fy = py - iy;
+        int y0 = iy < 0 ? 0 : iy > th - 1 ? th - 1 : (int)iy, y1 = iy + 1 > th - 1 ? th - 1 : (int)iy + 1;
+        for (x = 0; x < w; ++x) {
+            double px = (x + 0.5) * 0.5 - 0.5, ix = floor(px), fx = px - ix;
+            int x0 = ix < 0 ? 0 : ix > tw - 1 ? tw - 1 : (int)ix, x1 = ix + 1 > tw - 1 ? tw - 1 : (int)ix + 1;
+            double a = lo[y0 * tw + x0] + (lo[y0 * tw + x1] - (double)lo[y0 * tw + x0]) * fx;
+            double c = lo[y1 * tw + x0] + (lo[y1 * tw + x1] - (double)lo[y1 * tw + x0]) * fx;
+            ctx->frame.debug_thickness[(size_t)y * (size_t)w + (size_t)x] = (float)((a + (c - a) * fy) * range);
+        }
+    }
+}
+
 /* Decoded thickness per pixel (world units) from the sum targets, and the
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
 static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int *overflow)
@@ -7542,7 +7628,9 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
     r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, b, n * 4u);
     if (ctx->tier == FOGVOL_TIER_FLOAT) {
         fl = (float *)(void *)b;
-        for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->frame.debug_thickness[i] = (float)(fl[i] * range);
+        if (r == FOGVOL_SUCCESS && ctx->frame.downsample == 2) fogvol__debug_upsample(ctx, fl, range);
+        else
+            for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->frame.debug_thickness[i] = (float)(fl[i] * range);
         fogvol__free(&ctx->alloc, b);
         return r;
     }
@@ -7662,24 +7750,26 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
 
 /* The program p built for this configuration (fogvol_shader_desc.specialize = bits) in the current
    sample set, made on first use (the GL backend builds programs inside a frame without disturbing
-   it); the general program when specialising is off or the build failed (logged once). COUNT is
-   not an option but another program: built with SPECIALIZE off too, and if it cannot be, the
-   frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged). */
+   it); the general program when specialising is off or the build failed (logged once). COUNT and
+   DOWNSAMPLE are not options but other programs, built with SPECIALIZE off too. If COUNT cannot
+   be, the frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged); if
+   DOWNSAMPLE cannot be, 0 (the caller skips the pass). */
 static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
 {
     fogvol__spec_program *sp;
     int i;
-    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT, and a COUNT face's NO_DENSITY */
-        bits &= (bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u;
+    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
+        bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
+                FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
     if (!bits) return ctx->prog[p];
     for (i = 0; i < ctx->nspec; ++i) {
         sp = &ctx->spec[i];
         if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
-            return sp->handle ? sp->handle : ctx->prog[p];
+            return sp->handle ? sp->handle : (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) ? 0 : ctx->prog[p];
     }
     if (ctx->nspec == FOGVOL__SPEC_MAX) {
         if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
-        return ctx->prog[p];
+        return (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) ? 0 : ctx->prog[p];
     }
     sp = &ctx->spec[ctx->nspec++];
     sp->program = p;
@@ -7695,6 +7785,7 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
         if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
     }
     ctx->compile_samples = 0;
+    if (!sp->handle && (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
     return sp->handle ? sp->handle : ctx->prog[p];
 }
 
@@ -7753,7 +7844,7 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     fogvol_frame_info fi;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
     if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3]);
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, k);
@@ -7871,6 +7962,11 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
                                                  "fogvol_add_occluder* calls and a backend with native_texture");
         return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if (ctx->frame.downsample == 2) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need full-resolution sums "
+                                                 "(fogvol_frame_desc.downsample 0 or 1)");
+        return FOGVOL_ERROR_UNSUPPORTED;
     }
     if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
         fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
@@ -8356,6 +8452,14 @@ static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
                                                  "pass a depth texture (engine_depth_texture)");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
+    if (fd->downsample == 2 && (ctx->tier != FOGVOL_TIER_FLOAT || ctx->nlight > 0 ||
+                                fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS))) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: downsample 2 needs the FLOAT tier without ENGINE_DEPTH or COLORS and no "
+                    "fogvol_add_light (tier %s, variants 0x%x, %d lights); nothing drawn",
+                    fogvol_tier_name(ctx->tier), ctx->variants, ctx->nlight);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
     if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) && (i = fogvol__count_near_cut(ctx)) >= 0) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: COUNT variant: the near plane may cut volume %d (the camera is inside it or closer than "
@@ -8372,7 +8476,15 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
 {
     const fogvol_frame_desc *fd = &ctx->frame;
     fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
-    if (r == FOGVOL_SUCCESS) r = fogvol__ensure_targets(ctx, run->w, run->h);
+    if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->samples > 1) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "
+                                                 "sample (use FOGVOL_MSAA_SINGLE_SAMPLE); nothing drawn",
+                    ctx->samples);
+        r = FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (r == FOGVOL_SUCCESS) /* downsample 2: half the width and height, rounded up */
+        r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
+                                : fogvol__ensure_targets(ctx, run->w, run->h, 0);
     if (r != FOGVOL_SUCCESS) return r;
     run->engine_depth = fd->engine_depth_texture;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
@@ -8412,8 +8524,8 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
     ps->uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
     ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
     ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->enc.dither_steps;
-    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)run->w;
-    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)run->h;
+    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->target_w; /* target space (downsample: half) */
+    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->target_h;
     if (run->rgba8) {
         memcpy(ps->uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
         if (run->count || ctx->tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
@@ -8594,7 +8706,17 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
     spec |= fogvol__origin_bit(ctx) | ctx->count_bit;
+    if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
+        spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
+        ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)fd->viewport[2];
+        ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)fd->viewport[3];
+    }
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
+    if (!ps->program) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no half-resolution composite program: group not drawn");
+        run->r = FOGVOL_ERROR_BACKEND;
+        return;
+    }
     ctx->be.begin_pass(ctx->be.user_data, ps);
     run->st.passes++;
     ctx->be.draw_fullscreen(ctx->be.user_data);
@@ -9567,6 +9689,7 @@ typedef struct fogvol__gl {
     int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
     int stencil_override;
     int has_msaa; /* multisample textures and per-sample shading */
+    int float_linear; /* R32F textures can be filtered (GL 3.0; GLES 3 + OES_texture_float_linear) */
 #define FOGVOL__GL_MEMBER_MSAA(ret, name, params) fogvol__PFN_##name name;
     FOGVOL__GL_MSAA(FOGVOL__GL_MEMBER_MSAA)
 #undef FOGVOL__GL_MEMBER_MSAA
@@ -10319,6 +10442,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
                     d->label ? d->label : "target", d->samples, d->color_count == 2 ? " with two attachments" : "");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
+    if (d->linear && (d->samples > 1 || d->format != FOGVOL_FORMAT_R32F || !gl->float_linear))
+        return FOGVOL_ERROR_UNSUPPORTED; /* fogvol filters in the shader instead */
     t = (fogvol__gl_target *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(t, 0, sizeof *t);
@@ -10331,7 +10456,8 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     if (d->samples > 1)
         t->base.tex = fogvol__gl_new_texture_ms(gl, d);
     else
-        t->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format, FOGVOL__GL_NEAREST,
+        t->base.tex = fogvol__gl_new_texture(gl, d->width, d->height, d->format,
+                                             d->linear ? FOGVOL__GL_LINEAR : FOGVOL__GL_NEAREST,
                                              FOGVOL__GL_CLAMP_TO_EDGE, NULL);
     t->base.samples = d->samples > 1 ? d->samples : 0;
     gl->GenFramebuffers(1, &t->fbo);
@@ -10980,12 +11106,14 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
             caps |= FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
             if (fogvol__gl_has_ext3(gl, "GL_EXT_color_buffer_float") && fogvol__gl_has_ext3(gl, "GL_EXT_float_blend"))
                 caps |= FOGVOL_CAP_FLOAT_BLEND;
+            gl->float_linear = fogvol__gl_has_ext3(gl, "GL_OES_texture_float_linear");
         } else if (fogvol__has_ext(ext, "GL_OES_depth_texture")) {
             caps |= FOGVOL_CAP_DEPTH_TEXTURE;
         }
     } else {
         caps |= FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
         if (gl->major >= 3) caps |= FOGVOL_CAP_FLOAT_BLEND; /* R32F render targets and float blending are core */
+        gl->float_linear = gl->major >= 3;
     }
     return caps;
 }

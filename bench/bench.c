@@ -43,7 +43,7 @@
 #include <time.h>
 #include <sys/utsname.h>
 
-#define NTIER 7
+#define NTIER 8
 #define NDEFAULT 5 /* the first NDEFAULT tiers: fogvol's default configuration (every speed-up on) */
 #define M_FLOOR NTIER
 #define M_OCCFLOOR (NTIER + 1)
@@ -64,17 +64,19 @@ typedef struct tier_cfg {
     fogvol_tier tier;
     unsigned variants;
     unsigned speedups_off; /* fogvol_context_desc.disable_speedups */
+    int downsample;        /* fogvol_frame_desc.downsample */
 } tier_cfg;
-static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0},
-                                        {"PS20", FOGVOL_TIER_PS20, 0, 0},
-                                        {"MRT", FOGVOL_TIER_MRT, 0, 0},
-                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0, 0},
-                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0},
-                                        {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL},
-                                        {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL}};
+static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0, 0},
+                                        {"PS20", FOGVOL_TIER_PS20, 0, 0, 0},
+                                        {"MRT", FOGVOL_TIER_MRT, 0, 0, 0},
+                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0, 0, 0},
+                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0},
+                                        {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL, 0},
+                                        {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL, 0},
+                                        {"FLOAT, half resolution", FOGVOL_TIER_FLOAT, 0, 0, 2}};
 static const char *const g_meth_names[NMETH] = {
     "PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "FLOAT, speed-ups off", "PS20, speed-ups off",
-    "floor", "occluder floor", "scissored floor", "depth peeling"};
+    "FLOAT, half resolution", "floor", "occluder floor", "scissored floor", "depth peeling"};
 
 /* ---- small utilities -------------------------------------------------------- */
 static double now_ms(void)
@@ -633,6 +635,7 @@ static fogvol_result fog_frame(fogs *F, int t, const scene *s, const view *vw, c
     fd.viewport[2] = r->w;
     fd.viewport[3] = r->h;
     fd.debug_thickness = debug;
+    fd.downsample = g_tiers[t].downsample;
     fd.engine_depth_texture = ed ? r->eng_depth : 0;
     glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo);
     if ((res = fogvol_begin_frame(c, &fd)) != FOGVOL_SUCCESS) return res;
@@ -1498,13 +1501,14 @@ static const char *pass_name(int m, int p, int np, int occluders)
                                                  {"B-F", "composite", "", "", "", ""},
                                                  {"O", "B-F", "composite", "", "", ""},
                                                  {"O", "B", "F", "check", "composite", ""},
+                                                 {"O", "B-F", "composite", "", "", ""},
                                                  {"geometry", "composite", "", "", "", ""}};
     const char *names[6];
     int full = 0, i, k = 0;
     const char *const *src = pn[m < NTIER ? m : NTIER];
     while (full < 6 && src[full][0]) ++full;
     for (i = 0; i < full; ++i) {
-        if (strcmp(src[i], "O") == 0 && m < NDEFAULT && !occluders) continue;
+        if (strcmp(src[i], "O") == 0 && m < NTIER && !g_tiers[m].speedups_off && !occluders) continue;
         names[k++] = src[i];
     }
     if (np == k - 1) /* no check pass this frame */
@@ -1600,7 +1604,8 @@ static void print_summary(const result *rs, int n)
                 {2, -1, 2.0, "MRT (x floor / occluder floor)"},
                 {0, -1, 2.5, "PS13 (x floor / occluder floor)"},
                 {5, 0, 1.2, "FLOAT, speed-ups off, without occluders (for comparison)"},
-                {6, -1, 2.0, "PS20, speed-ups off (for comparison)"}};
+                {6, -1, 2.0, "PS20, speed-ups off (for comparison)"},
+                {7, -1, 1.2, "FLOAT, half resolution (x floor / occluder floor)"}};
     int j;
     double pm = peel_min(rs, n);
     out("\n### Targets (worst over scenes and sizes)\n\n| configuration | worst | scene | target |\n|---|---:|---|---|\n");

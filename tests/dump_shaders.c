@@ -30,8 +30,13 @@ static int spec_applies(int p, unsigned bits)
 
 /* FOGVOL_SPECIALIZE_COUNT: the COUNT variant's ENCODE, FACE (with NO_DENSITY), RESOLVE and COMPOSITE,
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
-static int count_applies(int t, unsigned v, int d, int p, unsigned bits)
+static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if ((bits & FOGVOL_SPECIALIZE_FILTERED) && !(bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
+    if (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) /* FLOAT's composite (not COLORS), single-sample; FILTERED with it */
+        return t == FOGVOL_TIER_FLOAT && !(v & FOGVOL_VARIANT_COLORS) && !ms && p == FOGVOL_PROGRAM_COMPOSITE &&
+               variant_spec_applies(t, v, d, p,
+                                    bits & ~(unsigned)(FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED), ms);
     const unsigned no = FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
                         FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS;
     if (!(bits & FOGVOL_SPECIALIZE_COUNT)) return spec_applies(p, bits);
@@ -75,7 +80,16 @@ int main(int argc, char **argv)
                                          FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_DITHER,
                                      FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP |
                                          FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
-                                         FOGVOL_SPECIALIZE_NO_OVERFLOW};
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_FILTERED,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED | FOGVOL_SPECIALIZE_ORIGIN |
+                                         FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;
@@ -102,7 +116,7 @@ int main(int argc, char **argv)
                         if (ms && st == FOGVOL_STAGE_VERTEX) continue; /* the same as single-sample */
                         r = fogvol_shader_strings(&sd, s, &count);
                         if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
-                            !count_applies(t, v, d, p, specs[k]) ||
+                            !variant_spec_applies(t, v, d, p, specs[k], ms) ||
                             !fogvol_tier_uses_program((fogvol_tier)t, v, (fogvol_program)p) ||
                             (ms && fogvol_msaa_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS)) {
                             if (r != FOGVOL_ERROR_UNSUPPORTED || count != 0) {

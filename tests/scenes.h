@@ -247,25 +247,20 @@ static void free_scenes(void)
         for (j = 0; j < g_scenes[i].n; ++j) shp_free(&g_scenes[i].obj[j].mesh);
 }
 
-/* Ground truth for every pixel centre: thickness, pairs of faces crossed,
-   interior mask (rc_interior), covered mask (a volume face on the ray) and, where slope is not
-   NULL, the interior pixels' depth slopes (rc_depth_slope; 0 elsewhere): a test adds
-   slope * snap_pixels() to its bound for what the GL's vertex snapping moves the faces. */
-static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char *interior, unsigned char *covered,
-                         int *max_faces, double *tmax, double *slope)
+/* The ray caster's scene of s (with_occluders 0: without its occluders); free with rc_scene_free. */
+static void scene_raycaster(const tscene *s, int with_occluders, rc_scene *rs)
 {
     rc_object ro[MAX_OBJ];
     unsigned *reversed[MAX_OBJ] = {0};
-    rc_scene rs;
-    int i, x, y;
-    *max_faces = 0;
-    *tmax = 0;
-    /* ground truth; a mirrored instance is the same solid, so its triangles are
-       reversed for the ray caster, which reads orientation from the winding */
+    int i, n = 0;
+    /* a mirrored instance is the same solid, so its triangles are reversed for the ray caster, which
+       reads orientation from the winding */
     for (i = 0; i < s->n; ++i) {
-        ro[i].pos = s->obj[i].mesh.pos;
-        ro[i].vcount = s->obj[i].mesh.vcount;
-        ro[i].idx = s->obj[i].mesh.idx;
+        rc_object *o = &ro[n];
+        if (!with_occluders && s->obj[i].sign == 0) continue;
+        o->pos = s->obj[i].mesh.pos;
+        o->vcount = s->obj[i].mesh.vcount;
+        o->idx = s->obj[i].mesh.idx;
         if (mirrored(s->obj[i].model)) {
             unsigned *rev = (unsigned *)malloc(sizeof(unsigned) * (size_t)s->obj[i].mesh.icount);
             int t;
@@ -274,15 +269,30 @@ static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char 
                 rev[t + 1] = s->obj[i].mesh.idx[t + 2];
                 rev[t + 2] = s->obj[i].mesh.idx[t + 1];
             }
-            ro[i].idx = rev;
-            reversed[i] = rev;
+            o->idx = rev;
+            reversed[n] = rev;
         }
-        ro[i].icount = s->obj[i].mesh.icount;
-        memcpy(ro[i].model, s->obj[i].model, sizeof ro[i].model);
-        ro[i].sign = s->obj[i].sign;
+        o->icount = s->obj[i].mesh.icount;
+        memcpy(o->model, s->obj[i].model, sizeof o->model);
+        o->sign = s->obj[i].sign;
+        n++;
     }
-    assert_true(rc_scene_init(&rs, ro, s->n));
-    for (i = 0; i < s->n; ++i) free(reversed[i]);
+    assert_true(rc_scene_init(rs, ro, n));
+    for (i = 0; i < n; ++i) free(reversed[i]);
+}
+
+/* Ground truth for every pixel centre: thickness, pairs of faces crossed,
+   interior mask (rc_interior), covered mask (a volume face on the ray) and, where slope is not
+   NULL, the interior pixels' depth slopes (rc_depth_slope; 0 elsewhere): a test adds
+   slope * snap_pixels() to its bound for what the GL's vertex snapping moves the faces. */
+static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char *interior, unsigned char *covered,
+                         int *max_faces, double *tmax, double *slope)
+{
+    rc_scene rs;
+    int x, y;
+    *max_faces = 0;
+    *tmax = 0;
+    scene_raycaster(s, 1, &rs);
     for (y = 0; y < H; ++y)
         for (x = 0; x < W; ++x) {
             rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);

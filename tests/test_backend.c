@@ -242,7 +242,7 @@ typedef struct rec {
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 2048; ++k) { /* every program, every set of specialize bits */
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 8192; ++k) { /* every program, every set of specialize bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
@@ -2745,6 +2745,150 @@ static void test_b_gl_alloc_faults(void **state)
     assert_true(fails >= 2);
 }
 
+/* fogvol_frame_desc.downsample: 2 puts the FLOAT sums at half the viewport (rounded up), the O and
+   face passes in that target space, the composite at the viewport with a program of its own
+   (FOGVOL_SPECIALIZE_DOWNSAMPLE); other values and the configurations it does not cover are refused. */
+static void test_a6_half_resolution(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    fogvol_mesh *box, *plane;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_light_desc ld;
+    fogvol_frame_stats st;
+    shp_mesh bm = box_mesh(), pm = shp_grid_plane(1, 1, 2);
+    fogvol_handle comp_half = 0, comp_full = 0;
+    float om[16];
+    int pass, round, k, begun;
+    (void)state;
+    rec_init(&r);
+    r.table.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_MULTISAMPLE;
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r.table;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.logger = cap_logger(&lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &pm, 1, 0, &plane), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = box;
+    vd.ramp = ramp;
+    mat_ts(vd.model, 0, 0, 0, 1, 1, 1);
+    mat_ts(om, 0, 0, -2, 1, 1, 1);
+    a_frame_desc(&fd);
+    fd.viewport[2] = 63; /* odd: the half-resolution targets round up to 32 x 24 */
+    fd.viewport[3] = 47;
+    fd.downsample = 3;
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    fd.downsample = -1;
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    for (round = 0; round < 3; ++round) { /* half, full, half again: the targets follow */
+        int half = round != 1, tw = half ? 32 : 63, thh = half ? 24 : 47;
+        fd.downsample = half ? 2 : 0;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_add_occluder(fv, plane, om), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        log_reset(&lc);
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        assert_int_equal(lc.errors + lc.warnings, 0);
+        assert_int_equal(st.passes, 3); /* O, the signed sum, the composite */
+        assert_int_equal(r.ntgt, 2 * (round + 1)); /* O and the sum, made again when the size changes */
+        for (k = r.ntgt - 2; k < r.ntgt; ++k) {
+            assert_int_equal(r.tgt[k].w, tw);
+            assert_int_equal(r.tgt[k].hgt, thh);
+        }
+        for (pass = 0; pass < 2; ++pass) { /* O and the faces: target space at the targets' size */
+            const fogvol_pass *p = &r.nb.passes[pass];
+            assert_int_equal(p->viewport[0], 0);
+            assert_int_equal(p->viewport[1], 0);
+            assert_int_equal(p->viewport[2], tw);
+            assert_int_equal(p->viewport[3], thh);
+            assert_close(p->uniforms[FOGVOL_U_SCREEN][0], 1.0 / tw, 1e-7, "target-space 1 / width");
+            assert_close(p->uniforms[FOGVOL_U_SCREEN][1], 1.0 / thh, 1e-7, "target-space 1 / height");
+        }
+        { /* the composite: the engine's viewport, window-space 1 / size, its own program */
+            const fogvol_pass *p = &r.nb.passes[2];
+            assert_int_equal(p->target, 0);
+            assert_int_equal(p->viewport[2], 63);
+            assert_int_equal(p->viewport[3], 47);
+            assert_close(p->uniforms[FOGVOL_U_SCREEN][0], 1.0 / 63, 1e-7, "window 1 / width");
+            assert_close(p->uniforms[FOGVOL_U_SCREEN][1], 1.0 / 47, 1e-7, "window 1 / height");
+            if (half) {
+                if (comp_half) assert_int_equal(p->program, comp_half);
+                comp_half = p->program;
+            } else {
+                comp_full = p->program;
+            }
+        }
+    }
+    assert_int_not_equal(comp_half, comp_full);
+    { /* the program is the documented one: FLOAT composite with DOWNSAMPLE, and only there */
+        fogvol_shader_desc sd;
+        const char *strs[FOGVOL_MAX_SHADER_STRINGS];
+        int n;
+        memset(&sd, 0, sizeof sd);
+        sd.tier = FOGVOL_TIER_FLOAT;
+        sd.program = FOGVOL_PROGRAM_COMPOSITE;
+        sd.dialect = FOGVOL_GLSL_330;
+        sd.stage = FOGVOL_STAGE_FRAGMENT;
+        sd.specialize = FOGVOL_SPECIALIZE_DOWNSAMPLE;
+        assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_SUCCESS);
+        sd.samples = 4;
+        assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_ERROR_UNSUPPORTED);
+        sd.samples = 0;
+        sd.program = FOGVOL_PROGRAM_FACE;
+        assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_ERROR_UNSUPPORTED);
+        sd.program = FOGVOL_PROGRAM_COMPOSITE;
+        sd.tier = FOGVOL_TIER_PS20;
+        assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_ERROR_UNSUPPORTED);
+    }
+    /* refused at end_frame, nothing drawn: a light, a multisampled framebuffer drawn per sample */
+    fd.downsample = 2;
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = box;
+    mat_ts(ld.model, 0, 0, 0, 1, 1, 1);
+    ld.color[0] = ld.color[1] = ld.color[2] = 1.0f;
+    begun = r.nb.frames_begun;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r.nb.frames_begun, begun);
+    r.nb.samples = 4;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r.nb.frames_begun, r.nb.frames_ended);
+    r.nb.samples = 0;
+    fogvol_destroy_mesh(fv, box);
+    fogvol_destroy_mesh(fv, plane);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    /* another tier: refused before the backend is touched */
+    cd.tier = FOGVOL_TIER_PS20;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+    vd.mesh = box;
+    vd.ramp = ramp;
+    begun = r.nb.frames_begun;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r.nb.frames_begun, begun);
+    fogvol_destroy_mesh(fv, box);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r.nb.creates, r.nb.destroys);
+    shp_free(&bm);
+    shp_free(&pm);
+}
+
 int main(void)
 {
     const struct CMUnitTest null_tests[] = {
@@ -2763,6 +2907,7 @@ int main(void)
         cmocka_unit_test(test_a5_alloc_faults_context),
         cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),
         cmocka_unit_test(test_a5_target_faults),
+        cmocka_unit_test(test_a6_half_resolution),
     };
     const struct CMUnitTest gl_tests[] = {
         cmocka_unit_test_setup_teardown(test_b6_missing_core33, setup_core, teardown_gl),

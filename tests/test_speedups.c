@@ -37,9 +37,11 @@
 /* frame f draws the occluders: frames 0, 1 and 3 without, frame 2 with */
 static int with_occluders(int f) { return f == 2; }
 
+static int g_shader_filtered; /* INFO messages: the half-resolution sum filtered in the shader */
 static void logger(void *u, fogvol_log_level l, const char *m)
 {
     (void)u;
+    if (l == FOGVOL_LOG_INFO && strstr(m, "four texels")) g_shader_filtered++;
     if (l <= FOGVOL_LOG_WARNING) print_message("  [fogvol %s] %s\n", l == 0 ? "error" : "warning", m);
 }
 
@@ -54,6 +56,14 @@ typedef struct run_out {
    (g_x0, g_y0) of g's buffer, whose pixels outside it must keep the clear colour */
 static int g_x0, g_y0;
 static unsigned g_variants; /* fogvol_context_desc.variants */
+static int g_downsample;    /* fogvol_frame_desc.downsample */
+static int g_no_linear;     /* 1: the GL backend's create_target refuses linear targets (filtering in the shader) */
+static fogvol_backend g_inner;
+static fogvol_result refuse_linear(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+{
+    if (d->linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
+    return g_inner.create_target(u, d, out);
+}
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
 {
     fogvol_context_desc cd;
@@ -67,6 +77,11 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = logger;
+    if (g_no_linear) {
+        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
+        cd.backend = g_inner;
+        cd.backend.create_target = refuse_linear;
+    }
     cd.tier = t;
     cd.disable_speedups = off;
     cd.variants = g_variants;
@@ -89,6 +104,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         fd.viewport[2] = W;
         fd.viewport[3] = H;
         fd.debug_thickness = out->th[f];
+        fd.downsample = g_downsample;
         glClearColor(0.2f, 0.5f, 0.8f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, clear); /* 0.5 -> 127 or 128: the GL's rounding */
@@ -110,6 +126,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
+    if (g_no_linear) g_inner.destroy(g_inner.user_data);
 }
 
 static int max_diff(const unsigned char *a, const unsigned char *b, int *count)
@@ -282,10 +299,156 @@ static void test_wide_alu(void **state)
     glu_destroy(&g);
 }
 
+/* The composite against the thickness the frame read back (debug_thickness): every pixel,
+   mix(background, fog colour, 1 - exp(-density t)) in bytes; returns the largest error */
+static int check_composite(const tscene *s, const unsigned char *px, const float *th)
+{
+    static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
+    int i, c, worst = 0;
+    for (i = 0; i < W * H; ++i) {
+        double a = th[i] > 0.0f ? 1.0 - exp(-(double)s->density * th[i]) : 0.0;
+        for (c = 0; c < 3; ++c) {
+            double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
+            int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[4 * i + c]);
+            if (d > worst) worst = d;
+        }
+    }
+    return worst;
+}
+
+/* fogvol_frame_desc.downsample 2 (FLOAT): the sums at half width and height, upsampled bilinearly.
+   Independent truth: the ray cast at the low-resolution texel centres (window coordinates 2i + 1,
+   2j + 1), interpolated bilinearly, at every pixel whose four taps and own centre see the same hit
+   topology (within the FLOAT bound of test_tiers, 3e-5 of the depth range, plus what vertex snapping
+   at half resolution moves: twice the pixel's depth slope times the snap grid). Then the error of
+   the method itself, against the full-resolution ray cast and composite, silhouettes included,
+   measured and bounded. The composite, filtered by the GL (fogvol_target_desc.linear) or by four
+   reads where the backend refuses that, against the debug thickness (the same bilinear values) at
+   every pixel. Viewports at the origin and away from it; frames with and without occluders. */
+static void test_half_resolution(void **state)
+{
+    static run_out full, half;
+    static double tap[(H / 2) * (W / 2)], gt[W * H], slope[W * H];
+    static unsigned sig[(H / 2) * (W / 2)];
+    static int pairs[W * H];
+    static unsigned char interior[W * H], covered[W * H];
+    const char *names[3] = {"plane_cuts_sphere", "layers_opaque_between", "negative_pokes_out"};
+    const int tw = W / 2, th = H / 2;
+    glu_ctx g;
+    int si, f, k;
+    (void)state;
+    assert_true(glu_create(&g, W + 13, H + 7, 1));
+    for (k = 0; k < 3; ++k) /* viewport at the origin, then at (13, 7); k = 2: filtered in the shader */
+        for (si = 0; si < 3; ++si) {
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            double range = s->cam.zfar - s->cam.znear, snap = snap_pixels();
+            g_x0 = k == 1 ? 13 : 0;
+            g_y0 = k == 1 ? 7 : 0;
+            g_downsample = 0;
+            run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &full);
+            g_downsample = 2;
+            g_no_linear = k == 2;
+            g_shader_filtered = 0;
+            run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &half);
+            assert_int_equal(g_shader_filtered, k == 2); /* llvmpipe filters R32F; the wrapper refuses it */
+            g_downsample = g_no_linear = 0;
+            g_x0 = g_y0 = 0;
+            for (f = 0; f < 3; ++f) { /* frame 0 without occluders, frame 2 with */
+                rc_scene rs;
+                double worst = 0.0, tmax = 0.0, sum_all = 0.0, worst_all = 0.0, cmean = 0.0;
+                int x, y, i, n_smooth = 0, n_fog = 0, n_cov = 0, maxf, cmax = 0, n_c4 = 0;
+                if (f == 1) continue;
+                scene_raycaster(s, with_occluders(f), &rs);
+                for (y = 0; y < th; ++y)
+                    for (x = 0; x < tw; ++x) {
+                        rc_result r = rc_trace(&rs, &s->cam, 2 * x + 1.0, 2 * y + 1.0);
+                        tap[y * tw + x] = r.thickness;
+                        sig[y * tw + x] = r.signature;
+                    }
+                for (y = 0; y < H; ++y)
+                    for (x = 0; x < W; ++x) {
+                        double py = (y + 0.5) * 0.5 - 0.5, px = (x + 0.5) * 0.5 - 0.5, fy, fx, want, e, tol;
+                        int iy = (int)floor(py), ix = (int)floor(px), y0, y1, x0, x1, j;
+                        unsigned s0;
+                        fy = py - iy;
+                        fx = px - ix;
+                        y0 = iy < 0 ? 0 : iy;
+                        y1 = iy + 1 > th - 1 ? th - 1 : iy + 1;
+                        x0 = ix < 0 ? 0 : ix;
+                        x1 = ix + 1 > tw - 1 ? tw - 1 : ix + 1;
+                        s0 = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5).signature;
+                        if (s0 != sig[y0 * tw + x0] || s0 != sig[y0 * tw + x1] || s0 != sig[y1 * tw + x0] ||
+                            s0 != sig[y1 * tw + x1] || !rc_interior(&rs, &s->cam, x, y))
+                            continue;
+                        want = (tap[y0 * tw + x0] * (1 - fx) + tap[y0 * tw + x1] * fx) * (1 - fy) +
+                               (tap[y1 * tw + x0] * (1 - fx) + tap[y1 * tw + x1] * fx) * fy;
+                        e = fabs(half.th[f][y * W + x] - want);
+                        j = 1 + rc_trace(&rs, &s->cam, x + 0.5, y + 0.5).faces_back;
+                        tol = 3e-5 * range * j + 2.0 * rc_depth_slope(&rs, &s->cam, x, y) * snap;
+                        if (e > tol)
+                            fail_msg("%s frame %d pixel (%d,%d): half-resolution thickness %.6f, bilinear ray cast "
+                                     "%.6f (bound %.2g)",
+                                     names[si], f, x, y, (double)half.th[f][y * W + x], want, tol);
+                        if (e / range > worst) worst = e / range;
+                        n_smooth++;
+                        n_fog += want > 0.0;
+                    }
+                rc_scene_free(&rs);
+                /* the method's own error: against the full-resolution ray cast (every covered pixel,
+                   silhouettes included) and the full-resolution composite */
+                if (with_occluders(f)) ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax, slope);
+                else {
+                    scene_raycaster(s, 0, &rs);
+                    for (i = 0; i < W * H; ++i) {
+                        rc_result r = rc_trace(&rs, &s->cam, i % W + 0.5, i / W + 0.5);
+                        gt[i] = r.thickness;
+                        covered[i] = r.faces_front + r.faces_back > 0;
+                        if (gt[i] > tmax) tmax = gt[i];
+                    }
+                    rc_scene_free(&rs);
+                }
+                for (i = 0; i < W * H; ++i) {
+                    double e = fabs(half.th[f][i] - gt[i]);
+                    int c, m = 0;
+                    for (c = 0; c < 3; ++c) {
+                        int d = abs((int)half.px[f][4 * i + c] - (int)full.px[f][4 * i + c]);
+                        if (d > m) m = d;
+                    }
+                    if (m > cmax) cmax = m;
+                    cmean += m;
+                    n_c4 += m > 4;
+                    if (!covered[i] && half.th[f][i] == 0.0f) continue;
+                    n_cov++;
+                    sum_all += e;
+                    if (e > worst_all) worst_all = e;
+                }
+                print_message("# half resolution, %-21s %s, viewport at (%d,%d): %d smooth pixels (%d fogged) within %.2g of the "
+                              "range of the bilinear ray cast; against full resolution (silhouettes included): "
+                              "thickness max %.3f / mean %.4f of the thickest ray (%d px), composite max %d/255, "
+                              "mean %.2f/255, %.1f%% of pixels over 4/255\n",
+                              names[si], with_occluders(f) ? "with occluders" : "no occluders", g_x0, g_y0, n_smooth, n_fog, worst, worst_all / tmax, sum_all / (n_cov ? n_cov : 1) / tmax,
+                              n_cov, cmax, cmean / (W * H), 100.0 * n_c4 / (W * H));
+                assert_true(n_fog > W * H / 8); /* the interpolated thickness checked where there is fog */
+                i = check_composite(s, half.px[f], half.th[f]);
+                print_message("#   composite (%s) against the debug thickness: max %d/255 over every pixel\n",
+                              k == 2 ? "four reads in the shader" : "filtered by the GL", i);
+                assert_true(i <= 2); /* FAST_EXP 0.69/255 + rounding, and the filter's weights */
+                if (k == 0 && si == 1 && with_occluders(f)) {
+                    write_png("half", half.px[f]);
+                    write_png("full", full.px[f]);
+                }
+                assert_true(cmean / (W * H) <= 1.0);                  /* on average under 1/255 */
+                assert_true(sum_all / (n_cov ? n_cov : 1) / tmax <= 0.01); /* mean under 1% of the thickest */
+            }
+        }
+    glu_destroy(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
-                                       cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu)};
+                                       cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
+                                       cmocka_unit_test(test_half_resolution)};
     int r;
     build_scenes();
     r = cmocka_run_group_tests(tests, NULL, NULL);
