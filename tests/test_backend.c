@@ -938,6 +938,53 @@ static void test_a1_pass_structure_fullscreen(void **state)
     free(s);
 }
 
+/* A context of tier t on the recording backend (extra caps, speed-ups off) with a box volume of
+   half-size 0.5 (model: at the origin) and an open plane occluder at x = 0, z = -2 (om). */
+typedef struct box_scene {
+    rec r;
+    fogvol_context *fv;
+    fogvol_mesh *box, *plane;
+    fogvol_ramp *ramp;
+    shp_mesh bm, pm;
+    fogvol_volume_desc vd;
+    float om[16];
+} box_scene;
+
+static void box_scene_open(box_scene *b, fogvol_tier t, unsigned caps, unsigned off, logcap *lc)
+{
+    fogvol_context_desc cd;
+    rec_init(&b->r);
+    b->r.table.caps |= caps;
+    memset(&cd, 0, sizeof cd);
+    cd.backend = b->r.table;
+    cd.tier = t;
+    cd.disable_speedups = off;
+    if (lc) cd.logger = cap_logger(lc);
+    b->fv = NULL;
+    assert_int_equal(fogvol_create_context(&cd, &b->fv), FOGVOL_SUCCESS);
+    b->bm = box_mesh();
+    b->pm = shp_grid_plane(1, 1, 2);
+    assert_int_equal(make_mesh(b->fv, &b->bm, 0, 0, &b->box), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(b->fv, &b->pm, 1, 0, &b->plane), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(b->fv, FOGVOL_BLEND_FOG, &b->ramp), FOGVOL_SUCCESS);
+    memset(&b->vd, 0, sizeof b->vd);
+    b->vd.mesh = b->box;
+    b->vd.ramp = b->ramp;
+    mat_ts(b->vd.model, 0, 0, 0, 1, 1, 1);
+    mat_ts(b->om, 0, 0, -2, 1, 1, 1);
+}
+
+static void box_scene_close(box_scene *b)
+{
+    fogvol_destroy_mesh(b->fv, b->box);
+    fogvol_destroy_mesh(b->fv, b->plane);
+    fogvol_destroy_ramp(b->fv, b->ramp);
+    fogvol_destroy_context(b->fv);
+    assert_int_equal(b->r.nb.creates, b->r.nb.destroys);
+    shp_free(&b->bm);
+    shp_free(&b->pm);
+}
+
 /* FOGVOL_SPEEDUP_DEPTH_TEST takes a frame only where the face count holds: occluders drawn by fogvol,
    and every volume's box wholly between the planes or wholly outside them, on PS20 and PS13 (FLOAT
    keeps the min compare). The camera of part A (w = 5 - x, near 0.5, far 10.5) and a box of
@@ -961,54 +1008,28 @@ static void test_a1_depth_test_frames(void **state)
     (void)state;
     for (t = 0; t < 3; ++t)
         for (i = 0; i < (int)(sizeof c / sizeof c[0]); ++i) {
-            rec r;
-            fogvol_context_desc cd;
-            fogvol_context *fv = NULL;
-            fogvol_mesh *box, *plane;
-            fogvol_ramp *ramp;
+            static box_scene b;
             fogvol_frame_desc fd;
-            fogvol_volume_desc vd;
             fogvol_frame_stats st;
-            shp_mesh bm = box_mesh(), pm = shp_grid_plane(1, 1, 2);
-            float om[16];
             int k, face_passes = 0, want = tiers[t] == FOGVOL_TIER_FLOAT ? 0 : c[i].tested;
-            rec_init(&r);
-            r.table.caps |= FOGVOL_CAP_FLOAT_BLEND;
-            memset(&cd, 0, sizeof cd);
-            cd.backend = r.table;
-            cd.tier = tiers[t];
-            cd.disable_speedups = c[i].off ? FOGVOL_SPEEDUP_DEPTH_TEST : 0u;
-            assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-            assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
-            assert_int_equal(make_mesh(fv, &pm, 1, 0, &plane), FOGVOL_SUCCESS);
-            assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+            box_scene_open(&b, tiers[t], FOGVOL_CAP_FLOAT_BLEND, c[i].off ? FOGVOL_SPEEDUP_DEPTH_TEST : 0u, NULL);
             a_frame_desc(&fd);
-            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-            mat_ts(om, 0, 0, -2, 1, 1, 1);
-            if (c[i].occluders) assert_int_equal(fogvol_add_occluder(fv, plane, om), FOGVOL_SUCCESS);
-            memset(&vd, 0, sizeof vd);
-            vd.mesh = box;
-            vd.ramp = ramp;
-            mat_ts(vd.model, c[i].tx, 0, 0, 1, 1, 1);
-            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+            if (c[i].occluders) assert_int_equal(fogvol_add_occluder(b.fv, b.plane, b.om), FOGVOL_SUCCESS);
+            mat_ts(b.vd.model, c[i].tx, 0, 0, 1, 1, 1);
+            assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_end_frame(b.fv, &st), FOGVOL_SUCCESS);
             if (st.depth_tested != want)
                 fail_msg("%s, %s: depth_tested %d, want %d", fogvol_tier_name(tiers[t]), c[i].what, st.depth_tested,
                          want);
-            for (k = 0; k < r.nb.pass_count; ++k) /* the face passes: depth-tested exactly then */
-                if (r.nb.passes[k].target && r.nb.passes[k].blend != FOGVOL_PASS_BLEND_NONE) {
-                    assert_int_equal(r.nb.passes[k].depth_test != 0, want);
-                    assert_int_equal(r.nb.passes[k].depth_write, 0);
+            for (k = 0; k < b.r.nb.pass_count; ++k) /* the face passes: depth-tested exactly then */
+                if (b.r.nb.passes[k].target && b.r.nb.passes[k].blend != FOGVOL_PASS_BLEND_NONE) {
+                    assert_int_equal(b.r.nb.passes[k].depth_test != 0, want);
+                    assert_int_equal(b.r.nb.passes[k].depth_write, 0);
                     face_passes++;
                 }
             assert_int_equal(face_passes, tiers[t] == FOGVOL_TIER_FLOAT ? 1 : 2);
-            fogvol_destroy_mesh(fv, box);
-            fogvol_destroy_mesh(fv, plane);
-            fogvol_destroy_ramp(fv, ramp);
-            fogvol_destroy_context(fv);
-            assert_int_equal(r.nb.creates, r.nb.destroys);
-            shp_free(&bm);
-            shp_free(&pm);
+            box_scene_close(&b);
         }
 }
 
@@ -2750,60 +2771,40 @@ static void test_b_gl_alloc_faults(void **state)
    (FOGVOL_SPECIALIZE_DOWNSAMPLE); other values and the configurations it does not cover are refused. */
 static void test_a6_half_resolution(void **state)
 {
-    rec r;
+    static box_scene b;
     logcap lc;
-    fogvol_context_desc cd;
-    fogvol_context *fv = NULL;
-    fogvol_mesh *box, *plane;
-    fogvol_ramp *ramp;
     fogvol_frame_desc fd;
-    fogvol_volume_desc vd;
     fogvol_light_desc ld;
     fogvol_frame_stats st;
-    shp_mesh bm = box_mesh(), pm = shp_grid_plane(1, 1, 2);
     fogvol_handle comp_half = 0, comp_full = 0;
-    float om[16];
+    rec *r = &b.r;
     int pass, round, k, begun;
     (void)state;
-    rec_init(&r);
-    r.table.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_MULTISAMPLE;
-    memset(&cd, 0, sizeof cd);
-    cd.backend = r.table;
-    cd.tier = FOGVOL_TIER_FLOAT;
-    cd.logger = cap_logger(&lc);
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
-    assert_int_equal(make_mesh(fv, &pm, 1, 0, &plane), FOGVOL_SUCCESS);
-    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
-    memset(&vd, 0, sizeof vd);
-    vd.mesh = box;
-    vd.ramp = ramp;
-    mat_ts(vd.model, 0, 0, 0, 1, 1, 1);
-    mat_ts(om, 0, 0, -2, 1, 1, 1);
+    box_scene_open(&b, FOGVOL_TIER_FLOAT, FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_MULTISAMPLE, 0u, &lc);
     a_frame_desc(&fd);
     fd.viewport[2] = 63; /* odd: the half-resolution targets round up to 32 x 24 */
     fd.viewport[3] = 47;
     fd.downsample = 3;
-    EXPECT_LOGGED(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    EXPECT_LOGGED(fogvol_begin_frame(b.fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
     fd.downsample = -1;
-    EXPECT_LOGGED(fogvol_begin_frame(fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    EXPECT_LOGGED(fogvol_begin_frame(b.fv, &fd), FOGVOL_ERROR_INVALID_ARGUMENT);
     for (round = 0; round < 3; ++round) { /* half, full, half again: the targets follow */
         int half = round != 1, tw = half ? 32 : 63, thh = half ? 24 : 47;
         fd.downsample = half ? 2 : 0;
-        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-        assert_int_equal(fogvol_add_occluder(fv, plane, om), FOGVOL_SUCCESS);
-        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_add_occluder(b.fv, b.plane, b.om), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
         log_reset(&lc);
-        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(b.fv, &st), FOGVOL_SUCCESS);
         assert_int_equal(lc.errors + lc.warnings, 0);
-        assert_int_equal(st.passes, 3); /* O, the signed sum, the composite */
-        assert_int_equal(r.ntgt, 2 * (round + 1)); /* O and the sum, made again when the size changes */
-        for (k = r.ntgt - 2; k < r.ntgt; ++k) {
-            assert_int_equal(r.tgt[k].w, tw);
-            assert_int_equal(r.tgt[k].hgt, thh);
+        assert_int_equal(st.passes, 3);                 /* O, the signed sum, the composite */
+        assert_int_equal(r->ntgt, 2 * (round + 1));     /* O and the sum, made again when the size changes */
+        for (k = r->ntgt - 2; k < r->ntgt; ++k) {
+            assert_int_equal(r->tgt[k].w, tw);
+            assert_int_equal(r->tgt[k].hgt, thh);
         }
         for (pass = 0; pass < 2; ++pass) { /* O and the faces: target space at the targets' size */
-            const fogvol_pass *p = &r.nb.passes[pass];
+            const fogvol_pass *p = &r->nb.passes[pass];
             assert_int_equal(p->viewport[0], 0);
             assert_int_equal(p->viewport[1], 0);
             assert_int_equal(p->viewport[2], tw);
@@ -2812,7 +2813,7 @@ static void test_a6_half_resolution(void **state)
             assert_close(p->uniforms[FOGVOL_U_SCREEN][1], 1.0 / thh, 1e-7, "target-space 1 / height");
         }
         { /* the composite: the engine's viewport, window-space 1 / size, its own program */
-            const fogvol_pass *p = &r.nb.passes[2];
+            const fogvol_pass *p = &r->nb.passes[2];
             assert_int_equal(p->target, 0);
             assert_int_equal(p->viewport[2], 63);
             assert_int_equal(p->viewport[3], 47);
@@ -2838,6 +2839,9 @@ static void test_a6_half_resolution(void **state)
         sd.stage = FOGVOL_STAGE_FRAGMENT;
         sd.specialize = FOGVOL_SPECIALIZE_DOWNSAMPLE;
         assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_SUCCESS);
+        sd.specialize = FOGVOL_SPECIALIZE_FILTERED; /* only with DOWNSAMPLE */
+        assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_ERROR_UNSUPPORTED);
+        sd.specialize = FOGVOL_SPECIALIZE_DOWNSAMPLE;
         sd.samples = 4;
         assert_int_equal(fogvol_shader_strings(&sd, strs, &n), FOGVOL_ERROR_UNSUPPORTED);
         sd.samples = 0;
@@ -2850,43 +2854,30 @@ static void test_a6_half_resolution(void **state)
     /* refused at end_frame, nothing drawn: a light, a multisampled framebuffer drawn per sample */
     fd.downsample = 2;
     memset(&ld, 0, sizeof ld);
-    ld.mesh = box;
+    ld.mesh = b.box;
     mat_ts(ld.model, 0, 0, 0, 1, 1, 1);
     ld.color[0] = ld.color[1] = ld.color[2] = 1.0f;
-    begun = r.nb.frames_begun;
-    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
-    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(r.nb.frames_begun, begun);
-    r.nb.samples = 4;
-    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(r.nb.frames_begun, r.nb.frames_ended);
-    r.nb.samples = 0;
-    fogvol_destroy_mesh(fv, box);
-    fogvol_destroy_mesh(fv, plane);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
+    begun = r->nb.frames_begun;
+    assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_light(b.fv, &ld), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(b.fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r->nb.frames_begun, begun);
+    r->nb.samples = 4;
+    assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(b.fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r->nb.frames_begun, r->nb.frames_ended);
+    r->nb.samples = 0;
+    box_scene_close(&b);
     /* another tier: refused before the backend is touched */
-    cd.tier = FOGVOL_TIER_PS20;
-    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    assert_int_equal(make_mesh(fv, &bm, 0, 0, &box), FOGVOL_SUCCESS);
-    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
-    vd.mesh = box;
-    vd.ramp = ramp;
-    begun = r.nb.frames_begun;
-    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-    EXPECT_LOGGED(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
-    assert_int_equal(r.nb.frames_begun, begun);
-    fogvol_destroy_mesh(fv, box);
-    fogvol_destroy_ramp(fv, ramp);
-    fogvol_destroy_context(fv);
-    assert_int_equal(r.nb.creates, r.nb.destroys);
-    shp_free(&bm);
-    shp_free(&pm);
+    box_scene_open(&b, FOGVOL_TIER_PS20, 0u, 0u, &lc);
+    begun = r->nb.frames_begun;
+    assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+    EXPECT_LOGGED(fogvol_end_frame(b.fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(r->nb.frames_begun, begun);
+    box_scene_close(&b);
 }
 
 int main(void)

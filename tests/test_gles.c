@@ -395,6 +395,8 @@ static fogvol_context *scene_context(const tier_combo *cb, const tscene *s, fogv
     return fv;
 }
 
+static int g_downsample; /* fogvol_frame_desc.downsample of engine_frame */
+
 /* One frame of scene s as an engine would draw it, the engine's state checked
    around fogvol_end_frame. base: the engine's picture before the fog. */
 static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine *e, const tscene *s,
@@ -414,6 +416,7 @@ static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine 
     fd.debug_thickness = thick;
     fd.engine_depth_texture = c->depth_tex;
     fd.show_overflow = 1; /* where nothing overflows, a magenta pixel fails the composite check */
+    fd.downsample = g_downsample;
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
     if (mrt_tier) assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
     engine_draw(e, c, s, fd.view, fd.projection, mrt_tier ? &mrt : NULL);
@@ -553,6 +556,70 @@ static void test_combo(void **state)
     assert_true(n > 1000);
     assert_true(g_mean[tc->ctx][tc->combo] <= 0.5 + (n ? slack_pp / n : 0)); /* + the mean snapping allowance */
     assert_true(comp <= 2.0 / 255.0);
+}
+
+/* fogvol_frame_desc.downsample 2 in an OpenGL ES 3 context (FLOAT where the context has float
+   blending): the engine's state kept as at full resolution, the picture close to the full-resolution
+   one (the bounds of test_speedups' measurement), with or without OES_texture_float_linear. */
+static void test_half_resolution(void **state)
+{
+    int ci = (int)(intptr_t)*state, k, sc = 0, i, combo = -1, n = 0;
+    unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *full = (unsigned char *)malloc((size_t)W * H * 4),
+                  *half = (unsigned char *)malloc((size_t)W * H * 4);
+    float *tf = (float *)calloc((size_t)W * H, sizeof(float)), *th = (float *)calloc((size_t)W * H, sizeof(float));
+    double sum = 0.0, csum = 0.0;
+    const tscene *s;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    fogvol_context *fv;
+    fogvol_frame_stats st;
+    eglu_ctx c;
+    engine e;
+    for (k = 0; k < NTIER_COMBO; ++k)
+        if (g_tier_combos[k].tier == FOGVOL_TIER_FLOAT && !g_tier_combos[k].variants) combo = k;
+    for (k = 0; k < NSCENE; ++k)
+        if (strcmp(g_scene_names[k], "layers_opaque_between") == 0) sc = k;
+    s = &g_scenes[scene_index(g_scene_names[sc])];
+    context_up(ci, &c);
+    if (!has_ext("GL_EXT_color_buffer_float") || !has_ext("GL_EXT_float_blend")) {
+        print_message("  %s: no float blending: FLOAT (and its half resolution) not available, skipped\n",
+                      g_ctx[ci].name);
+        eglu_destroy(&c);
+        free(base), free(full), free(half), free(tf), free(th);
+        skip();
+    }
+    engine_init(&e, 1);
+    fv = scene_context(&g_tier_combos[combo], s, meshes, &ramp);
+    g_downsample = 0;
+    assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 0, tf, base, full, &st), FOGVOL_SUCCESS);
+    g_downsample = 2;
+    assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 0, th, base, half, &st), FOGVOL_SUCCESS);
+    g_downsample = 0;
+    for (i = 0; i < W * H; ++i) {
+        int ch, m = 0;
+        for (ch = 0; ch < 3; ++ch) {
+            int d = abs((int)half[4 * i + ch] - (int)full[4 * i + ch]);
+            if (d > m) m = d;
+        }
+        csum += m;
+        if (!g_gt[sc].covered[i]) continue;
+        sum += fabs((double)th[i] - tf[i]);
+        n++;
+    }
+    print_message("  %s, half resolution (%s OES_texture_float_linear): thickness %.4f of the thickest ray off the "
+                  "full-resolution one on average, composite %.2f/255\n",
+                  g_ctx[ci].name, has_ext("GL_OES_texture_float_linear") ? "with" : "without",
+                  sum / n / g_gt[sc].tmax, csum / (W * H));
+    assert_true(n > 1000);
+    assert_true(sum / n / g_gt[sc].tmax <= 0.01);
+    assert_true(csum / (W * H) <= 1.0);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    engine_free(&e);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    eglu_destroy(&c);
+    free(base), free(full), free(half), free(tf), free(th);
 }
 
 static int is_magenta(const unsigned char *p) { return p[0] == 255 && p[1] == 0 && p[2] == 255; }
@@ -849,8 +916,8 @@ static int print_table(void **state)
 static int run_context(int ci)
 {
     static tcase cases[NTIER_COMBO];
-    static struct CMUnitTest tests[NTIER_COMBO + 4];
-    static char names[NTIER_COMBO + 4][64], group[32];
+    static struct CMUnitTest tests[NTIER_COMBO + 5];
+    static char names[NTIER_COMBO + 5][64], group[32];
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
@@ -879,6 +946,11 @@ static int run_context(int ci)
         snprintf(names[n], sizeof names[n], "%s_drawbuffers", g_ctx[ci].file);
         tests[n].name = names[n];
         tests[n].test_func = test_drawbuffers;
+        tests[n].initial_state = (void *)(intptr_t)ci;
+        ++n;
+        snprintf(names[n], sizeof names[n], "%s_half_resolution", g_ctx[ci].file);
+        tests[n].name = names[n];
+        tests[n].test_func = test_half_resolution;
         tests[n].initial_state = (void *)(intptr_t)ci;
         ++n;
     }
