@@ -1100,9 +1100,10 @@ typedef struct fogvol_target_desc {
     fogvol_handle share_depth;/* non-zero: use this target's depth buffer instead */
     const char *label;
     int linear;               /* 1: sampled with bilinear filtering (R32F, single-sample: the sum of
-                                 fogvol_frame_desc.downsample 2). A backend that cannot filter the
-                                 format returns FOGVOL_ERROR_UNSUPPORTED, and fogvol makes the target
-                                 without it and filters in the shader (four reads) */
+                                 fogvol_frame_desc.downsample 2). Asked only of backends reporting
+                                 FOGVOL_CAP_FILTER_FLOAT; one that then cannot filter returns
+                                 FOGVOL_ERROR_UNSUPPORTED, and fogvol makes the target without it and
+                                 filters in the shader (four reads), as for the other backends */
 } fogvol_target_desc;
 
 #define FOGVOL_MAX_SHADER_STRINGS 16
@@ -1185,7 +1186,8 @@ enum {
     FOGVOL_CAP_DEPTH_TEXTURE = 1u << 3,   /* the engine can sample its depth buffer */
     FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
                                              (GL 4.0, or GL 3.2 + ARB_sample_shading) */
-    FOGVOL_CAP_MESH_LAYOUT = 1u << 5      /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
+    FOGVOL_CAP_MESH_LAYOUT = 1u << 5,     /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
+    FOGVOL_CAP_FILTER_FLOAT = 1u << 6     /* create_target honours fogvol_target_desc.linear for R32F */
 };
 
 typedef struct fogvol_frame_info {
@@ -5394,8 +5396,9 @@ static const char fogvol__fs_composite[] =
     "uniform sampler2D fv_front2;\n"
     "#endif\n"
     /* FV_DOWNSAMPLE (FLOAT, GLSL 130+): the sum at half resolution, bilinear between the four
-       nearest low-resolution texel centres (low-resolution texel i covers pixels 2i and 2i + 1:
-       its centre lies at window coordinate 2i + 1), clamped at the edges */
+       nearest low-resolution texel centres, clamped at the edges. The tw texels span the w pixels of
+       the viewport: texel i's centre lies at viewport coordinate (i + 0.5) w / tw (2i + 1 where w is
+       even), so the texel coordinate of a pixel is st * tw - 0.5 (st = fv_st(): 1 / w in fv_screen) */
     "#ifdef FV_DOWNSAMPLE\n"
     "#ifdef FV_NO_FETCH\n"
     "#define FV_TAP(c, n) FV_TEXTURE(fv_back, (vec2(c) + 0.5) / vec2(n + 1)).r\n"
@@ -5404,9 +5407,9 @@ static const char fogvol__fs_composite[] =
     "#endif\n"
     "float fv_half_sum() {\n"
     "#ifdef FV_FILTERED\n"                   /* the sampler interpolates (fogvol_target_desc.linear) */
-    "    return FV_TEXTURE(fv_back, FV_PIXEL * 0.5 / vec2(textureSize(fv_back, 0))).r;\n"
+    "    return FV_TEXTURE(fv_back, fv_st()).r;\n"
     "#else\n"
-    "    vec2 p = FV_PIXEL * 0.5 - 0.5, i = floor(p), f = p - i;\n"
+    "    vec2 p = fv_st() * vec2(textureSize(fv_back, 0)) - 0.5, i = floor(p), f = p - i;\n"
     "    ivec2 n = textureSize(fv_back, 0) - 1;\n"
     "    ivec2 a = clamp(ivec2(i), ivec2(0), n), c = clamp(ivec2(i) + 1, ivec2(0), n);\n"
     "    return mix(mix(FV_TAP(a, n), FV_TAP(ivec2(c.x, a.y), n), f.x),\n"
@@ -6080,7 +6083,7 @@ static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
 
 /* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
    it failed to build and the general program stands in. */
-#define FOGVOL__SPEC_MAX 64
+#define FOGVOL__SPEC_MAX 128
 typedef struct fogvol__spec_program {
     fogvol_program program;
     unsigned bits;
@@ -6289,8 +6292,8 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
 {
     fogvol_target_desc td;
     fogvol_result r;
-    if (ctx->tgt_o && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples &&
-        ctx->target_half == half)
+    if (ctx->tgt_b && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples &&
+        ctx->target_half == half) /* (B: every tier has it; FLOAT + ENGINE_DEPTH has no O) */
         return FOGVOL_SUCCESS;
     fogvol__destroy_targets(ctx);
     ctx->target_half = half;
@@ -6309,10 +6312,10 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         }
         td.depth = 0;
         td.label = "fogvol signed depth sum (float)";
-        td.linear = half; /* downsample 2: the composite reads it bilinearly */
+        td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
-        ctx->target_filtered = r == FOGVOL_SUCCESS && half;
-        if (r == FOGVOL_ERROR_UNSUPPORTED && half) {
+        ctx->target_filtered = r == FOGVOL_SUCCESS && td.linear;
+        if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
             fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
                                                     "the composite reads four texels instead");
             td.linear = 0;
@@ -7593,15 +7596,15 @@ static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overfl
 }
 
 /* fogvol_frame_desc.downsample 2: the viewport's debug thickness from the half-resolution float sums,
-   bilinear as the composite reads them (FV_DOWNSAMPLE) */
+   bilinear as the composite reads them (FV_DOWNSAMPLE: the tw x th texels span the w x h pixels) */
 static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double range)
 {
     int w = ctx->frame.viewport[2], h = ctx->frame.viewport[3], tw = ctx->target_w, th = ctx->target_h, x, y;
     for (y = 0; y < h; ++y) {
-        double py = (y + 0.5) * 0.5 - 0.5, iy = floor(py), fy = py - iy;
+        double py = (y + 0.5) * th / h - 0.5, iy = floor(py), fy = py - iy;
         int y0 = iy < 0 ? 0 : iy > th - 1 ? th - 1 : (int)iy, y1 = iy + 1 > th - 1 ? th - 1 : (int)iy + 1;
         for (x = 0; x < w; ++x) {
-            double px = (x + 0.5) * 0.5 - 0.5, ix = floor(px), fx = px - ix;
+            double px = (x + 0.5) * tw / w - 0.5, ix = floor(px), fx = px - ix;
             int x0 = ix < 0 ? 0 : ix > tw - 1 ? tw - 1 : (int)ix, x1 = ix + 1 > tw - 1 ? tw - 1 : (int)ix + 1;
             double a = lo[y0 * tw + x0] + (lo[y0 * tw + x1] - (double)lo[y0 * tw + x0]) * fx;
             double c = lo[y1 * tw + x0] + (lo[y1 * tw + x1] - (double)lo[y1 * tw + x0]) * fx;
@@ -7700,8 +7703,9 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
             }
         }
     }
-    for (c = 0; c < 2; ++c) {
-        double a = FOGVOL_FLOOR(lo[c]) - 1.0, b = FOGVOL_FLOOR(hi[c]) + 2.0;
+    for (c = 0; c < 2; ++c) { /* downsample 2: the bilinear read spreads a texel over 2 more pixels */
+        double m = ctx->frame.downsample == 2 ? 2.0 : 0.0;
+        double a = FOGVOL_FLOOR(lo[c]) - 1.0 - m, b = FOGVOL_FLOOR(hi[c]) + 2.0 + m;
         if (a < vp[c]) a = vp[c];
         if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
         rect[c] = (int)a;
@@ -11109,6 +11113,7 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
             if (fogvol__gl_has_ext3(gl, "GL_EXT_color_buffer_float") && fogvol__gl_has_ext3(gl, "GL_EXT_float_blend"))
                 caps |= FOGVOL_CAP_FLOAT_BLEND;
             gl->float_linear = fogvol__gl_has_ext3(gl, "GL_OES_texture_float_linear");
+            if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
         } else if (fogvol__has_ext(ext, "GL_OES_depth_texture")) {
             caps |= FOGVOL_CAP_DEPTH_TEXTURE;
         }
@@ -11116,6 +11121,7 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         caps |= FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
         if (gl->major >= 3) caps |= FOGVOL_CAP_FLOAT_BLEND; /* R32F render targets and float blending are core */
         gl->float_linear = gl->major >= 3;
+        if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
     }
     return caps;
 }

@@ -938,7 +938,7 @@ static void test_a1_pass_structure_fullscreen(void **state)
     free(s);
 }
 
-/* A context of tier t on the recording backend (extra caps, speed-ups off) with a box volume of
+/* A context of tier t and variants on the recording backend (extra caps, speed-ups off) with a box volume of
    half-size 0.5 (model: at the origin) and an open plane occluder at x = 0, z = -2 (om). */
 typedef struct box_scene {
     rec r;
@@ -950,7 +950,7 @@ typedef struct box_scene {
     float om[16];
 } box_scene;
 
-static void box_scene_open(box_scene *b, fogvol_tier t, unsigned caps, unsigned off, logcap *lc)
+static void box_scene_open(box_scene *b, fogvol_tier t, unsigned variants, unsigned caps, unsigned off, logcap *lc)
 {
     fogvol_context_desc cd;
     rec_init(&b->r);
@@ -958,6 +958,7 @@ static void box_scene_open(box_scene *b, fogvol_tier t, unsigned caps, unsigned 
     memset(&cd, 0, sizeof cd);
     cd.backend = b->r.table;
     cd.tier = t;
+    cd.variants = variants;
     cd.disable_speedups = off;
     if (lc) cd.logger = cap_logger(lc);
     b->fv = NULL;
@@ -1012,7 +1013,7 @@ static void test_a1_depth_test_frames(void **state)
             fogvol_frame_desc fd;
             fogvol_frame_stats st;
             int k, face_passes = 0, want = tiers[t] == FOGVOL_TIER_FLOAT ? 0 : c[i].tested;
-            box_scene_open(&b, tiers[t], FOGVOL_CAP_FLOAT_BLEND, c[i].off ? FOGVOL_SPEEDUP_DEPTH_TEST : 0u, NULL);
+            box_scene_open(&b, tiers[t], 0u, FOGVOL_CAP_FLOAT_BLEND, c[i].off ? FOGVOL_SPEEDUP_DEPTH_TEST : 0u, NULL);
             a_frame_desc(&fd);
             assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
             if (c[i].occluders) assert_int_equal(fogvol_add_occluder(b.fv, b.plane, b.om), FOGVOL_SUCCESS);
@@ -2780,7 +2781,7 @@ static void test_a6_half_resolution(void **state)
     rec *r = &b.r;
     int pass, round, k, begun;
     (void)state;
-    box_scene_open(&b, FOGVOL_TIER_FLOAT, FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_MULTISAMPLE, 0u, &lc);
+    box_scene_open(&b, FOGVOL_TIER_FLOAT, 0u, FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_MULTISAMPLE, 0u, &lc);
     a_frame_desc(&fd);
     fd.viewport[2] = 63; /* odd: the half-resolution targets round up to 32 x 24 */
     fd.viewport[3] = 47;
@@ -2871,13 +2872,45 @@ static void test_a6_half_resolution(void **state)
     r->nb.samples = 0;
     box_scene_close(&b);
     /* another tier: refused before the backend is touched */
-    box_scene_open(&b, FOGVOL_TIER_PS20, 0u, 0u, &lc);
+    box_scene_open(&b, FOGVOL_TIER_PS20, 0u, 0u, 0u, &lc);
     begun = r->nb.frames_begun;
     assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
     EXPECT_LOGGED(fogvol_end_frame(b.fv, &st), FOGVOL_ERROR_UNSUPPORTED);
     assert_int_equal(r->nb.frames_begun, begun);
     box_scene_close(&b);
+}
+
+/* fogvol's targets are made once per size: FLOAT + ENGINE_DEPTH, which has no O target, kept making
+   its sum target again in every frame (found in review). Every tier and the variants that change the
+   set of targets, three frames each: targets only at the first. */
+static void test_a6_targets_once(void **state)
+{
+    static const struct {
+        fogvol_tier t;
+        unsigned v;
+    } c[] = {{FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH}, {FOGVOL_TIER_FLOAT, 0}, {FOGVOL_TIER_PS20, 0},
+             {FOGVOL_TIER_PS13, 0}, {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET}};
+    int i, f, made = 0;
+    (void)state;
+    for (i = 0; i < (int)(sizeof c / sizeof c[0]); ++i) {
+        static box_scene b;
+        fogvol_frame_desc fd;
+        box_scene_open(&b, c[i].t, c[i].v, FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_DEPTH_TEXTURE, 0u, NULL);
+        a_frame_desc(&fd);
+        fd.engine_depth_texture = 77; /* ENGINE_DEPTH: any native texture name (the null backend draws nothing) */
+        for (f = 0; f < 3; ++f) {
+            assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_end_frame(b.fv, NULL), FOGVOL_SUCCESS);
+            if (f == 0) made = b.r.ntgt;
+            if (b.r.ntgt != made)
+                fail_msg("%s variants 0x%x: %d targets made by frame %d, %d after the first", fogvol_tier_name(c[i].t),
+                         c[i].v, b.r.ntgt, f, made);
+        }
+        assert_true(made >= 1);
+        box_scene_close(&b);
+    }
 }
 
 int main(void)
@@ -2899,6 +2932,7 @@ int main(void)
         cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),
         cmocka_unit_test(test_a5_target_faults),
         cmocka_unit_test(test_a6_half_resolution),
+        cmocka_unit_test(test_a6_targets_once),
     };
     const struct CMUnitTest gl_tests[] = {
         cmocka_unit_test_setup_teardown(test_b6_missing_core33, setup_core, teardown_gl),

@@ -57,6 +57,7 @@ typedef struct run_out {
 static int g_x0, g_y0;
 static unsigned g_variants; /* fogvol_context_desc.variants */
 static int g_downsample;    /* fogvol_frame_desc.downsample */
+static int g_w = W, g_h = H; /* the viewport's size (out's pixels: rows of g_w) */
 static int g_no_linear;     /* 1: the GL backend's create_target refuses linear targets (filtering in the shader) */
 static fogvol_backend g_inner;
 static fogvol_result refuse_linear(void *u, const fogvol_target_desc *d, fogvol_handle *out)
@@ -101,8 +102,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         fd.zfar = (float)s->cam.zfar;
         fd.viewport[0] = g_x0;
         fd.viewport[1] = g_y0;
-        fd.viewport[2] = W;
-        fd.viewport[3] = H;
+        fd.viewport[2] = g_w;
+        fd.viewport[3] = g_h;
         fd.debug_thickness = out->th[f];
         fd.downsample = g_downsample;
         glClearColor(0.2f, 0.5f, 0.8f, 1.0f);
@@ -115,8 +116,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         for (y = 0; y < g->height; ++y)
             for (x = 0; x < g->width; ++x) {
                 const unsigned char *p = g->pixels + 4 * ((size_t)y * g->width + x);
-                if (x >= g_x0 && x < g_x0 + W && y >= g_y0 && y < g_y0 + H)
-                    memcpy(out->px[f] + 4 * ((y - g_y0) * W + (x - g_x0)), p, 4);
+                if (x >= g_x0 && x < g_x0 + g_w && y >= g_y0 && y < g_y0 + g_h)
+                    memcpy(out->px[f] + 4 * ((y - g_y0) * g_w + (x - g_x0)), p, 4);
                 else /* outside the viewport: the clear colour, untouched */
                     assert_memory_equal(p, clear, 4);
             }
@@ -299,13 +300,13 @@ static void test_wide_alu(void **state)
     glu_destroy(&g);
 }
 
-/* The composite against the thickness the frame read back (debug_thickness): every pixel,
+/* The composite against the thickness the frame read back (debug_thickness): each of the n pixels,
    mix(background, fog colour, 1 - exp(-density t)) in bytes; returns the largest error */
-static int check_composite(const tscene *s, const unsigned char *px, const float *th)
+static int check_composite(const tscene *s, const unsigned char *px, const float *th, int n)
 {
     static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
     int i, c, worst = 0;
-    for (i = 0; i < W * H; ++i) {
+    for (i = 0; i < n; ++i) {
         double a = th[i] > 0.0f ? 1.0 - exp(-(double)s->density * th[i]) : 0.0;
         for (c = 0; c < 3; ++c) {
             double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
@@ -316,129 +317,130 @@ static int check_composite(const tscene *s, const unsigned char *px, const float
     return worst;
 }
 
+/* One frame f of test_half_resolution: scene s (its camera at the viewport's size vw x vh) drawn at
+   full and half resolution, checked against the ray cast */
+static void half_check(const tscene *s, const char *name, int f, int vw, int vh, int x0, int y0, int shader_filter,
+                       const run_out *full, const run_out *half)
+{
+    static double tap[(H / 2 + 1) * (W / 2 + 1)], gt[W * H];
+    static unsigned sig[(H / 2 + 1) * (W / 2 + 1)];
+    const int tw = (vw + 1) / 2, th = (vh + 1) / 2, n = vw * vh;
+    double range = s->cam.zfar - s->cam.znear, snap = snap_pixels();
+    double worst = 0.0, tmax = 0.0, sum_all = 0.0, worst_all = 0.0, cmean = 0.0;
+    int x, y, i, n_smooth = 0, n_fog = 0, n_cov = 0, cmax = 0, n_c4 = 0, ce;
+    rc_scene rs;
+    scene_raycaster(s, with_occluders(f), &rs);
+    for (y = 0; y < th; ++y) /* the low-resolution texel centres: (i + 0.5) * vw / tw */
+        for (x = 0; x < tw; ++x) {
+            rc_result r = rc_trace(&rs, &s->cam, (x + 0.5) * vw / tw, (y + 0.5) * vh / th);
+            tap[y * tw + x] = r.thickness;
+            sig[y * tw + x] = r.signature;
+        }
+    for (y = 0; y < vh; ++y)
+        for (x = 0; x < vw; ++x) {
+            double py = (y + 0.5) * th / vh - 0.5, px = (x + 0.5) * tw / vw - 0.5, fy, fx, want, e, tol;
+            int iy = (int)floor(py), ix = (int)floor(px), ya, yb, xa, xb, k = y * vw + x;
+            rc_result r = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5);
+            fy = py - iy;
+            fx = px - ix;
+            ya = iy < 0 ? 0 : iy;
+            yb = iy + 1 > th - 1 ? th - 1 : iy + 1;
+            xa = ix < 0 ? 0 : ix;
+            xb = ix + 1 > tw - 1 ? tw - 1 : ix + 1;
+            gt[k] = r.thickness;
+            if (r.thickness > tmax) tmax = r.thickness;
+            if (r.faces_front + r.faces_back > 0 || half->th[f][k] != 0.0f) { /* covered (or fogged) pixels */
+                e = fabs(half->th[f][k] - gt[k]);
+                n_cov++;
+                sum_all += e;
+                if (e > worst_all) worst_all = e;
+            }
+            if (r.signature != sig[ya * tw + xa] || r.signature != sig[ya * tw + xb] ||
+                r.signature != sig[yb * tw + xa] || r.signature != sig[yb * tw + xb] || !rc_interior(&rs, &s->cam, x, y))
+                continue;
+            want = (tap[ya * tw + xa] * (1 - fx) + tap[ya * tw + xb] * fx) * (1 - fy) +
+                   (tap[yb * tw + xa] * (1 - fx) + tap[yb * tw + xb] * fx) * fy;
+            e = fabs(half->th[f][k] - want);
+            tol = 3e-5 * range * (1 + r.faces_back) + 2.0 * rc_depth_slope(&rs, &s->cam, x, y) * snap;
+            if (e > tol)
+                fail_msg("%s frame %d pixel (%d,%d): half-resolution thickness %.6f, bilinear ray cast %.6f (bound %.2g)",
+                         name, f, x, y, (double)half->th[f][k], want, tol);
+            if (e / range > worst) worst = e / range;
+            n_smooth++;
+            n_fog += want > 0.0;
+        }
+    rc_scene_free(&rs);
+    for (i = 0; i < n; ++i) { /* the composite against the full-resolution one */
+        int c, m = 0;
+        for (c = 0; c < 3; ++c) {
+            int d = abs((int)half->px[f][4 * i + c] - (int)full->px[f][4 * i + c]);
+            if (d > m) m = d;
+        }
+        if (m > cmax) cmax = m;
+        cmean += m;
+        n_c4 += m > 4;
+    }
+    ce = check_composite(s, half->px[f], half->th[f], n);
+    print_message("# half resolution, %-21s %s, %dx%d at (%d,%d), %s: %d smooth pixels (%d fogged) within %.2g of the "
+                  "range of the bilinear ray cast, composite within %d/255 of the read-back thickness; against full "
+                  "resolution (silhouettes included): thickness max %.3f / mean %.4f of the thickest ray (%d px), "
+                  "composite max %d/255, mean %.2f/255, %.1f%% of pixels over 4/255\n",
+                  name, with_occluders(f) ? "with occluders" : "no occluders", vw, vh, x0, y0,
+                  shader_filter ? "four reads in the shader" : "filtered by the GL", n_smooth, n_fog, worst, ce,
+                  worst_all / tmax, sum_all / (n_cov ? n_cov : 1) / tmax, n_cov, cmax, cmean / n, 100.0 * n_c4 / n);
+    assert_true(n_fog > n / 8);                              /* the interpolated thickness checked where there is fog */
+    assert_true(ce <= 2);                                    /* FAST_EXP 0.69/255 + rounding, the filter's weights */
+    assert_true(cmean / n <= 1.0);                           /* on average under 1/255 of full resolution */
+    assert_true(sum_all / (n_cov ? n_cov : 1) / tmax <= 0.01); /* mean under 1% of the thickest ray */
+}
+
 /* fogvol_frame_desc.downsample 2 (FLOAT): the sums at half width and height, upsampled bilinearly.
-   Independent truth: the ray cast at the low-resolution texel centres (window coordinates 2i + 1,
-   2j + 1), interpolated bilinearly, at every pixel whose four taps and own centre see the same hit
-   topology (within the FLOAT bound of test_tiers, 3e-5 of the depth range, plus what vertex snapping
-   at half resolution moves: twice the pixel's depth slope times the snap grid). Then the error of
-   the method itself, against the full-resolution ray cast and composite, silhouettes included,
-   measured and bounded. The composite, filtered by the GL (fogvol_target_desc.linear) or by four
-   reads where the backend refuses that, against the debug thickness (the same bilinear values) at
-   every pixel. Viewports at the origin and away from it; frames with and without occluders. */
+   Independent truth: the ray cast at the low-resolution texel centres ((i + 0.5) w / tw: the tw texels
+   span the w pixels), interpolated bilinearly, at every pixel whose four taps and own centre see the
+   same hit topology (within the FLOAT bound of test_tiers, 3e-5 of the depth range per face pair, plus
+   what vertex snapping at half resolution moves: twice the pixel's depth slope times the snap grid).
+   The composite, filtered by the GL (fogvol_target_desc.linear) or by four reads where the backend
+   refuses that, against the read-back thickness (the same bilinear values) at every pixel. Then the
+   error of the method itself against the full-resolution ray cast and composite, silhouettes included,
+   measured and bounded. Viewports at the origin, away from it, and of odd width and height; frames
+   with and without occluders. */
 static void test_half_resolution(void **state)
 {
     static run_out full, half;
-    static double tap[(H / 2) * (W / 2)], gt[W * H], slope[W * H];
-    static unsigned sig[(H / 2) * (W / 2)];
-    static int pairs[W * H];
-    static unsigned char interior[W * H], covered[W * H];
+    static const struct {
+        int w, h, x0, y0, shader_filter;
+    } vc[4] = {{W, H, 0, 0, 0}, {W, H, 13, 7, 0}, {W, H, 0, 0, 1}, {W - 1, H - 3, 0, 0, 0}};
     const char *names[3] = {"plane_cuts_sphere", "layers_opaque_between", "negative_pokes_out"};
-    const int tw = W / 2, th = H / 2;
     glu_ctx g;
     int si, f, k;
     (void)state;
     assert_true(glu_create(&g, W + 13, H + 7, 1));
-    for (k = 0; k < 3; ++k) /* viewport at the origin, then at (13, 7); k = 2: filtered in the shader */
+    for (k = 0; k < 4; ++k)
         for (si = 0; si < 3; ++si) {
-            const tscene *s = &g_scenes[scene_index(names[si])];
-            double range = s->cam.zfar - s->cam.znear, snap = snap_pixels();
-            g_x0 = k == 1 ? 13 : 0;
-            g_y0 = k == 1 ? 7 : 0;
+            tscene sc = g_scenes[scene_index(names[si])]; /* the camera at the viewport's size */
+            sc.cam.width = vc[k].w;
+            sc.cam.height = vc[k].h;
+            g_w = vc[k].w;
+            g_h = vc[k].h;
+            g_x0 = vc[k].x0;
+            g_y0 = vc[k].y0;
             g_downsample = 0;
-            run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &full);
+            run_frames(&sc, FOGVOL_TIER_FLOAT, 0, &g, &full);
             g_downsample = 2;
-            g_no_linear = k == 2;
+            g_no_linear = vc[k].shader_filter;
             g_shader_filtered = 0;
-            run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &half);
-            assert_int_equal(g_shader_filtered, k == 2); /* llvmpipe filters R32F; the wrapper refuses it */
+            run_frames(&sc, FOGVOL_TIER_FLOAT, 0, &g, &half);
+            assert_int_equal(g_shader_filtered, vc[k].shader_filter); /* llvmpipe filters R32F; the wrapper refuses it */
             g_downsample = g_no_linear = 0;
             g_x0 = g_y0 = 0;
-            for (f = 0; f < 3; ++f) { /* frame 0 without occluders, frame 2 with */
-                rc_scene rs;
-                double worst = 0.0, tmax = 0.0, sum_all = 0.0, worst_all = 0.0, cmean = 0.0;
-                int x, y, i, n_smooth = 0, n_fog = 0, n_cov = 0, maxf, cmax = 0, n_c4 = 0;
-                if (f == 1) continue;
-                scene_raycaster(s, with_occluders(f), &rs);
-                for (y = 0; y < th; ++y)
-                    for (x = 0; x < tw; ++x) {
-                        rc_result r = rc_trace(&rs, &s->cam, 2 * x + 1.0, 2 * y + 1.0);
-                        tap[y * tw + x] = r.thickness;
-                        sig[y * tw + x] = r.signature;
-                    }
-                for (y = 0; y < H; ++y)
-                    for (x = 0; x < W; ++x) {
-                        double py = (y + 0.5) * 0.5 - 0.5, px = (x + 0.5) * 0.5 - 0.5, fy, fx, want, e, tol;
-                        int iy = (int)floor(py), ix = (int)floor(px), y0, y1, x0, x1, j;
-                        unsigned s0;
-                        fy = py - iy;
-                        fx = px - ix;
-                        y0 = iy < 0 ? 0 : iy;
-                        y1 = iy + 1 > th - 1 ? th - 1 : iy + 1;
-                        x0 = ix < 0 ? 0 : ix;
-                        x1 = ix + 1 > tw - 1 ? tw - 1 : ix + 1;
-                        s0 = rc_trace(&rs, &s->cam, x + 0.5, y + 0.5).signature;
-                        if (s0 != sig[y0 * tw + x0] || s0 != sig[y0 * tw + x1] || s0 != sig[y1 * tw + x0] ||
-                            s0 != sig[y1 * tw + x1] || !rc_interior(&rs, &s->cam, x, y))
-                            continue;
-                        want = (tap[y0 * tw + x0] * (1 - fx) + tap[y0 * tw + x1] * fx) * (1 - fy) +
-                               (tap[y1 * tw + x0] * (1 - fx) + tap[y1 * tw + x1] * fx) * fy;
-                        e = fabs(half.th[f][y * W + x] - want);
-                        j = 1 + rc_trace(&rs, &s->cam, x + 0.5, y + 0.5).faces_back;
-                        tol = 3e-5 * range * j + 2.0 * rc_depth_slope(&rs, &s->cam, x, y) * snap;
-                        if (e > tol)
-                            fail_msg("%s frame %d pixel (%d,%d): half-resolution thickness %.6f, bilinear ray cast "
-                                     "%.6f (bound %.2g)",
-                                     names[si], f, x, y, (double)half.th[f][y * W + x], want, tol);
-                        if (e / range > worst) worst = e / range;
-                        n_smooth++;
-                        n_fog += want > 0.0;
-                    }
-                rc_scene_free(&rs);
-                /* the method's own error: against the full-resolution ray cast (every covered pixel,
-                   silhouettes included) and the full-resolution composite */
-                if (with_occluders(f)) ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax, slope);
-                else {
-                    scene_raycaster(s, 0, &rs);
-                    for (i = 0; i < W * H; ++i) {
-                        rc_result r = rc_trace(&rs, &s->cam, i % W + 0.5, i / W + 0.5);
-                        gt[i] = r.thickness;
-                        covered[i] = r.faces_front + r.faces_back > 0;
-                        if (gt[i] > tmax) tmax = gt[i];
-                    }
-                    rc_scene_free(&rs);
-                }
-                for (i = 0; i < W * H; ++i) {
-                    double e = fabs(half.th[f][i] - gt[i]);
-                    int c, m = 0;
-                    for (c = 0; c < 3; ++c) {
-                        int d = abs((int)half.px[f][4 * i + c] - (int)full.px[f][4 * i + c]);
-                        if (d > m) m = d;
-                    }
-                    if (m > cmax) cmax = m;
-                    cmean += m;
-                    n_c4 += m > 4;
-                    if (!covered[i] && half.th[f][i] == 0.0f) continue;
-                    n_cov++;
-                    sum_all += e;
-                    if (e > worst_all) worst_all = e;
-                }
-                print_message("# half resolution, %-21s %s, viewport at (%d,%d): %d smooth pixels (%d fogged) within %.2g of the "
-                              "range of the bilinear ray cast; against full resolution (silhouettes included): "
-                              "thickness max %.3f / mean %.4f of the thickest ray (%d px), composite max %d/255, "
-                              "mean %.2f/255, %.1f%% of pixels over 4/255\n",
-                              names[si], with_occluders(f) ? "with occluders" : "no occluders", g_x0, g_y0, n_smooth, n_fog, worst, worst_all / tmax, sum_all / (n_cov ? n_cov : 1) / tmax,
-                              n_cov, cmax, cmean / (W * H), 100.0 * n_c4 / (W * H));
-                assert_true(n_fog > W * H / 8); /* the interpolated thickness checked where there is fog */
-                i = check_composite(s, half.px[f], half.th[f]);
-                print_message("#   composite (%s) against the debug thickness: max %d/255 over every pixel\n",
-                              k == 2 ? "four reads in the shader" : "filtered by the GL", i);
-                assert_true(i <= 2); /* FAST_EXP 0.69/255 + rounding, and the filter's weights */
+            g_w = W;
+            g_h = H;
+            for (f = 0; f < 3; f += 2) { /* frame 0 without occluders, frame 2 with */
+                half_check(&sc, names[si], f, vc[k].w, vc[k].h, vc[k].x0, vc[k].y0, vc[k].shader_filter, &full, &half);
                 if (k == 0 && si == 1 && with_occluders(f)) {
                     write_png("half", half.px[f]);
                     write_png("full", full.px[f]);
                 }
-                assert_true(cmean / (W * H) <= 1.0);                  /* on average under 1/255 */
-                assert_true(sum_all / (n_cov ? n_cov : 1) / tmax <= 0.01); /* mean under 1% of the thickest */
             }
         }
     glu_destroy(&g);
