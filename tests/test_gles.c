@@ -911,6 +911,18 @@ static int print_table(void **state)
     return 0;
 }
 
+/* tests[n]: <context>_<what>, fn run with the context index as its state; returns n + 1 */
+static int add_ctx_test(struct CMUnitTest *tests, char (*names)[64], int n, int ci, const char *what,
+                        CMUnitTestFunction fn)
+{
+    snprintf(names[n], sizeof names[n], "%s_%s", g_ctx[ci].file, what);
+    tests[n].name = names[n];
+    tests[n].test_func = fn;
+    tests[n].initial_state = (void *)(intptr_t)ci;
+    tests[n].setup_func = tests[n].teardown_func = NULL;
+    return n + 1;
+}
+
 /* One process per context kind (tests/egl_util.h): a child runs the group of
    context ci, the parent waits for it. */
 static int run_context(int ci)
@@ -921,11 +933,7 @@ static int run_context(int ci)
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
-    snprintf(names[n], sizeof names[n], "%s_auto_choice", g_ctx[ci].file);
-    tests[n].name = names[n];
-    tests[n].test_func = test_auto_choice;
-    tests[n].initial_state = (void *)(intptr_t)ci;
-    ++n;
+    n = add_ctx_test(tests, names, n, ci, "auto_choice", test_auto_choice);
     for (k = 0; k < NTIER_COMBO; ++k) {
         if (fogvol_combination_supported(g_tier_combos[k].tier, g_tier_combos[k].variants, d) != FOGVOL_SUCCESS) continue;
         if (g_ctx[ci].plain_tiers_only && g_tier_combos[k].variants) continue;
@@ -937,30 +945,13 @@ static int run_context(int ci)
         tests[n].initial_state = &cases[nc++];
         ++n;
     }
-    snprintf(names[n], sizeof names[n], "%s_overflow", g_ctx[ci].file);
-    tests[n].name = names[n];
-    tests[n].test_func = test_overflow;
-    tests[n].initial_state = (void *)(intptr_t)ci;
-    ++n;
+    n = add_ctx_test(tests, names, n, ci, "overflow", test_overflow);
     if (g_ctx[ci].major >= 3) {
-        snprintf(names[n], sizeof names[n], "%s_drawbuffers", g_ctx[ci].file);
-        tests[n].name = names[n];
-        tests[n].test_func = test_drawbuffers;
-        tests[n].initial_state = (void *)(intptr_t)ci;
-        ++n;
-        snprintf(names[n], sizeof names[n], "%s_half_resolution", g_ctx[ci].file);
-        tests[n].name = names[n];
-        tests[n].test_func = test_half_resolution;
-        tests[n].initial_state = (void *)(intptr_t)ci;
-        ++n;
+        n = add_ctx_test(tests, names, n, ci, "drawbuffers", test_drawbuffers);
+        n = add_ctx_test(tests, names, n, ci, "half_resolution", test_half_resolution);
     }
-    if (g_ctx[ci].major == 3 && g_ctx[ci].override) { /* GLES 3.0 */
-        snprintf(names[n], sizeof names[n], "%s_partial_extension", g_ctx[ci].file);
-        tests[n].name = names[n];
-        tests[n].test_func = test_partial_extension;
-        tests[n].initial_state = (void *)(intptr_t)ci;
-        ++n;
-    }
+    if (g_ctx[ci].major == 3 && g_ctx[ci].override) /* GLES 3.0 */
+        n = add_ctx_test(tests, names, n, ci, "partial_extension", test_partial_extension);
     snprintf(group, sizeof group, "gles_%s", g_ctx[ci].file);
     return _cmocka_run_group_tests(group, tests, (size_t)n, setup_all, print_table);
 }

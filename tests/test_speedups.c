@@ -153,23 +153,31 @@ static void write_png(const char *name, const unsigned char *px)
 
 /* FLOAT, frame with occluders: every interior pixel against the ray-cast thickness through the
    extinction law, mix(background, fog colour, 1 - exp(-density t)), in bytes; returns the max error */
+/* The largest byte error of pixel px against mix(background, fog colour, 1 - exp(-density t)) */
+static int fog_error(const tscene *s, const unsigned char *px, double t)
+{
+    static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
+    double a = t > 0.0 ? 1.0 - exp(-(double)s->density * t) : 0.0;
+    int c, worst = 0;
+    for (c = 0; c < 3; ++c) {
+        double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
+        int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[c]);
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
 static int check_ground_truth(const tscene *s, const unsigned char *px)
 {
     static double gt[W * H], tmax;
     static int pairs[W * H], maxf;
     static unsigned char interior[W * H], covered[W * H];
-    static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
-    int i, c, worst = 0, n = 0;
+    int i, e, worst = 0, n = 0;
     ground_truth(s, gt, pairs, interior, covered, &maxf, &tmax, NULL);
     for (i = 0; i < W * H; ++i) {
-        double a = 1.0 - exp(-(double)s->density * gt[i]);
         if (!interior[i]) continue;
         ++n;
-        for (c = 0; c < 3; ++c) {
-            double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
-            int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[4 * i + c]);
-            if (d > worst) worst = d;
-        }
+        if ((e = fog_error(s, px + 4 * i, gt[i])) > worst) worst = e;
     }
     assert_true(n > W * H / 4);
     return worst;
@@ -304,16 +312,9 @@ static void test_wide_alu(void **state)
    mix(background, fog colour, 1 - exp(-density t)) in bytes; returns the largest error */
 static int check_composite(const tscene *s, const unsigned char *px, const float *th, int n)
 {
-    static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
-    int i, c, worst = 0;
-    for (i = 0; i < n; ++i) {
-        double a = th[i] > 0.0f ? 1.0 - exp(-(double)s->density * th[i]) : 0.0;
-        for (c = 0; c < 3; ++c) {
-            double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
-            int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[4 * i + c]);
-            if (d > worst) worst = d;
-        }
-    }
+    int i, e, worst = 0;
+    for (i = 0; i < n; ++i)
+        if ((e = fog_error(s, px + 4 * i, th[i])) > worst) worst = e;
     return worst;
 }
 
