@@ -324,8 +324,9 @@ enum {
        checks each volume's bounds and refuses such a frame
        (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). */
     FOGVOL_VARIANT_COUNT = 1u << 1,
-    /* PS20/MRT: RGB-encode by arithmetic in the fragment shader instead of
-       ramp textures ("newer hardware can calculate the ramp values"). Same bytes. */
+    /* PS20/MRT, and PS13 in GLSL 330 / 300 es (highp integers): RGB-encode by
+       arithmetic in the fragment shader instead of ramp textures ("newer
+       hardware can calculate the ramp values"). Same bytes. */
     FOGVOL_VARIANT_ALU = 1u << 2,
     /* Snap vertices behind the near plane onto it (Baker) instead of relying
        on near-plane clipping for a camera partly inside a volume. */
@@ -458,9 +459,11 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  target and engine-depth reads without the viewport offset where the viewport
                  starts at the window origin) instead of one program that switches on uniforms;
                  built on first use (same pixels).
-   ALU           PS20 and MRT (not WIDE) take FOGVOL_VARIANT_ALU: the depth is encoded and the dither
-                 row computed by arithmetic instead of three lookup texture reads per face fragment
-                 (same bytes; fogvol_context_tier reports the variant).
+   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
+                 the depth is encoded and the dither row computed by arithmetic instead of three
+                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
+                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
+                 (FOGVOL_SPECIALIZE_ENCODING).
    OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
                  horizontal bands of the group's rectangle, in turn, instead of all of it (an
                  eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
@@ -1106,7 +1109,7 @@ typedef struct fogvol_target_desc {
                                  filters in the shader (four reads), as for the other backends */
 } fogvol_target_desc;
 
-#define FOGVOL_MAX_SHADER_STRINGS 16
+#define FOGVOL_MAX_SHADER_STRINGS 20
 
 typedef struct fogvol_program_desc {
     const char *vs[FOGVOL_MAX_SHADER_STRINGS];
@@ -1457,8 +1460,11 @@ typedef struct fogvol_shader_desc {
    width and height: a bilinear read of fv_back at the pixel, four texels; fogvol_frame_desc.downsample),
    with FILTERED (one read: the backend filters fv_back, fogvol_target_desc.linear). Every program:
    ORIGIN (the frame's viewport starts at the window origin: fogvol's targets and the engine's
-   depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). Other
-   bits, EXP with RAMP, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
+   depth texture are read at gl_FragCoord, without the offsets fv_screen.zw and fv_nf.zw). ENCODE and
+   FACE: FOGVOL_SPECIALIZE_ENCODING(L), L = 1..8 (fogvol_encoding.bits): the RGBA8 encode with that
+   encoding's N = 2^L and D (dither_steps) compiled in instead of read from fv_enc.xy and fv_dith.yz,
+   so its arithmetic on them folds at compile time (the same bytes for that encoding; no effect on
+   FLOAT). Other bits, EXP with RAMP, L > 8, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1472,8 +1478,10 @@ enum {
     FOGVOL_SPECIALIZE_DITHER = 1u << 9,
     FOGVOL_SPECIALIZE_COUNT = 1u << 10,
     FOGVOL_SPECIALIZE_DOWNSAMPLE = 1u << 11,
-    FOGVOL_SPECIALIZE_FILTERED = 1u << 12
+    FOGVOL_SPECIALIZE_FILTERED = 1u << 12,
+    FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13 /* FOGVOL_SPECIALIZE_ENCODING(bits) */
 };
+#define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
 /* The strings of one shader, ready for glShaderSource(shader, *count, strings, NULL).
    Combinations that do not exist (fogvol_combination_supported) or programs a
@@ -5149,6 +5157,10 @@ static const char fogvol__fs_common[] =
    string of the shared fragment code (one string would pass the 4095 characters C99 guarantees). */
 static const char fogvol__fs_encode_common[] =
     "#if !defined(FV_FLOAT)\n"
+    /* FV_N, FV_DD: the digit base N and the dither steps D; FV_ENC_* (SPECIALIZE_ENCODING): the
+       context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
+    "#ifdef FV_ENC_LN\n#define FV_N FV_ENC_N\n#define FV_DD FV_ENC_D\n#define FV_RDD (1.0 / FV_ENC_D)\n"
+    "#else\n#define FV_N fv_enc.x\n#define FV_DD fv_dith.z\n#define FV_RDD fv_dith.y\n#endif\n"
     "uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
     "uniform sampler2D fv_rg;\n"
@@ -5159,6 +5171,7 @@ static const char fogvol__fs_encode_common[] =
        (the same bytes as the float arithmetic below, with about a third of its operations) */
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
     "#define FV_IALU\n"
+    "#ifdef FV_ENC_LN\n#define FV_DD_I (1 << FV_ENC_LD)\n#else\n#define FV_DD_I int(fv_dith.z)\n#endif\n"
     "highp int fv_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n"
     /* fv_dither_scaled_i: (v D) >> 6, v the 8x8 index of fogvol_make_dither_index (bits 5..0: x0 y0
        x1 y1 x2 y2 of x = px ^ py, y = py); (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2, so the
@@ -5166,10 +5179,10 @@ static const char fogvol__fs_encode_common[] =
     "highp int fv_dither_scaled_i() {\n"
     "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
     "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n"
-    "    return (((s.x << 1) | s.y) * int(fv_dith.z)) >> 8;\n"
+    "    return (((s.x << 1) | s.y) * FV_DD_I) >> 8;\n"
     "}\n"
     "float fv_dither_row() {\n"
-    "    highp int dd = int(fv_dith.z);\n"
+    "    highp int dd = FV_DD_I;\n"
     "    return fv_dith.x > 0.5 ? float((fv_dither_scaled_i() + (dd >> 1)) & (dd - 1)) : 0.0;\n"
     "}\n"
     /* the encode's offset (row + D/2) mod D = (v D) >> 6 (the dither off: D/2) */
@@ -5177,7 +5190,7 @@ static const char fogvol__fs_encode_common[] =
     "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
     "    return fv_dither_scaled_i();\n"
     "#else\n"
-    "    return fv_dith.x > 0.5 ? fv_dither_scaled_i() : int(fv_dith.z) >> 1;\n"
+    "    return fv_dith.x > 0.5 ? fv_dither_scaled_i() : FV_DD_I >> 1;\n"
     "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
@@ -5186,7 +5199,7 @@ static const char fogvol__fs_encode_common[] =
     "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n"
     "    float v = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
     "              abs(b2.x - b2.y) * 2.0 + b2.y;\n"    /* 8x8 Bayer index by bit interleaving */
-    "    float dd = fv_dith.z;\n"
+    "    float dd = FV_DD;\n"
     "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5), dd) : 0.0;\n"
     "}\n"
     "#else\n"
@@ -5195,8 +5208,12 @@ static const char fogvol__fs_encode_common[] =
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
     "#ifdef FV_IALU\n"                          /* T: the blue-ramp texel count floor(u N^3 D) */
+    "#ifdef FV_ENC_LN\n"
+    "    const highp int ln = FV_ENC_LN, ld = FV_ENC_LD, n = 1 << ln;\n"
+    "#else\n"
     "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln;\n"
-    "    highp int T = int(u * (fv_enc.y * fv_enc.x * fv_dith.z));\n" /* powers of two: exact either way */
+    "#endif\n"
+    "    highp int T = int(u * (FV_N * FV_N * FV_N * FV_DD));\n" /* powers of two: exact either way */
     "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
     "    highp int q = ((x + fv_dither_offset_i()) >> ld) - 1;\n"
     "    highp int a = q < 0 ? 1 : 0;\n"
@@ -5204,16 +5221,16 @@ static const char fogvol__fs_encode_common[] =
     "#else\n"
     "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
-    "    float n = fv_enc.x, dd = fv_dith.z;\n"
-    "    float t = u * fv_enc.y * n;\n"            /* blue LSBs; scaling by powers of two is exact */
+    "    float n = FV_N, dd = FV_DD;\n"
+    "    float t = u * n * n * n;\n"            /* blue LSBs; scaling by powers of two is exact */
     "    float h = floor(t / n);\n"
     "    float x = mod(floor(t * dd), n * dd);\n"   /* the blue-ramp texel */
     "    float q = floor((x + mod(row + dd * 0.5, dd)) / dd) - 1.0;\n"
     "    float a = q < 0.0 ? 1.0 : 0.0;\n"
     "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n"
     "#else\n"
-    "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * fv_enc.x));\n"
-    "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * fv_enc.y, (row + 0.5) * fv_dith.y));\n"
+    "    vec4 rg = FV_TEXTURE(fv_rg, vec2(u, u * FV_N));\n"
+    "    vec4 b = FV_TEXTURE(fv_blue, vec2(u * (FV_N * FV_N), (row + 0.5) * FV_RDD));\n"
     "    return rg + b;\n"
     "#endif\n"
     "#endif\n"
@@ -5223,18 +5240,18 @@ static const char fogvol__fs_encode_common[] =
     "#endif\n"
     "#ifdef FV_WIDE\n"                            /* six digits: V = floor(u N^6 + threshold), no borrow */
     "void fv_encode_wide(float d, out vec4 hi, out vec4 lo) {\n"
-    "    float n = fv_enc.x, n3 = fv_enc.x * fv_enc.y, dd = fv_dith.z;\n"
+    "    float n = FV_N, n3 = FV_N * FV_N * FV_N, dd = FV_DD;\n"
     "    float row = fv_dither_row();\n"
     "    float v = floor(clamp(d, 0.0, fv_enc.w) * n3 * n3 + mod(row + dd * 0.5, dd) / dd);\n"
     "    float a = floor(v / n3), b = v - a * n3;\n"
-    "    hi = vec4(floor(a / fv_enc.y), mod(floor(a / n), n), mod(a, n), 0.0) * (1.0 / 255.0);\n"
-    "    lo = vec4(floor(b / fv_enc.y), mod(floor(b / n), n), mod(b, n), 0.0) * (1.0 / 255.0);\n"
+    "    hi = vec4(floor(a / (n * n)), mod(floor(a / n), n), mod(a, n), 0.0) * (1.0 / 255.0);\n"
+    "    lo = vec4(floor(b / (n * n)), mod(floor(b / n), n), mod(b, n), 0.0) * (1.0 / 255.0);\n"
     "}\n"
     "#endif\n"
     "vec4 fv_normalize(vec4 e) {\n"                /* fold the borrow: digits R, G, B in [0, N-1], alpha 0 */
     "    float g = e.g - e.a;\n"
     "    float c = g < -0.5 / 255.0 ? 1.0 : 0.0;\n"
-    "    vec4 r = vec4(e.r - c / 255.0, g + c * fv_enc.x / 255.0, e.b, 0.0);\n"
+    "    vec4 r = vec4(e.r - c / 255.0, g + c * FV_N / 255.0, e.b, 0.0);\n"
     "    return r.r < -0.5 / 255.0 ? vec4(0.0) : r;\n"
     "}\n"
     "#endif\n";
@@ -5613,9 +5630,11 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
                                       (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
         return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
     switch (tier) {
-    case FOGVOL_TIER_PS13: /* texture ramps only: the tier is for GPUs without fp32 fragment maths */
-        return (v & (FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET |
-                     FOGVOL_VARIANT_WIDE))
+    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
+                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
+        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
                    ? FOGVOL_ERROR_UNSUPPORTED
                    : FOGVOL_SUCCESS;
     case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
@@ -5734,7 +5753,9 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_FILTERED) && !(bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE) /* (FLOAT: the caller) */
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED);
-    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
+    if ((bits & FOGVOL_SPECIALIZE_ENCODING_MASK) > FOGVOL_SPECIALIZE_ENCODING(8)) return 0;
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE)
+        bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
@@ -5752,7 +5773,19 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
                                         "#define FV_EXP\n#define FV_NO_CTEX\n",
                                         "#define FV_RAMP\n#define FV_NO_CTEX\n",
                                         ""};
+    /* SPECIALIZE_ENCODING(L): L, log2 D, N and D of fogvol_encoding_init(L) */
+    static const char *const enc[8] = {
+        "#define FV_ENC_LN 1\n#define FV_ENC_LD 5\n#define FV_ENC_N 2.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 2\n#define FV_ENC_LD 5\n#define FV_ENC_N 4.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 3\n#define FV_ENC_LD 5\n#define FV_ENC_N 8.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 4\n#define FV_ENC_LD 5\n#define FV_ENC_N 16.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 5\n#define FV_ENC_LD 5\n#define FV_ENC_N 32.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 6\n#define FV_ENC_LD 5\n#define FV_ENC_N 64.0\n#define FV_ENC_D 32.0\n",
+        "#define FV_ENC_LN 7\n#define FV_ENC_LD 4\n#define FV_ENC_N 128.0\n#define FV_ENC_D 16.0\n",
+        "#define FV_ENC_LN 8\n#define FV_ENC_LD 3\n#define FV_ENC_N 256.0\n#define FV_ENC_D 8.0\n"};
+    unsigned L = (d->specialize & FOGVOL_SPECIALIZE_ENCODING_MASK) >> 13;
     if (d->stage != FOGVOL_STAGE_FRAGMENT) return n;
+    if (L && (d->program == FOGVOL_PROGRAM_FACE || d->program == FOGVOL_PROGRAM_ENCODE)) strings[n++] = enc[L - 1];
     if (d->specialize & FOGVOL_SPECIALIZE_ORIGIN) strings[n++] = "#define FV_ORIGIN\n";
     if (d->specialize & FOGVOL_SPECIALIZE_NO_OVERFLOW) strings[n++] = "#define FV_NO_SAT\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FAST_EXP) strings[n++] = "#define FV_FAST_EXP\n";
@@ -6642,12 +6675,13 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     return r;
 }
 
-/* FOGVOL_SPEEDUP_ALU: PS20 and MRT encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes, no
-   lookup texture reads) unless the variant set cannot take it. */
+/* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
+   no lookup texture reads) unless the variant set or dialect cannot take it. */
 static void fogvol__default_alu(fogvol_context *ctx)
 {
     unsigned v = ctx->variants | FOGVOL_VARIANT_ALU;
-    if ((ctx->tier == FOGVOL_TIER_PS20 || ctx->tier == FOGVOL_TIER_MRT) && !(ctx->speedups_off & FOGVOL_SPEEDUP_ALU) &&
+    if ((ctx->tier == FOGVOL_TIER_PS20 || ctx->tier == FOGVOL_TIER_MRT || ctx->tier == FOGVOL_TIER_PS13) &&
+        !(ctx->speedups_off & FOGVOL_SPEEDUP_ALU) &&
         !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
         fogvol_combination_supported(ctx->tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
         ctx->variants = v;
@@ -7767,6 +7801,8 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
         bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
                 FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
+    else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->tier != FOGVOL_TIER_FLOAT)
+        bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->enc.bits); /* the context's encoding compiled in */
     if (!bits) return ctx->prog[p];
     for (i = 0; i < ctx->nspec; ++i) {
         sp = &ctx->spec[i];

@@ -5,7 +5,8 @@
    (fogvol_shader_desc.samples = 4, where fogvol_msaa_supported) go to
    <tier>_v<variants>_<program>_<dialect>_ms.frag. The programs built for one configuration
    (fogvol_shader_desc.specialize) get _s<bits> before the extension; a program must refuse the
-   bits it does not take (spec_applies). */
+   bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
+   L = 1..8 and refused above. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -21,7 +22,9 @@ static int spec_applies(int p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program takes it */
-    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) bits &= ~(unsigned)FOGVOL_SPECIALIZE_DITHER;
+    if ((bits & FOGVOL_SPECIALIZE_ENCODING_MASK) > FOGVOL_SPECIALIZE_ENCODING(8)) return 0; /* L = 1..8 */
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE)
+        bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
     if (!bits) return 1;
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
@@ -89,7 +92,15 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED,
                                      FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED | FOGVOL_SPECIALIZE_ORIGIN |
                                          FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
-                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW};
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_ENCODING(1),
+                                     FOGVOL_SPECIALIZE_ENCODING(4) | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
+                                         FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_ENCODING(7) | FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_ENCODING(8) | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN |
+                                         FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_ENCODING(9),
+                                     FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;

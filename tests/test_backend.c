@@ -239,10 +239,16 @@ typedef struct rec {
 /* The program kind whose sources (every string of both stages) equal desc's. */
 /* A program's kind: its fogvol_program, plus its fogvol_shader_desc.specialize bits times 256. */
 #define KIND(p, spec) ((int)(p) | (int)(spec) << 8)
+/* the encoding of FOGVOL_SPECIALIZE_ENCODING compiled into the default context's ENCODE and FACE
+   programs: L = 4 (fogvol_context_desc.encoding_bits 0) */
+#define ENC4 FOGVOL_SPECIALIZE_ENCODING(4)
 static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
 {
     int k, found = -1;
-    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 8192; ++k) { /* every program, every set of specialize bits */
+    unsigned enc = 0;
+    for (k = 0; k < d->fs_count; ++k) /* FOGVOL_SPECIALIZE_ENCODING(L): "#define FV_ENC_LN L" */
+        if (strncmp(d->fs[k], "#define FV_ENC_LN ", 18) == 0) enc = FOGVOL_SPECIALIZE_ENCODING(atoi(d->fs[k] + 18));
+    for (k = 0; k < FOGVOL_PROGRAM_COUNT * 8192; ++k) { /* every program, every set of the other bits */
         const char *vs[FOGVOL_MAX_SHADER_STRINGS], *fs[FOGVOL_MAX_SHADER_STRINGS];
         int nv = 0, nf = 0, i, same, p = k % FOGVOL_PROGRAM_COUNT;
         fogvol_shader_desc sd;
@@ -251,7 +257,7 @@ static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
         sd.variants = FOGVOL_VARIANT_ALU; /* the PS20 default (FOGVOL_SPEEDUP_ALU) */
         sd.program = (fogvol_program)p;
         sd.dialect = dialect;
-        sd.specialize = (unsigned)(k / FOGVOL_PROGRAM_COUNT);
+        sd.specialize = (unsigned)(k / FOGVOL_PROGRAM_COUNT) | enc;
         if (fogvol_shader_strings(&sd, vs, &nv) != FOGVOL_SUCCESS) continue;
         sd.stage = FOGVOL_STAGE_FRAGMENT;
         if (fogvol_shader_strings(&sd, fs, &nf) != FOGVOL_SUCCESS) continue;
@@ -775,11 +781,11 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     assert_int_equal(r->nb.frames_begun, r->nb.frames_ended);
 
     /* resources identified by what they are, not by creation order */
-    enc = rec_program(r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER | cbit)); /* the ALU encode, dither on */
+    enc = rec_program(r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER | ENC4 | cbit)); /* the ALU encode, dither on */
     /* the passes run programs built for their configuration: occluders, so the faces read O, no density
        texture; extinction ramps reaching 7 / density: the exp() composite (FAST_EXP), no colour
        texture, no show_overflow; the viewport starts at (A_X0, A_Y0): reads with the offset (no ORIGIN) */
-    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER | cbit));
+    face = rec_program(r, KIND(FOGVOL_PROGRAM_FACE, FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER | ENC4 | cbit));
     comp = rec_program(r, KIND(FOGVOL_PROGRAM_COMPOSITE, FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
                                                              FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                                                              FOGVOL_SPECIALIZE_NO_OVERFLOW | cbit));
@@ -1281,7 +1287,7 @@ static void test_a3_frame_protocol(void **state)
     assert_int_equal(cb.pass_count_at_call, 1); /* inside pass 0 ... */
     assert_int_equal(cb.in_pass_at_call, 1);
     /* (drawn as COUNT: FOGVOL_SPEEDUP_DEPTH_TEST, the box between the planes) */
-    assert_int_equal(cb.program_at_call, rec_program(&r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER |
+    assert_int_equal(cb.program_at_call, rec_program(&r, KIND(FOGVOL_PROGRAM_ENCODE, FOGVOL_SPECIALIZE_DITHER | ENC4 |
                                                                                        FOGVOL_SPECIALIZE_COUNT)));
     assert_int_equal(cb.transform_result, FOGVOL_SUCCESS);
     assert_int_equal(cb.nan_result, FOGVOL_ERROR_INVALID_ARGUMENT);

@@ -358,7 +358,14 @@ static void test_choice_and_support(void **state)
                      FOGVOL_ERROR_UNSUPPORTED);
     assert_int_equal(n, 0);
     assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_MRT, 0, FOGVOL_GLSL_120), FOGVOL_ERROR_UNSUPPORTED);
+    /* PS13 encodes by integer arithmetic only where the dialect guarantees highp integers */
     assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS13, FOGVOL_VARIANT_ALU, FOGVOL_GLSL_330),
+                     FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS13, FOGVOL_VARIANT_ALU, FOGVOL_GLSL_300ES),
+                     FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS13, FOGVOL_VARIANT_ALU, FOGVOL_GLSL_100),
+                     FOGVOL_ERROR_UNSUPPORTED);
+    assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS13, FOGVOL_VARIANT_ALU, FOGVOL_GLSL_150),
                      FOGVOL_ERROR_UNSUPPORTED);
     assert_int_equal(fogvol_combination_supported(FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET |
                                                   FOGVOL_VARIANT_COUNT, FOGVOL_GLSL_330), FOGVOL_ERROR_UNSUPPORTED);
