@@ -5216,8 +5216,9 @@ static const char fogvol__fs_encode_common[] =
     "    highp int T = int(u * (FV_N * FV_N * FV_N * FV_DD));\n" /* powers of two: exact either way */
     "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
     "    highp int q = ((x + fv_dither_offset_i()) >> ld) - 1;\n"
-    "    highp int a = q < 0 ? 1 : 0;\n"
-    "    return vec4(ivec4((h >> ln) & (n - 1), h & (n - 1), q + a * n, a)) * (1.0 / 255.0);\n"
+    /* h < N^2 (u < 1); q in [-1, N - 1]: q & (N - 1) is q + N for the borrow (q = -1), whose flag
+       is the sign bit (two's complement, >> extends the sign) */
+    "    return vec4(ivec4(h >> ln, h & (n - 1), q & (n - 1), (q >> 31) & 1)) * (1.0 / 255.0);\n"
     "#else\n"
     "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
