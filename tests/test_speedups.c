@@ -11,7 +11,9 @@
    A viewport away from the window origin gives the same pixels, shifted, as one at the origin (the
    composite reads fogvol's targets with the offset there, without it at the origin).
    PS20 + WIDE with FOGVOL_VARIANT_ALU gives the lookup textures' sums bit for bit (the integer
-   dither row of the wide encode).
+   dither row of the wide encode). The encode with the encoding's constants compiled in
+   (FOGVOL_SPECIALIZE_ENCODING; PS13 too, on the ALU encode in GLSL 330) gives the bytes of the
+   uniform-driven encode and of the lookup textures for every L.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -50,6 +52,8 @@ typedef struct run_out {
     float th[NFRAMES][W * H]; /* fogvol_frame_desc.debug_thickness: the sums read back and decoded */
     int passes[NFRAMES];
     int depth_tested[NFRAMES]; /* fogvol_frame_stats.depth_tested */
+    unsigned variants;         /* fogvol_context_tier: the variants the context ran */
+    int enc_programs;          /* programs built with the encoding compiled in (FOGVOL_SPECIALIZE_ENCODING) */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -66,6 +70,15 @@ static fogvol_result refuse_linear(void *u, const fogvol_target_desc *d, fogvol_
     if (d->linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
     return g_inner.create_target(u, d, out);
 }
+/* counts the programs whose fragment shader has this context's encoding compiled in */
+static int g_enc_programs;
+static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
+{
+    int i;
+    for (i = 0; i < d->fs_count; ++i)
+        g_enc_programs += strncmp(d->fs[i], "#define FV_ENC_LN ", 18) == 0 && atoi(d->fs[i] + 18) == (g_bits ? g_bits : 4);
+    return g_inner.create_program(u, d, out);
+}
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
 {
     fogvol_context_desc cd;
@@ -80,16 +93,17 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = logger;
-    if (g_no_linear) {
-        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
-        cd.backend = g_inner;
-        cd.backend.create_target = refuse_linear;
-    }
+    assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
+    cd.backend = g_inner;
+    if (g_no_linear) cd.backend.create_target = refuse_linear;
+    cd.backend.create_program = watch_program;
+    g_enc_programs = 0;
     cd.tier = t;
     cd.disable_speedups = off;
     cd.variants = g_variants;
     cd.encoding_bits = g_bits;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    fogvol_context_tier(fv, &out->variants);
     upload_meshes(fv, s, meshes);
     memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.9f;
@@ -134,7 +148,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
-    if (g_no_linear) g_inner.destroy(g_inner.user_data);
+    g_inner.destroy(g_inner.user_data);
+    out->enc_programs = g_enc_programs;
 }
 
 static int max_diff(const unsigned char *a, const unsigned char *b, int *count)
@@ -340,6 +355,11 @@ static void test_encoding_constants(void **state)
                 assert_int_equal(max_diff(spec.px[f], tex.px[f], &n), 0);
                 assert_int_equal(spec.depth_tested[f], with_occluders(f));
             }
+            /* the three ran what they stand for: the ALU encode with L compiled into its ENCODE and
+               FACE programs (min compare and COUNT), the ALU encode on uniforms, the lookup textures */
+            assert_true((spec.variants & FOGVOL_VARIANT_ALU) && spec.enc_programs >= 3);
+            assert_true((uni.variants & FOGVOL_VARIANT_ALU) && uni.enc_programs == 0);
+            assert_true(!(tex.variants & FOGVOL_VARIANT_ALU) && tex.enc_programs == 0);
             for (n = 0; n < W * H; ++n) covered += spec.th[0][n] > 0.0f;
             print_message("# %-5s L = %d: encoding compiled in = uniforms = lookup textures, bit for bit; "
                           "%d pixels with thickness\n", g_tier_names[ti], L, covered);
