@@ -372,8 +372,9 @@ FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned varian
 typedef struct fogvol_tier_info {
     int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
     int library_passes; /* passes fogvol issues per frame for one colour-ramp group
-                           (+1 per negative group pass in the RGBA8 tiers) */
-    int targets;        /* render targets fogvol allocates */
+                           (+1 per negative group pass in the RGBA8 tiers; PS13: 1 fewer with
+                           FOGVOL_SPEEDUP_INLINE_RESOLVE, fogvol_frame_stats.inline_resolved) */
+    int targets;        /* render targets fogvol allocates (PS13: T not with INLINE_RESOLVE) */
     const char *name;
 } fogvol_tier_info;
 FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned variants, fogvol_tier_info *out);
@@ -486,7 +487,12 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  both ways tried measured slower on llvmpipe than the O read per face fragment
                  they save (cut by floor+pillars: an RG32F sum and count with O read by the
                  composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
-                 against 16.1 ms). */
+                 against 16.1 ms).
+   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
+                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
+                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
+                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
+                 its resolve pass, which is exact in mediump. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -496,7 +502,8 @@ enum {
     FOGVOL_SPEEDUP_ALU = 1u << 5,
     FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
     FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
-    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8
+    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
+    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -683,6 +690,8 @@ typedef struct fogvol_frame_stats {
     int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
     int depth_tested;        /* 1: the faces were depth-tested against the occluders and counted (the
                                 COUNT variant, or FOGVOL_SPEEDUP_DEPTH_TEST took this frame) */
+    int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
+                                pass per group fewer than fogvol_tier_costs counts */
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -1464,7 +1473,11 @@ typedef struct fogvol_shader_desc {
    FACE: FOGVOL_SPECIALIZE_ENCODING(L), L = 1..8 (fogvol_encoding.bits): the RGBA8 encode with that
    encoding's N = 2^L and D (dither_steps) compiled in instead of read from fv_enc.xy and fv_dith.yz,
    so its arithmetic on them folds at compile time (the same bytes for that encoding; no effect on
-   FLOAT). Other bits, EXP with RAMP, L > 8, or bits for another program: FOGVOL_ERROR_UNSUPPORTED. */
+   FLOAT). COMPOSITE, COMPOSITE_MESH and CHECK of PS13: INLINE_RESOLVE (fv_back and fv_front are B
+   and F, and with COUNT fv_opaque is O, resolved in the program as RESOLVE does, instead of fv_back
+   being the resolved T; needs fp32 fragment arithmetic, see FOGVOL_SPEEDUP_INLINE_RESOLVE; other
+   tiers: FOGVOL_ERROR_UNSUPPORTED). Other bits, EXP with RAMP, L > 8, or bits for another program:
+   FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1479,7 +1492,8 @@ enum {
     FOGVOL_SPECIALIZE_COUNT = 1u << 10,
     FOGVOL_SPECIALIZE_DOWNSAMPLE = 1u << 11,
     FOGVOL_SPECIALIZE_FILTERED = 1u << 12,
-    FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13 /* FOGVOL_SPECIALIZE_ENCODING(bits) */
+    FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13, /* FOGVOL_SPECIALIZE_ENCODING(bits) */
+    FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -5358,17 +5372,17 @@ static const char fogvol__fs_face[] =
     "}\n"
     "#endif\n";
 
-/* PS13 resolve: B - F per channel with carries into normalised digits (exact
-   small-integer arithmetic, fine in mediump), alpha marks covered pixels. */
-static const char fogvol__fs_resolve[] =
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "void main() {\n"
-    "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
+/* PS13: B - F per channel with carries into digits (exact small-integer arithmetic, fine in
+   mediump), + the opaque depth's digits once per missing back face with COUNT (o: FV_RESOLVE_O, O
+   there, unused otherwise); the digits past the top one are below N after the carries, the top one
+   is negative where B - F is. fv_resolve_sat: some channel of B or F at 255 (saturated). Read by
+   the RESOLVE program and, with FV_INLINE_RESOLVE (FOGVOL_SPEEDUP_INLINE_RESOLVE), the composite. */
+static const char fogvol__fs_resolve_fn[] =
+    "#ifdef FV_COUNT\n#define FV_RESOLVE_O(s) FV_SCREEN(s)\n#else\n#define FV_RESOLVE_O(s) vec4(0.0)\n#endif\n"
+    "vec3 fv_resolve(vec4 b, vec4 f, vec4 o) {\n"
     "    vec3 d = floor((b.rgb - f.rgb) * 255.0 + 0.5);\n"
-    "#ifdef FV_COUNT\n"                           /* + the opaque depth once per missing back face */
-    "    d += floor((f.a - b.a) * 255.0 + 0.5) * floor(FV_SCREEN(fv_opaque).rgb * 255.0 + 0.5);\n"
+    "#ifdef FV_COUNT\n"
+    "    d += floor((f.a - b.a) * 255.0 + 0.5) * floor(o.rgb * 255.0 + 0.5);\n"
     "#endif\n"
     "    float n = fv_enc.x, c = floor(d.b / n);\n"
     "    d.b -= c * n;\n"
@@ -5376,9 +5390,22 @@ static const char fogvol__fs_resolve[] =
     "    c = floor(d.g / n);\n"
     "    d.g -= c * n;\n"
     "    d.r += c;\n"
-    "    float sat = max(max(b.r, b.g), max(b.b, max(f.r, max(f.g, f.b)))) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
+    "    return d;\n"
+    "}\n"
+    "float fv_resolve_sat(vec4 b, vec4 f) {\n"
+    "    return max(max(b.r, b.g), max(b.b, max(f.r, max(f.g, f.b)))) > 254.5 / 255.0 ? 1.0 : 0.0;\n"
+    "}\n";
+
+/* PS13 resolve into T: the digits (0 where B - F < 0), alpha marks covered pixels (2: saturated). */
+static const char fogvol__fs_resolve[] =
+    "uniform FV_TARGET_SAMPLER fv_back;\n"
+    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "void main() {\n"
+    "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
+    "    vec3 d = fv_resolve(b, f, FV_RESOLVE_O(fv_opaque));\n"
     "    float covered = b + f == vec4(0.0) ? 0.0 : 1.0;\n"
-    "    FV_FRAGCOLOR = vec4(d.r < 0.0 ? vec3(0.0) : d / 255.0, covered * (1.0 + sat) / 255.0);\n"
+    "    FV_FRAGCOLOR = vec4(d.r < 0.0 ? vec3(0.0) : d / 255.0, covered * (1.0 + fv_resolve_sat(b, f)) / 255.0);\n"
     "}\n";
 
 /* Composite: thickness -> colour ramp. PS20/MRT: decode(B - F);
@@ -5446,6 +5473,12 @@ static const char fogvol__fs_composite[] =
     "#if defined(FV_FLOAT)\n"
     "    if (b.r == 0.0) discard;\n"
     "    t = b.r * fv_dec.x;\n"
+    "#elif defined(FV_PS13) && defined(FV_INLINE_RESOLVE)\n"  /* T's digits (clamped to 255) */
+    "    vec4 f = FV_SCREEN(fv_front);\n"
+    "    if (b + f == vec4(0.0)) discard;\n"
+    "    vec3 d = fv_resolve(b, f, FV_RESOLVE_O(fv_opaque));\n"
+    "    t = d.r < 0.0 ? 0.0 : dot(min(d, 255.0) / 255.0, fv_dec.xyz);\n"
+    "    sat = fv_resolve_sat(b, f);\n"
     "#elif defined(FV_PS13)\n"
     "    if (b.a == 0.0) discard;\n"
     "    t = dot(b.rgb, fv_dec.xyz);\n"
@@ -5727,6 +5760,8 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
     if (d->program == FOGVOL_PROGRAM_CHECK) strings[n++] = "#define FV_CHECK\n";
     strings[n++] = fogvol__fs_common;
     strings[n++] = fogvol__fs_encode_common;
+    if (d->program == FOGVOL_PROGRAM_RESOLVE || (d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE))
+        strings[n++] = fogvol__fs_resolve_fn;
     switch (d->program) {
     case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
     case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
@@ -5757,6 +5792,8 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_ENCODING_MASK) > FOGVOL_SPECIALIZE_ENCODING(8)) return 0;
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE)
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
+    if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK)
+        bits &= ~(unsigned)FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* PS13 only (fogvol_shader_strings) */
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
@@ -5793,6 +5830,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_DITHER) strings[n++] = "#define FV_DITHER_ON\n";
     if (d->specialize & FOGVOL_SPECIALIZE_DOWNSAMPLE) strings[n++] = "#define FV_DOWNSAMPLE\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FILTERED) strings[n++] = "#define FV_FILTERED\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) strings[n++] = "#define FV_INLINE_RESOLVE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -5831,6 +5869,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     v = d->variants;
     if ((d->specialize & FOGVOL_SPECIALIZE_DOWNSAMPLE) &&
         (d->tier != FOGVOL_TIER_FLOAT || (v & FOGVOL_VARIANT_COLORS) || d->samples > 1))
+        return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__count_spec_ok(d->tier, v) ||
@@ -6231,6 +6271,7 @@ struct fogvol_context {
     int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
     int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
+    int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
 };
 
 /* column-major 4x4 helpers in double */
@@ -6380,7 +6421,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         td.share_depth = 0;
         td.color_count = 1;
         td.label = "fogvol T (resolved thickness)";
-        if (r == FOGVOL_SUCCESS && ctx->tier == FOGVOL_TIER_PS13)
+        if (r == FOGVOL_SUCCESS && ctx->tier == FOGVOL_TIER_PS13 && !ctx->inline_resolve)
             r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_t);
         if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
             ctx->tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_o, 1);
@@ -6483,6 +6524,12 @@ enum {
     FOGVOL__UNIT_CTEX = 6     /* fv_ctex: the group's colour texture */
 };
 
+/* fogvol_tier_uses_program for this context: no RESOLVE with FOGVOL_SPEEDUP_INLINE_RESOLVE */
+static int fogvol__uses_program(const fogvol_context *ctx, fogvol_program p)
+{
+    return fogvol_tier_uses_program(ctx->tier, ctx->variants, p) && !(p == FOGVOL_PROGRAM_RESOLVE && ctx->inline_resolve);
+}
+
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, unsigned specialize,
                                           fogvol_handle *out)
 {
@@ -6505,6 +6552,9 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     sd.dialect = ctx->be.dialect;
     sd.samples = ctx->compile_samples;
     sd.specialize = specialize;
+    if (ctx->inline_resolve && (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
+                                p == FOGVOL_PROGRAM_CHECK))
+        sd.specialize |= FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* the general programs too: there is no T */
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
@@ -6670,10 +6720,17 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     /* COMPOSITE_MESH: for engines only (the geometry composite is scissored); CHECK: made when a
        frame first runs a check pass; LIGHT: when a frame first draws a light */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i) &&
-            i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)
+        if (fogvol__uses_program(ctx, (fogvol_program)i) && i != FOGVOL_PROGRAM_COMPOSITE_MESH &&
+            i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)
             r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
     return r;
+}
+
+/* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13 resolves B - F in its composite where fragment shaders have fp32. */
+static void fogvol__default_inline_resolve(fogvol_context *ctx)
+{
+    ctx->inline_resolve = ctx->tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
+                          !(ctx->speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
@@ -6717,7 +6774,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return r;
     }
     r = fogvol__choose_tier(ctx, desc);
-    if (r == FOGVOL_SUCCESS) fogvol__default_alu(ctx);
+    if (r == FOGVOL_SUCCESS) {
+        fogvol__default_alu(ctx);
+        fogvol__default_inline_resolve(ctx);
+    }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
@@ -7783,7 +7843,7 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
     ctx->prog_ms = ms;
     ctx->compile_samples = ms ? 2 : 0;
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (!ctx->prog[i] && fogvol_tier_uses_program(ctx->tier, ctx->variants, (fogvol_program)i))
+        if (!ctx->prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
             r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
     ctx->compile_samples = 0;
     return r;
@@ -8688,7 +8748,8 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
 
 /* *ps: target-space state reading the sums (composite texture units), scissored to the group's
    window rectangle when the composite is (the passes after the sums read nothing outside it); PS13
-   first resolves B - F into T, which the later passes read instead. */
+   first resolves B - F into T, which the later passes read instead (not with
+   FOGVOL_SPEEDUP_INLINE_RESOLVE: they resolve it themselves). */
 static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
     const fogvol_frame_desc *fd = &ctx->frame;
@@ -8710,7 +8771,7 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_COUNTS] = run->count ? ctx->tgt_o : 0;
     ps->textures[FOGVOL__UNIT_BACK2] = ctx->tgt_b2;
     ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
-    if (ctx->tier != FOGVOL_TIER_PS13) return;
+    if (ctx->tier != FOGVOL_TIER_PS13 || ctx->inline_resolve) return;
     ps->target = ctx->tgt_t;
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx) | ctx->count_bit);
     ctx->be.begin_pass(ctx->be.user_data, ps);
@@ -8957,6 +9018,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     ctx->count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
     run.count = ctx->count_frame = fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || ctx->count_bit;
     run.st.depth_tested = run.count;
+    run.st.inline_resolved = ctx->inline_resolve;
     run.rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {

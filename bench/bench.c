@@ -53,7 +53,7 @@
 #define SPEEDUPS_ALL                                                                                              \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
-     FOGVOL_SPEEDUP_DEPTH_TEST)
+     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE)
 #define MAXI 32 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96
@@ -1491,10 +1491,11 @@ static void print_results(const result *rs, int n)
 
 /* name of pass p of method m in a scene with or without occluders that ran np passes: the
    default tiers skip O in scenes without occluders; RGBA8 tiers run an overflow check pass
-   before the composite while they count overflow */
+   before the composite while they count overflow; PS13 resolves B - F in its composite
+   (FOGVOL_SPEEDUP_INLINE_RESOLVE: every GL here has fp32 fragment shaders) */
 static const char *pass_name(int m, int p, int np, int occluders)
 {
-    static const char *const pn[NTIER + 1][6] = {{"O", "B", "F", "resolve", "check", "composite"},
+    static const char *const pn[NTIER + 1][6] = {{"O", "B", "F", "check", "composite", ""},
                                                  {"O", "B", "F", "check", "composite", ""},
                                                  {"B", "F", "check", "composite", "", ""},
                                                  {"O", "B-F", "composite", "", "", ""},

@@ -6,7 +6,8 @@
    <tier>_v<variants>_<program>_<dialect>_ms.frag. The programs built for one configuration
    (fogvol_shader_desc.specialize) get _s<bits> before the extension; a program must refuse the
    bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
-   L = 1..8 and refused above. */
+   L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
+   and CHECK only. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -35,6 +36,10 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if (bits & FOGVOL_SPECIALIZE_INLINE_RESOLVE)
+        return t == FOGVOL_TIER_PS13 &&
+               (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK) &&
+               variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_INLINE_RESOLVE, ms);
     if ((bits & FOGVOL_SPECIALIZE_FILTERED) && !(bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
     if (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) /* FLOAT's composite (not COLORS), single-sample; FILTERED with it */
         return t == FOGVOL_TIER_FLOAT && !(v & FOGVOL_VARIANT_COLORS) && !ms && p == FOGVOL_PROGRAM_COMPOSITE &&
@@ -99,6 +104,12 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_ENCODING(7) | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_ENCODING(8) | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN |
                                          FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER,
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE,
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN |
+                                         FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_RAMP,
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

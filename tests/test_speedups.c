@@ -13,7 +13,8 @@
    PS20 + WIDE with FOGVOL_VARIANT_ALU gives the lookup textures' sums bit for bit (the integer
    dither row of the wide encode). The encode with the encoding's constants compiled in
    (FOGVOL_SPECIALIZE_ENCODING; PS13 too, on the ALU encode in GLSL 330) gives the bytes of the
-   uniform-driven encode and of the lookup textures for every L.
+   uniform-driven encode and of the lookup textures for every L. PS13 resolving B - F in its
+   composite (INLINE_RESOLVE) gives the resolve pass's bytes, sums and overflow counts.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -52,6 +53,8 @@ typedef struct run_out {
     float th[NFRAMES][W * H]; /* fogvol_frame_desc.debug_thickness: the sums read back and decoded */
     int passes[NFRAMES];
     int depth_tested[NFRAMES]; /* fogvol_frame_stats.depth_tested */
+    int inline_resolved[NFRAMES]; /* fogvol_frame_stats.inline_resolved */
+    int late[NFRAMES];         /* fogvol_frame_stats.overflow_pixels_late */
     unsigned variants;         /* fogvol_context_tier: the variants the context ran */
     int enc_programs;          /* programs built with the encoding compiled in (FOGVOL_SPECIALIZE_ENCODING) */
 } run_out;
@@ -64,6 +67,8 @@ static int g_downsample;    /* fogvol_frame_desc.downsample */
 static int g_w = W, g_h = H; /* the viewport's size (out's pixels: rows of g_w) */
 static int g_no_linear;     /* 1: the GL backend's create_target refuses linear targets (filtering in the shader) */
 static int g_bits;          /* fogvol_context_desc.encoding_bits */
+static int g_no_highp;      /* 1: the backend reports no FOGVOL_CAP_HIGHP_FRAGMENT (a mediump GPU) */
+static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 static fogvol_result refuse_linear(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
@@ -97,6 +102,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.backend = g_inner;
     if (g_no_linear) cd.backend.create_target = refuse_linear;
     cd.backend.create_program = watch_program;
+    if (g_no_highp) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_HIGHP_FRAGMENT;
     g_enc_programs = 0;
     cd.tier = t;
     cd.disable_speedups = off;
@@ -123,6 +129,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         fd.viewport[3] = g_h;
         fd.debug_thickness = out->th[f];
         fd.downsample = g_downsample;
+        fd.show_overflow = g_show_overflow;
         glClearColor(0.2f, 0.5f, 0.8f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, clear); /* 0.5 -> 127 or 128: the GL's rounding */
@@ -144,6 +151,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
             }
         out->passes[f] = st.passes;
         out->depth_tested[f] = st.depth_tested;
+        out->inline_resolved[f] = st.inline_resolved;
+        out->late[f] = st.overflow_pixels_late;
     }
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_ramp(fv, ramp);
@@ -210,7 +219,7 @@ static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
-     FOGVOL_SPEEDUP_DEPTH_TEST)
+     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE)
 
 static void test_same_pixels_and_exp(void **state)
 {
@@ -245,8 +254,11 @@ static void test_same_pixels_and_exp(void **state)
                 if (m > fast_max) fast_max = m;
                 fast_n += n;
                 /* one O pass drawn with speed-ups off in every frame; on: only in the first frame
-                   and where occluders come (or leave: O must become the far plane again) */
-                assert_int_equal(def.passes[f], off.passes[f] - (f == 1 ? 1 : 0));
+                   and where occluders come (or leave: O must become the far plane again); PS13:
+                   no resolve pass (INLINE_RESOLVE, this context has fp32 fragment shaders) */
+                assert_int_equal(def.inline_resolved[f], g_tiers[ti] == FOGVOL_TIER_PS13);
+                assert_int_equal(off.inline_resolved[f], 0);
+                assert_int_equal(def.passes[f], off.passes[f] - (f == 1 ? 1 : 0) - def.inline_resolved[f]);
                 /* DEPTH_TEST: PS20 and PS13 frames with occluders (both scenes lie between the planes)
                    are drawn as COUNT, faces depth-tested; the bytes above are the same */
                 assert_int_equal(def.depth_tested[f], g_tiers[ti] != FOGVOL_TIER_FLOAT && with_occluders(f));
@@ -366,6 +378,65 @@ static void test_encoding_constants(void **state)
             assert_true(covered > W * H / 8);
         }
     g_bits = 0;
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13's composite and overflow check resolve B - F themselves
+   (this context has fp32 fragment shaders): the bytes, sums and GPU overflow counts of the resolve
+   pass into T, with one pass fewer per frame, with and without occluders (COUNT frames add O's
+   digits), and at L = 8, where the sums saturate, with and without
+   show_overflow's magenta. A backend without
+   FOGVOL_CAP_HIGHP_FRAGMENT keeps the resolve pass (exact in mediump). */
+static int magenta(const unsigned char *px)
+{
+    int i, n = 0;
+    for (i = 0; i < W * H; ++i) n += px[4 * i] == 255 && px[4 * i + 1] == 0 && px[4 * i + 2] == 255;
+    return n;
+}
+static void test_inline_resolve(void **state)
+{
+    static run_out in, res, mediump;
+    const char *names[2] = {"layers_opaque_between", "plane_cuts_sphere"};
+    glu_ctx g;
+    int si, k, f, n;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (si = 0; si < 2; ++si)
+        for (k = 0; k < 3; ++k) { /* k = 1: L = 8, k = 2: L = 8 with show_overflow */
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            int covered = 0, shown = 0, late = 0;
+            g_bits = k ? 8 : 0;
+            g_show_overflow = k == 2;
+            run_frames(s, FOGVOL_TIER_PS13, 0, &g, &in);
+            run_frames(s, FOGVOL_TIER_PS13, FOGVOL_SPEEDUP_INLINE_RESOLVE, &g, &res);
+            g_no_highp = 1;
+            run_frames(s, FOGVOL_TIER_PS13, 0, &g, &mediump);
+            g_no_highp = 0;
+            for (f = 0; f < NFRAMES; ++f) {
+                assert_int_equal(max_diff(in.px[f], res.px[f], &n), 0);
+                assert_memory_equal(in.th[f], res.th[f], sizeof res.th[f]);
+                assert_int_equal(in.late[f], res.late[f]);
+                assert_int_equal(max_diff(mediump.px[f], res.px[f], &n), 0);
+                assert_int_equal(in.inline_resolved[f], 1);
+                assert_int_equal(res.inline_resolved[f], 0);
+                assert_int_equal(mediump.inline_resolved[f], 0);
+                assert_int_equal(in.passes[f], res.passes[f] - 1);
+                assert_int_equal(mediump.passes[f], res.passes[f]);
+                assert_int_equal(in.depth_tested[f], with_occluders(f));
+                shown += magenta(in.px[f]);
+                if (in.late[f] > late) late = in.late[f];
+            }
+            for (n = 0; n < W * H; ++n) covered += in.th[2][n] > 0.0f;
+            print_message("# PS13 %-22s L = %d%s: resolved in the composite = resolve pass, bit for bit, one pass "
+                          "fewer; %d pixels with thickness, %d magenta pixel-frames, overflow_pixels_late up to %d\n",
+                          names[si], k ? 8 : 4, k == 2 ? " show_overflow" : "", covered, shown, late);
+            assert_true(covered > W * H / 8);
+            if (k) assert_true(late > 0); /* the GPU counts the saturated sums */
+            if (k == 2) assert_true(shown > 100); /* and they show */
+            else assert_int_equal(shown, 0);
+        }
+    g_bits = 0;
+    g_show_overflow = 0;
     glu_destroy(&g);
 }
 
@@ -513,6 +584,7 @@ int main(void)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
+                                       cmocka_unit_test(test_inline_resolve),
                                        cmocka_unit_test(test_half_resolution)};
     int r;
     build_scenes();
