@@ -904,8 +904,9 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
 /* MRT tier: GLSL for the engine's opaque fragment shader. It declares
    uniform vec4 fogvol_mrt[2] (values from fogvol_mrt_prepare) and
    vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
-   writes to its second colour output. Insert after the #version line and the
-   engine's precision statements. */
+   writes to its second colour output (fogvol_encode_depth's bytes; computed in
+   integers where the engine's GLSL has bit operations and floatBitsToInt: 330+,
+   300 es). Insert after the #version line and the engine's precision statements. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 
 /* Occluders drawn by the engine with its own programs, pipelines and vertex
@@ -2016,7 +2017,7 @@ FOGVOL_API fogvol_result fogvol_encode_depth(const fogvol_encoding *enc, double 
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     n = enc->levels;
     n3 = n * n * n;
-    dmax = 1.0 - 1.5 / n3;
+    dmax = (double)(float)(1.0 - 1.5 / n3); /* the GPU's clamp, fogvol_compute_constants' float (L = 8: 1 - 2^-23) */
     u = d < 0 ? 0 : (d > dmax ? dmax : d);
     u += 1.0 / n3;
     t1 = u * n3;                 /* blue units, exact scaling by a power of two */
@@ -5919,9 +5920,24 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 }
 
 /* MRT tier: the engine's copy of the ALU encode, dither pattern by arithmetic
-   (the same 8x8 ordered pattern as fogvol_make_dither_index). */
+   (the same 8x8 ordered pattern as fogvol_make_dither_index); in integers where the dialect has
+   floatBitsToInt and bit operations (GLSL 330+, 300 es), as FV_IALU: the same bytes. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "#if __VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300)\n" \
+    "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
+    "    highp int ln = (floatBitsToInt(fogvol_mrt[0].z) >> 23) - 127, n = 1 << ln;\n" \
+    "    highp int ld = (floatBitsToInt(fogvol_mrt[1].z) >> 23) - 127, dd = 1 << ld;\n" \
+    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n" \
+    "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n" /* bits of the 8x8 index, as FV_IALU */ \
+    "    highp int k = fogvol_mrt[1].w > 0.5 ? (((s.x << 1) | s.y) * dd) >> 8 : dd >> 1;\n" \
+    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
+    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
+    "    highp int t = int(u * (fogvol_mrt[0].w * fogvol_mrt[0].z * fogvol_mrt[1].z));\n" \
+    "    highp int h = t >> (ln + ld), q = (((t & ((n << ld) - 1)) + k) >> ld) - 1;\n" \
+    "    return vec4(ivec4(h >> ln, h & (n - 1), q & (n - 1), (q >> 31) & 1)) * (1.0 / 255.0);\n" \
+    "}\n" \
+    "#else\n" \
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
     "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n" \
     "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n" \
@@ -5937,7 +5953,8 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "    float q = floor((x + k) / dd) - 1.0;\n" \
     "    float a = q < 0.0 ? 1.0 : 0.0;\n" \
     "    return vec4(mod(floor(h / n), n), mod(h, n), q + a * n, a) * (1.0 / 255.0);\n" \
-    "}\n"
+    "}\n" \
+    "#endif\n"
 static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
 /* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks the FLOAT tier's R32F target */
 static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT

@@ -14,7 +14,8 @@
    dither row of the wide encode). The encode with the encoding's constants compiled in
    (FOGVOL_SPECIALIZE_ENCODING; PS13 too, on the ALU encode in GLSL 330) gives the bytes of the
    uniform-driven encode and of the lookup textures for every L. PS13 resolving B - F in its
-   composite (INLINE_RESOLVE) gives the resolve pass's bytes, sums and overflow counts.
+   composite (INLINE_RESOLVE) gives the resolve pass's bytes, sums and overflow counts. The MRT
+   snippet's encode, in integers (GLSL 330) and in floats, gives fogvol_encode_depth's bytes.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -35,6 +36,7 @@
 #include <sys/stat.h>
 
 #include "tests/scenes.h"
+#include "tests/fixtures.h"
 
 #define NFRAMES 4
 /* frame f draws the occluders: frames 0, 1 and 3 without, frame 2 with */
@@ -440,6 +442,77 @@ static void test_inline_resolve(void **state)
     glu_destroy(&g);
 }
 
+/* The MRT snippet's encode, fogvol_encode_view_depth, in integers (GLSL 330) and in floats (the
+   same snippet under #version 150), against the CPU reference fogvol_encode_depth: for L = 1..8,
+   dither on and off, 16384 depths from -0.125 to 1.125 (exact in fp32: one per pixel, so each of
+   the 64 dither cells sees 256 of them), byte for byte. The dither row of a pixel is the red of
+   fogvol_make_dither_index's 8x8 texel there, 0 without dither. */
+static void test_mrt_snippet_encode(void **state)
+{
+    static const char *vs[1] = {"#version 150\nvoid main() {\n"
+                                "    gl_Position = vec4(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0, 0.0, 1.0);\n}\n"};
+    static const char *main_fs = "out vec4 o;\nvoid main() {\n"
+                                 "    float i = (gl_FragCoord.x - 0.5) + (gl_FragCoord.y - 0.5) * 128.0;\n"
+                                 "    o = fogvol_encode_view_depth(i * (1.25 / 16384.0) - 0.125);\n}\n";
+    const char *versions[2] = {"#version 330 core\n", "#version 150\n"};
+    unsigned char index[8 * 8 * 4];
+    glu_ctx g;
+    GLuint vao, prog[2];
+    int k, L, dither, i, checked = 0;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (k = 0; k < 2; ++k) {
+        const char *fs[3];
+        fs[0] = versions[k];
+        fs[1] = fogvol_mrt_snippet();
+        fs[2] = main_fs;
+        prog[k] = fx_program(vs, 1, fs, 3);
+    }
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    for (L = 1; L <= 8; ++L)
+        for (dither = 0; dither < 2; ++dither)
+            for (k = 0; k < 2; ++k) {
+                fogvol_encoding enc;
+                fogvol_constants c;
+                fogvol_image img;
+                float u[8];
+                unsigned char *px;
+                assert_int_equal(fogvol_encoding_init(L, &enc), FOGVOL_SUCCESS);
+                assert_int_equal(fogvol_make_dither_index(&enc, index, sizeof index, &img), FOGVOL_SUCCESS);
+                fogvol_compute_constants(&enc, 0.0f, 1.0f, 0.0f, &c);
+                u[0] = 1.0f; /* d = view depth: near 0, far 1 */
+                u[1] = 0.0f;
+                u[2] = (float)enc.levels;
+                u[3] = (float)enc.levels * (float)enc.levels;
+                u[4] = c.depth_offset;
+                u[5] = c.depth_max;
+                u[6] = (float)enc.dither_steps;
+                u[7] = (float)dither;
+                glUseProgram(prog[k]);
+                glUniform4fv(glGetUniformLocation(prog[k], "fogvol_mrt"), 2, u);
+                glDrawArrays(GL_TRIANGLES, 0, 3);
+                px = glu_pixels(&g);
+                for (i = 0; i < W * H; ++i) {
+                    int x = i % W, y = i / W, row = 0;
+                    unsigned char want[4];
+                    if (dither) row = index[4 * ((y % 8) * 8 + x % 8)];
+                    assert_int_equal(fogvol_encode_depth(&enc, i * (1.25 / 16384.0) - 0.125, row, want), FOGVOL_SUCCESS);
+                    if (memcmp(px + 4 * i, want, 4) != 0)
+                        fail_msg("%s, L = %d, dither %d, pixel (%d, %d): %d %d %d %d, want %d %d %d %d", versions[k], L,
+                                 dither, x, y, px[4 * i], px[4 * i + 1], px[4 * i + 2], px[4 * i + 3], want[0], want[1],
+                                 want[2], want[3]);
+                    ++checked;
+                }
+            }
+    print_message("# MRT snippet: integer (GLSL 330) and float (GLSL 150) encodes = fogvol_encode_depth, %d values "
+                  "byte for byte (L = 1..8, dither on and off)\n", checked);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteProgram(prog[0]);
+    glDeleteProgram(prog[1]);
+    glu_destroy(&g);
+}
+
 /* The composite against the thickness the frame read back (debug_thickness): each of the n pixels,
    mix(background, fog colour, 1 - exp(-density t)) in bytes; returns the largest error */
 static int check_composite(const tscene *s, const unsigned char *px, const float *th, int n)
@@ -585,6 +658,7 @@ int main(void)
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
                                        cmocka_unit_test(test_inline_resolve),
+                                       cmocka_unit_test(test_mrt_snippet_encode),
                                        cmocka_unit_test(test_half_resolution)};
     int r;
     build_scenes();
