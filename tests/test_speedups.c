@@ -59,6 +59,7 @@ typedef struct run_out {
     int late[NFRAMES];         /* fogvol_frame_stats.overflow_pixels_late */
     unsigned variants;         /* fogvol_context_tier: the variants the context ran */
     int enc_programs;          /* programs built with the encoding compiled in (FOGVOL_SPECIALIZE_ENCODING) */
+    int targets;               /* render targets the context created */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -72,9 +73,12 @@ static int g_bits;          /* fogvol_context_desc.encoding_bits */
 static int g_no_highp;      /* 1: the backend reports no FOGVOL_CAP_HIGHP_FRAGMENT (a mediump GPU) */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
-static fogvol_result refuse_linear(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+/* counts the targets the context creates; refuses linear ones with g_no_linear */
+static int g_targets;
+static fogvol_result watch_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
-    if (d->linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
+    if (d->linear && g_no_linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
+    g_targets++;
     return g_inner.create_target(u, d, out);
 }
 /* counts the programs whose fragment shader has this context's encoding compiled in */
@@ -102,7 +106,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.logger.func = logger;
     assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
     cd.backend = g_inner;
-    if (g_no_linear) cd.backend.create_target = refuse_linear;
+    cd.backend.create_target = watch_target;
+    g_targets = 0;
     cd.backend.create_program = watch_program;
     if (g_no_highp) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_HIGHP_FRAGMENT;
     g_enc_programs = 0;
@@ -161,6 +166,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     fogvol_destroy_context(fv);
     g_inner.destroy(g_inner.user_data);
     out->enc_programs = g_enc_programs;
+    out->targets = g_targets;
 }
 
 static int max_diff(const unsigned char *a, const unsigned char *b, int *count)
@@ -428,6 +434,8 @@ static void test_inline_resolve(void **state)
                 shown += magenta(in.px[f]);
                 if (in.late[f] > late) late = in.late[f];
             }
+            assert_int_equal(in.targets, res.targets - 1); /* no T */
+            assert_int_equal(mediump.targets, res.targets);
             for (n = 0; n < W * H; ++n) covered += in.th[2][n] > 0.0f;
             print_message("# PS13 %-22s L = %d%s: resolved in the composite = resolve pass, bit for bit, one pass "
                           "fewer; %d pixels with thickness, %d magenta pixel-frames, overflow_pixels_late up to %d\n",
