@@ -391,10 +391,9 @@ static void test_encoding_constants(void **state)
 
 /* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13's composite and overflow check resolve B - F themselves
    (this context has fp32 fragment shaders): the bytes, sums and GPU overflow counts of the resolve
-   pass into T, with one pass fewer per frame, with and without occluders (COUNT frames add O's
-   digits), and at L = 8, where the sums saturate, with and without
-   show_overflow's magenta. A backend without
-   FOGVOL_CAP_HIGHP_FRAGMENT keeps the resolve pass (exact in mediump). */
+   pass into T, with one pass and one target fewer, with and without occluders (COUNT frames add
+   O's digits), and at L = 8, where the sums saturate, with and without show_overflow's magenta. A
+   backend without FOGVOL_CAP_HIGHP_FRAGMENT keeps the resolve pass (exact in mediump). */
 static int magenta(const unsigned char *px)
 {
     int i, n = 0;
@@ -468,6 +467,7 @@ static void test_mrt_snippet_encode(void **state)
     GLuint vao, prog[2];
     int k, L, dither, i, checked = 0;
     (void)state;
+    assert_true(W == 128 && H == 128); /* the shader's pixel index and depth step */
     assert_true(glu_create(&g, W, H, 1));
     for (k = 0; k < 2; ++k) {
         const char *fs[3];
