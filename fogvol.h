@@ -5168,6 +5168,28 @@ static const char fogvol__fs_common[] =
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
     "}\n";
 
+/* The RGBA8 encode in integers, shared by fogvol's programs (FV_IALU) and the engine's MRT and
+   occluder snippets, where the dialect has floatBitsToInt and bit operations (GLSL 330+, 300 es): N
+   and D are powers of two, so every division is a shift, every mod a mask (the same bytes as the
+   float arithmetic, with about a third of its operations).
+   fogvol_dither_scaled(D): (v D) >> 6, v the 8x8 index of fogvol_make_dither_index (bits 5..0: x0
+   y0 x1 y1 x2 y2 of x = px ^ py, y = py); (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2, so the
+   two spread 3-bit values make 4 v.
+   fogvol_encode_int: the digits of t = floor(u N^3 D) (u < 1, N = 2^ln, D = 2^ld) with the dither
+   offset k added below the blue digit: h = t / (N D) < N^2 gives red and green; q in [-1, N - 1] is
+   the blue digit, q & (N - 1) is q + N for the borrow (q = -1), whose flag is the sign bit. */
+#define FOGVOL__IALU_TEXT \
+    "highp int fogvol_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n" \
+    "highp int fogvol_dither_scaled(highp int dd) {\n" \
+    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n" \
+    "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n" \
+    "    return (((s.x << 1) | s.y) * dd) >> 8;\n" \
+    "}\n" \
+    "vec4 fogvol_encode_int(highp int t, highp int ln, highp int ld, highp int k) {\n" \
+    "    highp int n = 1 << ln, h = t >> (ln + ld), q = (((t & ((n << ld) - 1)) + k) >> ld) - 1;\n" \
+    "    return vec4(ivec4(h >> ln, h & (n - 1), q & (n - 1), (q >> 31) & 1)) * (1.0 / 255.0);\n" \
+    "}\n"
+
 /* The RGBA8 tiers' encode (lookup textures or ALU, the dither) and the borrow fold: the second
    string of the shared fragment code (one string would pass the 4095 characters C99 guarantees). */
 static const char fogvol__fs_encode_common[] =
@@ -5181,31 +5203,21 @@ static const char fogvol__fs_encode_common[] =
     "uniform sampler2D fv_rg;\n"
     "uniform sampler2D fv_blue;\n"
     "#endif\n"
-    /* FV_IALU: the ALU encode in integers where the dialect has floatBitsToInt and bit operations
-       (GLSL 330+, 300 es): N and D are powers of two, so every division is a shift, every mod a mask
-       (the same bytes as the float arithmetic below, with about a third of its operations) */
+    /* FV_IALU: the ALU encode in integers (FOGVOL__IALU_TEXT) */
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
     "#define FV_IALU\n"
     "#ifdef FV_ENC_LN\n#define FV_DD_I (1 << FV_ENC_LD)\n#else\n#define FV_DD_I int(fv_dith.z)\n#endif\n"
-    "highp int fv_log2i(float p) { return (floatBitsToInt(p) >> 23) - 127; }\n"
-    /* fv_dither_scaled_i: (v D) >> 6, v the 8x8 index of fogvol_make_dither_index (bits 5..0: x0 y0
-       x1 y1 x2 y2 of x = px ^ py, y = py); (b * 73) & 0x54 puts bits 0, 1, 2 of b at 6, 4, 2, so the
-       two spread 3-bit values make 4 v */
-    "highp int fv_dither_scaled_i() {\n"
-    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n"
-    "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n"
-    "    return (((s.x << 1) | s.y) * FV_DD_I) >> 8;\n"
-    "}\n"
+    FOGVOL__IALU_TEXT
     "float fv_dither_row() {\n"
     "    highp int dd = FV_DD_I;\n"
-    "    return fv_dith.x > 0.5 ? float((fv_dither_scaled_i() + (dd >> 1)) & (dd - 1)) : 0.0;\n"
+    "    return fv_dith.x > 0.5 ? float((fogvol_dither_scaled(dd) + (dd >> 1)) & (dd - 1)) : 0.0;\n"
     "}\n"
     /* the encode's offset (row + D/2) mod D = (v D) >> 6 (the dither off: D/2) */
     "highp int fv_dither_offset_i() {\n"
     "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
-    "    return fv_dither_scaled_i();\n"
+    "    return fogvol_dither_scaled(FV_DD_I);\n"
     "#else\n"
-    "    return fv_dith.x > 0.5 ? fv_dither_scaled_i() : FV_DD_I >> 1;\n"
+    "    return fv_dith.x > 0.5 ? fogvol_dither_scaled(FV_DD_I) : FV_DD_I >> 1;\n"
     "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
@@ -5222,18 +5234,14 @@ static const char fogvol__fs_encode_common[] =
     "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
-    "#ifdef FV_IALU\n"                          /* T: the blue-ramp texel count floor(u N^3 D) */
+    "#ifdef FV_IALU\n"                          /* t: the blue-ramp texel count floor(u N^3 D) */
     "#ifdef FV_ENC_LN\n"
-    "    const highp int ln = FV_ENC_LN, ld = FV_ENC_LD, n = 1 << ln;\n"
+    "    const highp int ln = FV_ENC_LN, ld = FV_ENC_LD;\n"
     "#else\n"
-    "    highp int ln = fv_log2i(fv_enc.x), ld = fv_log2i(fv_dith.z), n = 1 << ln;\n"
+    "    highp int ln = fogvol_log2i(fv_enc.x), ld = fogvol_log2i(fv_dith.z);\n"
     "#endif\n"
-    "    highp int T = int(u * (FV_N * FV_N * FV_N * FV_DD));\n" /* powers of two: exact either way */
-    "    highp int h = T >> (ln + ld), x = T & ((n << ld) - 1);\n"
-    "    highp int q = ((x + fv_dither_offset_i()) >> ld) - 1;\n"
-    /* h < N^2 (u < 1); q in [-1, N - 1]: q & (N - 1) is q + N for the borrow (q = -1), whose flag
-       is the sign bit (two's complement, >> extends the sign) */
-    "    return vec4(ivec4(h >> ln, h & (n - 1), q & (n - 1), (q >> 31) & 1)) * (1.0 / 255.0);\n"
+    "    highp int t = int(u * (FV_N * FV_N * FV_N * FV_DD));\n" /* powers of two: exact either way */
+    "    return fogvol_encode_int(t, ln, ld, fv_dither_offset_i());\n"
     "#else\n"
     "    float row = fv_dither_row();\n"
     "#ifdef FV_ALU\n"
@@ -5921,21 +5929,16 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 
 /* MRT tier: the engine's copy of the ALU encode, dither pattern by arithmetic
    (the same 8x8 ordered pattern as fogvol_make_dither_index); in integers where the dialect has
-   floatBitsToInt and bit operations (GLSL 330+, 300 es), as FV_IALU: the same bytes. */
+   floatBitsToInt and bit operations (GLSL 330+, 300 es), by FV_IALU's FOGVOL__IALU_TEXT. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
     "#if __VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300)\n" \
+    FOGVOL__IALU_TEXT \
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
-    "    highp int ln = (floatBitsToInt(fogvol_mrt[0].z) >> 23) - 127, n = 1 << ln;\n" \
-    "    highp int ld = (floatBitsToInt(fogvol_mrt[1].z) >> 23) - 127, dd = 1 << ld;\n" \
-    "    highp ivec2 p = ivec2(gl_FragCoord.xy) & 7;\n" \
-    "    highp ivec2 s = (ivec2(p.x ^ p.y, p.y) * 73) & 0x54;\n" /* bits of the 8x8 index, as FV_IALU */ \
-    "    highp int k = fogvol_mrt[1].w > 0.5 ? (((s.x << 1) | s.y) * dd) >> 8 : dd >> 1;\n" \
-    "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
-    "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
-    "    highp int t = int(u * (fogvol_mrt[0].w * fogvol_mrt[0].z * fogvol_mrt[1].z));\n" \
-    "    highp int h = t >> (ln + ld), q = (((t & ((n << ld) - 1)) + k) >> ld) - 1;\n" \
-    "    return vec4(ivec4(h >> ln, h & (n - 1), q & (n - 1), (q >> 31) & 1)) * (1.0 / 255.0);\n" \
+    "    highp int ln = fogvol_log2i(fogvol_mrt[0].z), ld = fogvol_log2i(fogvol_mrt[1].z), dd = 1 << ld;\n" \
+    "    highp int k = fogvol_mrt[1].w > 0.5 ? fogvol_dither_scaled(dd) : dd >> 1;\n" \
+    "    float u = clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
+    "    return fogvol_encode_int(int(u * (fogvol_mrt[0].w * fogvol_mrt[0].z * fogvol_mrt[1].z)), ln, ld, k);\n" \
     "}\n" \
     "#else\n" \
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \

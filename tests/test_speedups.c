@@ -460,8 +460,11 @@ static void test_mrt_snippet_encode(void **state)
                                 "    gl_Position = vec4(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0, 0.0, 1.0);\n}\n"};
     static const char *main_fs = "out vec4 o;\nvoid main() {\n"
                                  "    float i = (gl_FragCoord.x - 0.5) + (gl_FragCoord.y - 0.5) * 128.0;\n"
-                                 "    o = fogvol_encode_view_depth(i * (1.25 / 16384.0) - 0.125);\n}\n";
-    const char *versions[2] = {"#version 330 core\n", "#version 150\n"};
+                                 "    o = fogvol_encode_view_depth(i * (1.25 / 16384.0) - 0.125);\n"
+                                 "#ifdef INTEGER\n" /* the integer encode must be there: this fails to compile without it */
+                                 "    if (o.a > 2.0) o = fogvol_encode_int(0, 4, 5, 16);\n"
+                                 "#endif\n}\n";
+    const char *versions[2] = {"#version 330 core\n#define INTEGER\n", "#version 150\n"};
     unsigned char index[8 * 8 * 4];
     glu_ctx g;
     GLuint vao, prog[2];
