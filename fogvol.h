@@ -492,7 +492,13 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
                  in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
                  one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
-                 its resolve pass, which is exact in mediump. */
+                 its resolve pass, which is exact in mediump.
+   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
+                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
+                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
+                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
+                 through the fragment shader (the same blend equation; the same pixels where the
+                 blender rounds the constant colour as it rounds a shader's output, as Mesa does). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -503,7 +509,8 @@ enum {
     FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
     FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
     FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
-    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9
+    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
+    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -1174,6 +1181,11 @@ typedef struct fogvol_pass {
     int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
     int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
     int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
+    int blend_constant;     /* FOG/LIGHT blends, only on a backend with FOGVOL_CAP_BLEND_CONSTANT: the colour
+                               blended in is blend_color.rgb times the shader's alpha, which the shader
+                               writes to every channel (GL: RGB source factor CONSTANT_COLOR instead of
+                               SRC_ALPHA, glBlendColor(blend_color)) */
+    float blend_color[4];
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
@@ -1200,7 +1212,8 @@ enum {
     FOGVOL_CAP_MULTISAMPLE = 1u << 4,     /* multisampled targets and per-sample shading
                                              (GL 4.0, or GL 3.2 + ARB_sample_shading) */
     FOGVOL_CAP_MESH_LAYOUT = 1u << 5,     /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
-    FOGVOL_CAP_FILTER_FLOAT = 1u << 6     /* create_target honours fogvol_target_desc.linear for R32F */
+    FOGVOL_CAP_FILTER_FLOAT = 1u << 6,    /* create_target honours fogvol_target_desc.linear for R32F */
+    FOGVOL_CAP_BLEND_CONSTANT = 1u << 7   /* begin_pass honours fogvol_pass.blend_constant */
 };
 
 typedef struct fogvol_frame_info {
@@ -1477,7 +1490,9 @@ typedef struct fogvol_shader_desc {
    FLOAT). COMPOSITE, COMPOSITE_MESH and CHECK of PS13: INLINE_RESOLVE (fv_back and fv_front are B
    and F, and with COUNT fv_opaque is O, resolved in the program as RESOLVE does, instead of fv_back
    being the resolved T; needs fp32 fragment arithmetic, see FOGVOL_SPEEDUP_INLINE_RESOLVE; other
-   tiers: FOGVOL_ERROR_UNSUPPORTED). Other bits, EXP with RAMP, L > 8, or bits for another program:
+   tiers: FOGVOL_ERROR_UNSUPPORTED). COMPOSITE and COMPOSITE_MESH with EXP, NO_COLOR_TEXTURE and
+   NO_OVERFLOW: BLEND_COLOR (the program writes its alpha to all four channels, for a pass whose
+   blend takes the colour from fogvol_pass.blend_color: FOGVOL_SPEEDUP_BLEND_COLOR). Other bits, EXP with RAMP, L > 8, or bits for another program:
    FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
@@ -1494,7 +1509,8 @@ enum {
     FOGVOL_SPECIALIZE_DOWNSAMPLE = 1u << 11,
     FOGVOL_SPECIALIZE_FILTERED = 1u << 12,
     FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13, /* FOGVOL_SPECIALIZE_ENCODING(bits) */
-    FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17
+    FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17,
+    FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -5527,7 +5543,9 @@ static const char fogvol__fs_composite[] =
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
     "    vec4 c;\n"
-    "#if defined(FV_EXP)\n"
+    "#if defined(FV_EXP) && defined(FV_BLEND_COLOR)\n" /* the colour: fogvol_pass.blend_color */
+    "    c = vec4(1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
+    "#elif defined(FV_EXP)\n"
     "    c = vec4(fv_speed.rgb, 1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
     "#elif defined(FV_RAMP)\n"
     "    c = FV_TEXTURE(fv_colors, vec2(t * fv_rampmap.x + fv_rampmap.y, 0.5));\n"
@@ -5791,7 +5809,11 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
                     FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
-    bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program */
+    if ((bits & FOGVOL_SPECIALIZE_BLEND_COLOR) &&
+        ((p != FOGVOL_PROGRAM_COMPOSITE && p != FOGVOL_PROGRAM_COMPOSITE_MESH) ||
+         (~bits & (FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW))))
+        return 0; /* one colour for every pixel */
+    bits &= ~(unsigned)(FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_BLEND_COLOR); /* (ORIGIN: every program) */
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_RESOLVE ||
         p == FOGVOL_PROGRAM_COMPOSITE)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_COUNT; /* the tier and variants decide (fogvol__count_spec_ok) */
@@ -5840,6 +5862,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_DOWNSAMPLE) strings[n++] = "#define FV_DOWNSAMPLE\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FILTERED) strings[n++] = "#define FV_FILTERED\n";
     if (d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) strings[n++] = "#define FV_INLINE_RESOLVE\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_BLEND_COLOR) strings[n++] = "#define FV_BLEND_COLOR\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -8802,6 +8825,21 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT] = 0;
 }
 
+/* FOGVOL_SPEEDUP_BLEND_COLOR: a composite of one colour (spec: EXP, no colour texture, no
+   overflow test) takes it from the blend unit where the backend can. */
+static void fogvol__blend_color(const fogvol_context *ctx, fogvol_pass *ps, unsigned *spec)
+{
+    unsigned need = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW;
+    ps->blend_constant = 0;
+    if ((*spec & need) != need || !(ctx->be.caps & FOGVOL_CAP_BLEND_CONSTANT) ||
+        (ctx->speedups_off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE)))
+        return;
+    *spec |= FOGVOL_SPECIALIZE_BLEND_COLOR;
+    ps->blend_constant = 1;
+    memcpy(ps->blend_color, ps->uniforms[FOGVOL_U_SPEEDUP], 3 * sizeof(float));
+    ps->blend_color[3] = 1.0f;
+}
+
 /* Composite one ramp group into the engine framebuffer: thickness -> ramp colour and alpha, blended
    as fog or light. ps: the state of fogvol__sum_sources. */
 static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, const fogvol_ramp *ramp)
@@ -8830,6 +8868,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
     spec |= fogvol__origin_bit(ctx) | ctx->count_bit;
+    fogvol__blend_color(ctx, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
         spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
         ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)fd->viewport[2];
@@ -9440,7 +9479,7 @@ enum {
     FOGVOL__GL_TEXTURE_WRAP_S = 0x2802, FOGVOL__GL_TEXTURE_WRAP_T = 0x2803, FOGVOL__GL_REPEAT = 0x2901,
     FOGVOL__GL_POLYGON_OFFSET_FILL = 0x8037, FOGVOL__GL_RGBA8 = 0x8058, FOGVOL__GL_TEXTURE_BINDING_2D = 0x8069,
     FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
-    FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
+    FOGVOL__GL_CONSTANT_COLOR = 0x8001, FOGVOL__GL_BLEND_COLOR = 0x8005, FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
     FOGVOL__GL_BLEND_SRC_ALPHA = 0x80CB, FOGVOL__GL_FUNC_ADD = 0x8006, FOGVOL__GL_BLEND_EQUATION_RGB = 0x8009,
     FOGVOL__GL_CLAMP_TO_EDGE = 0x812F, FOGVOL__GL_DEPTH_COMPONENT16 = 0x81A5,
     FOGVOL__GL_DEPTH_COMPONENT24 = 0x81A6, FOGVOL__GL_TEXTURE0 = 0x84C0, FOGVOL__GL_ACTIVE_TEXTURE = 0x84E0,
@@ -9520,6 +9559,7 @@ enum {
     X(void, FrontFace, (fogvol__GLenum)) \
     X(void, BlendFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
     X(void, BlendEquationSeparate, (fogvol__GLenum, fogvol__GLenum)) \
+    X(void, BlendColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
     X(void, StencilFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint, fogvol__GLuint)) \
     X(void, StencilOpSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
     X(void, StencilMaskSeparate, (fogvol__GLenum, fogvol__GLuint)) \
@@ -9756,7 +9796,7 @@ typedef struct fogvol__gl_state {
     fogvol__GLint st_func[3], st_op[3], st_wmask, stb_func[3], stb_op[3], stb_wmask, st_clear; /* stb: back */
     fogvol__GLint pixel_align[2], unpack_rows[3], pack_rows[3]; /* row length, skip rows, skip pixels */
     fogvol__GLboolean depth_mask, color_mask[4];
-    fogvol__GLfloat clear_color[4];
+    fogvol__GLfloat clear_color[4], blend_color[4];
     /* the rows of FOGVOL__GL_ENABLES, in order */
     fogvol__GLboolean enabled[FOGVOL__GL_N_ENABLES];
     /* fogvol__gl_save_depth */
@@ -9899,7 +9939,7 @@ enum {
     FOGVOL__GLV_PIXEL_STORE, FOGVOL__GLV_VIEWPORT, FOGVOL__GLV_SCISSOR, FOGVOL__GLV_BLEND_FUNC, FOGVOL__GLV_BLEND_EQ,
     FOGVOL__GLV_DEPTH_FUNC, FOGVOL__GLV_CULL_FACE, FOGVOL__GLV_FRONT_FACE, FOGVOL__GLV_POLYGON_MODE,
     FOGVOL__GLV_DEPTH_MASK, FOGVOL__GLV_COLOR_MASK, FOGVOL__GLV_CLEAR_COLOR, FOGVOL__GLV_STENCIL_FUNC,
-    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL
+    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL, FOGVOL__GLV_BLEND_COLOR
 };
 
 /* Plain values: each name of a row is read with glGet<type>v into per consecutive values from the row's
@@ -9926,6 +9966,7 @@ static const fogvol__gl_value_row fogvol__gl_values[] = {
     {FOGVOL__GLV_DEPTH_MASK, 'b', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(depth_mask), 0, {FOGVOL__GL_DEPTH_WRITEMASK}},
     {FOGVOL__GLV_COLOR_MASK, 'b', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(color_mask), 0, {FOGVOL__GL_COLOR_WRITEMASK}},
     {FOGVOL__GLV_CLEAR_COLOR, 'f', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(clear_color), 0, {FOGVOL__GL_COLOR_CLEAR_VALUE}},
+    {FOGVOL__GLV_BLEND_COLOR, 'f', FOGVOL__GLW_ALL, 4, FOGVOL__GL_AT(blend_color), 0, {FOGVOL__GL_BLEND_COLOR}},
     {FOGVOL__GLV_STENCIL_FUNC, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_func), FOGVOL__GL_FRONT,
      {FOGVOL__GL_STENCIL_FUNC, FOGVOL__GL_STENCIL_REF, FOGVOL__GL_STENCIL_VALUE_MASK}},
     {FOGVOL__GLV_STENCIL_OP, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_op), FOGVOL__GL_FRONT,
@@ -9971,6 +10012,7 @@ static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const 
     case FOGVOL__GLV_DEPTH_MASK: gl->DepthMask(b[0]); break;
     case FOGVOL__GLV_COLOR_MASK: gl->ColorMask(b[0], b[1], b[2], b[3]); break;
     case FOGVOL__GLV_CLEAR_COLOR: gl->ClearColor(f[0], f[1], f[2], f[3]); break;
+    case FOGVOL__GLV_BLEND_COLOR: gl->BlendColor(f[0], f[1], f[2], f[3]); break;
     case FOGVOL__GLV_STENCIL_FUNC:
         gl->StencilFuncSeparate(r->arg, (fogvol__GLenum)v[0], v[1], (fogvol__GLuint)v[2]);
         break;
@@ -10854,7 +10896,9 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
     case FOGVOL_PASS_BLEND_FOG:
     case FOGVOL_PASS_BLEND_LIGHT:
         gl->Enable(FOGVOL__GL_BLEND);
-        gl->BlendFuncSeparate(FOGVOL__GL_SRC_ALPHA,
+        if (p->blend_constant)
+            gl->BlendColor(p->blend_color[0], p->blend_color[1], p->blend_color[2], p->blend_color[3]);
+        gl->BlendFuncSeparate(p->blend_constant ? FOGVOL__GL_CONSTANT_COLOR : FOGVOL__GL_SRC_ALPHA,
                               p->blend == FOGVOL_PASS_BLEND_FOG ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE,
                               p->alpha_coverage ? FOGVOL__GL_ONE : FOGVOL__GL_ZERO,
                               p->alpha_coverage ? FOGVOL__GL_ONE_MINUS_SRC_ALPHA : FOGVOL__GL_ONE);
@@ -11222,7 +11266,7 @@ static int fogvol__gl_has_ext3(fogvol__gl *gl, const char *name)
 /* What the context can do (ext: the GL 2 / GLES 2 extension string or NULL). */
 static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
 {
-    unsigned caps = 0;
+    unsigned caps = FOGVOL_CAP_BLEND_CONSTANT; /* glBlendColor: GL 1.4, GLES 2 */
     if (gl->gles) {
         fogvol__GLint range[2] = {0, 0}, precision = 0;
         gl->GetShaderPrecisionFormat(FOGVOL__GL_FRAGMENT_SHADER, FOGVOL__GL_HIGH_FLOAT, range, &precision);

@@ -7,7 +7,8 @@
    (fogvol_shader_desc.specialize) get _s<bits> before the extension; a program must refuse the
    bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
-   and CHECK only. */
+   and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
+   NO_COLOR_TEXTURE and NO_OVERFLOW only. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -23,6 +24,11 @@ static int spec_applies(int p, unsigned bits)
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program takes it */
+    if (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) { /* a composite of one colour */
+        const unsigned one = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW;
+        if ((p != FOGVOL_PROGRAM_COMPOSITE && p != FOGVOL_PROGRAM_COMPOSITE_MESH) || (bits & one) != one) return 0;
+        bits &= ~(unsigned)FOGVOL_SPECIALIZE_BLEND_COLOR;
+    }
     if ((bits & FOGVOL_SPECIALIZE_ENCODING_MASK) > FOGVOL_SPECIALIZE_ENCODING(8)) return 0; /* L = 1..8 */
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE)
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
@@ -110,6 +116,19 @@ int main(int argc, char **argv)
                                          FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
                                      FOGVOL_SPECIALIZE_INLINE_RESOLVE | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_RAMP,
                                      FOGVOL_SPECIALIZE_INLINE_RESOLVE | FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_INLINE_RESOLVE |
+                                         FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_DOWNSAMPLE |
+                                         FOGVOL_SPECIALIZE_FILTERED | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

@@ -306,7 +306,7 @@ typedef struct gl_snapshot {
     GLint fbo, program, active, tex3, array_buf, viewport[4], scissor[4], depth_func, cull, blend_src, blend_dst;
     GLint attrib0_enabled;
     GLboolean depth_test, cull_face, blend, scissor_test, stencil_test, depth_mask, color_mask[4];
-    GLfloat clear[4];
+    GLfloat clear[4], blend_color[4];
 } gl_snapshot;
 
 static void snapshot(gl_snapshot *s)
@@ -332,6 +332,7 @@ static void snapshot(gl_snapshot *s)
     glGetBooleanv(GL_DEPTH_WRITEMASK, &s->depth_mask);
     glGetBooleanv(GL_COLOR_WRITEMASK, s->color_mask);
     glGetFloatv(GL_COLOR_CLEAR_VALUE, s->clear);
+    glGetFloatv(GL_BLEND_COLOR, s->blend_color);
 }
 
 /* What an engine leaves set mid-frame (none of it may change fogvol's picture). */
@@ -352,6 +353,7 @@ static void engine_leaves_state(const engine *e)
     glBindBuffer(GL_ARRAY_BUFFER, e->dummy_buf);
     glEnableVertexAttribArray(0);
     glClearColor(0.1f, 0.2f, 0.3f, 0.4f);
+    glBlendColor(0.625f, 0.375f, 0.875f, 0.25f);
 }
 
 static void write_png(const char *ctx_file, const char *what, const unsigned char *px)

@@ -135,7 +135,7 @@ typedef struct snap {
         stencil_writemask;
     GLint stencil_back_func, stencil_back_ref, stencil_back_value_mask, stencil_back_fail, stencil_back_zfail,
         stencil_back_zpass, stencil_back_writemask;
-    GLfloat clear_color[4], clear_depth;
+    GLfloat clear_color[4], clear_depth, blend_color[4];
     GLint clear_stencil;
     GLint unpack_alignment, unpack_row_length, unpack_skip_rows, unpack_skip_pixels;
     GLint pack_alignment, pack_row_length, pack_skip_rows, pack_skip_pixels;
@@ -211,6 +211,7 @@ static void snapshot(snap *s, int compat)
     glGetIntegerv(GL_STENCIL_BACK_PASS_DEPTH_PASS, &s->stencil_back_zpass);
     glGetIntegerv(GL_STENCIL_BACK_WRITEMASK, &s->stencil_back_writemask);
     glGetFloatv(GL_COLOR_CLEAR_VALUE, s->clear_color);
+    glGetFloatv(GL_BLEND_COLOR, s->blend_color);
     glGetFloatv(GL_DEPTH_CLEAR_VALUE, &s->clear_depth);
     glGetIntegerv(GL_STENCIL_CLEAR_VALUE, &s->clear_stencil);
     glGetIntegerv(GL_UNPACK_ALIGNMENT, &s->unpack_alignment);
@@ -332,7 +333,7 @@ static void snap_walk(snap_cmp *c, const snap *a, const snap *b)
     CMP_I(stencil_zfail); CMP_I(stencil_zpass); CMP_I(stencil_writemask);
     CMP_I(stencil_back_func); CMP_I(stencil_back_ref); CMP_I(stencil_back_value_mask); CMP_I(stencil_back_fail);
     CMP_I(stencil_back_zfail); CMP_I(stencil_back_zpass); CMP_I(stencil_back_writemask);
-    CMP_FA(clear_color, 4); CMP_F(clear_depth); CMP_I(clear_stencil);
+    CMP_FA(clear_color, 4); CMP_F(clear_depth); CMP_I(clear_stencil); CMP_FA(blend_color, 4);
     CMP_I(unpack_alignment); CMP_I(unpack_row_length); CMP_I(unpack_skip_rows); CMP_I(unpack_skip_pixels);
     CMP_I(pack_alignment); CMP_I(pack_row_length); CMP_I(pack_skip_rows); CMP_I(pack_skip_pixels);
     CMP_I(pixel_unpack_buffer); CMP_I(pixel_pack_buffer);
@@ -547,6 +548,7 @@ static void apply_engine_state(fx *x, int split_read, int discard)
     gf.StencilOpSeparate(GL_BACK, GL_ZERO, GL_INCR_WRAP, GL_DECR);
     gf.StencilMaskSeparate(GL_BACK, 0xA5);
     glClearColor(0.25f, 0.5f, 0.75f, 0.125f);
+    glBlendColor(0.625f, 0.375f, 0.875f, 0.25f); /* fogvol's composite blends a constant colour */
     glClearDepth(0.375);
     glClearStencil(0x47);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 2);

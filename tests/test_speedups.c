@@ -60,6 +60,7 @@ typedef struct run_out {
     unsigned variants;         /* fogvol_context_tier: the variants the context ran */
     int enc_programs;          /* programs built with the encoding compiled in (FOGVOL_SPECIALIZE_ENCODING) */
     int targets;               /* render targets the context created */
+    int blend_constant[NFRAMES]; /* passes with fogvol_pass.blend_constant (FOGVOL_SPEEDUP_BLEND_COLOR) */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -71,6 +72,8 @@ static int g_w = W, g_h = H; /* the viewport's size (out's pixels: rows of g_w) 
 static int g_no_linear;     /* 1: the GL backend's create_target refuses linear targets (filtering in the shader) */
 static int g_bits;          /* fogvol_context_desc.encoding_bits */
 static int g_no_highp;      /* 1: the backend reports no FOGVOL_CAP_HIGHP_FRAGMENT (a mediump GPU) */
+static int g_no_blend_constant; /* 1: the backend reports no FOGVOL_CAP_BLEND_CONSTANT */
+static int g_light;             /* 1: the ramp blends as FOGVOL_BLEND_LIGHT */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
@@ -89,6 +92,13 @@ static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol
     for (i = 0; i < d->fs_count; ++i)
         g_enc_programs += strncmp(d->fs[i], "#define FV_ENC_LN ", 18) == 0 && atoi(d->fs[i] + 18) == (g_bits ? g_bits : 4);
     return g_inner.create_program(u, d, out);
+}
+/* counts the passes that blend a constant colour */
+static int g_blend_constant;
+static void watch_pass(void *u, const fogvol_pass *p)
+{
+    g_blend_constant += p->blend_constant != 0;
+    g_inner.begin_pass(u, p);
 }
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
 {
@@ -109,7 +119,9 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.backend.create_target = watch_target;
     g_targets = 0;
     cd.backend.create_program = watch_program;
+    cd.backend.begin_pass = watch_pass;
     if (g_no_highp) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_HIGHP_FRAGMENT;
+    if (g_no_blend_constant) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_BLEND_CONSTANT;
     g_enc_programs = 0;
     cd.tier = t;
     cd.disable_speedups = off;
@@ -123,7 +135,9 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     rd.color[1] = 0.6f;
     rd.color[2] = 0.3f;
     rd.density = s->density;
+    rd.blend = g_light ? FOGVOL_BLEND_LIGHT : FOGVOL_BLEND_FOG;
     assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    g_blend_constant = 0;
     for (f = 0; f < NFRAMES; ++f) {
         fogvol_frame_desc fd;
         memset(&fd, 0, sizeof fd);
@@ -148,6 +162,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         else
             assert_int_equal(r, FOGVOL_SUCCESS);
         glu_pixels(g);
+        out->blend_constant[f] = g_blend_constant;
+        g_blend_constant = 0;
         for (y = 0; y < g->height; ++y)
             for (x = 0; x < g->width; ++x) {
                 const unsigned char *p = g->pixels + 4 * ((size_t)y * g->width + x);
@@ -190,9 +206,8 @@ static void write_png(const char *name, const unsigned char *px)
     assert_true(stbi_write_png(path, W, H, 4, px, W * 4) != 0);
 }
 
-/* FLOAT, frame with occluders: every interior pixel against the ray-cast thickness through the
-   extinction law, mix(background, fog colour, 1 - exp(-density t)), in bytes; returns the max error */
-/* The largest byte error of pixel px against mix(background, fog colour, 1 - exp(-density t)) */
+/* The largest byte error of pixel px against mix(background, fog colour, 1 - exp(-density t)), or
+   with g_light (a FOGVOL_BLEND_LIGHT ramp) background + fog colour (1 - exp(-density t)), clamped */
 static int fog_error(const tscene *s, const unsigned char *px, double t)
 {
     static const float bg[3] = {0.2f, 0.5f, 0.8f}, fog[3] = {0.9f, 0.6f, 0.3f};
@@ -200,12 +215,15 @@ static int fog_error(const tscene *s, const unsigned char *px, double t)
     int c, worst = 0;
     for (c = 0; c < 3; ++c) {
         double fog8 = floor(fog[c] * 255.0 + 0.5), bg8 = floor(bg[c] * 255.0 + 0.5);
-        int want = (int)floor(bg8 * (1.0 - a) + fog8 * a + 0.5), d = abs(want - (int)px[c]);
+        double v = g_light ? fmin(bg8 + fog8 * a, 255.0) : bg8 * (1.0 - a) + fog8 * a;
+        int want = (int)floor(v + 0.5), d = abs(want - (int)px[c]);
         if (d > worst) worst = d;
     }
     return worst;
 }
 
+/* FLOAT, frame with occluders: every interior pixel against the ray-cast thickness through the
+   extinction law (fog_error); returns the max error */
 static int check_ground_truth(const tscene *s, const unsigned char *px)
 {
     static double gt[W * H], tmax;
@@ -227,7 +245,7 @@ static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
-     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE)
+     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR)
 
 static void test_same_pixels_and_exp(void **state)
 {
@@ -445,6 +463,54 @@ static void test_inline_resolve(void **state)
             else assert_int_equal(shown, 0);
         }
     g_bits = 0;
+    g_show_overflow = 0;
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_BLEND_COLOR: the composite's colour from the blend unit (GL: CONSTANT_COLOR) and
+   only its alpha from the program. Fog and light ramps, every tier here: the same bytes as the
+   colour written by the program (speed-up off, or a backend without FOGVOL_CAP_BLEND_CONSTANT),
+   one such pass per frame, none with show_overflow (its magenta comes from the program); the FLOAT
+   pictures against the ray-cast thickness through the extinction law. The fog colour (0.9, 0.6,
+   0.3) is not a whole number of 255ths in red and blue, so both ways round it. */
+static void test_blend_color(void **state)
+{
+    static run_out bc, off, nocap;
+    const tscene *s = &g_scenes[scene_index("plane_cuts_sphere")];
+    glu_ctx g;
+    int ti, k, f, n;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (ti = 0; ti < 3; ++ti)
+        for (k = 0; k < 3; ++k) { /* fog, light, fog with show_overflow */
+            int fogged = 0, e = -1;
+            g_light = k == 1;
+            g_show_overflow = k == 2;
+            run_frames(s, g_tiers[ti], 0, &g, &bc);
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_BLEND_COLOR, &g, &off);
+            g_no_blend_constant = 1;
+            run_frames(s, g_tiers[ti], 0, &g, &nocap);
+            g_no_blend_constant = 0;
+            for (f = 0; f < NFRAMES; ++f) {
+                assert_int_equal(max_diff(bc.px[f], off.px[f], &n), 0);
+                assert_int_equal(max_diff(nocap.px[f], off.px[f], &n), 0);
+                assert_memory_equal(bc.th[f], off.th[f], sizeof off.th[f]);
+                assert_int_equal(bc.blend_constant[f], k < 2);
+                assert_int_equal(off.blend_constant[f], 0);
+                assert_int_equal(nocap.blend_constant[f], 0);
+            }
+            for (n = 0; n < W * H; ++n) fogged += bc.th[2][n] > 0.0f;
+            if (g_tiers[ti] == FOGVOL_TIER_FLOAT) {
+                e = check_ground_truth(s, bc.px[2]);
+                assert_true(e <= 2);
+            }
+            if (k == 1) write_png("light_blend_color", bc.px[2]);
+            print_message("# %-5s %s%s: blend colour = program colour, bit for bit, %d fogged pixels; vs ray cast "
+                          "%d/255 (-1: not FLOAT)\n", g_tier_names[ti], k == 1 ? "light" : "fog",
+                          k == 2 ? " show_overflow" : "", fogged, e);
+            assert_true(fogged > W * H / 8);
+        }
+    g_light = 0;
     g_show_overflow = 0;
     glu_destroy(&g);
 }
@@ -669,6 +735,7 @@ int main(void)
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
                                        cmocka_unit_test(test_inline_resolve),
+                                       cmocka_unit_test(test_blend_color),
                                        cmocka_unit_test(test_mrt_snippet_encode),
                                        cmocka_unit_test(test_half_resolution)};
     int r;
