@@ -1492,7 +1492,11 @@ typedef struct fogvol_shader_desc {
    being the resolved T; needs fp32 fragment arithmetic, see FOGVOL_SPEEDUP_INLINE_RESOLVE; other
    tiers: FOGVOL_ERROR_UNSUPPORTED). COMPOSITE and COMPOSITE_MESH with EXP, NO_COLOR_TEXTURE and
    NO_OVERFLOW: BLEND_COLOR (the program writes its alpha to all four channels, for a pass whose
-   blend takes the colour from fogvol_pass.blend_color: FOGVOL_SPEEDUP_BLEND_COLOR). Other bits, EXP with RAMP, L > 8, or bits for another program:
+   blend takes the colour from fogvol_pass.blend_color: FOGVOL_SPEEDUP_BLEND_COLOR). Every program:
+   DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
+   position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
+   jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
+   that do not read the engine's depth). Other bits, EXP with RAMP, L > 8, or bits for another program:
    FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
@@ -1510,7 +1514,8 @@ enum {
     FOGVOL_SPECIALIZE_FILTERED = 1u << 12,
     FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13, /* FOGVOL_SPECIALIZE_ENCODING(bits) */
     FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17,
-    FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18
+    FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18,
+    FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -5180,8 +5185,12 @@ static const char fogvol__fs_common[] =
     "uniform vec4 fv_lin;\n"
     "uniform vec4 fv_lin2;\n"
     "float fv_engine_view_depth(vec2 st, float z) {\n"
+    "#ifdef FV_DEPTH_FROM_Z\n"                 /* fv_lin.xy = fv_lin2.xy = 0 (no oblique near plane) */
+    "    return (fv_lin.z * z + fv_lin.w) / (fv_lin2.z * z + fv_lin2.w);\n"
+    "#else\n"
     "    vec4 q = vec4(st, z, 1.0);\n"
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
+    "#endif\n"
     "}\n";
 
 /* The RGBA8 encode in integers, shared by fogvol's programs (FV_IALU) and the engine's MRT and
@@ -5813,7 +5822,8 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
         ((p != FOGVOL_PROGRAM_COMPOSITE && p != FOGVOL_PROGRAM_COMPOSITE_MESH) ||
          (~bits & (FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW))))
         return 0; /* one colour for every pixel */
-    bits &= ~(unsigned)(FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_BLEND_COLOR); /* (ORIGIN: every program) */
+    bits &= ~(unsigned)(FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DEPTH_FROM_Z | FOGVOL_SPECIALIZE_BLEND_COLOR);
+    /* (ORIGIN, DEPTH_FROM_Z: every program) */
     if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_RESOLVE ||
         p == FOGVOL_PROGRAM_COMPOSITE)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_COUNT; /* the tier and variants decide (fogvol__count_spec_ok) */
@@ -5863,6 +5873,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_FILTERED) strings[n++] = "#define FV_FILTERED\n";
     if (d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) strings[n++] = "#define FV_INLINE_RESOLVE\n";
     if (d->specialize & FOGVOL_SPECIALIZE_BLEND_COLOR) strings[n++] = "#define FV_BLEND_COLOR\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_DEPTH_FROM_Z) strings[n++] = "#define FV_DEPTH_FROM_Z\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -7607,6 +7618,21 @@ static unsigned fogvol__dither_bit(const fogvol_context *ctx)
     return ctx->dither && fogvol__has(ctx, FOGVOL_VARIANT_ALU) ? (unsigned)FOGVOL_SPECIALIZE_DITHER : 0u;
 }
 
+/* SPECIALIZE_DEPTH_FROM_Z where the pass's fv_lin and fv_lin2 (fogvol__lin_uniforms) do not depend on
+   the pixel: their x and y terms, which come out of eyerow * invVP as rounding residues for a
+   projection without an oblique near plane (1e-17 of the others from separate view and projection
+   matrices, 4e-9 from a float view-projection), are below 2^-24 of the z and constant terms, the
+   rounding the general program's float dot products make in those anyway */
+static unsigned fogvol__depth_from_z_bit(const fogvol_pass *ps)
+{
+    const float *a = ps->uniforms[FOGVOL_U_LINEAR], *b = ps->uniforms[FOGVOL_U_LINEAR_W];
+    double tiny = 1.0 / 16777216.0;
+    return fabs(a[0]) + fabs(a[1]) <= tiny * (fabs(a[2]) + fabs(a[3])) &&
+                   fabs(b[0]) + fabs(b[1]) <= tiny * (fabs(b[2]) + fabs(b[3]))
+               ? (unsigned)FOGVOL_SPECIALIZE_DEPTH_FROM_Z
+               : 0u;
+}
+
 /* SPECIALIZE_ORIGIN where the frame's viewport starts at the window origin (its offset, added to
    every read of fogvol's targets and of the engine's depth, is 0) */
 static unsigned fogvol__origin_bit(const fogvol_context *ctx)
@@ -8713,8 +8739,9 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
-    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, (engine ? fogvol__origin_bit(ctx) : 0u) |
-                                                                 fogvol__dither_bit(ctx) | ctx->count_bit);
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE,
+                                 (engine ? fogvol__origin_bit(ctx) | fogvol__depth_from_z_bit(&ps) : 0u) |
+                                     fogvol__dither_bit(ctx) | ctx->count_bit);
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
@@ -8746,6 +8773,8 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     else if (ctx->tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+        spec |= fogvol__depth_from_z_bit(&ps); /* (FLOAT faces read the engine's depth) */
     spec |= fogvol__dither_bit(ctx) | ctx->count_bit;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */

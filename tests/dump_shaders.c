@@ -23,7 +23,7 @@ static int spec_applies(int p, unsigned bits)
                           FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
-    bits &= ~(unsigned)FOGVOL_SPECIALIZE_ORIGIN; /* every program takes it */
+    bits &= ~(unsigned)(FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DEPTH_FROM_Z); /* every program takes them */
     if (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) { /* a composite of one colour */
         const unsigned one = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW;
         if ((p != FOGVOL_PROGRAM_COMPOSITE && p != FOGVOL_PROGRAM_COMPOSITE_MESH) || (bits & one) != one) return 0;
@@ -129,6 +129,10 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
                                      FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                                          FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_DEPTH_FROM_Z | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
+                                         FOGVOL_SPECIALIZE_OPAQUE,
+                                     FOGVOL_SPECIALIZE_DEPTH_FROM_Z | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DITHER |
+                                         FOGVOL_SPECIALIZE_ENCODING(4),
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

@@ -427,6 +427,30 @@ static void logger(void *u, fogvol_log_level l, const char *m)
     if (l <= FOGVOL_LOG_WARNING) fprintf(stderr, "  [fogvol] %s\n", m);
 }
 
+/* The GL backend, watched: which programs linearise the engine's depth from z alone
+   (FOGVOL_SPECIALIZE_DEPTH_FROM_Z, "#define FV_DEPTH_FROM_Z"), and how many passes of a frame
+   ran one of them. */
+static fogvol_backend g_inner;
+static fogvol_handle g_from_z[64];
+static int g_nfrom_z, g_from_z_passes;
+static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
+{
+    fogvol_result r = g_inner.create_program(u, d, out);
+    int i, from_z = 0;
+    for (i = 0; i < d->fs_count; ++i) from_z |= strcmp(d->fs[i], "#define FV_DEPTH_FROM_Z\n") == 0;
+    if (r == FOGVOL_SUCCESS && from_z) {
+        assert_true(g_nfrom_z < 64);
+        g_from_z[g_nfrom_z++] = *out;
+    }
+    return r;
+}
+static void watch_pass(void *u, const fogvol_pass *p)
+{
+    int i;
+    for (i = 0; i < g_nfrom_z; ++i) g_from_z_passes += p->program == g_from_z[i];
+    g_inner.begin_pass(u, p);
+}
+
 typedef struct depth_state {
     GLint origin, mode, func;
     GLdouble range[2], clear;
@@ -621,6 +645,11 @@ static void test_conventions(void **state)
         cd.tier = cb->tier;
         cd.variants = cb->variants;
         cd.disable_dither = 1;
+        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
+        cd.backend = g_inner;
+        cd.backend.create_program = watch_program;
+        cd.backend.begin_pass = watch_pass;
+        g_nfrom_z = 0;
         assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
         memset(&md, 0, sizeof md);
         md.positions = box.pos;
@@ -649,9 +678,13 @@ static void test_conventions(void **state)
                behind the camera under every convention (standard GL included) */
             if (c->inside && (cb->variants & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_NEAR_CLAMP))) continue;
             snprintf(png, sizeof png, "build/engine_depth/%s_%02d.png", cb->name, ci);
+            g_from_z_passes = 0;
             r = run_case(&e, c, cb, (const fogvol_mesh **)m, fv, ramp, ti < 3 ? png : NULL);
             ok = r.r == FOGVOL_SUCCESS && r.max_over <= r.bound && r.comp_max <= 2.0 / 255.0 && r.state_ok &&
                  r.fogged > 200 && r.interior > W * H / 2;
+            /* the faces that read the engine's depth linearise it from z alone unless the near
+               plane is oblique (x and y terms); nothing else reads it */
+            ok = ok && g_from_z_passes == ((cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && c->proj != P_OBLIQUE);
             printf("# %-18s %-48s max |err| %.3g (less vertex snapping: %.3f of bound %.3g), composite %.1f/255, "
                    "%d fogged of %d interior, state %s, %s%s\n",
                    cb->name, c->name, r.max_err, r.max_over / r.bound, r.bound, r.comp_max * 255.0, r.fogged,
@@ -662,6 +695,7 @@ static void test_conventions(void **state)
         fogvol_destroy_mesh(fv, m[0]);
         fogvol_destroy_mesh(fv, m[1]);
         fogvol_destroy_context(fv);
+        g_inner.destroy(g_inner.user_data);
     }
     engine_free(&e);
     glu_destroy(&g);
