@@ -43,8 +43,9 @@ $(BUILD):
 
 # --- test programs ---------------------------------------------------------------------
 # Adding a test program is one line:
-#   - a cmocka program tests/test_NAME.c: add NAME to TESTS. The pattern rules below build
-#     $(BUILD)/test_NAME (C99) and $(BUILD)/test_NAME_san (ASan+UBSan); both go into TEST_BINS and
+#   - a cmocka program tests/test_NAME.c (including fogvol.h through tests/fogvol_test.h): add NAME
+#     to TESTS. The rules below build $(BUILD)/test_NAME (C99) and $(BUILD)/test_NAME_san
+#     (ASan+UBSan), linked with fogvol's implementation built once per flag set; both go into TEST_BINS and
 #     `make test` runs them as NAME and NAME_asan_ubsan (TAP). It links -lcmocka $(GL_LIBS) unless
 #     you set test_NAME_LIBS (e.g. test_gles_LIBS = -lcmocka -lEGL -lGLESv2 -lm); extra compile
 #     flags: test_NAME_FLAGS. Add NAME to CXX_TESTS as well for a C++11 build (test_NAME_cpp, run
@@ -72,6 +73,24 @@ $(BUILD)/%: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
 $(BUILD)/%_san: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $($*_FLAGS) $(SAN) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+
+# The cmocka programs but test_cpu (FOGVOL_NO_GL; its C++ and valgrind builds keep the
+# implementation inline too), test_backend and test_post (they read internal tables and state) link
+# fogvol's implementation built once per flag set
+# (tests/fogvol_impl.c; tests/fogvol_test.h leaves it out with FOGVOL_TEST_LINKED): the
+# implementation is compiled twice per build instead of twice per program.
+LINKED_TESTS = $(filter-out cpu backend post,$(TESTS))
+$(BUILD)/fogvol_impl.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -c $< -o $@
+$(BUILD)/fogvol_impl_san.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
+	$(CC) -std=c99 $(SAN) $(WARN) $(INC) -c $< -o $@
+$(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)): $(BUILD)/test_%: tests/test_%.c $(TEST_DEPS) $(BUILD)/fogvol_impl.o
+	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< $(BUILD)/fogvol_impl.o -o $@ \
+	  $(call libs_of,test_$*)
+$(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) \
+	  $(BUILD)/fogvol_impl_san.o
+	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(SAN) $(WARN) $(INC) $< $(BUILD)/fogvol_impl_san.o -o $@ \
+	  $(call libs_of,test_$*)
 $(BUILD)/%_cpp: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CXX) -x c++ -std=c++11 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
 $(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)

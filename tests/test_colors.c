@@ -14,8 +14,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#define FOGVOL_IMPLEMENTATION
-#include "fogvol.h"
+#include "tests/fogvol_test.h"
 #define GL_GLEXT_PROTOTYPES
 #include "tests/gl_util.h"
 #include "tests/raycast.h"

@@ -30,8 +30,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#define FOGVOL_IMPLEMENTATION
-#include "fogvol.h"
+#include "tests/fogvol_test.h"
 #define GL_GLEXT_PROTOTYPES /* libOSMesa exports the GL entry points */
 #include "tests/gl_util.h"
 #include <GL/glext.h>

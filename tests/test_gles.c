@@ -31,8 +31,7 @@
 #include <cmocka.h>
 #include <time.h>
 
-#define FOGVOL_IMPLEMENTATION
-#include "fogvol.h"
+#include "tests/fogvol_test.h"
 #include "tests/egl_util.h"
 #include "tests/raycast.h"
 #include "tests/shapes.h"

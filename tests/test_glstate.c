@@ -41,8 +41,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#define FOGVOL_IMPLEMENTATION
-#include "fogvol.h"
+#include "tests/fogvol_test.h"
 #include "tests/gl_util.h"
 #include "tests/shapes.h"
 #include "tests/fixtures.h"

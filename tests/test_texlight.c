@@ -17,8 +17,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#define FOGVOL_IMPLEMENTATION
-#include "fogvol.h"
+#include "tests/fogvol_test.h"
 #include "tests/gl_util.h"
 #include "tests/shapes.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
