@@ -7926,6 +7926,9 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
    DOWNSAMPLE cannot be, 0 (the caller skips the pass). */
 static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
 {
+    /* programs that have no general stand-in: 0 (DOWNSAMPLE: the pass is skipped; BLEND_COLOR: the
+       caller asks again without it) */
+    const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR;
     fogvol__spec_program *sp;
     int i;
     if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
@@ -7937,11 +7940,11 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     for (i = 0; i < ctx->nspec; ++i) {
         sp = &ctx->spec[i];
         if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
-            return sp->handle ? sp->handle : (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) ? 0 : ctx->prog[p];
+            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->prog[p];
     }
     if (ctx->nspec == FOGVOL__SPEC_MAX) {
-        if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
-        return (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) ? 0 : ctx->prog[p];
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->count_broken = 1;
+        return (bits & none) ? 0 : ctx->prog[p];
     }
     sp = &ctx->spec[ctx->nspec++];
     sp->program = p;
@@ -7949,15 +7952,18 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     sp->ms = ctx->prog_ms;
     ctx->compile_samples = ctx->prog_ms ? 2 : 0;
     if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
+        int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
         sp->handle = 0;
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: the specialised program (0x%x) did not build; the general program draws instead%s", bits,
-                    (bits & FOGVOL_SPECIALIZE_COUNT) ? " (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off from now on)"
-                                                     : "");
-        if (bits & FOGVOL_SPECIALIZE_COUNT) ctx->count_broken = 1;
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: the specialised program (0x%x) did not build; %s", bits,
+                    retried ? "the composite takes its colour from the program instead of the blend unit"
+                    : (bits & FOGVOL_SPECIALIZE_COUNT)
+                        ? "the general program draws instead (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off "
+                          "from now on)"
+                        : "the general program draws instead");
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !retried) ctx->count_broken = 1;
     }
     ctx->compile_samples = 0;
-    if (!sp->handle && (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE)) return 0;
+    if (!sp->handle && (bits & none)) return 0;
     return sp->handle ? sp->handle : ctx->prog[p];
 }
 
@@ -8904,6 +8910,10 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)fd->viewport[3];
     }
     ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec);
+    if (!ps->program && (spec & FOGVOL_SPECIALIZE_BLEND_COLOR)) { /* it did not build: the colour from the program */
+        ps->blend_constant = 0;
+        ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec & ~(unsigned)FOGVOL_SPECIALIZE_BLEND_COLOR);
+    }
     if (!ps->program) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no half-resolution composite program: group not drawn");
         run->r = FOGVOL_ERROR_BACKEND;
@@ -9508,7 +9518,8 @@ enum {
     FOGVOL__GL_TEXTURE_WRAP_S = 0x2802, FOGVOL__GL_TEXTURE_WRAP_T = 0x2803, FOGVOL__GL_REPEAT = 0x2901,
     FOGVOL__GL_POLYGON_OFFSET_FILL = 0x8037, FOGVOL__GL_RGBA8 = 0x8058, FOGVOL__GL_TEXTURE_BINDING_2D = 0x8069,
     FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
-    FOGVOL__GL_CONSTANT_COLOR = 0x8001, FOGVOL__GL_BLEND_COLOR = 0x8005, FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
+    FOGVOL__GL_CONSTANT_COLOR = 0x8001, FOGVOL__GL_BLEND_COLOR = 0x8005,
+    FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
     FOGVOL__GL_BLEND_SRC_ALPHA = 0x80CB, FOGVOL__GL_FUNC_ADD = 0x8006, FOGVOL__GL_BLEND_EQUATION_RGB = 0x8009,
     FOGVOL__GL_CLAMP_TO_EDGE = 0x812F, FOGVOL__GL_DEPTH_COMPONENT16 = 0x81A5,
     FOGVOL__GL_DEPTH_COMPONENT24 = 0x81A6, FOGVOL__GL_TEXTURE0 = 0x84C0, FOGVOL__GL_ACTIVE_TEXTURE = 0x84E0,

@@ -73,6 +73,7 @@ static int g_bits;          /* fogvol_context_desc.encoding_bits */
 static int g_no_highp;      /* 1: the backend reports no FOGVOL_CAP_HIGHP_FRAGMENT (a mediump GPU) */
 static int g_no_blend_constant; /* 1: the backend reports no FOGVOL_CAP_BLEND_CONSTANT */
 static int g_light;             /* 1: the ramp blends as FOGVOL_BLEND_LIGHT */
+static int g_fail_blend_color;  /* 1: the backend fails to build FOGVOL_SPECIALIZE_BLEND_COLOR programs */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
@@ -83,13 +84,16 @@ static fogvol_result watch_target(void *u, const fogvol_target_desc *d, fogvol_h
     g_targets++;
     return g_inner.create_target(u, d, out);
 }
-/* counts the programs whose fragment shader has this context's encoding compiled in */
+/* counts the programs whose fragment shader has this context's encoding compiled in; with
+   g_fail_blend_color fails those that take their colour from the blend unit */
 static int g_enc_programs;
 static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     int i;
-    for (i = 0; i < d->fs_count; ++i)
+    for (i = 0; i < d->fs_count; ++i) {
         g_enc_programs += strncmp(d->fs[i], "#define FV_ENC_LN ", 18) == 0 && atoi(d->fs[i] + 18) == (g_bits ? g_bits : 4);
+        if (g_fail_blend_color && strcmp(d->fs[i], "#define FV_BLEND_COLOR\n") == 0) return FOGVOL_ERROR_BACKEND;
+    }
     return g_inner.create_program(u, d, out);
 }
 /* counts the passes that blend a constant colour */
@@ -469,12 +473,14 @@ static void test_inline_resolve(void **state)
 /* FOGVOL_SPEEDUP_BLEND_COLOR: the composite's colour from the blend unit (GL: CONSTANT_COLOR) and
    only its alpha from the program. Fog and light ramps, every tier here: the same bytes as the
    colour written by the program (speed-up off, or a backend without FOGVOL_CAP_BLEND_CONSTANT),
-   one such pass per frame, none with show_overflow (its magenta comes from the program); the FLOAT
-   pictures against the ray-cast thickness through the extinction law. The fog colour (0.9, 0.6,
-   0.3) is not a whole number of 255ths in red and blue, so both ways round it. */
+   one such pass per frame, none with show_overflow (its magenta comes from the program), none where
+   the backend fails to build the program (the same program without the speed-up draws: the same
+   bytes, and PS20's face count stays on); the FLOAT pictures
+   against the ray-cast thickness through the extinction law. The fog colour (0.9, 0.6, 0.3) is not
+   a whole number of 255ths in red and blue, so both ways round it. */
 static void test_blend_color(void **state)
 {
-    static run_out bc, off, nocap;
+    static run_out bc, off, nocap, failed;
     const tscene *s = &g_scenes[scene_index("plane_cuts_sphere")];
     glu_ctx g;
     int ti, k, f, n;
@@ -490,9 +496,15 @@ static void test_blend_color(void **state)
             g_no_blend_constant = 1;
             run_frames(s, g_tiers[ti], 0, &g, &nocap);
             g_no_blend_constant = 0;
+            g_fail_blend_color = 1;
+            run_frames(s, g_tiers[ti], 0, &g, &failed);
+            g_fail_blend_color = 0;
             for (f = 0; f < NFRAMES; ++f) {
                 assert_int_equal(max_diff(bc.px[f], off.px[f], &n), 0);
                 assert_int_equal(max_diff(nocap.px[f], off.px[f], &n), 0);
+                assert_int_equal(max_diff(failed.px[f], off.px[f], &n), 0);
+                assert_int_equal(failed.blend_constant[f], 0);
+                assert_int_equal(failed.depth_tested[f], bc.depth_tested[f]);
                 assert_memory_equal(bc.th[f], off.th[f], sizeof off.th[f]);
                 assert_int_equal(bc.blend_constant[f], k < 2);
                 assert_int_equal(off.blend_constant[f], 0);
