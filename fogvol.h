@@ -9535,7 +9535,8 @@ enum {
     FOGVOL__GL_PIXEL_PACK_BUFFER = 0x88EB, FOGVOL__GL_PIXEL_UNPACK_BUFFER = 0x88EC,
     FOGVOL__GL_PIXEL_PACK_BUFFER_BINDING = 0x88ED, FOGVOL__GL_PIXEL_UNPACK_BUFFER_BINDING = 0x88EF,
     FOGVOL__GL_SAMPLER_BINDING = 0x8919, FOGVOL__GL_FRAGMENT_SHADER = 0x8B30, FOGVOL__GL_VERTEX_SHADER = 0x8B31,
-    FOGVOL__GL_COMPILE_STATUS = 0x8B81, FOGVOL__GL_LINK_STATUS = 0x8B82, FOGVOL__GL_INFO_LOG_LENGTH = 0x8B84,
+    FOGVOL__GL_DELETE_STATUS = 0x8B80, FOGVOL__GL_COMPILE_STATUS = 0x8B81, FOGVOL__GL_LINK_STATUS = 0x8B82,
+    FOGVOL__GL_INFO_LOG_LENGTH = 0x8B84,
     FOGVOL__GL_CURRENT_PROGRAM = 0x8B8D, FOGVOL__GL_SHADING_LANGUAGE_VERSION = 0x8B8C,
     FOGVOL__GL_RASTERIZER_DISCARD = 0x8C89, FOGVOL__GL_STENCIL_BACK_REF = 0x8CA3,
     FOGVOL__GL_STENCIL_BACK_VALUE_MASK = 0x8CA4, FOGVOL__GL_STENCIL_BACK_WRITEMASK = 0x8CA5,
@@ -9826,6 +9827,7 @@ typedef struct fogvol__gl_state {
     /* bindings (fogvol__gl_save_bindings, fogvol__gl_save_msaa) */
     fogvol__GLint draw_fbo, read_fbo, renderbuffer, program, vao, array_buffer, element_buffer, active_texture,
         tex2d[FOGVOL_MAX_TEXTURE_UNITS], sampler[FOGVOL_MAX_TEXTURE_UNITS], unpack_buffer, pack_buffer;
+    fogvol__GLint program_deleted; /* the engine deleted its current program: it is freed once fogvol binds its own */
     fogvol__GLint a0_enabled, a0_size, a0_type, a0_normalized, a0_stride, a0_buffer;
     void *a0_pointer;
     fogvol__GLint tex2dms[FOGVOL_MAX_TEXTURE_UNITS]; /* multisample texture bindings (GL 3.2+) */
@@ -10300,6 +10302,8 @@ static void fogvol__gl_save_bindings(fogvol__gl *gl, fogvol__gl_state *s)
     if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
     gl->GetIntegerv(FOGVOL__GL_RENDERBUFFER_BINDING, &s->renderbuffer);
     gl->GetIntegerv(FOGVOL__GL_CURRENT_PROGRAM, &s->program);
+    s->program_deleted = 0;
+    if (s->program) gl->GetProgramiv((fogvol__GLuint)s->program, FOGVOL__GL_DELETE_STATUS, &s->program_deleted);
     if (gl->has_vao) gl->GetIntegerv(FOGVOL__GL_VERTEX_ARRAY_BINDING, &s->vao);
     gl->GetIntegerv(FOGVOL__GL_ARRAY_BUFFER_BINDING, &s->array_buffer);
     gl->GetIntegerv(FOGVOL__GL_ELEMENT_ARRAY_BUFFER_BINDING, &s->element_buffer);
@@ -10327,7 +10331,7 @@ static void fogvol__gl_restore_bindings(fogvol__gl *gl, const fogvol__gl_state *
         gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)s->draw_fbo);
     }
     gl->BindRenderbuffer(FOGVOL__GL_RENDERBUFFER, (fogvol__GLuint)s->renderbuffer);
-    gl->UseProgram((fogvol__GLuint)s->program);
+    gl->UseProgram(s->program_deleted ? 0u : (fogvol__GLuint)s->program); /* (a freed name: INVALID_VALUE) */
     if (gl->has_vao) gl->BindVertexArray((fogvol__GLuint)s->vao); /* brings its element buffer back */
     else fogvol__gl_restore_attrib0(gl, s);
     gl->BindBuffer(FOGVOL__GL_ARRAY_BUFFER, (fogvol__GLuint)s->array_buffer);

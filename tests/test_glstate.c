@@ -81,6 +81,8 @@
     X(PFNGLLINKPROGRAMPROC, LinkProgram) \
     X(PFNGLGETPROGRAMIVPROC, GetProgramiv) \
     X(PFNGLUSEPROGRAMPROC, UseProgram) \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram) \
+    X(PFNGLISPROGRAMPROC, IsProgram) \
     X(PFNGLACTIVETEXTUREPROC, ActiveTexture) \
     X(PFNGLGENSAMPLERSPROC, GenSamplers) \
     X(PFNGLBINDSAMPLERPROC, BindSampler) \
@@ -847,6 +849,37 @@ static void test_core_rasterizer_discard(void **state)
     expect_fog_thickness(x, W, H);
 }
 
+/* The engine deleted the program it has current (GL keeps it until it is no longer current): fogvol
+   binds its own, which frees it, so it restores program 0 instead of the freed name (glUseProgram of
+   a freed name would raise GL_INVALID_VALUE in the engine's error queue). Every other item of state
+   comes back. */
+static void deleted_program_case(fx *x)
+{
+    snap before, after;
+    GLuint p;
+    GLint cur = -1, isp = 1;
+    fv_create(x, NULL);
+    engine_clear(x);
+    set_engine_state(x, !x->compat, 0, &before);
+    p = compile_engine_program(x->compat);
+    gf.UseProgram(p);
+    gf.DeleteProgram(p);
+    glGetIntegerv(GL_CURRENT_PROGRAM, &cur);
+    assert_int_equal(cur, (GLint)p); /* deleted, still current */
+    run_frame(x, FOGVOL_COMPOSITE_FULLSCREEN, W, H);
+    expect_no_gl_error("frame after the engine deleted its current program");
+    glGetIntegerv(GL_CURRENT_PROGRAM, &cur);
+    assert_int_equal(cur, 0);
+    isp = gf.IsProgram(p);
+    assert_false(isp);
+    gf.UseProgram((GLuint)before.program); /* the rest of the engine's state is untouched */
+    snapshot(&after, x->compat);
+    expect_same_state(&before, &after, "frame after the engine deleted its current program");
+    expect_fog_thickness(x, W, H);
+}
+static void test_core_deleted_program(void **state) { deleted_program_case((fx *)*state); }
+static void test_compat21_deleted_program(void **state) { deleted_program_case((fx *)*state); }
+
 /* (c) resource creation outside a frame, target creation, resize, destruction. */
 static void resources_case(fx *x)
 {
@@ -882,6 +915,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_core_fullscreen, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_rasterizer_discard, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_resources, setup_core, teardown),
+        cmocka_unit_test_setup_teardown(test_core_deleted_program, setup_core, teardown),
+        cmocka_unit_test_setup_teardown(test_compat21_deleted_program, setup_compat, teardown),
         cmocka_unit_test_setup_teardown(test_compat21_geometry, setup_compat, teardown),
         cmocka_unit_test_setup_teardown(test_compat21_fullscreen, setup_compat, teardown),
         cmocka_unit_test_setup_teardown(test_compat21_read_framebuffer, setup_compat, teardown),
