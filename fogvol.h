@@ -136,7 +136,8 @@
    MRT TIER (the engine's opaque pass writes the opaque depth as a 2nd output)
    ========
        fogvol_begin_frame(fv, &fd);
-       fogvol_mrt_info mi; fogvol_mrt_prepare(fv, &mi);   // O texture, clear colour, uniforms
+       fogvol_mrt_info mi; fogvol_mrt_prepare(fv, &mi);   // O texture (RGBA8, or R32F: FOGVOL_SPEEDUP_FLOAT_O),
+                                                           // clear colour, uniforms
        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, (GLuint)mi.texture, 0);
        glDrawBuffers(2, bufs); glClearBufferfv(GL_COLOR, 1, mi.clear_color);
        // opaque shader: fogvol_mrt_snippet() pasted in, uniform fogvol_mrt[2] = mi.uniforms,
@@ -258,7 +259,8 @@ typedef struct fogvol_texture_desc {
 
 typedef enum fogvol_format {
     FOGVOL_FORMAT_RGBA8 = 0,
-    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND) */
+    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND). MRT's O
+                                with FOGVOL_SPEEDUP_FLOAT_O: renderable (FOGVOL_CAP_FLOAT_TARGET) */
     FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
                                  wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
                                  EXT_color_buffer_float + EXT_float_blend) */
@@ -498,7 +500,15 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
                  writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
                  through the fragment shader (the same blend equation; the same pixels where the
-                 blender rounds the constant colour as it rounds a shader's output, as Mesa does). */
+                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
+   FLOAT_O       MRT (not WIDE) on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F texture that
+                 the engine's pass writes the normalised view depth d = (view depth - near) / (far -
+                 near) into (fogvol_mrt_info.format; the snippet switches on its uniforms), and the
+                 faces encode min(own depth, O) (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their
+                 own depth and comparing it with O's digits: one encode per fragment and no compare
+                 in the faces, and no encode in the engine's pass. The same bytes: the faces encode O
+                 as the snippet did (the same arithmetic on the same float), and the encode is
+                 monotonic, so the lesser encoding is the encoding of the lesser depth. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -510,7 +520,8 @@ enum {
     FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
     FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
     FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
-    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10
+    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
+    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -899,13 +910,17 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
    makes the O texture the size of the frame's viewport (this touches the GPU,
    state restored) and returns what the engine needs: the texture to attach as
    its second colour target (backend API object, GL: texture name), the colour
-   to clear that attachment to before drawing ("far"), and the values of the
-   snippet's uniform vec4 fogvol_mrt[2]. The engine's framebuffer must be
-   viewport-sized with origin (0,0). */
+   to clear that attachment to before drawing ("far"), the values of the
+   snippet's uniform vec4 fogvol_mrt[2], and the texture's format: RGBA8 (the
+   encoded depth) or, with FOGVOL_SPEEDUP_FLOAT_O, R32F (the normalised view
+   depth; the snippet writes it when its uniforms say so, the engine changes
+   nothing). The engine's framebuffer must be viewport-sized with origin (0,0),
+   and its pass must not blend into the attachment. */
 typedef struct fogvol_mrt_info {
     uintptr_t texture;
     float clear_color[4];
     float uniforms[8];
+    fogvol_format format;
 } fogvol_mrt_info;
 FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info);
 /* MRT tier: GLSL for the engine's opaque fragment shader. It declares
@@ -913,7 +928,8 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
    vec4 fogvol_encode_view_depth(float view_depth), whose result the engine
    writes to its second colour output (fogvol_encode_depth's bytes; computed in
    integers where the engine's GLSL has bit operations and floatBitsToInt: 330+,
-   300 es). Insert after the #version line and the engine's precision statements. */
+   300 es; with an R32F O, fogvol_mrt[0].z = 0: the normalised view depth in
+   red). Insert after the #version line and the engine's precision statements. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 
 /* Occluders drawn by the engine with its own programs, pipelines and vertex
@@ -1213,7 +1229,11 @@ enum {
                                              (GL 4.0, or GL 3.2 + ARB_sample_shading) */
     FOGVOL_CAP_MESH_LAYOUT = 1u << 5,     /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
     FOGVOL_CAP_FILTER_FLOAT = 1u << 6,    /* create_target honours fogvol_target_desc.linear for R32F */
-    FOGVOL_CAP_BLEND_CONSTANT = 1u << 7   /* begin_pass honours fogvol_pass.blend_constant */
+    FOGVOL_CAP_BLEND_CONSTANT = 1u << 7,  /* begin_pass honours fogvol_pass.blend_constant */
+    FOGVOL_CAP_FLOAT_TARGET = 1u << 8     /* R32F colour targets the engine's MRT pass can write at
+                                             full precision, blending not needed (GL 3.0; GLES 3 with
+                                             EXT_color_buffer_float where the engine declares its
+                                             output highp: the GL backend reports it on desktop GL only) */
 };
 
 typedef struct fogvol_frame_info {
@@ -1496,7 +1516,9 @@ typedef struct fogvol_shader_desc {
    DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
    position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
    jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
-   that do not read the engine's depth). Other bits, EXP with RAMP, L > 8, or bits for another program:
+   that do not read the engine's depth). FACE and LIGHT of MRT without WIDE: FLOAT_O (fv_opaque is an
+   R32F O holding the normalised view depth, encoded by the program where it needs O's digits; see
+   FOGVOL_SPEEDUP_FLOAT_O). Other bits, EXP with RAMP, L > 8, or bits for another program:
    FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
@@ -1515,7 +1537,8 @@ enum {
     FOGVOL_SPECIALIZE_ENCODING_MASK = 15u << 13, /* FOGVOL_SPECIALIZE_ENCODING(bits) */
     FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17,
     FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18,
-    FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19
+    FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19,
+    FOGVOL_SPECIALIZE_FLOAT_O = 1u << 20
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -5218,6 +5241,9 @@ static const char fogvol__fs_common[] =
 /* The RGBA8 tiers' encode (lookup textures or ALU, the dither) and the borrow fold: the second
    string of the shared fragment code (one string would pass the 4095 characters C99 guarantees). */
 static const char fogvol__fs_encode_common[] =
+    /* O as stored (FLOAT: d; RGBA8: digits); FV_O_FLOAT (SPECIALIZE_FLOAT_O): an R32F O, encoded
+       as the engine's snippet would have */
+    "#ifdef FV_O_FLOAT\n#define FV_O_DIGITS(s) fv_encode(FV_SCREEN(s).r)\n#else\n#define FV_O_DIGITS(s) FV_SCREEN(s)\n#endif\n"
     "#if !defined(FV_FLOAT)\n"
     /* FV_N, FV_DD: the digit base N and the dither steps D; FV_ENC_* (SPECIALIZE_ENCODING): the
        context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
@@ -5381,7 +5407,7 @@ static const char fogvol__fs_face[] =
     "void main() {\n"
     "#ifdef FV_DENSITY\n"                        /* decoded opaque depth, then v re-encoded */
     "    if (fv_dens.y > 0.5) {\n"
-    "        float od = dot(FV_SCREEN(fv_opaque), fv_dec) * fv_dens.z;\n"
+    "        float od = dot(FV_O_DIGITS(fv_opaque), fv_dec) * fv_dens.z;\n"
     "        FV_FRAGCOLOR = fv_encode(fv_density_apply(min(max(fv_d, 0.0), od), od));\n"
     "        return;\n"
     "    }\n"
@@ -5394,6 +5420,8 @@ static const char fogvol__fs_face[] =
     "    FV_FRAGCOLOR = vec4(e.rgb, 1.0 / 255.0);\n"
     "#elif defined(FV_NO_OPAQUE)\n"             /* O is the far plane: e never lies behind it */
     "    FV_FRAGCOLOR = e;\n"
+    "#elif defined(FV_O_FLOAT)\n"                /* the lesser depth's encoding (monotonic) */
+    "    FV_FRAGCOLOR = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n" /* (e: dead code) */
     "#else\n"
     "    vec4 o = FV_SCREEN(fv_opaque);\n"
     "#ifdef FV_PS13\n"
@@ -5595,7 +5623,7 @@ static const char fogvol__fs_light[] =
     "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
-    "    return fv_light_depth(FV_SCREEN(fv_opaque));\n"
+    "    return fv_light_depth(FV_O_DIGITS(fv_opaque));\n"
     "#endif\n"
     "}\n"
     "void main() {\n"
@@ -5835,7 +5863,8 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* PS13 only (fogvol_shader_strings) */
-    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
+    if (p == FOGVOL_PROGRAM_LIGHT) bits &= ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O;
+    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~(face | FOGVOL_SPECIALIZE_FLOAT_O)) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
 }
@@ -5874,6 +5903,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) strings[n++] = "#define FV_INLINE_RESOLVE\n";
     if (d->specialize & FOGVOL_SPECIALIZE_BLEND_COLOR) strings[n++] = "#define FV_BLEND_COLOR\n";
     if (d->specialize & FOGVOL_SPECIALIZE_DEPTH_FROM_Z) strings[n++] = "#define FV_DEPTH_FROM_Z\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) strings[n++] = "#define FV_O_FLOAT\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -5915,6 +5945,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && (d->tier != FOGVOL_TIER_MRT || (v & FOGVOL_VARIANT_WIDE)))
+        return FOGVOL_ERROR_UNSUPPORTED; /* (the engine writes WIDE's two RGBA8 attachments) */
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__count_spec_ok(d->tier, v) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
@@ -5966,9 +5998,13 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
    floatBitsToInt and bit operations (GLSL 330+, 300 es), by FV_IALU's FOGVOL__IALU_TEXT. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "vec4 fogvol_view_depth_r32f(float view_depth) {\n" /* N = 0: an R32F target */ \
+    "    return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n" \
+    "}\n" \
     "#if __VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300)\n" \
     FOGVOL__IALU_TEXT \
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
+    "    if (fogvol_mrt[0].z == 0.0) return fogvol_view_depth_r32f(view_depth);\n" \
     "    highp int ln = fogvol_log2i(fogvol_mrt[0].z), ld = fogvol_log2i(fogvol_mrt[1].z), dd = 1 << ld;\n" \
     "    highp int k = fogvol_mrt[1].w > 0.5 ? fogvol_dither_scaled(dd) : dd >> 1;\n" \
     "    float u = clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
@@ -5976,6 +6012,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "}\n" \
     "#else\n" \
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
+    "    if (fogvol_mrt[0].z == 0.0) return fogvol_view_depth_r32f(view_depth);\n" \
     "    vec2 p = mod(floor(gl_FragCoord.xy), 8.0);\n" \
     "    vec2 b0 = mod(p, 2.0), b1 = mod(floor(p * 0.5), 2.0), b2 = mod(floor(p * 0.25), 2.0);\n" \
     "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n" \
@@ -5995,11 +6032,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
 static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
 /* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks the FLOAT tier's R32F target */
 static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
-    "vec4 fogvol_occluder_color(float view_depth) {\n"
-    "    if (fogvol_mrt[0].z == 0.0)\n"
-    "        return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
-    "    return fogvol_encode_view_depth(view_depth);\n"
-    "}\n";
+    "vec4 fogvol_occluder_color(float view_depth) { return fogvol_encode_view_depth(view_depth); }\n";
 
 FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
 FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_snippet; }
@@ -6326,6 +6359,7 @@ struct fogvol_context {
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
     int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
     int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
+    int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: MRT's O is R32F */
 };
 
 /* column-major 4x4 helpers in double */
@@ -6462,8 +6496,10 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
     } else {
         td.depth = ctx->tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
         td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
-        td.label = "fogvol O (opaque depth)";
+        td.label = ctx->float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
+        td.format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+        td.format = FOGVOL_FORMAT_RGBA8;
         td.depth = 0;
         if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->tier, ctx->variants))
             td.share_depth = ctx->tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
@@ -6609,6 +6645,8 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (ctx->inline_resolve && (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
                                 p == FOGVOL_PROGRAM_CHECK))
         sd.specialize |= FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* the general programs too: there is no T */
+    if (ctx->float_o && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT))
+        sd.specialize |= FOGVOL_SPECIALIZE_FLOAT_O; /* the general programs too: O is R32F */
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
@@ -6775,8 +6813,16 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
        frame first runs a check pass; LIGHT: when a frame first draws a light */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol__uses_program(ctx, (fogvol_program)i) && i != FOGVOL_PROGRAM_COMPOSITE_MESH &&
-            i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)
+            i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT) {
             r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
+            if (r != FOGVOL_SUCCESS && ctx->float_o && i == FOGVOL_PROGRAM_FACE) {
+                fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: the face program for an R32F O did not build "
+                                                           "(%s); O stays RGBA8 (FOGVOL_SPEEDUP_FLOAT_O off)",
+                            fogvol_result_string(r));
+                ctx->float_o = 0; /* (before any program that reads O is made) */
+                r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
+            }
+        }
     return r;
 }
 
@@ -6785,6 +6831,13 @@ static void fogvol__default_inline_resolve(fogvol_context *ctx)
 {
     ctx->inline_resolve = ctx->tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
                           !(ctx->speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
+}
+
+/* FOGVOL_SPEEDUP_FLOAT_O: MRT's O is R32F where the backend renders float targets. */
+static void fogvol__default_float_o(fogvol_context *ctx)
+{
+    ctx->float_o = ctx->tier == FOGVOL_TIER_MRT && !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
+                   (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O);
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
@@ -6831,6 +6884,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     if (r == FOGVOL_SUCCESS) {
         fogvol__default_alu(ctx);
         fogvol__default_inline_resolve(ctx);
+        fogvol__default_float_o(ctx);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
@@ -8043,11 +8097,16 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     }
     r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
-    info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    info->format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (ctx->float_o) { /* d = 1, the far plane; fogvol_mrt[0].z = N = 0 marks the R32F target */
+        info->clear_color[0] = 1.0f;
+    } else {
+        info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+        info->uniforms[2] = (float)ctx->enc.levels;
+        info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    }
     info->uniforms[0] = k.near_far[0];
     info->uniforms[1] = k.near_far[1];
-    info->uniforms[2] = (float)ctx->enc.levels;
-    info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
     info->uniforms[4] = k.depth_offset;
     info->uniforms[5] = k.depth_max;
     info->uniforms[6] = (float)ctx->enc.dither_steps;
@@ -11326,7 +11385,8 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         }
     } else {
         caps |= FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
-        if (gl->major >= 3) caps |= FOGVOL_CAP_FLOAT_BLEND; /* R32F render targets and float blending are core */
+        if (gl->major >= 3) /* R32F render targets and float blending are core */
+            caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_FLOAT_TARGET;
         gl->float_linear = gl->major >= 3;
         if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
     }

@@ -8,7 +8,8 @@
    bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
-   NO_COLOR_TEXTURE and NO_OVERFLOW only. */
+   NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by MRT's FACE and LIGHT without
+   WIDE only. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -42,6 +43,10 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
+        return t == FOGVOL_TIER_MRT && !(v & FOGVOL_VARIANT_WIDE) &&
+               (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
+               variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O, ms);
     if (bits & FOGVOL_SPECIALIZE_INLINE_RESOLVE)
         return t == FOGVOL_TIER_PS13 &&
                (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK) &&
@@ -133,6 +138,10 @@ int main(int argc, char **argv)
                                          FOGVOL_SPECIALIZE_OPAQUE,
                                      FOGVOL_SPECIALIZE_DEPTH_FROM_Z | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DITHER |
                                          FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_FLOAT_O,
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
+                                         FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

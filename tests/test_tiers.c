@@ -497,6 +497,149 @@ static void test_single_target_limit(void **state)
     assert_true(err <= 12.0);
 }
 
+/* FOGVOL_SPEEDUP_FLOAT_O: MRT's O as R32F, written by the same snippet and read by faces that encode
+   min(own depth, O), gives the bytes of the RGBA8 O (the speed-up switched off, and a backend without
+   FOGVOL_CAP_FLOAT_TARGET): every pixel of the engine's colour after the composite and every debug
+   thickness, dither on, with a density-textured volume and a light, whose faces decode O's digits
+   (FV_O_DIGITS). Camera inside: O is the clear colour everywhere. */
+static void float_o_frame(const tscene *s, int mode, int light, unsigned char *px, float *thick)
+{
+    static const char *const names[3] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET"};
+    fogvol_context_desc cd;
+    fogvol_backend be;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ], *lbox;
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_desc fd;
+    fogvol_frame_stats st;
+    fogvol_mrt_info mrt;
+    fogvol_volume_desc vd;
+    fogvol_light_desc ld;
+    fogvol_volume_texture *tex;
+    fogvol_texture_desc td;
+    fogvol_mesh_desc md;
+    shp_mesh box = shp_box(0.8f, 0.8f, 0.8f);
+    unsigned char dens[16 * 16 * 4];
+    GLint fmt = 0;
+    engine e;
+    int i;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.tier = FOGVOL_TIER_MRT;
+    if (mode == 1) cd.disable_speedups = FOGVOL_SPEEDUP_FLOAT_O;
+    if (mode == 2) {
+        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
+        assert_true(be.caps & FOGVOL_CAP_FLOAT_TARGET); /* desktop GL 3.0+ */
+        be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
+        cd.backend = be;
+    }
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    engine_init(&e);
+    upload_meshes(fv, s, meshes);
+    memset(&md, 0, sizeof md);
+    md.positions = box.pos;
+    md.vertex_count = box.vcount;
+    md.indices = (const uint32_t *)box.idx;
+    md.index_count = box.icount;
+    assert_int_equal(fogvol_create_mesh(fv, &md, &lbox, NULL), FOGVOL_SUCCESS);
+    for (i = 0; i < 16 * 16; ++i) {
+        dens[4 * i] = (unsigned char)(40 + (i * 53) % 216);
+        dens[4 * i + 1] = dens[4 * i + 2] = 0;
+        dens[4 * i + 3] = 255;
+    }
+    memset(&td, 0, sizeof td);
+    td.width = td.height = 16;
+    td.pixels = dens;
+    td.filter = FOGVOL_FILTER_NEAREST;
+    assert_int_equal(fogvol_create_volume_texture(fv, &td, &tex), FOGVOL_SUCCESS);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.9f, rd.color[1] = 0.6f, rd.color[2] = 0.3f;
+    rd.density = s->density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    fx_frame_desc(&fd, &s->cam, W, H);
+    fd.debug_thickness = thick;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+    glBindTexture(GL_TEXTURE_2D, (GLuint)mrt.texture);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    assert_int_equal(fmt, mode == 0 ? GL_R32F : GL_RGBA8);
+    assert_int_equal(mrt.format, mode == 0 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
+    engine_draw(&e, s, fd.view, fd.projection, &mrt);
+    add_scene(fv, s, meshes, ramp, 0);
+    memset(&vd, 0, sizeof vd); /* the first volume's mesh once more, shifted, density-textured across x and y */
+    for (i = 0; s->obj[i].sign == 0; ++i) continue;
+    vd.mesh = meshes[i];
+    vd.ramp = ramp;
+    glu_translate_scale(vd.model, 0.15f, -0.1f, 0.05f, 0.9f);
+    vd.density = tex;
+    vd.density_map[0] = 0.4f, vd.density_map[3] = 0.5f, vd.density_map[5] = 0.4f, vd.density_map[7] = 0.5f;
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = lbox;
+    glu_translate_scale(ld.model, 0.1f, -0.2f, -0.3f, 1);
+    ld.color[0] = 0.3f, ld.color[1] = 0.25f, ld.color[2] = 0.1f;
+    if (light) assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.lights, light);
+    glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    if (strcmp(s->name, "plane_cuts_sphere") == 0 && mode == 0 && light) {
+        mkdir("build", 0777);
+        stbi_flip_vertically_on_write(1);
+        stbi_write_png("build/tiers/mrt_float_o.png", W, H, 4, px, W * 4);
+    }
+    print_message("  MRT %s, %s%s: O %s\n", names[mode], s->name, light ? "" : " (no light)",
+                  mode == 0 ? "R32F" : "RGBA8");
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_volume_texture(fv, tex);
+    fogvol_destroy_mesh(fv, lbox);
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_context(fv);
+    engine_free(&e);
+    shp_free(&box);
+}
+
+static void test_float_o(void **state)
+{
+    static const char *const scenes[] = {"plane_cuts_sphere", "layers_opaque_between", "camera_inside_sphere"};
+    unsigned char *px[4];
+    float *thick[4];
+    glu_ctx g;
+    int sc, m, i, lit = 0, differ;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (m = 0; m < 4; ++m) {
+        px[m] = (unsigned char *)malloc((size_t)W * H * 4);
+        thick[m] = (float *)malloc((size_t)W * H * sizeof(float));
+    }
+    for (sc = 0; sc < 3; ++sc) {
+        const tscene *s = &g_scenes[scene_index(scenes[sc])];
+        for (m = 0; m < 3; ++m) float_o_frame(s, m, 1, px[m], thick[m]);
+        float_o_frame(s, 0, 0, px[3], thick[3]);
+        for (m = 1; m < 3; ++m) {
+            for (i = 0, differ = 0; i < W * H * 4; ++i) differ += px[0][i] != px[m][i];
+            if (differ) print_message("  %s: %d bytes differ from the RGBA8 O (mode %d)\n", s->name, differ, m);
+            assert_int_equal(differ, 0);
+            assert_memory_equal(thick[0], thick[m], (size_t)W * H * sizeof(float));
+        }
+        /* the light lit occluder pixels (its back faces read O) where the scene has occluders */
+        for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[3] + 4 * i, 4) != 0;
+        print_message("  %s: %d pixels lit\n", s->name, differ);
+        if (s->n > 1) assert_true(differ > 50);
+        lit += differ;
+    }
+    print_message("  FLOAT_O: the same bytes in 3 scenes x 3 ways; %d pixels lit\n", lit);
+    for (m = 0; m < 4; ++m) {
+        free(px[m]);
+        free(thick[m]);
+    }
+    glu_destroy(&g);
+}
+
 /* The pass counts of the seed (engine pass included) and fogvol's own. */
 static void test_pass_counts(void **state)
 {
@@ -576,7 +719,7 @@ static int setup_all(void **state)
 int main(void)
 {
     static tcase cases[NTIER_COMBO * NDIALECT];
-    static struct CMUnitTest tests[NTIER_COMBO * NDIALECT + 3];
+    static struct CMUnitTest tests[NTIER_COMBO * NDIALECT + 4];
     static char names[NTIER_COMBO * NDIALECT][64];
     int ci, di, n = 0;
     tests[n].name = "choice_and_support";
@@ -588,15 +731,18 @@ int main(void)
     tests[n].name = "single_target_limit";
     tests[n].test_func = test_single_target_limit;
     ++n;
+    tests[n].name = "float_o";
+    tests[n].test_func = test_float_o;
+    ++n;
     for (ci = 0; ci < NTIER_COMBO; ++ci)
         for (di = 0; di < NDIALECT; ++di) {
-            tcase *t = &cases[n - 3];
+            tcase *t = &cases[n - 4];
             if (fogvol_combination_supported(g_tier_combos[ci].tier, g_tier_combos[ci].variants, g_dialects[di]) != 0) continue;
             t->combo = ci;
             t->dialect = di;
-            snprintf(names[n - 3], sizeof names[n - 3], "%s_glsl_%s", g_tier_combos[ci].name,
+            snprintf(names[n - 4], sizeof names[n - 4], "%s_glsl_%s", g_tier_combos[ci].name,
                      fogvol_dialect_name(g_dialects[di]));
-            tests[n].name = names[n - 3];
+            tests[n].name = names[n - 4];
             tests[n].test_func = run_case;
             tests[n].initial_state = t;
             ++n;
