@@ -501,10 +501,26 @@ static void test_single_target_limit(void **state)
    min(own depth, O), gives the bytes of the RGBA8 O (the speed-up switched off, and a backend without
    FOGVOL_CAP_FLOAT_TARGET): every pixel of the engine's colour after the composite and every debug
    thickness, dither on, with a density-textured volume and a light, whose faces decode O's digits
-   (FV_O_DIGITS). Camera inside: O is the clear colour everywhere. */
+   (FV_O_DIGITS). Camera inside: O is the clear colour everywhere. A backend that cannot build the
+   programs for an R32F O (mode 3) gets the RGBA8 O and the same bytes, and a warning. */
+static fogvol_backend g_fo_inner;
+static int g_fo_warnings;
+static fogvol_result fo_fail_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
+{
+    int i;
+    for (i = 0; i < d->fs_count; ++i)
+        if (strcmp(d->fs[i], "#define FV_O_FLOAT\n") == 0) return FOGVOL_ERROR_BACKEND;
+    return g_fo_inner.create_program(u, d, out);
+}
+static void fo_logger(void *u, fogvol_log_level l, const char *m)
+{
+    g_fo_warnings += l == FOGVOL_LOG_WARNING && strstr(m, "O stays RGBA8") != NULL;
+    logger(u, l, m);
+}
 static void float_o_frame(const tscene *s, int mode, int light, unsigned char *px, float *thick)
 {
-    static const char *const names[3] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET"};
+    static const char *const names[4] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET",
+                                         "R32F programs fail to build"};
     fogvol_context_desc cd;
     fogvol_backend be;
     fogvol_context *fv;
@@ -526,8 +542,9 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     int i;
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = logger;
+    cd.logger.func = fo_logger;
     cd.tier = FOGVOL_TIER_MRT;
+    g_fo_warnings = 0;
     if (mode == 1) cd.disable_speedups = FOGVOL_SPEEDUP_FLOAT_O;
     if (mode == 2) {
         assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
@@ -535,7 +552,14 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
         be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
         cd.backend = be;
     }
+    if (mode == 3) {
+        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
+        g_fo_inner = be;
+        be.create_program = fo_fail_program;
+        cd.backend = be;
+    }
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(g_fo_warnings, mode == 3);
     engine_init(&e);
     upload_meshes(fv, s, meshes);
     memset(&md, 0, sizeof md);
@@ -606,34 +630,34 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
 static void test_float_o(void **state)
 {
     static const char *const scenes[] = {"plane_cuts_sphere", "layers_opaque_between", "camera_inside_sphere"};
-    unsigned char *px[4];
-    float *thick[4];
+    unsigned char *px[5];
+    float *thick[5];
     glu_ctx g;
     int sc, m, i, lit = 0, differ;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
-    for (m = 0; m < 4; ++m) {
+    for (m = 0; m < 5; ++m) {
         px[m] = (unsigned char *)malloc((size_t)W * H * 4);
         thick[m] = (float *)malloc((size_t)W * H * sizeof(float));
     }
     for (sc = 0; sc < 3; ++sc) {
         const tscene *s = &g_scenes[scene_index(scenes[sc])];
-        for (m = 0; m < 3; ++m) float_o_frame(s, m, 1, px[m], thick[m]);
-        float_o_frame(s, 0, 0, px[3], thick[3]);
-        for (m = 1; m < 3; ++m) {
+        for (m = 0; m < 4; ++m) float_o_frame(s, m, 1, px[m], thick[m]);
+        float_o_frame(s, 0, 0, px[4], thick[4]);
+        for (m = 1; m < 4; ++m) {
             for (i = 0, differ = 0; i < W * H * 4; ++i) differ += px[0][i] != px[m][i];
             if (differ) print_message("  %s: %d bytes differ from the RGBA8 O (mode %d)\n", s->name, differ, m);
             assert_int_equal(differ, 0);
             assert_memory_equal(thick[0], thick[m], (size_t)W * H * sizeof(float));
         }
         /* the light lit occluder pixels (its back faces read O) where the scene has occluders */
-        for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[3] + 4 * i, 4) != 0;
+        for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[4] + 4 * i, 4) != 0;
         print_message("  %s: %d pixels lit\n", s->name, differ);
         if (s->n > 1) assert_true(differ > 50);
         lit += differ;
     }
-    print_message("  FLOAT_O: the same bytes in 3 scenes x 3 ways; %d pixels lit\n", lit);
-    for (m = 0; m < 4; ++m) {
+    print_message("  FLOAT_O: the same bytes in 3 scenes x 4 ways; %d pixels lit\n", lit);
+    for (m = 0; m < 5; ++m) {
         free(px[m]);
         free(thick[m]);
     }
