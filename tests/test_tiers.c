@@ -623,6 +623,7 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     fogvol_destroy_mesh(fv, lbox);
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_context(fv);
+    if (mode >= 2) be.destroy(be.user_data); /* (a backend table passed in stays the caller's) */
     engine_free(&e);
     shp_free(&box);
 }
