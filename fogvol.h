@@ -5421,7 +5421,7 @@ static const char fogvol__fs_face[] =
     "#elif defined(FV_NO_OPAQUE)\n"             /* O is the far plane: e never lies behind it */
     "    FV_FRAGCOLOR = e;\n"
     "#elif defined(FV_O_FLOAT)\n"                /* the lesser depth's encoding (monotonic) */
-    "    FV_FRAGCOLOR = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n" /* (e: dead code) */
+    "    FV_FRAGCOLOR = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n" /* (e unused: compiled out) */
     "#else\n"
     "    vec4 o = FV_SCREEN(fv_opaque);\n"
     "#ifdef FV_PS13\n"
@@ -6030,7 +6030,8 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "}\n" \
     "#endif\n"
 static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
-/* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks the FLOAT tier's R32F target */
+/* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks an R32F target (the FLOAT tier's O,
+   as MRT's with FOGVOL_SPEEDUP_FLOAT_O) */
 static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
     "vec4 fogvol_occluder_color(float view_depth) { return fogvol_encode_view_depth(view_depth); }\n";
 
