@@ -501,7 +501,7 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
                  through the fragment shader (the same blend equation; the same pixels where the
                  blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT (not WIDE) on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F texture that
+   FLOAT_O       MRT on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F texture that
                  the engine's pass writes the normalised view depth d = (view depth - near) / (far -
                  near) into (fogvol_mrt_info.format; the snippet switches on its uniforms), and the
                  faces encode min(own depth, O) (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their
@@ -1516,7 +1516,7 @@ typedef struct fogvol_shader_desc {
    DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
    position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
    jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
-   that do not read the engine's depth). FACE and LIGHT of MRT without WIDE: FLOAT_O (fv_opaque is an
+   that do not read the engine's depth). FACE and LIGHT of MRT: FLOAT_O (fv_opaque is an
    R32F O holding the normalised view depth, encoded by the program where it needs O's digits; see
    FOGVOL_SPEEDUP_FLOAT_O). Other bits, EXP with RAMP, L > 8, or bits for another program:
    FOGVOL_ERROR_UNSUPPORTED. */
@@ -5945,8 +5945,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
-    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && (d->tier != FOGVOL_TIER_MRT || (v & FOGVOL_VARIANT_WIDE)))
-        return FOGVOL_ERROR_UNSUPPORTED; /* (the engine writes WIDE's two RGBA8 attachments) */
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && d->tier != FOGVOL_TIER_MRT) return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__count_spec_ok(d->tier, v) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
@@ -6837,8 +6836,8 @@ static void fogvol__default_inline_resolve(fogvol_context *ctx)
 /* FOGVOL_SPEEDUP_FLOAT_O: MRT's O is R32F where the backend renders float targets. */
 static void fogvol__default_float_o(fogvol_context *ctx)
 {
-    ctx->float_o = ctx->tier == FOGVOL_TIER_MRT && !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
-                   (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O);
+    ctx->float_o = ctx->tier == FOGVOL_TIER_MRT && (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) &&
+                   !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O); /* (MRT has no WIDE) */
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,

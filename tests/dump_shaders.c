@@ -8,8 +8,7 @@
    bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
-   NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by MRT's FACE and LIGHT without
-   WIDE only. */
+   NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by MRT's FACE and LIGHT only. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -44,8 +43,7 @@ static int spec_applies(int p, unsigned bits)
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
     if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
-        return t == FOGVOL_TIER_MRT && !(v & FOGVOL_VARIANT_WIDE) &&
-               (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
+        return t == FOGVOL_TIER_MRT && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O, ms);
     if (bits & FOGVOL_SPECIALIZE_INLINE_RESOLVE)
         return t == FOGVOL_TIER_PS13 &&
