@@ -5243,7 +5243,8 @@ static const char fogvol__fs_common[] =
 static const char fogvol__fs_encode_common[] =
     /* O as stored (FLOAT: d; RGBA8: digits); FV_O_FLOAT (SPECIALIZE_FLOAT_O): an R32F O, encoded
        as the engine's snippet would have */
-    "#ifdef FV_O_FLOAT\n#define FV_O_DIGITS(s) fv_encode(FV_SCREEN(s).r)\n#else\n#define FV_O_DIGITS(s) FV_SCREEN(s)\n#endif\n"
+    "#ifdef FV_O_FLOAT\n#define FV_O_DIGITS(s) fv_encode(FV_SCREEN(s).r)\n"
+    "#else\n#define FV_O_DIGITS(s) FV_SCREEN(s)\n#endif\n"
     "#if !defined(FV_FLOAT)\n"
     /* FV_N, FV_DD: the digit base N and the dither steps D; FV_ENC_* (SPECIALIZE_ENCODING): the
        context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
