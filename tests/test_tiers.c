@@ -393,6 +393,20 @@ static void test_choice_and_support(void **state)
     glu_destroy(&g);
 }
 
+/* A shape as a closed fogvol mesh. */
+static fogvol_mesh *upload_shape(fogvol_context *fv, const shp_mesh *m)
+{
+    fogvol_mesh_desc md;
+    fogvol_mesh *out = NULL;
+    memset(&md, 0, sizeof md);
+    md.positions = m->pos;
+    md.vertex_count = m->vcount;
+    md.indices = (const uint32_t *)m->idx;
+    md.index_count = m->icount;
+    assert_int_equal(fogvol_create_mesh(fv, &md, &out, NULL), FOGVOL_SUCCESS);
+    return out;
+}
+
 /* The single-target variant sums on top of 128: half the faces fit. k nested
    shells near the far plane (digits up to 15 at L = 4): 8 per sign still sum
    exactly, 12 saturate and are reported, while the two-target PS20 holds 12. */
@@ -407,7 +421,6 @@ static void shells(int k, unsigned variants, fogvol_result *result, int *overflo
     fogvol_frame_desc fd;
     fogvol_frame_stats st;
     fogvol_volume_desc vd;
-    fogvol_mesh_desc md;
     rc_camera cam;
     float *thick = (float *)calloc((size_t)W * H, sizeof(float));
     shp_mesh all = shp_sphere(0.25f, 32, 16);
@@ -434,12 +447,7 @@ static void shells(int k, unsigned variants, fogvol_result *result, int *overflo
     cd.variants = variants;
     cd.disable_dither = 1;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    memset(&md, 0, sizeof md);
-    md.positions = all.pos;
-    md.vertex_count = all.vcount;
-    md.indices = (const uint32_t *)all.idx;
-    md.index_count = all.icount;
-    assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+    mesh = upload_shape(fv, &all);
     memset(&rd, 0, sizeof rd);
     rd.density = 1;
     assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
@@ -534,7 +542,6 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     fogvol_light_desc ld;
     fogvol_volume_texture *tex;
     fogvol_texture_desc td;
-    fogvol_mesh_desc md;
     shp_mesh box = shp_box(0.8f, 0.8f, 0.8f);
     unsigned char dens[16 * 16 * 4];
     GLint fmt = 0;
@@ -546,28 +553,19 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     cd.tier = FOGVOL_TIER_MRT;
     g_fo_warnings = 0;
     if (mode == 1) cd.disable_speedups = FOGVOL_SPEEDUP_FLOAT_O;
-    if (mode == 2) {
+    if (mode >= 2) {
         assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
         assert_true(be.caps & FOGVOL_CAP_FLOAT_TARGET); /* desktop GL 3.0+ */
-        be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
-        cd.backend = be;
-    }
-    if (mode == 3) {
-        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
         g_fo_inner = be;
-        be.create_program = fo_fail_program;
+        if (mode == 2) be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
+        else be.create_program = fo_fail_program;
         cd.backend = be;
     }
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
     assert_int_equal(g_fo_warnings, mode == 3);
     engine_init(&e);
     upload_meshes(fv, s, meshes);
-    memset(&md, 0, sizeof md);
-    md.positions = box.pos;
-    md.vertex_count = box.vcount;
-    md.indices = (const uint32_t *)box.idx;
-    md.index_count = box.icount;
-    assert_int_equal(fogvol_create_mesh(fv, &md, &lbox, NULL), FOGVOL_SUCCESS);
+    lbox = upload_shape(fv, &box);
     for (i = 0; i < 16 * 16; ++i) {
         dens[4 * i] = (unsigned char)(40 + (i * 53) % 216);
         dens[4 * i + 1] = dens[4 * i + 2] = 0;
