@@ -821,8 +821,11 @@ typedef struct fogvol_frame_desc {
    (out-of-memory and context-loss codes cannot be raised again: logged as a
    warning); an active transform feedback is paused during the call (GL 4.0 /
    GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); fogvol must not be called between glBeginConditionalRender and
-   glEndConditionalRender (not queryable: its passes could be skipped). */
+   one); an occlusion or PRIMITIVES_GENERATED query the engine has running
+   counts fogvol's draws too (GL cannot pause those; fogvol then skips its
+   own overflow query for the frame); fogvol must not be called between
+   glBeginConditionalRender and glEndConditionalRender (not queryable: its
+   passes could be skipped). */
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *desc);
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16]);
 /* The callback runs inside the O pass with the depth-encode program bound:
@@ -9845,8 +9848,7 @@ FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
      turns those off);
    - PROVOKING_VERTEX: fogvol's shaders have no flat varyings;
    - PATCH_VERTICES and default patch levels: fogvol draws TRIANGLES with no tessellation stage;
-   - uniform, shader-storage, atomic-counter and image bindings, BLEND_COLOR: no fogvol shader or blend
-     function reads them;
+   - uniform, shader-storage, atomic-counter and image bindings: no fogvol shader reads them;
    - texture bindings of targets other than TEXTURE_2D on fogvol's units: it samples sampler2D only;
    - conditional rendering: it cannot be queried; fogvol must not be called between
      glBeginConditionalRender and glEndConditionalRender (its passes could be discarded). */
