@@ -395,6 +395,13 @@ typedef struct fogvol_gl_desc {
     int version_minor;
     int gles;                 /* with version_major: 1 = treat as OpenGL ES */
     int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
+    int mrt_highp;            /* OpenGL ES: 1 = the engine declares the output it writes fogvol's O with
+                                 highp (layout(location = 1) out highp vec4, or precision highp float):
+                                 on GLES 3 with EXT_color_buffer_float the backend then reports
+                                 FOGVOL_CAP_FLOAT_TARGET and the MRT tier keeps O as R32F
+                                 (FOGVOL_SPEEDUP_FLOAT_O). Left 0, a mediump output could round the
+                                 depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
+                                 precision). */
 } fogvol_gl_desc;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -1235,8 +1242,8 @@ enum {
     FOGVOL_CAP_BLEND_CONSTANT = 1u << 7,  /* begin_pass honours fogvol_pass.blend_constant */
     FOGVOL_CAP_FLOAT_TARGET = 1u << 8     /* R32F colour targets the engine's MRT pass can write at
                                              full precision, blending not needed (GL 3.0; GLES 3 with
-                                             EXT_color_buffer_float where the engine declares its
-                                             output highp: the GL backend reports it on desktop GL only) */
+                                             EXT_color_buffer_float where the engine's output is highp:
+                                             fogvol_gl_desc.mrt_highp) */
 };
 
 typedef struct fogvol_frame_info {
@@ -9959,6 +9966,7 @@ typedef struct fogvol__gl {
     int stencil_override;
     int has_msaa; /* multisample textures and per-sample shading */
     int float_linear; /* R32F textures can be filtered (GL 3.0; GLES 3 + OES_texture_float_linear) */
+    int mrt_highp;    /* fogvol_gl_desc.mrt_highp */
 #define FOGVOL__GL_MEMBER_MSAA(ret, name, params) fogvol__PFN_##name name;
     FOGVOL__GL_MSAA(FOGVOL__GL_MEMBER_MSAA)
 #undef FOGVOL__GL_MEMBER_MSAA
@@ -11379,8 +11387,10 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         if (precision > 0) caps |= FOGVOL_CAP_HIGHP_FRAGMENT;
         if (gl->major >= 3) {
             caps |= FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE;
-            if (fogvol__gl_has_ext3(gl, "GL_EXT_color_buffer_float") && fogvol__gl_has_ext3(gl, "GL_EXT_float_blend"))
-                caps |= FOGVOL_CAP_FLOAT_BLEND;
+            if (fogvol__gl_has_ext3(gl, "GL_EXT_color_buffer_float")) {
+                if (fogvol__gl_has_ext3(gl, "GL_EXT_float_blend")) caps |= FOGVOL_CAP_FLOAT_BLEND;
+                if (gl->mrt_highp) caps |= FOGVOL_CAP_FLOAT_TARGET; /* (fogvol_gl_desc.mrt_highp) */
+            }
             gl->float_linear = fogvol__gl_has_ext3(gl, "GL_OES_texture_float_linear");
             if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
         } else if (fogvol__has_ext(ext, "GL_OES_depth_texture")) {
@@ -11668,6 +11678,7 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
     gl->dialect = desc->dialect;
     if (gl->dialect == FOGVOL_GLSL_AUTO) gl->dialect = fogvol__dialect_for_gl(gl->gles, gl->major, gl->minor);
     gl->stencil_override = desc->stencil_bits;
+    gl->mrt_highp = desc->mrt_highp != 0;
     gl->caps = fogvol__gl_caps(gl, ext);
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
     fogvol__gl_load_clip_control(gl, desc, ext);

@@ -258,7 +258,6 @@ static void engine_draw(engine *e, const eglu_ctx *c, const tscene *s, const flo
     if (mrt) {
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, (GLuint)mrt->texture, 0);
         glDrawBuffers(2, bufs);
-        glClearBufferfv(GL_COLOR, 1, mrt->clear_color);
     }
     glViewport(0, 0, W, H);
     glDepthMask(GL_TRUE);
@@ -267,6 +266,7 @@ static void engine_draw(engine *e, const eglu_ctx *c, const tscene *s, const flo
     glClearDepthf(1.0f);
     glClearStencil(0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    if (mrt) glClearBufferfv(GL_COLOR, 1, mrt->clear_color); /* after glClear, which clears every draw buffer */
     glEnable(GL_DEPTH_TEST); /* its own state, whatever the last frame left */
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
@@ -367,12 +367,15 @@ static void write_png(const char *ctx_file, const char *what, const unsigned cha
     stbi_write_png(path, W, H, 4, px, W * 4);
 }
 
+static int g_mrt_highp; /* fogvol_gl_desc.mrt_highp of make_context */
+
 static fogvol_context *make_context(const tier_combo *cb, int bits)
 {
     fogvol_context_desc cd;
     fogvol_context *fv = NULL;
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = eglu_proc;
+    cd.gl.mrt_highp = g_mrt_highp;
     cd.logger.func = logger;
     cd.tier = cb->tier;
     cd.variants = cb->variants;
@@ -421,9 +424,9 @@ static fogvol_result engine_frame(fogvol_context *fv, const eglu_ctx *c, engine 
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
     if (mrt_tier) {
         assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
-        /* the GL backend reports no FOGVOL_CAP_FLOAT_TARGET on GLES (an engine's mediump output would
-           round a float O to fp16): O stays the encoded RGBA8 */
-        assert_int_equal(mrt.format, FOGVOL_FORMAT_RGBA8);
+        /* on GLES the GL backend reports FOGVOL_CAP_FLOAT_TARGET only when the engine says its output is
+           highp (a mediump output could round a float O to fp16): else O stays the encoded RGBA8 */
+        assert_int_equal(mrt.format, g_mrt_highp ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
     }
     engine_draw(e, c, s, fd.view, fd.projection, mrt_tier ? &mrt : NULL);
     add_scene(fv, s, meshes, ramp, !mrt_tier);
@@ -572,6 +575,64 @@ static void test_combo(void **state)
     assert_true(n > 1000);
     assert_true(g_mean[tc->ctx][tc->combo] <= 0.5 + (n ? slack_pp / n : 0)); /* + the mean snapping allowance */
     assert_true(comp <= 2.0 / 255.0);
+}
+
+/* fogvol_gl_desc.mrt_highp (this engine's fragment shader is precision highp): on GLES 3 with
+   EXT_color_buffer_float MRT keeps O as R32F (FOGVOL_SPEEDUP_FLOAT_O), and every scene gives the
+   bytes and the debug thickness of the encoded RGBA8 O, inside the engine's state checks of
+   engine_frame. */
+static void test_mrt_float_o(void **state)
+{
+    int ci = (int)(intptr_t)*state, sc, k, i, cb = -1;
+    unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged[2];
+    float *thick[2];
+    eglu_ctx c;
+    engine e;
+    for (k = 0; k < NTIER_COMBO; ++k)
+        if (g_tier_combos[k].tier == FOGVOL_TIER_MRT && g_tier_combos[k].variants == 0) cb = k;
+    assert_true(cb >= 0);
+    context_up(ci, &c);
+    if (!has_ext("GL_EXT_color_buffer_float")) {
+        print_message("  %s has no EXT_color_buffer_float: skipped\n", g_ctx[ci].name);
+        eglu_destroy(&c);
+        free(base);
+        skip();
+    }
+    engine_init(&e, 1);
+    for (k = 0; k < 2; ++k) {
+        fogged[k] = (unsigned char *)malloc((size_t)W * H * 4);
+        thick[k] = (float *)malloc((size_t)W * H * sizeof(float));
+    }
+    for (sc = 0; sc < NSCENE; ++sc) {
+        const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
+        int differ = 0;
+        for (k = 0; k < 2; ++k) {
+            fogvol_mesh *meshes[MAX_OBJ];
+            fogvol_ramp *ramp;
+            fogvol_frame_stats st;
+            fogvol_context *fv;
+            g_mrt_highp = k == 0;
+            fv = scene_context(&g_tier_combos[cb], s, meshes, &ramp);
+            assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 1, thick[k], base, fogged[k], &st),
+                             FOGVOL_SUCCESS);
+            for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+            fogvol_destroy_ramp(fv, ramp);
+            fogvol_destroy_context(fv);
+        }
+        g_mrt_highp = 0;
+        for (i = 0; i < W * H * 4; ++i) differ += fogged[0][i] != fogged[1][i];
+        print_message("  %s, MRT, %s: R32F O against RGBA8 O: %d bytes differ\n", g_ctx[ci].name, s->name, differ);
+        assert_int_equal(differ, 0);
+        assert_memory_equal(thick[0], thick[1], (size_t)W * H * sizeof(float));
+    }
+    engine_free(&e);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    eglu_destroy(&c);
+    for (k = 0; k < 2; ++k) {
+        free(fogged[k]);
+        free(thick[k]);
+    }
+    free(base);
 }
 
 /* fogvol_frame_desc.downsample 2 in an OpenGL ES 3 context (FLOAT where the context has float
@@ -944,8 +1005,8 @@ static int add_ctx_test(struct CMUnitTest *tests, char (*names)[64], int n, int 
 static int run_context(int ci)
 {
     static tcase cases[NTIER_COMBO];
-    static struct CMUnitTest tests[NTIER_COMBO + 5];
-    static char names[NTIER_COMBO + 5][64], group[32];
+    static struct CMUnitTest tests[NTIER_COMBO + 6];
+    static char names[NTIER_COMBO + 6][64], group[32];
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
@@ -965,6 +1026,7 @@ static int run_context(int ci)
     if (g_ctx[ci].major >= 3) {
         n = add_ctx_test(tests, names, n, ci, "drawbuffers", test_drawbuffers);
         n = add_ctx_test(tests, names, n, ci, "half_resolution", test_half_resolution);
+        n = add_ctx_test(tests, names, n, ci, "mrt_float_o", test_mrt_float_o);
     }
     if (g_ctx[ci].major == 3 && g_ctx[ci].override) /* GLES 3.0 */
         n = add_ctx_test(tests, names, n, ci, "partial_extension", test_partial_extension);
