@@ -5423,16 +5423,18 @@ static const char fogvol__fs_face[] =
     "        return;\n"
     "    }\n"
     "#endif\n"
+    "#if defined(FV_O_FLOAT) && !defined(FV_NO_OPAQUE)\n" /* the lesser depth's encoding (monotonic) */
+    "    vec4 e = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n"
+    "#else\n"
     "    vec4 e = fv_encode(fv_d);\n"
+    "#endif\n"
     "#ifdef FV_NORMALIZE\n"
     "    e = fv_normalize(e);\n"
     "#endif\n"
     "#ifdef FV_COUNT\n"
     "    FV_FRAGCOLOR = vec4(e.rgb, 1.0 / 255.0);\n"
-    "#elif defined(FV_NO_OPAQUE)\n"             /* O is the far plane: e never lies behind it */
+    "#elif defined(FV_NO_OPAQUE) || defined(FV_O_FLOAT)\n" /* O far, or already in e */
     "    FV_FRAGCOLOR = e;\n"
-    "#elif defined(FV_O_FLOAT)\n"                /* the lesser depth's encoding (monotonic) */
-    "    FV_FRAGCOLOR = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n" /* (e unused: compiled out) */
     "#else\n"
     "    vec4 o = FV_SCREEN(fv_opaque);\n"
     "#ifdef FV_PS13\n"
@@ -5874,8 +5876,9 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* PS13 only (fogvol_shader_strings) */
-    if (p == FOGVOL_PROGRAM_LIGHT) bits &= ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O;
-    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~(face | FOGVOL_SPECIALIZE_FLOAT_O)) == 0;
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT)
+        bits &= ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O; /* MRT only (fogvol_shader_strings) */
+    if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
 }

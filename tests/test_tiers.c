@@ -611,6 +611,7 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     assert_int_equal(glGetError(), GL_NO_ERROR);
     if (strcmp(s->name, "plane_cuts_sphere") == 0 && mode == 0 && light) {
         mkdir("build", 0777);
+        mkdir("build/tiers", 0777); /* (this test runs before the tier cases that also make it) */
         stbi_flip_vertically_on_write(1);
         stbi_write_png("build/tiers/mrt_float_o.png", W, H, 4, px, W * 4);
     }
