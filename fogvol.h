@@ -259,8 +259,9 @@ typedef struct fogvol_texture_desc {
 
 typedef enum fogvol_format {
     FOGVOL_FORMAT_RGBA8 = 0,
-    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND). MRT's O
-                                with FOGVOL_SPEEDUP_FLOAT_O: renderable (FOGVOL_CAP_FLOAT_TARGET) */
+    FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND). The O of
+                                MRT and PS20 with FOGVOL_SPEEDUP_FLOAT_O: renderable
+                                (FOGVOL_CAP_FLOAT_TARGET) */
     FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
                                  wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
                                  EXT_color_buffer_float + EXT_float_blend) */
@@ -399,8 +400,10 @@ typedef struct fogvol_gl_desc {
                                  highp (layout(location = 1) out highp vec4, or precision highp float):
                                  on GLES 3 with EXT_color_buffer_float the backend then reports
                                  FOGVOL_CAP_FLOAT_TARGET and the MRT tier keeps O as R32F
-                                 (FOGVOL_SPEEDUP_FLOAT_O). Left 0, a mediump output could round the
-                                 depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
+                                 (FOGVOL_SPEEDUP_FLOAT_O; PS20 too, whose occluders the engine may
+                                 draw with its own shaders, fogvol_occluder_prepare: their output
+                                 must be highp as well). Left 0, a mediump output could round
+                                 the depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
                                  precision). */
 } fogvol_gl_desc;
 
@@ -483,7 +486,8 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
                  exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
                  1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
-   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) in frames with
+   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
+                 FLOAT_O, below) in frames with
                  fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
                  and every volume's box either wholly between the near and far planes or wholly
                  outside that range: the frame is drawn as the COUNT variant (Baker's face count,
@@ -508,14 +512,21 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
                  through the fragment shader (the same blend equation; the same pixels where the
                  blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F texture that
-                 the engine's pass writes the normalised view depth d = (view depth - near) / (far -
-                 near) into (fogvol_mrt_info.format; the snippet switches on its uniforms), and the
-                 faces encode min(own depth, O) (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their
-                 own depth and comparing it with O's digits: one encode per fragment and no compare
-                 in the faces, and no encode in the engine's pass. The same bytes: the faces encode O
-                 as the snippet did (the same arithmetic on the same float), and the encode is
-                 monotonic, so the lesser encoding is the encoding of the lesser depth. */
+   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
+                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
+                 texture holding the normalised view depth d = (view depth - near) / (far - near),
+                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
+                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
+                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
+                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
+                 O's digits: one encode per fragment and no compare in the faces, and no encode where
+                 O is written. PS20 then draws frames with occluders with that compare, not
+                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
+                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
+                 PS13 keeps its RGBA8 O and the count). The
+                 same bytes: the faces encode O as the snippet or the O pass did (the same
+                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
+                 is the encoding of the lesser depth. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -958,7 +969,8 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
 typedef struct fogvol_occluder_info {
     uintptr_t texture;        /* backend API object (GL: texture name) */
     int width, height;
-    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT: d = (view depth - near)/(far - near)) */
+    fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT, and PS20 with
+                                 FOGVOL_SPEEDUP_FLOAT_O: d = (view depth - near)/(far - near)) */
     float clear_color[4];
     float uniforms[8];        /* uniform vec4 fogvol_mrt[2] of the snippet */
 } fogvol_occluder_info;
@@ -1240,8 +1252,9 @@ enum {
     FOGVOL_CAP_MESH_LAYOUT = 1u << 5,     /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
     FOGVOL_CAP_FILTER_FLOAT = 1u << 6,    /* create_target honours fogvol_target_desc.linear for R32F */
     FOGVOL_CAP_BLEND_CONSTANT = 1u << 7,  /* begin_pass honours fogvol_pass.blend_constant */
-    FOGVOL_CAP_FLOAT_TARGET = 1u << 8     /* R32F colour targets the engine's MRT pass can write at
-                                             full precision, blending not needed (GL 3.0; GLES 3 with
+    FOGVOL_CAP_FLOAT_TARGET = 1u << 8     /* R32F colour targets that fogvol's O pass and the engine's
+                                             MRT pass or occluder shaders can write at full precision,
+                                             blending not needed (GL 3.0; GLES 3 with
                                              EXT_color_buffer_float where the engine's output is highp:
                                              fogvol_gl_desc.mrt_highp) */
 };
@@ -1526,9 +1539,10 @@ typedef struct fogvol_shader_desc {
    DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
    position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
    jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
-   that do not read the engine's depth). FACE and LIGHT of MRT: FLOAT_O (fv_opaque is an
-   R32F O holding the normalised view depth, encoded by the program where it needs O's digits; see
-   FOGVOL_SPEEDUP_FLOAT_O). Other bits, EXP with RAMP, L > 8, or bits for another program:
+   that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT and PS20 (not WIDE,
+   ENGINE_DEPTH or COUNT, nor with FOGVOL_SPECIALIZE_COUNT): FLOAT_O (fv_opaque is an R32F O holding
+   the normalised view depth, which ENCODE writes, encoded by the program where it needs O's digits;
+   see FOGVOL_SPEEDUP_FLOAT_O). Other bits, EXP with RAMP, L > 8, or bits for another program:
    FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
@@ -5252,7 +5266,7 @@ static const char fogvol__fs_common[] =
    string of the shared fragment code (one string would pass the 4095 characters C99 guarantees). */
 static const char fogvol__fs_encode_common[] =
     /* O as stored (FLOAT: d; RGBA8: digits); FV_O_FLOAT (SPECIALIZE_FLOAT_O): an R32F O, encoded
-       as the engine's snippet would have */
+       as the engine's snippet or the O pass would have */
     "#ifdef FV_O_FLOAT\n#define FV_O_DIGITS(s) fv_encode(FV_SCREEN(s).r)\n"
     "#else\n#define FV_O_DIGITS(s) FV_SCREEN(s)\n#endif\n"
     "#if !defined(FV_FLOAT)\n"
@@ -5358,7 +5372,7 @@ static const char fogvol__fs_encode[] =
     "    fv_encode_wide(fv_d, hi, lo);\n"
     "    FV_OUT0 = hi;\n"
     "    FV_OUT1 = lo;\n"
-    "#elif defined(FV_FLOAT)\n"
+    "#elif defined(FV_FLOAT) || defined(FV_O_FLOAT)\n" /* (FV_O_FLOAT: PS20 with an R32F O) */
     "    FV_FRAGCOLOR = vec4(clamp(fv_d, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
     "#elif defined(FV_NORMALIZE)\n"
     "    FV_FRAGCOLOR = fv_normalize(fv_encode(fv_d));\n"
@@ -5876,8 +5890,9 @@ static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
         bits &= ~(unsigned)(FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING_MASK);
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH || p == FOGVOL_PROGRAM_CHECK)
         bits &= ~(unsigned)FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* PS13 only (fogvol_shader_strings) */
-    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT)
-        bits &= ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O; /* MRT only (fogvol_shader_strings) */
+    if (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT || p == FOGVOL_PROGRAM_ENCODE)
+        bits &= ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O; /* the programs that read or write O (tiers and
+                                                         variants: fogvol_shader_strings) */
     if (p == FOGVOL_PROGRAM_FACE) return (bits & ~face) == 0;
     if (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH) return (bits & ~comp) == 0;
     return bits == 0;
@@ -5927,6 +5942,16 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     return n;
 }
 
+/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
+   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
+   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
+   comparing with an R32F O than counting with its RGBA8 O) */
+static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
+{
+    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20) &&
+           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
+}
+
 /* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
    with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
 static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
@@ -5959,7 +5984,6 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
-    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && d->tier != FOGVOL_TIER_MRT) return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__count_spec_ok(d->tier, v) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
@@ -5967,6 +5991,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
             return FOGVOL_ERROR_UNSUPPORTED; /* (COUNT has no density texture) */
         v |= FOGVOL_VARIANT_COUNT;
     }
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__float_o_ok(d->tier, v)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
     strings[n++] = per_sample ? di->version_msaa : di->version;
@@ -6044,7 +6069,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "#endif\n"
 static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
 /* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks an R32F target (the FLOAT tier's O,
-   as MRT's with FOGVOL_SPEEDUP_FLOAT_O) */
+   and PS20's as MRT's with FOGVOL_SPEEDUP_FLOAT_O) */
 static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
     "vec4 fogvol_occluder_color(float view_depth) { return fogvol_encode_view_depth(view_depth); }\n";
 
@@ -6373,7 +6398,7 @@ struct fogvol_context {
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
     int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
     int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
-    int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: MRT's O is R32F */
+    int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (MRT, PS20) */
 };
 
 /* column-major 4x4 helpers in double */
@@ -6659,7 +6684,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (ctx->inline_resolve && (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
                                 p == FOGVOL_PROGRAM_CHECK))
         sd.specialize |= FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* the general programs too: there is no T */
-    if (ctx->float_o && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT))
+    if (ctx->float_o && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT || p == FOGVOL_PROGRAM_ENCODE))
         sd.specialize |= FOGVOL_SPECIALIZE_FLOAT_O; /* the general programs too: O is R32F */
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
@@ -6829,12 +6854,19 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
         if (fogvol__uses_program(ctx, (fogvol_program)i) && i != FOGVOL_PROGRAM_COMPOSITE_MESH &&
             i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT) {
             r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
-            if (r != FOGVOL_SUCCESS && ctx->float_o && i == FOGVOL_PROGRAM_FACE) {
-                fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: the face program for an R32F O did not build "
-                                                           "(%s); O stays RGBA8 (FOGVOL_SPEEDUP_FLOAT_O off)",
+            if (r != FOGVOL_SUCCESS && ctx->float_o) { /* the programs made so far again, for an RGBA8 O */
+                int j;
+                fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: a program for an R32F O did not build (%s); "
+                                                           "O stays RGBA8 (FOGVOL_SPEEDUP_FLOAT_O off)",
                             fogvol_result_string(r));
-                ctx->float_o = 0; /* (before any program that reads O is made) */
-                r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
+                ctx->float_o = 0; /* (no target exists yet, and no specialised program) */
+                for (j = 0; j < i; ++j)
+                    if (ctx->prog[j]) {
+                        ctx->be.destroy_program(ctx->be.user_data, ctx->prog[j]);
+                        ctx->prog[j] = 0;
+                    }
+                r = FOGVOL_SUCCESS;
+                i = -1;
             }
         }
     return r;
@@ -6847,11 +6879,14 @@ static void fogvol__default_inline_resolve(fogvol_context *ctx)
                           !(ctx->speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
 }
 
-/* FOGVOL_SPEEDUP_FLOAT_O: MRT's O is R32F where the backend renders float targets. */
+/* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
+   fragment shaders have fp32 (the faces encode O's float); not WIDE, ENGINE_DEPTH or COUNT
+   (fogvol__float_o_ok). */
 static void fogvol__default_float_o(fogvol_context *ctx)
 {
-    ctx->float_o = ctx->tier == FOGVOL_TIER_MRT && (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) &&
-                   !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O); /* (MRT has no WIDE) */
+    ctx->float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
+                   fogvol__float_o_ok(ctx->tier, ctx->variants) &&
+                   (ctx->tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT));
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
@@ -8229,6 +8264,7 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     }
     r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
+    fl = fl || ctx->float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
     info->width = ctx->target_w;
     info->height = ctx->target_h;
     info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
@@ -8286,7 +8322,7 @@ static int fogvol__count_near_cut(const fogvol_context *ctx)
 static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
     int i;
-    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->nocc == 0 ||
+    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->float_o || ctx->nocc == 0 ||
         ctx->engine_occluders || ctx->nlight > 0 || !fogvol__count_spec_ok(ctx->tier, ctx->variants))
         return 0;
     for (i = 0; i < ctx->nvol; ++i) {
@@ -8815,7 +8851,8 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     ctx->o_far = run->no_opaque;
     ps.target = ctx->tgt_o;
     ps.clear = 1;
-    if (run->rgba8) ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    if (run->rgba8 && !ctx->float_o) /* the far plane: every digit N - 1, or d = 1 */
+        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE,

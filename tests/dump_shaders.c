@@ -8,7 +8,8 @@
    bits it does not take (spec_applies). FOGVOL_SPECIALIZE_ENCODING(L) is taken by ENCODE and FACE for
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
-   NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by MRT's FACE and LIGHT only. */
+   NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by the programs that write or read
+   O (ENCODE, FACE, LIGHT) of MRT and PS20 without WIDE, ENGINE_DEPTH and COUNT only. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -43,7 +44,10 @@ static int spec_applies(int p, unsigned bits)
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
     if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
-        return t == FOGVOL_TIER_MRT && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
+        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20) &&
+               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) &&
+               !(bits & FOGVOL_SPECIALIZE_COUNT) &&
+               (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O, ms);
     if (bits & FOGVOL_SPECIALIZE_INLINE_RESOLVE)
         return t == FOGVOL_TIER_PS13 &&
@@ -140,6 +144,10 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
                                          FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
                                      FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_INLINE_RESOLVE |
+                                         FOGVOL_SPECIALIZE_RAMP,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

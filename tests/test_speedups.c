@@ -15,7 +15,8 @@
    (FOGVOL_SPECIALIZE_ENCODING; PS13 too, on the ALU encode in GLSL 330) gives the bytes of the
    uniform-driven encode and of the lookup textures for every L. PS13 resolving B - F in its
    composite (INLINE_RESOLVE) gives the resolve pass's bytes, sums and overflow counts. The MRT
-   snippet's encode, in integers (GLSL 330) and in floats, gives fogvol_encode_depth's bytes.
+   snippet's encode, in integers (GLSL 330) and in floats, gives fogvol_encode_depth's bytes. FLOAT_O
+   (PS20 keeps O as R32F and compares instead of counting) gives the bytes of the RGBA8 O.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -60,6 +61,7 @@ typedef struct run_out {
     unsigned variants;         /* fogvol_context_tier: the variants the context ran */
     int enc_programs;          /* programs built with the encoding compiled in (FOGVOL_SPECIALIZE_ENCODING) */
     int targets;               /* render targets the context created */
+    int o_format;              /* the format of the O target (-1: none made) */
     int blend_constant[NFRAMES]; /* passes with fogvol_pass.blend_constant (FOGVOL_SPEEDUP_BLEND_COLOR) */
 } run_out;
 
@@ -78,11 +80,12 @@ static int g_fail_blend_color;  /* 1: the backend fails to build FOGVOL_SPECIALI
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
-static int g_targets;
+static int g_targets, g_o_format;
 static fogvol_result watch_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     if (d->linear && g_no_linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
     g_targets++;
+    if (d->label && strncmp(d->label, "fogvol O ", 9) == 0) g_o_format = (int)d->format;
     return g_inner.create_target(u, d, out);
 }
 /* counts the programs whose fragment shader has this context's encoding compiled in; with
@@ -122,6 +125,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.backend = g_inner;
     cd.backend.create_target = watch_target;
     g_targets = 0;
+    g_o_format = -1;
     cd.backend.create_program = watch_program;
     cd.backend.begin_pass = watch_pass;
     if (g_no_highp) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_HIGHP_FRAGMENT;
@@ -187,6 +191,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     g_inner.destroy(g_inner.user_data);
     out->enc_programs = g_enc_programs;
     out->targets = g_targets;
+    out->o_format = g_o_format;
 }
 
 static int max_diff(const unsigned char *a, const unsigned char *b, int *count)
@@ -249,7 +254,8 @@ static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
-     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR)
+     FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O)
+#define FO FOGVOL_SPEEDUP_FLOAT_O /* off in the runs that must give the bytes of ALL_OFF: see test_float_o */
 
 static void test_same_pixels_and_exp(void **state)
 {
@@ -263,9 +269,9 @@ static void test_same_pixels_and_exp(void **state)
         for (si = 0; si < 2; ++si) {
             const tscene *s = &g_scenes[scene_index(names[si])];
             int exp_max = 0, exp_n = 0, fast_max = 0, fast_n = 0, occluded = 0;
-            run_frames(s, g_tiers[ti], 0, &g, &def);
-            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP, &g, &exact);
-            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_EXP_COMPOSITE, &g, &noexp);
+            run_frames(s, g_tiers[ti], FO, &g, &def);
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP | FO, &g, &exact);
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_EXP_COMPOSITE | FO, &g, &noexp);
             run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
             for (f = 0; f < NFRAMES; ++f) {
                 int m;
@@ -374,10 +380,11 @@ static void test_wide_alu(void **state)
 
 /* FOGVOL_SPECIALIZE_ENCODING: the encode with the encoding's N and D compiled in gives, for every L,
    the bytes of the general program that reads them from uniforms and of the lookup textures (PS20
-   and PS13, whose ALU encode needs GLSL 330: this context), with and without occluders (COUNT) */
+   and PS13, whose ALU encode needs GLSL 330: this context), with and without occluders (COUNT, O
+   RGBA8; and PS20 with an R32F O, FOGVOL_SPEEDUP_FLOAT_O, the compare) */
 static void test_encoding_constants(void **state)
 {
-    static run_out spec, uni, tex;
+    static run_out spec, uni, tex, fo, mc;
     const tscene *s = &g_scenes[scene_index("layers_opaque_between")];
     glu_ctx g;
     int ti, f, n, L;
@@ -387,27 +394,76 @@ static void test_encoding_constants(void **state)
         for (L = 1; L <= 8; ++L) {
             int covered = 0;
             g_bits = L;
-            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP, &g, &spec);   /* exp(): the general composite's */
-            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_SPECIALIZE, &g, &uni); /* N and D from the uniforms */
-            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU, &g, &tex); /* ramps */
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP | FO, &g, &spec); /* exp(): the general composite's */
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_SPECIALIZE | FO, &g, &uni); /* N and D from the uniforms */
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FO, &g, &tex); /* ramps */
+            const run_out *want = g_tiers[ti] == FOGVOL_TIER_PS20 ? &mc : &spec; /* (PS13: fo is spec) */
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP, &g, &fo); /* PS20: R32F O, compiled in */
+            run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP | FOGVOL_SPEEDUP_DEPTH_TEST, &g, &mc); /* (PS20: as fo
+                                                                   compares; at L = 8 the count saturates apart) */
             for (f = 0; f < NFRAMES; ++f) {
                 assert_memory_equal(spec.th[f], uni.th[f], sizeof uni.th[f]);
                 assert_memory_equal(spec.th[f], tex.th[f], sizeof tex.th[f]);
+                assert_memory_equal(want->th[f], fo.th[f], sizeof fo.th[f]);
                 assert_int_equal(max_diff(spec.px[f], uni.px[f], &n), 0);
                 assert_int_equal(max_diff(spec.px[f], tex.px[f], &n), 0);
+                assert_int_equal(max_diff(want->px[f], fo.px[f], &n), 0);
                 assert_int_equal(spec.depth_tested[f], with_occluders(f));
+                assert_int_equal(fo.depth_tested[f], g_tiers[ti] == FOGVOL_TIER_PS20 ? 0 : with_occluders(f));
             }
             /* the three ran what they stand for: the ALU encode with L compiled into its ENCODE and
                FACE programs (min compare and COUNT), the ALU encode on uniforms, the lookup textures */
             assert_true((spec.variants & FOGVOL_VARIANT_ALU) && spec.enc_programs >= 3);
             assert_true((uni.variants & FOGVOL_VARIANT_ALU) && uni.enc_programs == 0);
             assert_true(!(tex.variants & FOGVOL_VARIANT_ALU) && tex.enc_programs == 0);
+            assert_true(fo.enc_programs >= 2 && spec.o_format == FOGVOL_FORMAT_RGBA8 &&
+                        fo.o_format == (g_tiers[ti] == FOGVOL_TIER_PS20 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8));
             for (n = 0; n < W * H; ++n) covered += spec.th[0][n] > 0.0f;
-            print_message("# %-5s L = %d: encoding compiled in = uniforms = lookup textures, bit for bit; "
+            print_message("# %-5s L = %d: encoding compiled in = uniforms = lookup textures; R32F O = RGBA8 O; bit for bit; "
                           "%d pixels with thickness\n", g_tier_names[ti], L, covered);
             assert_true(covered > W * H / 8);
         }
     g_bits = 0;
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_FLOAT_O on PS20 (this context renders R32F targets and has fp32 fragment shaders):
+   O is R32F, and the faces encode the lesser of their depth and O, as the O pass would have encoded
+   O. Frames with occluders take that compare instead of the face count (FOGVOL_SPEEDUP_DEPTH_TEST,
+   which the speed-up switched off draws them with): the same bytes and sums as the RGBA8 O
+   (counted), and the sums of every speed-up off (compared), in every frame. PS13 keeps its RGBA8 O
+   and the count either way. */
+static void test_float_o(void **state)
+{
+    static run_out on, rgba, off;
+    const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
+    glu_ctx g;
+    int ti, si, f, n, covered;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (ti = 1; ti < 3; ++ti)
+        for (si = 0; si < 2; ++si) {
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            run_frames(s, g_tiers[ti], 0, &g, &on);
+            run_frames(s, g_tiers[ti], FO, &g, &rgba);
+            run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
+            int ps20 = g_tiers[ti] == FOGVOL_TIER_PS20;
+            assert_int_equal(on.o_format, ps20 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
+            assert_int_equal(rgba.o_format, FOGVOL_FORMAT_RGBA8);
+            assert_int_equal(off.o_format, FOGVOL_FORMAT_RGBA8);
+            for (f = 0; f < NFRAMES; ++f) {
+                assert_int_equal(on.depth_tested[f], ps20 ? 0 : with_occluders(f));
+                assert_int_equal(rgba.depth_tested[f], with_occluders(f));
+                assert_int_equal(max_diff(on.px[f], rgba.px[f], &n), 0);
+                assert_memory_equal(on.th[f], rgba.th[f], sizeof on.th[f]); /* (off: the 8-bit ramp's pixels) */
+                assert_memory_equal(on.th[f], off.th[f], sizeof on.th[f]);
+            }
+            for (n = 0, covered = 0; n < W * H; ++n) covered += on.th[2][n] > 0.0f;
+            print_message("# %-5s %-22s %s O: the bytes and sums of the RGBA8 O (counted), the sums of every "
+                          "speed-up off, %d frames; %d pixels with thickness in the occluders' frame\n",
+                          g_tier_names[ti], names[si], ps20 ? "R32F" : "RGBA8", NFRAMES, covered);
+            assert_true(covered > W * H / 8);
+        }
     glu_destroy(&g);
 }
 
@@ -750,7 +806,7 @@ int main(void)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
-                                       cmocka_unit_test(test_inline_resolve),
+                                       cmocka_unit_test(test_float_o), cmocka_unit_test(test_inline_resolve),
                                        cmocka_unit_test(test_blend_color),
                                        cmocka_unit_test(test_mrt_snippet_encode),
                                        cmocka_unit_test(test_half_resolution)};

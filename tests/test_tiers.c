@@ -505,14 +505,16 @@ static void test_single_target_limit(void **state)
     assert_true(err <= 12.0);
 }
 
-/* FOGVOL_SPEEDUP_FLOAT_O: MRT's O as R32F, written by the same snippet and read by faces that encode
-   min(own depth, O), gives the bytes of the RGBA8 O (the speed-up switched off, and a backend without
-   FOGVOL_CAP_FLOAT_TARGET): every pixel of the engine's colour after the composite and every debug
-   thickness, dither on, with a density-textured volume and a light, whose faces decode O's digits
-   (FV_O_DIGITS). Camera inside: O is the clear colour everywhere. A backend that cannot build the
-   programs for an R32F O (mode 3) gets the RGBA8 O and the same bytes, and a warning. */
+/* FOGVOL_SPEEDUP_FLOAT_O: O as R32F (MRT: written by the same snippet; PS20: by fogvol's O pass
+   over the scene's occluders), read by faces that encode min(own depth, O), gives the bytes of the
+   RGBA8 O (the speed-up switched off, and a backend without FOGVOL_CAP_FLOAT_TARGET): every pixel of
+   the engine's colour after the composite and every debug thickness, dither on, with a
+   density-textured volume and a light, whose faces decode O's digits (FV_O_DIGITS); these frames
+   take the min compare (test_speedups test_float_o: COUNT frames). Camera inside: O is the far
+   plane everywhere. A backend that cannot build the programs for an R32F O (mode 3; PS20 builds its
+   O pass's program first) gets the RGBA8 O and the same bytes, and a warning. */
 static fogvol_backend g_fo_inner;
-static int g_fo_warnings;
+static int g_fo_warnings, g_fo_format;
 static fogvol_result fo_fail_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     int i;
@@ -520,12 +522,17 @@ static fogvol_result fo_fail_program(void *u, const fogvol_program_desc *d, fogv
         if (strcmp(d->fs[i], "#define FV_O_FLOAT\n") == 0) return FOGVOL_ERROR_BACKEND;
     return g_fo_inner.create_program(u, d, out);
 }
+static fogvol_result fo_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+{
+    if (d->label && strncmp(d->label, "fogvol O ", 9) == 0) g_fo_format = (int)d->format;
+    return g_fo_inner.create_target(u, d, out);
+}
 static void fo_logger(void *u, fogvol_log_level l, const char *m)
 {
     g_fo_warnings += l == FOGVOL_LOG_WARNING && strstr(m, "O stays RGBA8") != NULL;
     logger(u, l, m);
 }
-static void float_o_frame(const tscene *s, int mode, int light, unsigned char *px, float *thick)
+static void float_o_frame(const tscene *s, fogvol_tier tier, int mode, int light, unsigned char *px, float *thick)
 {
     static const char *const names[4] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET",
                                          "R32F programs fail to build"};
@@ -550,17 +557,17 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
     cd.logger.func = fo_logger;
-    cd.tier = FOGVOL_TIER_MRT;
+    cd.tier = tier;
     g_fo_warnings = 0;
+    g_fo_format = -1;
     if (mode == 1) cd.disable_speedups = FOGVOL_SPEEDUP_FLOAT_O;
-    if (mode >= 2) {
-        assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
-        assert_true(be.caps & FOGVOL_CAP_FLOAT_TARGET); /* desktop GL 3.0+ */
-        g_fo_inner = be;
-        if (mode == 2) be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
-        else be.create_program = fo_fail_program;
-        cd.backend = be;
-    }
+    assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &be), FOGVOL_SUCCESS);
+    assert_true(be.caps & FOGVOL_CAP_FLOAT_TARGET); /* desktop GL 3.0+ */
+    g_fo_inner = be;
+    be.create_target = fo_target;
+    if (mode == 2) be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
+    if (mode == 3) be.create_program = fo_fail_program;
+    cd.backend = be;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
     assert_int_equal(g_fo_warnings, mode == 3);
     engine_init(&e);
@@ -583,14 +590,18 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     fx_frame_desc(&fd, &s->cam, W, H);
     fd.debug_thickness = thick;
     assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-    assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
-    glBindTexture(GL_TEXTURE_2D, (GLuint)mrt.texture);
-    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    assert_int_equal(fmt, mode == 0 ? GL_R32F : GL_RGBA8);
-    assert_int_equal(mrt.format, mode == 0 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
-    engine_draw(&e, s, fd.view, fd.projection, &mrt);
-    add_scene(fv, s, meshes, ramp, 0);
+    if (tier == FOGVOL_TIER_MRT) {
+        assert_int_equal(fogvol_mrt_prepare(fv, &mrt), FOGVOL_SUCCESS);
+        glBindTexture(GL_TEXTURE_2D, (GLuint)mrt.texture);
+        glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        assert_int_equal(fmt, mode == 0 ? GL_R32F : GL_RGBA8);
+        assert_int_equal(mrt.format, mode == 0 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
+        engine_draw(&e, s, fd.view, fd.projection, &mrt);
+    } else {
+        engine_draw(&e, s, fd.view, fd.projection, NULL); /* the occluders: fogvol's O pass draws them */
+    }
+    add_scene(fv, s, meshes, ramp, tier != FOGVOL_TIER_MRT);
     memset(&vd, 0, sizeof vd); /* the first volume's mesh once more, shifted, density-textured across x and y */
     for (i = 0; s->obj[i].sign == 0; ++i) continue;
     vd.mesh = meshes[i];
@@ -606,23 +617,25 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
     if (light) assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
     assert_int_equal(st.lights, light);
+    assert_int_equal(st.depth_tested, 0); /* (a density-textured volume: the min compare) */
+    assert_int_equal(g_fo_format, mode == 0 ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8);
     glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
     glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
     assert_int_equal(glGetError(), GL_NO_ERROR);
-    if (strcmp(s->name, "plane_cuts_sphere") == 0 && mode == 0 && light) {
+    if (strcmp(s->name, "plane_cuts_sphere") == 0 && mode == 0 && light && tier == FOGVOL_TIER_MRT) {
         mkdir("build", 0777);
         mkdir("build/tiers", 0777); /* (this test runs before the tier cases that also make it) */
         stbi_flip_vertically_on_write(1);
         stbi_write_png("build/tiers/mrt_float_o.png", W, H, 4, px, W * 4);
     }
-    print_message("  MRT %s, %s%s: O %s\n", names[mode], s->name, light ? "" : " (no light)",
+    print_message("  %s %s, %s%s: O %s\n", fogvol_tier_name(tier), names[mode], s->name, light ? "" : " (no light)",
                   mode == 0 ? "R32F" : "RGBA8");
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_volume_texture(fv, tex);
     fogvol_destroy_mesh(fv, lbox);
     for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
     fogvol_destroy_context(fv);
-    if (mode >= 2) be.destroy(be.user_data); /* (a backend table passed in stays the caller's) */
+    be.destroy(be.user_data); /* (a backend table passed in stays the caller's) */
     engine_free(&e);
     shp_free(&box);
 }
@@ -630,33 +643,35 @@ static void float_o_frame(const tscene *s, int mode, int light, unsigned char *p
 static void test_float_o(void **state)
 {
     static const char *const scenes[] = {"plane_cuts_sphere", "layers_opaque_between", "camera_inside_sphere"};
+    static const fogvol_tier tiers[2] = {FOGVOL_TIER_MRT, FOGVOL_TIER_PS20};
     unsigned char *px[5];
     float *thick[5];
     glu_ctx g;
-    int sc, m, i, lit = 0, differ;
+    int sc, m, i, t, lit = 0, differ;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
     for (m = 0; m < 5; ++m) {
         px[m] = (unsigned char *)malloc((size_t)W * H * 4);
         thick[m] = (float *)malloc((size_t)W * H * sizeof(float));
     }
-    for (sc = 0; sc < 3; ++sc) {
-        const tscene *s = &g_scenes[scene_index(scenes[sc])];
-        for (m = 0; m < 4; ++m) float_o_frame(s, m, 1, px[m], thick[m]);
-        float_o_frame(s, 0, 0, px[4], thick[4]);
-        for (m = 1; m < 4; ++m) {
-            for (i = 0, differ = 0; i < W * H * 4; ++i) differ += px[0][i] != px[m][i];
-            if (differ) print_message("  %s: %d bytes differ from the RGBA8 O (mode %d)\n", s->name, differ, m);
-            assert_int_equal(differ, 0);
-            assert_memory_equal(thick[0], thick[m], (size_t)W * H * sizeof(float));
+    for (t = 0; t < 2; ++t)
+        for (sc = 0; sc < 3; ++sc) {
+            const tscene *s = &g_scenes[scene_index(scenes[sc])];
+            for (m = 0; m < 4; ++m) float_o_frame(s, tiers[t], m, 1, px[m], thick[m]);
+            float_o_frame(s, tiers[t], 0, 0, px[4], thick[4]);
+            for (m = 1; m < 4; ++m) {
+                for (i = 0, differ = 0; i < W * H * 4; ++i) differ += px[0][i] != px[m][i];
+                if (differ) print_message("  %s: %d bytes differ from the RGBA8 O (mode %d)\n", s->name, differ, m);
+                assert_int_equal(differ, 0);
+                assert_memory_equal(thick[0], thick[m], (size_t)W * H * sizeof(float));
+            }
+            /* the light lit occluder pixels (its back faces read O) where the scene has occluders */
+            for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[4] + 4 * i, 4) != 0;
+            print_message("  %s: %d pixels lit\n", s->name, differ);
+            if (s->n > 1) assert_true(differ > 50);
+            lit += differ;
         }
-        /* the light lit occluder pixels (its back faces read O) where the scene has occluders */
-        for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[4] + 4 * i, 4) != 0;
-        print_message("  %s: %d pixels lit\n", s->name, differ);
-        if (s->n > 1) assert_true(differ > 50);
-        lit += differ;
-    }
-    print_message("  FLOAT_O: the same bytes in 3 scenes x 4 ways; %d pixels lit\n", lit);
+    print_message("  FLOAT_O: the same bytes in 2 tiers x 3 scenes x 4 ways; %d pixels lit\n", lit);
     for (m = 0; m < 5; ++m) {
         free(px[m]);
         free(thick[m]);
