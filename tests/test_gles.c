@@ -578,19 +578,22 @@ static void test_combo(void **state)
 }
 
 /* fogvol_gl_desc.mrt_highp (this engine's fragment shader is precision highp): on GLES 3 with
-   EXT_color_buffer_float MRT keeps O as R32F (FOGVOL_SPEEDUP_FLOAT_O), and every scene gives the
-   bytes and the debug thickness of the encoded RGBA8 O, inside the engine's state checks of
+   EXT_color_buffer_float MRT keeps O as R32F (FOGVOL_SPEEDUP_FLOAT_O), and so does PS20, whose O
+   pass fogvol draws (frames with occluders then compare instead of counting), and every scene gives
+   the bytes and the debug thickness of the encoded RGBA8 O, inside the engine's state checks of
    engine_frame. */
 static void test_mrt_float_o(void **state)
 {
-    int ci = (int)(intptr_t)*state, sc, k, i, cb = -1;
+    int ci = (int)(intptr_t)*state, sc, k, i, t, cb = -1, cb20 = -1;
     unsigned char *base = (unsigned char *)malloc((size_t)W * H * 4), *fogged[2];
     float *thick[2];
     eglu_ctx c;
     engine e;
-    for (k = 0; k < NTIER_COMBO; ++k)
+    for (k = 0; k < NTIER_COMBO; ++k) {
         if (g_tier_combos[k].tier == FOGVOL_TIER_MRT && g_tier_combos[k].variants == 0) cb = k;
-    assert_true(cb >= 0);
+        if (g_tier_combos[k].tier == FOGVOL_TIER_PS20 && g_tier_combos[k].variants == 0) cb20 = k;
+    }
+    assert_true(cb >= 0 && cb20 >= 0);
     context_up(ci, &c);
     if (!has_ext("GL_EXT_color_buffer_float")) {
         print_message("  %s has no EXT_color_buffer_float: skipped\n", g_ctx[ci].name);
@@ -603,28 +606,31 @@ static void test_mrt_float_o(void **state)
         fogged[k] = (unsigned char *)malloc((size_t)W * H * 4);
         thick[k] = (float *)malloc((size_t)W * H * sizeof(float));
     }
-    for (sc = 0; sc < NSCENE; ++sc) {
-        const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
-        int differ = 0;
-        for (k = 0; k < 2; ++k) {
-            fogvol_mesh *meshes[MAX_OBJ];
-            fogvol_ramp *ramp;
-            fogvol_frame_stats st;
-            fogvol_context *fv;
-            g_mrt_highp = k == 0;
-            fv = scene_context(&g_tier_combos[cb], s, meshes, &ramp);
-            assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, 1, thick[k], base, fogged[k], &st),
-                             FOGVOL_SUCCESS);
-            for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
-            fogvol_destroy_ramp(fv, ramp);
-            fogvol_destroy_context(fv);
+    for (t = 0; t < 2; ++t)
+        for (sc = 0; sc < NSCENE; ++sc) {
+            const tscene *s = &g_scenes[scene_index(g_scene_names[sc])];
+            int differ = 0;
+            for (k = 0; k < 2; ++k) {
+                fogvol_mesh *meshes[MAX_OBJ];
+                fogvol_ramp *ramp;
+                fogvol_frame_stats st;
+                fogvol_context *fv;
+                g_mrt_highp = k == 0;
+                fv = scene_context(&g_tier_combos[t ? cb20 : cb], s, meshes, &ramp);
+                assert_int_equal(engine_frame(fv, &c, &e, s, meshes, ramp, !t, thick[k], base, fogged[k], &st),
+                                 FOGVOL_SUCCESS);
+                if (t && k == 0) assert_int_equal(st.depth_tested, 0); /* (an R32F O: the compare) */
+                for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+                fogvol_destroy_ramp(fv, ramp);
+                fogvol_destroy_context(fv);
+            }
+            g_mrt_highp = 0;
+            for (i = 0; i < W * H * 4; ++i) differ += fogged[0][i] != fogged[1][i];
+            print_message("  %s, %s, %s: R32F O against RGBA8 O: %d bytes differ\n", g_ctx[ci].name,
+                          t ? "PS20" : "MRT", s->name, differ);
+            assert_int_equal(differ, 0);
+            assert_memory_equal(thick[0], thick[1], (size_t)W * H * sizeof(float));
         }
-        g_mrt_highp = 0;
-        for (i = 0; i < W * H * 4; ++i) differ += fogged[0][i] != fogged[1][i];
-        print_message("  %s, MRT, %s: R32F O against RGBA8 O: %d bytes differ\n", g_ctx[ci].name, s->name, differ);
-        assert_int_equal(differ, 0);
-        assert_memory_equal(thick[0], thick[1], (size_t)W * H * sizeof(float));
-    }
     engine_free(&e);
     assert_int_equal(glGetError(), GL_NO_ERROR);
     eglu_destroy(&c);

@@ -511,15 +511,19 @@ static void test_single_target_limit(void **state)
    the engine's colour after the composite and every debug thickness, dither on, with a
    density-textured volume and a light, whose faces decode O's digits (FV_O_DIGITS); these frames
    take the min compare (test_speedups test_float_o: COUNT frames). Camera inside: O is the far
-   plane everywhere. A backend that cannot build the programs for an R32F O (mode 3; PS20 builds its
-   O pass's program first) gets the RGBA8 O and the same bytes, and a warning. */
+   plane everywhere. A backend that cannot build the face programs for an R32F O (mode 3) gets the
+   RGBA8 O and the same bytes, and a warning; with SPECIALIZE off (mode 4, the same sums) the frame
+   uses the general programs, PS20's O pass's among them, which was built for the R32F O before the
+   face's failed and must be built again. */
 static fogvol_backend g_fo_inner;
 static int g_fo_warnings, g_fo_format;
+/* modes 3 and 4: the face programs for an R32F O fail to build (PS20 has made its O pass's by then) */
 static fogvol_result fo_fail_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     int i;
     for (i = 0; i < d->fs_count; ++i)
-        if (strcmp(d->fs[i], "#define FV_O_FLOAT\n") == 0) return FOGVOL_ERROR_BACKEND;
+        if (strcmp(d->fs[i], "#define FV_O_FLOAT\n") == 0 && d->label && strcmp(d->label, "fogvol face") == 0)
+            return FOGVOL_ERROR_BACKEND;
     return g_fo_inner.create_program(u, d, out);
 }
 static fogvol_result fo_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
@@ -534,8 +538,9 @@ static void fo_logger(void *u, fogvol_log_level l, const char *m)
 }
 static void float_o_frame(const tscene *s, fogvol_tier tier, int mode, int light, unsigned char *px, float *thick)
 {
-    static const char *const names[4] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET",
-                                         "R32F programs fail to build"};
+    static const char *const names[5] = {"float O", "speed-up off", "no FOGVOL_CAP_FLOAT_TARGET",
+                                         "R32F programs fail to build",
+                                         "R32F programs fail to build, SPECIALIZE off"};
     fogvol_context_desc cd;
     fogvol_backend be;
     fogvol_context *fv;
@@ -566,10 +571,11 @@ static void float_o_frame(const tscene *s, fogvol_tier tier, int mode, int light
     g_fo_inner = be;
     be.create_target = fo_target;
     if (mode == 2) be.caps &= ~(unsigned)FOGVOL_CAP_FLOAT_TARGET;
-    if (mode == 3) be.create_program = fo_fail_program;
+    if (mode >= 3) be.create_program = fo_fail_program;
+    if (mode == 4) cd.disable_speedups = FOGVOL_SPEEDUP_SPECIALIZE; /* the general programs: made first */
     cd.backend = be;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-    assert_int_equal(g_fo_warnings, mode == 3);
+    assert_int_equal(g_fo_warnings, mode >= 3);
     engine_init(&e);
     upload_meshes(fv, s, meshes);
     lbox = upload_shape(fv, &box);
@@ -644,35 +650,37 @@ static void test_float_o(void **state)
 {
     static const char *const scenes[] = {"plane_cuts_sphere", "layers_opaque_between", "camera_inside_sphere"};
     static const fogvol_tier tiers[2] = {FOGVOL_TIER_MRT, FOGVOL_TIER_PS20};
-    unsigned char *px[5];
-    float *thick[5];
+    unsigned char *px[6];
+    float *thick[6];
     glu_ctx g;
     int sc, m, i, t, lit = 0, differ;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
-    for (m = 0; m < 5; ++m) {
+    for (m = 0; m < 6; ++m) {
         px[m] = (unsigned char *)malloc((size_t)W * H * 4);
         thick[m] = (float *)malloc((size_t)W * H * sizeof(float));
     }
     for (t = 0; t < 2; ++t)
         for (sc = 0; sc < 3; ++sc) {
             const tscene *s = &g_scenes[scene_index(scenes[sc])];
-            for (m = 0; m < 4; ++m) float_o_frame(s, tiers[t], m, 1, px[m], thick[m]);
-            float_o_frame(s, tiers[t], 0, 0, px[4], thick[4]);
-            for (m = 1; m < 4; ++m) {
-                for (i = 0, differ = 0; i < W * H * 4; ++i) differ += px[0][i] != px[m][i];
+            for (m = 0; m < 5; ++m) float_o_frame(s, tiers[t], m, 1, px[m], thick[m]);
+            float_o_frame(s, tiers[t], 0, 0, px[5], thick[5]);
+            for (m = 1; m < 5; ++m) {
+                /* (mode 4's general composite takes exp() instead of FAST_EXP: its sums alone) */
+                for (i = 0, differ = 0; i < W * H * 4 && m < 4; ++i) differ += px[0][i] != px[m][i];
                 if (differ) print_message("  %s: %d bytes differ from the RGBA8 O (mode %d)\n", s->name, differ, m);
                 assert_int_equal(differ, 0);
                 assert_memory_equal(thick[0], thick[m], (size_t)W * H * sizeof(float));
             }
             /* the light lit occluder pixels (its back faces read O) where the scene has occluders */
-            for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[4] + 4 * i, 4) != 0;
+            for (i = 0, differ = 0; i < W * H; ++i) differ += memcmp(px[0] + 4 * i, px[5] + 4 * i, 4) != 0;
             print_message("  %s: %d pixels lit\n", s->name, differ);
             if (s->n > 1) assert_true(differ > 50);
             lit += differ;
         }
-    print_message("  FLOAT_O: the same bytes in 2 tiers x 3 scenes x 4 ways; %d pixels lit\n", lit);
-    for (m = 0; m < 5; ++m) {
+    print_message("  FLOAT_O: the same bytes in 2 tiers x 3 scenes x 4 ways (the same sums 5 ways); %d pixels lit\n",
+                  lit);
+    for (m = 0; m < 6; ++m) {
         free(px[m]);
         free(thick[m]);
     }
