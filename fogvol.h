@@ -526,7 +526,13 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  PS13 keeps its RGBA8 O and the count). The
                  same bytes: the faces encode O as the snippet or the O pass did (the same
                  arithmetic on the same float), and the encode is monotonic, so the lesser encoding
-                 is the encoding of the lesser depth. */
+                 is the encoding of the lesser depth.
+   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
+                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
+                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
+                 at most one back and one front face on a ray (two within the convexity test's
+                 tolerance), so no sum can saturate, and the frame counts 0 for the group at once
+                 (fogvol_frame_stats.overflow_passes leaves it out). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -539,7 +545,8 @@ enum {
     FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
     FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
     FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
-    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11
+    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
+    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -9136,6 +9143,25 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 }
 /* <<one-pass colour group */
 
+/* FOGVOL_SPEEDUP_SKIP_CHECK: no pixel of the group's sums can saturate, so its check pass would find
+   nothing: every volume of the group is convex (at most one front and one back face on a ray; a mesh
+   convex only within fogvol__convexity's tolerance might give a grazing ray a second pair, hence
+   half of what a target sums), the faces are not folded onto the near plane (NEAR_CLAMP), and
+   SINGLE_TARGET keeps its peak check. */
+static int fogvol__unsaturable(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    int i, n = 0;
+    if ((ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) ||
+        fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET))
+        return 0;
+    for (i = 0; i < ctx->nvol; ++i)
+        if (ctx->vols[i].ramp == ramp) {
+            if (ctx->vols[i].mesh->convex != 1) return 0;
+            ++n;
+        }
+    return 2 * n <= ctx->enc.max_faces;
+}
+
 /* The passes of the colour-ramp group of volume g, unless an earlier volume shares its ramp (the
    groups come in order of first appearance) or the group holds negative volumes only (they
    subtract from nothing). */
@@ -9160,7 +9186,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     for (i = g; i < ctx->nvol; ++i) run->st.volumes += ctx->vols[i].ramp == ramp;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
-    if (run->counted) fogvol__check_pass(ctx, run, &ps, !run->single, &run->st);
+    if (run->counted && !fogvol__unsaturable(ctx, ramp)) fogvol__check_pass(ctx, run, &ps, !run->single, &run->st);
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }

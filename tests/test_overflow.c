@@ -597,7 +597,10 @@ typedef struct nullrig {
     logcap lc;
 } nullrig;
 
-static unsigned g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS; /* null_open: whole-picture checks */
+/* null_open: whole-picture checks, and the check kept: the rig's one tetrahedron is convex, whose sums
+   cannot saturate (FOGVOL_SPEEDUP_SKIP_CHECK would leave out the pass these tests look at) */
+#define NULL_OFF (FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_SKIP_CHECK)
+static unsigned g_null_speedups_off = NULL_OFF;
 
 static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned caps, int queries,
                       fogvol_overflow_policy policy)
@@ -814,7 +817,7 @@ static void test_null_bands(void **state)
     fogvol_frame_stats st;
     int f, rows = 0, nonempty = 0, ws[4];
     (void)state;
-    g_null_speedups_off = 0;
+    g_null_speedups_off = FOGVOL_SPEEDUP_SKIP_CHECK;
     null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
     n.nb.query_samples = 3;
     for (f = 0; f < FOGVOL_OVERFLOW_BANDS; ++f) {
@@ -868,7 +871,150 @@ static void test_null_bands(void **state)
     assert_int_equal(fogvol_context_encoding(n.fv)->bits, 3);
     assert_int_equal(st.overflow_pixels_late, 0);
     null_close(&n);
+    g_null_speedups_off = NULL_OFF;
+}
+
+/* FOGVOL_SPEEDUP_SKIP_CHECK: a group whose sums cannot saturate draws no check pass. On the null
+   backend (whole-picture checks): one convex tetrahedron, and 8 of them (at most one back and one
+   front face each on a ray, twice that within the convexity test's tolerance: 16 faces, what L = 4
+   sums), skip it and count 0 at once; 9 of them, a concave torus, NEAR_CLAMP (faces folded onto the
+   near plane) and the speed-up switched off draw it. In GL (PS20 on OSMesa, L = 6: 4 faces a
+   target), 2 overlapping spheres skip it and the debug read-back finds no saturated pixel, with the
+   pixels of the frame that checks; 3 spheres check. */
+static int skip_frame(nullrig *n, const fogvol_mesh *mesh, int volumes, fogvol_frame_stats *st)
+{
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    int i;
+    memset(&fd, 0, sizeof fd);
+    glu_identity(fd.view);
+    glu_perspective(fd.projection, 60, 1, 0.5, 10);
+    fd.znear = 0.5f;
+    fd.zfar = 10;
+    fd.viewport[2] = fd.viewport[3] = 16;
+    assert_int_equal(fogvol_begin_frame(n->fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = mesh;
+    vd.ramp = n->ramp;
+    for (i = 0; i < volumes; ++i) {
+        glu_translate_scale(vd.model, 0.01f * (float)i, 0, -3, 1);
+        assert_int_equal(fogvol_add_volume(n->fv, &vd), FOGVOL_SUCCESS);
+    }
+    assert_int_equal(fogvol_end_frame(n->fv, st), FOGVOL_SUCCESS);
+    return st->overflow_passes;
+}
+
+static void gl_spheres(int k, unsigned off, unsigned char *px, float *thick, fogvol_frame_stats *st)
+{
+    glu_ctx g;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *m;
+    fogvol_mesh_desc md;
+    fogvol_mesh_report rep;
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    shp_mesh sph = shp_sphere(0.7f, 32, 16);
+    int i;
+    assert_true(glu_create(&g, W, H, 1));
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.encoding_bits = 6;
+    cd.disable_speedups = FOGVOL_SPEEDUP_OVERFLOW_BANDS | off;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    fx_mesh_desc(&md, &sph, 0);
+    assert_int_equal(fogvol_create_mesh(fv, &md, &m, &rep), FOGVOL_SUCCESS);
+    assert_int_equal(rep.convex, 1);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.5f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    memset(&fd, 0, sizeof fd);
+    glu_identity(fd.view);
+    glu_perspective(fd.projection, 50, 1, 0.5, 10);
+    fd.znear = 0.5f;
+    fd.zfar = 10;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    fd.debug_thickness = thick;
+    glClearColor(0.2f, 0.3f, 0.4f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = m;
+    vd.ramp = ramp;
+    for (i = 0; i < k; ++i) { /* overlapping along x, every pixel of the middle crosses all k */
+        glu_translate_scale(vd.model, 0.25f * (float)i - 0.125f * (float)(k - 1), 0, -4, 1);
+        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    }
+    assert_int_equal(fogvol_end_frame(fv, st), FOGVOL_SUCCESS);
+    memcpy(px, glu_pixels(&g), (size_t)W * H * 4);
+    fogvol_destroy_mesh(fv, m);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    shp_free(&sph);
+    glu_destroy(&g);
+}
+
+static void test_skip_check(void **state)
+{
+    nullrig n;
+    fogvol_frame_stats st;
+    fogvol_mesh *torus;
+    fogvol_mesh_desc md;
+    shp_mesh tor = shp_torus(1.0f, 0.4f, 16, 8);
+    unsigned char *px[2];
+    float *thick[2];
+    int k, i, fogged;
+    (void)state;
     g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS;
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
+    n.nb.query_samples = 7;
+    assert_int_equal(skip_frame(&n, n.mesh, 1, &st), 0);
+    assert_int_equal(st.overflow_pixels_late, 0); /* counted at once: nothing to wait for */
+    assert_int_equal(st.overflow_frame, 0);
+    assert_int_equal(skip_frame(&n, n.mesh, 8, &st), 0);
+    assert_int_equal(skip_frame(&n, n.mesh, 9, &st), 1);
+    fx_mesh_desc(&md, &tor, 0);
+    assert_int_equal(fogvol_create_mesh(n.fv, &md, &torus, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(skip_frame(&n, torus, 1, &st), 1);
+    assert_int_equal(skip_frame(&n, n.mesh, 1, &st), 0);
+    fogvol_destroy_mesh(n.fv, torus);
+    null_close(&n);
+    null_open(&n, FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
+    assert_int_equal(skip_frame(&n, n.mesh, 1, &st), 1);
+    null_close(&n);
+    g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_SKIP_CHECK;
+    null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
+    assert_int_equal(skip_frame(&n, n.mesh, 1, &st), 1);
+    null_close(&n);
+    g_null_speedups_off = NULL_OFF;
+    shp_free(&tor);
+    for (k = 0; k < 2; ++k) {
+        px[k] = (unsigned char *)malloc((size_t)W * H * 4);
+        thick[k] = (float *)malloc((size_t)W * H * sizeof(float));
+    }
+    gl_spheres(2, 0, px[0], thick[0], &st);
+    assert_int_equal(st.overflow_passes, 0);
+    assert_int_equal(st.overflow_pixels, 0); /* the debug read-back: no saturated channel */
+    gl_spheres(2, FOGVOL_SPEEDUP_SKIP_CHECK, px[1], thick[1], &st);
+    assert_int_equal(st.overflow_passes, 1);
+    assert_int_equal(st.overflow_pixels, 0);
+    assert_memory_equal(px[0], px[1], (size_t)W * H * 4);
+    assert_memory_equal(thick[0], thick[1], (size_t)W * H * sizeof(float));
+    for (i = 0, fogged = 0; i < W * H; ++i) fogged += thick[0][i] > 0.0f;
+    assert_true(fogged > W * H / 8);
+    gl_spheres(3, 0, px[1], thick[1], &st);
+    assert_int_equal(st.overflow_passes, 1);
+    print_message("  skip check: 1 and 8 convex volumes skip it, 9, a torus and NEAR_CLAMP check; 2 spheres at "
+                  "L = 6 skip it (%d fogged pixels, none saturated), 3 check\n", fogged);
+    for (k = 0; k < 2; ++k) {
+        free(px[k]);
+        free(thick[k]);
+    }
 }
 
 static void test_bad_policy(void **state)
@@ -893,7 +1039,7 @@ static void test_bad_policy(void **state)
 int main(void)
 {
     static int params[NCOMBO * 3][2];
-    static struct CMUnitTest tests[NCOMBO * 3 + 8]; /* zeroed: the unused entries are skipped */
+    static struct CMUnitTest tests[NCOMBO * 3 + 9]; /* zeroed: the unused entries are skipped */
     int n = 0, i, j, fails;
     char *names[NCOMBO * 3];
     build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
@@ -914,10 +1060,17 @@ int main(void)
         const struct CMUnitTest more[] = {
             cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_null_bands),
             cmocka_unit_test(test_bands),           cmocka_unit_test(test_bad_policy),
+            cmocka_unit_test(test_skip_check),
             cmocka_unit_test(test_lower_bits),      cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
         };
-        for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) tests[n++] = more[i];
+        for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {
+            if (n >= (int)(sizeof tests / sizeof tests[0])) {
+                fprintf(stderr, "test_overflow: the test table is too small\n");
+                return 1;
+            }
+            tests[n++] = more[i];
+        }
     }
     fails = cmocka_run_group_tests_name("overflow", tests, NULL, NULL);
     for (i = 0; i < NCOMBO * 3; ++i) free(names[i]);
