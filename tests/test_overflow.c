@@ -635,19 +635,25 @@ static void null_open(nullrig *n, fogvol_tier tier, unsigned variants, unsigned 
 
 static int g_vp_x0, g_vp_y0; /* the viewport's origin in null_frame (0, 0 unless a test moves it) */
 
+/* A frame looking down -z from the origin, near 0.5 and far 10, with a w x h viewport at (0, 0). */
+static void frame_at(fogvol_frame_desc *fd, double fovy, int w, int h)
+{
+    memset(fd, 0, sizeof *fd);
+    glu_identity(fd->view);
+    glu_perspective(fd->projection, fovy, 1, 0.5, 10);
+    fd->znear = 0.5f;
+    fd->zfar = 10;
+    fd->viewport[2] = w;
+    fd->viewport[3] = h;
+}
+
 static fogvol_result null_frame(nullrig *n, int show_overflow, int volumes, fogvol_frame_stats *st)
 {
     fogvol_frame_desc fd;
     fogvol_volume_desc vd;
-    memset(&fd, 0, sizeof fd);
-    glu_identity(fd.view);
-    glu_perspective(fd.projection, 60, 1, 0.5, 10);
-    fd.znear = 0.5f;
-    fd.zfar = 10;
+    frame_at(&fd, 60, 16, 16);
     fd.viewport[0] = g_vp_x0;
     fd.viewport[1] = g_vp_y0;
-    fd.viewport[2] = 16;
-    fd.viewport[3] = 16;
     fd.show_overflow = show_overflow;
     assert_int_equal(fogvol_begin_frame(n->fv, &fd), FOGVOL_SUCCESS);
     memset(&vd, 0, sizeof vd);
@@ -886,12 +892,7 @@ static int skip_frame(nullrig *n, const fogvol_mesh *mesh, int volumes, fogvol_f
     fogvol_frame_desc fd;
     fogvol_volume_desc vd;
     int i;
-    memset(&fd, 0, sizeof fd);
-    glu_identity(fd.view);
-    glu_perspective(fd.projection, 60, 1, 0.5, 10);
-    fd.znear = 0.5f;
-    fd.zfar = 10;
-    fd.viewport[2] = fd.viewport[3] = 16;
+    frame_at(&fd, 60, 16, 16);
     assert_int_equal(fogvol_begin_frame(n->fv, &fd), FOGVOL_SUCCESS);
     memset(&vd, 0, sizeof vd);
     vd.mesh = mesh;
@@ -932,13 +933,7 @@ static void gl_spheres(int k, unsigned off, unsigned char *px, float *thick, fog
     memset(&rd, 0, sizeof rd);
     rd.density = 0.5f;
     assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-    memset(&fd, 0, sizeof fd);
-    glu_identity(fd.view);
-    glu_perspective(fd.projection, 50, 1, 0.5, 10);
-    fd.znear = 0.5f;
-    fd.zfar = 10;
-    fd.viewport[2] = W;
-    fd.viewport[3] = H;
+    frame_at(&fd, 50, W, H);
     fd.debug_thickness = thick;
     glClearColor(0.2f, 0.3f, 0.4f, 1);
     glClear(GL_COLOR_BUFFER_BIT);
