@@ -530,9 +530,11 @@ typedef struct fogvol_context_desc fogvol_context_desc;
    SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
                  convex (fogvol_mesh_report.convex), at most half as many as a target sums
                  (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
-                 at most one back and one front face on a ray (two within the convexity test's
-                 tolerance), so no sum can saturate, and the frame counts 0 for the group at once
-                 (fogvol_frame_stats.overflow_passes leaves it out). */
+                 at most one back and one front face on a ray, so no sum can saturate (the half is
+                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
+                 their box's diagonal, which a ray grazing them could cross more than once), and the
+                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
+                 out). */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -9144,10 +9146,10 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 /* <<one-pass colour group */
 
 /* FOGVOL_SPEEDUP_SKIP_CHECK: no pixel of the group's sums can saturate, so its check pass would find
-   nothing: every volume of the group is convex (at most one front and one back face on a ray; a mesh
-   convex only within fogvol__convexity's tolerance might give a grazing ray a second pair, hence
-   half of what a target sums), the faces are not folded onto the near plane (NEAR_CLAMP), and
-   SINGLE_TARGET keeps its peak check. */
+   nothing: every volume of the group is convex (at most one front and one back face on a ray; half
+   of what a target sums leaves a margin for a mesh convex only within fogvol__convexity's tolerance,
+   which a grazing ray could cross again), the faces are not folded onto the near plane
+   (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
 static int fogvol__unsaturable(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
     int i, n = 0;

@@ -882,8 +882,8 @@ static void test_null_bands(void **state)
 
 /* FOGVOL_SPEEDUP_SKIP_CHECK: a group whose sums cannot saturate draws no check pass. On the null
    backend (whole-picture checks): one convex tetrahedron, and 8 of them (at most one back and one
-   front face each on a ray, twice that within the convexity test's tolerance: 16 faces, what L = 4
-   sums), skip it and count 0 at once; 9 of them, a concave torus, NEAR_CLAMP (faces folded onto the
+   front face each on a ray; half the 16 faces L = 4 sums, a margin for meshes convex within the
+   convexity test's tolerance), skip it and count 0 at once; 9 of them, a concave torus, NEAR_CLAMP (faces folded onto the
    near plane) and the speed-up switched off draw it. In GL (PS20 on OSMesa, L = 6: 4 faces a
    target), 2 overlapping spheres skip it and the debug read-back finds no saturated pixel, with the
    pixels of the frame that checks; 3 spheres check. */
