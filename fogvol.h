@@ -8796,7 +8796,9 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
     run->fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
     run->counted = run->rgba8 && fogvol__overflow_open(ctx);
     run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
-    if (run->checks && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without checks */
+    /* SINGLE's peak check runs inside the sum passes; the others make the checks when a group first
+       draws one (fogvol__group_check) */
+    if (run->checks && run->single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
         run->counted = run->checks = 0;
         ctx->qcur = -1;
         run->r = r;
@@ -9150,18 +9152,24 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
    of what a target sums leaves a margin for a mesh convex only within fogvol__convexity's tolerance,
    which a grazing ray could cross again), the faces are not folded onto the near plane
    (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
-static int fogvol__unsaturable(const fogvol_context *ctx, const fogvol_ramp *ramp)
+static int fogvol__unsaturable(const fogvol_context *ctx, int volumes, int all_convex)
 {
-    int i, n = 0;
-    if ((ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) ||
-        fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET))
-        return 0;
-    for (i = 0; i < ctx->nvol; ++i)
-        if (ctx->vols[i].ramp == ramp) {
-            if (ctx->vols[i].mesh->convex != 1) return 0;
-            ++n;
-        }
-    return 2 * n <= ctx->enc.max_faces;
+    return all_convex && 2 * volumes <= ctx->enc.max_faces && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
+           !fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET);
+}
+
+/* The group's overflow check pass, its program and mask target made on first use (none while every
+   group skips it); when they cannot be made the frame is not counted. */
+static void fogvol__group_check(fogvol_context *ctx, fogvol__run *run, const fogvol_pass *ps)
+{
+    fogvol_result r = fogvol__ensure_checks(ctx);
+    if (r == FOGVOL_SUCCESS) {
+        fogvol__check_pass(ctx, run, ps, 1, &run->st);
+        return;
+    }
+    run->counted = 0; /* (no query begun this frame: any earlier check would have made them) */
+    ctx->qcur = -1;
+    run->r = r;
 }
 
 /* The passes of the colour-ramp group of volume g, unless an earlier volume shares its ramp (the
@@ -9171,7 +9179,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
 {
     const fogvol_ramp *ramp = ctx->vols[g].ramp;
     fogvol_pass ps;
-    int i, has_pos = 0, has_neg = 0;
+    int i, has_pos = 0, has_neg = 0, n = 0, convex = 1;
     if (fogvol__color_member(ctx, ramp)) {
         fogvol__color_group(ctx, run, g);
         return;
@@ -9182,13 +9190,19 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
         if (ctx->vols[i].ramp == ramp) {
             if (ctx->vols[i].negative) has_neg = 1;
             else has_pos = 1;
+            convex &= ctx->vols[i].mesh->convex == 1;
+            ++n;
         }
     if (!has_pos) return;
     run->st.groups++;
-    for (i = g; i < ctx->nvol; ++i) run->st.volumes += ctx->vols[i].ramp == ramp;
+    run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
-    if (run->counted && !fogvol__unsaturable(ctx, ramp)) fogvol__check_pass(ctx, run, &ps, !run->single, &run->st);
+    if (run->single) {
+        if (run->counted) fogvol__check_pass(ctx, run, &ps, 0, &run->st); /* after the subtractions */
+    } else if (run->counted && !fogvol__unsaturable(ctx, n, convex)) {
+        fogvol__group_check(ctx, run, &ps);
+    }
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }

@@ -883,7 +883,8 @@ static void test_null_bands(void **state)
 /* FOGVOL_SPEEDUP_SKIP_CHECK: a group whose sums cannot saturate draws no check pass. On the null
    backend (whole-picture checks): one convex tetrahedron, and 8 of them (at most one back and one
    front face each on a ray; half the 16 faces L = 4 sums, a margin for meshes convex within the
-   convexity test's tolerance), skip it and count 0 at once; 9 of them, a concave torus, NEAR_CLAMP (faces folded onto the
+   convexity test's tolerance), skip it and count 0 at once, the check's program and mask not made
+   until a frame checks; 9 of them, a concave torus, NEAR_CLAMP (faces folded onto the
    near plane) and the speed-up switched off draw it. In GL (PS20 on OSMesa, L = 6: 4 faces a
    target), 2 overlapping spheres skip it and the debug read-back finds no saturated pixel, with the
    pixels of the frame that checks; 3 spheres check. */
@@ -963,7 +964,7 @@ static void test_skip_check(void **state)
     shp_mesh tor = shp_torus(1.0f, 0.4f, 16, 8);
     unsigned char *px[2];
     float *thick[2];
-    int k, i, fogged;
+    int k, i, fogged, creates;
     (void)state;
     g_null_speedups_off = FOGVOL_SPEEDUP_OVERFLOW_BANDS;
     null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT, 1, FOGVOL_OVERFLOW_COUNT_ONLY);
@@ -971,8 +972,11 @@ static void test_skip_check(void **state)
     assert_int_equal(skip_frame(&n, n.mesh, 1, &st), 0);
     assert_int_equal(st.overflow_pixels_late, 0); /* counted at once: nothing to wait for */
     assert_int_equal(st.overflow_frame, 0);
+    creates = n.nb.creates;
     assert_int_equal(skip_frame(&n, n.mesh, 8, &st), 0);
+    assert_int_equal(n.nb.creates, creates); /* no check program or mask while every group skips */
     assert_int_equal(skip_frame(&n, n.mesh, 9, &st), 1);
+    assert_true(n.nb.creates >= creates + 2); /* made by the first check */
     fx_mesh_desc(&md, &tor, 0);
     assert_int_equal(fogvol_create_mesh(n.fv, &md, &torus, NULL), FOGVOL_SUCCESS);
     assert_int_equal(skip_frame(&n, torus, 1, &st), 1);
