@@ -534,7 +534,16 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
                  their box's diagonal, which a ray grazing them could cross more than once), and the
                  frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
-                 out). */
+                 out).
+   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
+                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
+                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
+                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
+                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
+                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
+                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
+                 about half a texture read, on tile-based GPUs it comes from tile memory
+                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -548,7 +557,8 @@ enum {
     FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
     FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
     FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
-    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12
+    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
+    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -735,6 +745,7 @@ typedef struct fogvol_frame_stats {
     int lights;              /* light volumes drawn (fogvol_add_light), 2 passes each */
     int depth_tested;        /* 1: the faces were depth-tested against the occluders and counted (the
                                 COUNT variant, or FOGVOL_SPEEDUP_DEPTH_TEST took this frame) */
+    int fetched_o;           /* 1: a face pass read O from the framebuffer (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
 } fogvol_frame_stats;
@@ -1233,6 +1244,10 @@ typedef struct fogvol_pass {
                                writes to every channel (GL: RGB source factor CONSTANT_COLOR instead of
                                SRC_ALPHA, glBlendColor(blend_color)) */
     float blend_color[4];
+    fogvol_handle read_target; /* non-zero (only with FOGVOL_CAP_FRAMEBUFFER_FETCH): this target's colour
+                                  is attached to the pass's target as colour attachment 1, never written
+                                  (GL: glColorMaski(1, all false)), for a program that reads it there
+                                  (FOGVOL_SPECIALIZE_FETCH_O's fv_ofb); 0: attachment 1 is not there */
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
@@ -1261,11 +1276,15 @@ enum {
     FOGVOL_CAP_MESH_LAYOUT = 1u << 5,     /* create_mesh reads fogvol_mesh_data's stride, offset, index_type */
     FOGVOL_CAP_FILTER_FLOAT = 1u << 6,    /* create_target honours fogvol_target_desc.linear for R32F */
     FOGVOL_CAP_BLEND_CONSTANT = 1u << 7,  /* begin_pass honours fogvol_pass.blend_constant */
-    FOGVOL_CAP_FLOAT_TARGET = 1u << 8     /* R32F colour targets that fogvol's O pass and the engine's
+    FOGVOL_CAP_FLOAT_TARGET = 1u << 8,    /* R32F colour targets that fogvol's O pass and the engine's
                                              MRT pass or occluder shaders can write at full precision,
                                              blending not needed (GL 3.0; GLES 3 with
                                              EXT_color_buffer_float where the engine's output is highp:
                                              fogvol_gl_desc.mrt_highp) */
+    FOGVOL_CAP_FRAMEBUFFER_FETCH = 1u << 9 /* begin_pass honours fogvol_pass.read_target, and FACE programs
+                                              with FOGVOL_SPECIALIZE_FETCH_O build (GL:
+                                              EXT_shader_framebuffer_fetch, GLSL 330 or 300 es, per-buffer
+                                              colour masks) */
 };
 
 typedef struct fogvol_frame_info {
@@ -1551,8 +1570,11 @@ typedef struct fogvol_shader_desc {
    that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT and PS20 (not WIDE,
    ENGINE_DEPTH or COUNT, nor with FOGVOL_SPECIALIZE_COUNT): FLOAT_O (fv_opaque is an R32F O holding
    the normalised view depth, which ENCODE writes, encoded by the program where it needs O's digits;
-   see FOGVOL_SPEEDUP_FLOAT_O). Other bits, EXP with RAMP, L > 8, or bits for another program:
-   FOGVOL_ERROR_UNSUPPORTED. */
+   see FOGVOL_SPEEDUP_FLOAT_O). FACE, dialects GLSL 330 and 300 es, single-sample, reading O (not
+   NO_OPAQUE, COUNT, WIDE, or FLOAT with ENGINE_DEPTH): FETCH_O (O is read from colour location 1,
+   "inout vec4 fv_ofb" with EXT_shader_framebuffer_fetch, where the pass binds it:
+   fogvol_pass.read_target; the output is at location 0). Other bits, EXP with RAMP, L > 8, or bits
+   for another program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1571,7 +1593,8 @@ enum {
     FOGVOL_SPECIALIZE_INLINE_RESOLVE = 1u << 17,
     FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18,
     FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19,
-    FOGVOL_SPECIALIZE_FLOAT_O = 1u << 20
+    FOGVOL_SPECIALIZE_FLOAT_O = 1u << 20,
+    FOGVOL_SPECIALIZE_FETCH_O = 1u << 21
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -3024,6 +3047,15 @@ static const char fogvol__fs_es100[] =
     "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
     "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
     "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
+/* FOGVOL_SPECIALIZE_FETCH_O: the extension before any declaration, the output at location 0 and O
+   read from location 1 (FV_FETCH_O) */
+#define FOGVOL__FS_FETCH                                                                                       \
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_fragcolor;\n"     \
+    "#define FV_FRAGCOLOR fv_fragcolor\nlayout(location = 1) inout vec4 fv_ofb;\n#define FV_FETCH_O\n"
+static const char fogvol__fs_fetch_330[] = "#extension GL_EXT_shader_framebuffer_fetch : require\n" FOGVOL__FS_FETCH;
+static const char fogvol__fs_fetch_es300[] = "#extension GL_EXT_shader_framebuffer_fetch : require\n"
+                                             "precision highp float;\nprecision highp sampler2D;\n" FOGVOL__FS_FETCH;
+#undef FOGVOL__FS_FETCH
 static const char fogvol__fs_es300[] =
     "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
     "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
@@ -3059,26 +3091,28 @@ typedef struct fogvol__dialect_info {
     const char *fs;                   /* fragment prelude, one output */
     const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
     const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
+    const char *fs_fetch;             /* fragment prelude of FOGVOL_SPECIALIZE_FETCH_O; NULL: not in this dialect */
 } fogvol__dialect_info;
 
 static const fogvol__dialect_info fogvol__dialects[] = {
-    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}},
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
     {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
     {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
-     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL},
     {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
-     fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}},
+     fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern},
+     NULL},
     {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
      {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
-     {NULL, fogvol__an_fs_modern}},
+     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330},
     {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
-     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}},
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL},
     {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
      {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
-     {fogvol__highp_float, fogvol__an_fs_modern}}};
+     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300}};
 #undef FOGVOL__SAMPLE_SHADING
 /* one row per value of fogvol_dialect */
 typedef char
@@ -5398,6 +5432,13 @@ static const char fogvol__fs_encode[] =
 static const char fogvol__fs_face[] =
     "FV_VARYING_IN float fv_d;\n"
     "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "#ifdef FV_FETCH_O\n" /* O from the framebuffer (FOGVOL_SPECIALIZE_FETCH_O) */
+    "#define FV_OREAD(s) fv_ofb\n"
+    "#undef FV_O_DIGITS\n"
+    "#ifdef FV_O_FLOAT\n#define FV_O_DIGITS(s) fv_encode(fv_ofb.r)\n#else\n#define FV_O_DIGITS(s) fv_ofb\n#endif\n"
+    "#else\n"
+    "#define FV_OREAD(s) FV_SCREEN(s)\n"
+    "#endif\n"
     "#ifdef FV_DENSITY\n"                        /* v = c + rho (min(d, o) - c), c = min(o, fv_dens.x) */
     "uniform sampler2D fv_density;\n"
     "uniform vec4 fv_dens;\n"
@@ -5417,9 +5458,9 @@ static const char fogvol__fs_face[] =
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
     "#if defined(FV_OPAQUE)\n"
-    "    o = FV_SCREEN(fv_opaque).r;\n"
+    "    o = FV_OREAD(fv_opaque).r;\n"
     "#elif !defined(FV_NO_OPAQUE)\n"
-    "    if (fv_speed.x < 0.5) o = FV_SCREEN(fv_opaque).r;\n"
+    "    if (fv_speed.x < 0.5) o = FV_OREAD(fv_opaque).r;\n"
     "#endif\n"
     "#endif\n"
     "    float d = min(max(fv_d, 0.0), o);\n"
@@ -5447,7 +5488,7 @@ static const char fogvol__fs_face[] =
     "    }\n"
     "#endif\n"
     "#if defined(FV_O_FLOAT) && !defined(FV_NO_OPAQUE)\n" /* the lesser depth's encoding (monotonic) */
-    "    vec4 e = fv_encode(min(fv_d, FV_SCREEN(fv_opaque).r));\n"
+    "    vec4 e = fv_encode(min(fv_d, FV_OREAD(fv_opaque).r));\n"
     "#else\n"
     "    vec4 e = fv_encode(fv_d);\n"
     "#endif\n"
@@ -5459,7 +5500,7 @@ static const char fogvol__fs_face[] =
     "#elif defined(FV_NO_OPAQUE) || defined(FV_O_FLOAT)\n" /* O far, or already in e */
     "    FV_FRAGCOLOR = e;\n"
     "#else\n"
-    "    vec4 o = FV_SCREEN(fv_opaque);\n"
+    "    vec4 o = FV_OREAD(fv_opaque);\n"
     "#ifdef FV_PS13\n"
     "    vec3 s = clamp((e.rgb - o.rgb) * 255.0, -1.0, 1.0);\n"
     "    FV_FRAGCOLOR = dot(s, vec3(1.0, 0.66, 0.31)) - 0.01 > 0.0 ? o : e;\n"
@@ -5877,11 +5918,14 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 /* fogvol_shader_desc.specialize: the bits a program accepts (FOGVOL_SPECIALIZE_*). */
 static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
 {
-    unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE;
+    unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE |
+                    FOGVOL_SPECIALIZE_FETCH_O;
     unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                     FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
+    if ((bits & FOGVOL_SPECIALIZE_FETCH_O) && (bits & (FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_COUNT)))
+        return 0; /* (it reads O) */
     if ((bits & FOGVOL_SPECIALIZE_BLEND_COLOR) &&
         ((p != FOGVOL_PROGRAM_COMPOSITE && p != FOGVOL_PROGRAM_COMPOSITE_MESH) ||
          (~bits & (FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW))))
@@ -5963,6 +6007,14 @@ static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
 
 /* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
    with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
+/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
+   FLOAT's engine depth texture, nor COLORS' faces) */
+static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
+{
+    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
+}
+
 static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
 {
     return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
@@ -6002,6 +6054,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     }
     if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__float_o_ok(d->tier, v)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
+    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__fetch_o_ok(d->tier, v) || d->samples > 1))
+        return FOGVOL_ERROR_UNSUPPORTED;
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
     strings[n++] = per_sample ? di->version_msaa : di->version;
     if (d->stage == FOGVOL_STAGE_VERTEX)
@@ -6011,7 +6065,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
              d->program == FOGVOL_PROGRAM_COLOR_FACE)
         n = fogvol__prelude(strings, n, di->fs_two);
     else
-        strings[n++] = di->fs;
+        strings[n++] = (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) ? di->fs_fetch : di->fs;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
@@ -6408,6 +6462,7 @@ struct fogvol_context {
     int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
     int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
     int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (MRT, PS20) */
+    int fetch_o;            /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O from the framebuffer */
 };
 
 /* column-major 4x4 helpers in double */
@@ -6943,6 +6998,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         fogvol__default_alu(ctx);
         fogvol__default_inline_resolve(ctx);
         fogvol__default_float_o(ctx);
+        ctx->fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
+                       !(ctx->speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
+                       fogvol__fetch_o_ok(ctx->tier, ctx->variants);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
@@ -7765,6 +7823,10 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
+        if (ps.read_target) { /* (the general program samples O) */
+            ps.textures[FOGVOL__UNIT_OPAQUE] = ps.read_target;
+            ps.read_target = 0;
+        }
         ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__origin_bit(ctx)); /* density texture */
         ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
@@ -8536,6 +8598,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
     int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
     if (ctx->qcur >= 0 && !fogvol__band_scissor(run, ctx->qf[ctx->qcur].band, cp.scissor)) return;
     cp.target = ctx->tgt_v;
+    cp.read_target = 0; /* (SINGLE_TARGET: the state of the sum passes) */
     cp.clear = first;
     memset(cp.clear_color, 0, sizeof cp.clear_color);
     cp.blend = FOGVOL_PASS_BLEND_NONE;
@@ -8889,6 +8952,28 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     fogvol__end_pass(ctx);
 }
 
+/* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: the face program of a group's sums reading O from the framebuffer
+   (ps->read_target: O beside the sum) where the frame's faces read fogvol's O; a program that does not
+   build turns the speed-up off and the faces sample O again. */
+static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, unsigned spec)
+{
+    fogvol_handle h;
+    ps->read_target = 0;
+    if (!ctx->fetch_o || run->no_opaque || run->count || ctx->samples > 1 || !ctx->tgt_o ||
+        (spec & FOGVOL_SPECIALIZE_NO_OPAQUE))
+        return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
+    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec | FOGVOL_SPECIALIZE_FETCH_O);
+    if (h && h != ctx->prog[FOGVOL_PROGRAM_FACE]) {
+        ps->read_target = ctx->tgt_o;
+        run->st.fetched_o = 1;
+        return h;
+    }
+    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no face program reading O from the framebuffer (it did "
+                                               "not build): the faces sample O (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH off)");
+    ctx->fetch_o = 0;
+    return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
+}
+
 /* The face sums of one ramp group: FLOAT one signed pass into B; SINGLE_TARGET back faces up and
    front faces down in B (with the overflow check at the peak); else back faces into B and front
    faces into F. The debug read-back, when asked for this group, follows the sums. */
@@ -8903,13 +8988,13 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
         spec |= fogvol__depth_from_z_bit(&ps); /* (FLOAT faces read the engine's depth) */
     spec |= fogvol__dither_bit(ctx) | ctx->count_bit;
-    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
+    ps.program = fogvol__face_program(ctx, run, &ps, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
     ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
     ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
         ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
+    else if (!ps.read_target) ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
     ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->tgt_o2;
     if (ctx->tier == FOGVOL_TIER_FLOAT) { /* every face, signed by gl_FrontFacing */
         ps.target = ctx->tgt_b;
@@ -10019,6 +10104,7 @@ typedef struct fogvol__gl_target {
     fogvol__GLuint fbo, depth;
     int width, height;
     int owns_depth; /* 0 when depth is another target's renderbuffer */
+    fogvol__GLuint read_tex; /* fogvol_pass.read_target's texture at colour attachment 1 (0: none) */
     fogvol_format format;
     struct fogvol__gl_target *second; /* WIDE: attachment 1 as a target of its own (own FBO) */
 } fogvol__gl_target;
@@ -11159,11 +11245,24 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
     }
 }
 
+/* fogvol_pass.read_target: its texture at colour attachment 1 of t's FBO, in the draw buffers (the
+   program reads it there), or nothing there; FBO state of our own FBO, changed only when it differs. */
+static void fogvol__gl_attach_read(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_pass *p)
+{
+    static const fogvol__GLenum bufs[2] = {FOGVOL__GL_COLOR_ATTACHMENT0, FOGVOL__GL_COLOR_ATTACHMENT0 + 1};
+    fogvol__GLuint tex = p->read_target ? ((const fogvol__gl_target *)p->read_target)->base.tex : 0;
+    if (!t || t->second || t->read_tex == tex) return; /* (WIDE's attachment 1 is its own) */
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_COLOR_ATTACHMENT0 + 1, FOGVOL__GL_TEXTURE_2D, tex, 0);
+    gl->DrawBuffers(tex ? 2 : 1, bufs);
+    t->read_tex = tex;
+}
+
 static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
-    const fogvol__gl_target *t = (const fogvol__gl_target *)p->target;
+    fogvol__gl_target *t = (fogvol__gl_target *)p->target;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
+    fogvol__gl_attach_read(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
     fogvol__gl_pass_enables(gl);
     if (!gl->gles) gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
@@ -11177,6 +11276,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         gl->Scissor(p->scissor[0], p->scissor[1], p->scissor[2], p->scissor[3]);
     }
     gl->ColorMask(1, 1, 1, 1);
+    if (p->read_target && t) gl->ColorMaski(1, 0, 0, 0, 0); /* read, never written (nor cleared) */
     if (p->clear) {
         fogvol__GLbitfield bits = FOGVOL__GL_COLOR_BUFFER_BIT;
         gl->ClearColor(p->clear_color[0], p->clear_color[1], p->clear_color[2], p->clear_color[3]);
@@ -11763,6 +11863,11 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
     gl->mrt_highp = desc->mrt_highp != 0;
     gl->caps = fogvol__gl_caps(gl, ext);
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+    if ((gl->dialect == FOGVOL_GLSL_330 || gl->dialect == FOGVOL_GLSL_300ES) && gl->has_indexed_mask &&
+        gl->DrawBuffers &&
+        (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_shader_framebuffer_fetch")
+                        : fogvol__has_ext(ext, "GL_EXT_shader_framebuffer_fetch")))
+        gl->caps |= FOGVOL_CAP_FRAMEBUFFER_FETCH; /* (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
     fogvol__gl_load_clip_control(gl, desc, ext);
     fogvol__gl_raster_caps(gl);
     if (gl->has_sampler) { /* sampler objects hold no binding: no state to save */
