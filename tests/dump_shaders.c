@@ -9,7 +9,9 @@
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
    NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by the programs that write or read
-   O (ENCODE, FACE, LIGHT) of MRT and PS20 without WIDE, ENGINE_DEPTH and COUNT only. */
+   O (ENCODE, FACE, LIGHT) of MRT and PS20 without WIDE, ENGINE_DEPTH and COUNT only;
+   FOGVOL_SPECIALIZE_FETCH_O by single-sample FACE programs in GLSL 330 and 300 es that read O (not
+   with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH). */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -43,6 +45,12 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if (bits & FOGVOL_SPECIALIZE_FETCH_O)
+        return p == FOGVOL_PROGRAM_FACE && !ms && (d == FOGVOL_GLSL_330 || d == FOGVOL_GLSL_300ES) &&
+               !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+               !(t == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH)) &&
+               !(bits & (FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_COUNT)) &&
+               variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FETCH_O, ms);
     if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
         return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20) &&
                !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) &&
@@ -148,6 +156,17 @@ int main(int argc, char **argv)
                                          FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW,
                                      FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_INLINE_RESOLVE |
                                          FOGVOL_SPECIALIZE_RAMP,
+                                     FOGVOL_SPECIALIZE_FETCH_O,
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_NO_DENSITY |
+                                         FOGVOL_SPECIALIZE_OPAQUE,
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_ORIGIN |
+                                         FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER |
+                                         FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_DITHER |
+                                         FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

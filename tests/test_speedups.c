@@ -17,6 +17,10 @@
    composite (INLINE_RESOLVE) gives the resolve pass's bytes, sums and overflow counts. The MRT
    snippet's encode, in integers (GLSL 330) and in floats, gives fogvol_encode_depth's bytes. FLOAT_O
    (PS20 keeps O as R32F and compares instead of counting) gives the bytes of the RGBA8 O.
+   FRAMEBUFFER_FETCH (the faces read O from a write-masked colour attachment beside the sum) gives
+   the bytes and sums of the texture read, on FLOAT, PS20 and PS13 comparing, with the backend's cap
+   off and with a backend whose fetching programs fail; O itself is never written there, and the
+   engine's per-buffer colour masks survive.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -63,6 +67,9 @@ typedef struct run_out {
     int targets;               /* render targets the context created */
     int o_format;              /* the format of the O target (-1: none made) */
     int blend_constant[NFRAMES]; /* passes with fogvol_pass.blend_constant (FOGVOL_SPEEDUP_BLEND_COLOR) */
+    int fetched[NFRAMES];        /* fogvol_frame_stats.fetched_o */
+    int read_passes[NFRAMES];    /* passes with fogvol_pass.read_target (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
+    int fetch_programs;          /* programs built reading O from the framebuffer */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -77,34 +84,54 @@ static int g_no_highp;      /* 1: the backend reports no FOGVOL_CAP_HIGHP_FRAGME
 static int g_no_blend_constant; /* 1: the backend reports no FOGVOL_CAP_BLEND_CONSTANT */
 static int g_light;             /* 1: the ramp blends as FOGVOL_BLEND_LIGHT */
 static int g_fail_blend_color;  /* 1: the backend fails to build FOGVOL_SPECIALIZE_BLEND_COLOR programs */
+static int g_no_fetch_cap;      /* 1: the backend reports no FOGVOL_CAP_FRAMEBUFFER_FETCH */
+static int g_fail_fetch;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_FETCH_O programs */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
 static int g_targets, g_o_format;
+static fogvol_handle g_o_target;
 static fogvol_result watch_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     if (d->linear && g_no_linear) return FOGVOL_ERROR_UNSUPPORTED; /* as a backend that cannot filter R32F */
+    fogvol_result r;
     g_targets++;
-    if (d->label && strncmp(d->label, "fogvol O ", 9) == 0) g_o_format = (int)d->format;
-    return g_inner.create_target(u, d, out);
+    r = g_inner.create_target(u, d, out);
+    if (d->label && strncmp(d->label, "fogvol O ", 9) == 0) {
+        g_o_format = (int)d->format;
+        g_o_target = r == FOGVOL_SUCCESS ? *out : 0;
+    }
+    return r;
 }
 /* counts the programs whose fragment shader has this context's encoding compiled in; with
    g_fail_blend_color fails those that take their colour from the blend unit */
-static int g_enc_programs;
+static int g_enc_programs, g_fetch_programs;
 static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     int i;
     for (i = 0; i < d->fs_count; ++i) {
+        if (strstr(d->fs[i], "#define FV_FETCH_O\n")) {
+            if (g_fail_fetch) return FOGVOL_ERROR_BACKEND;
+            g_fetch_programs++;
+        }
         g_enc_programs += strncmp(d->fs[i], "#define FV_ENC_LN ", 18) == 0 && atoi(d->fs[i] + 18) == (g_bits ? g_bits : 4);
         if (g_fail_blend_color && strcmp(d->fs[i], "#define FV_BLEND_COLOR\n") == 0) return FOGVOL_ERROR_BACKEND;
     }
     return g_inner.create_program(u, d, out);
 }
-/* counts the passes that blend a constant colour */
-static int g_blend_constant;
+/* counts the passes that blend a constant colour, and those that read a target from the framebuffer
+   (which must be O, beside a sum target, and not sampled as well) */
+static int g_blend_constant, g_read_passes;
 static void watch_pass(void *u, const fogvol_pass *p)
 {
     g_blend_constant += p->blend_constant != 0;
+    if (p->read_target) {
+        int i;
+        g_read_passes++;
+        assert_true(p->target != 0 && p->target != p->read_target);
+        assert_true(p->read_target == g_o_target);
+        for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) assert_true(p->textures[i] != p->read_target);
+    }
     g_inner.begin_pass(u, p);
 }
 static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g, run_out *out)
@@ -130,7 +157,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     cd.backend.begin_pass = watch_pass;
     if (g_no_highp) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_HIGHP_FRAGMENT;
     if (g_no_blend_constant) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_BLEND_CONSTANT;
-    g_enc_programs = 0;
+    if (g_no_fetch_cap) cd.backend.caps &= ~(unsigned)FOGVOL_CAP_FRAMEBUFFER_FETCH;
+    g_enc_programs = g_fetch_programs = 0;
     cd.tier = t;
     cd.disable_speedups = off;
     cd.variants = g_variants;
@@ -145,7 +173,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     rd.density = s->density;
     rd.blend = g_light ? FOGVOL_BLEND_LIGHT : FOGVOL_BLEND_FOG;
     assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-    g_blend_constant = 0;
+    g_blend_constant = g_read_passes = 0;
     for (f = 0; f < NFRAMES; ++f) {
         fogvol_frame_desc fd;
         memset(&fd, 0, sizeof fd);
@@ -171,7 +199,9 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
             assert_int_equal(r, FOGVOL_SUCCESS);
         glu_pixels(g);
         out->blend_constant[f] = g_blend_constant;
-        g_blend_constant = 0;
+        out->read_passes[f] = g_read_passes;
+        g_blend_constant = g_read_passes = 0;
+        out->fetched[f] = st.fetched_o;
         for (y = 0; y < g->height; ++y)
             for (x = 0; x < g->width; ++x) {
                 const unsigned char *p = g->pixels + 4 * ((size_t)y * g->width + x);
@@ -190,6 +220,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
     fogvol_destroy_context(fv);
     g_inner.destroy(g_inner.user_data);
     out->enc_programs = g_enc_programs;
+    out->fetch_programs = g_fetch_programs;
     out->targets = g_targets;
     out->o_format = g_o_format;
 }
@@ -255,7 +286,7 @@ static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
      FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O | \
-     FOGVOL_SPEEDUP_SKIP_CHECK)
+     FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH)
 #define FO FOGVOL_SPEEDUP_FLOAT_O /* off where a test looks at DEPTH_TEST's count, which PS20 with an R32F O
                                      does not take (test_float_o) */
 
@@ -470,6 +501,64 @@ static void test_float_o(void **state)
                           g_tier_names[ti], names[si], ps20 ? "R32F" : "RGBA8", NFRAMES, covered);
             assert_true(covered > W * H / 8);
         }
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH (this OSMesa context has EXT_shader_framebuffer_fetch): the faces of
+   frames with occluders read O from the framebuffer, FLOAT and PS20 (its R32F O) and PS13 comparing
+   with its RGBA8 O (DEPTH_TEST off: no face count), and give the bytes and sums of the same frames
+   reading O as a texture, of a backend without the cap and of one whose fetching programs fail (a
+   warning; the faces sample O again and no later frame asks for the program). Frames without
+   occluders read no O. The engine's colour mask of draw buffer 1, which the passes change, is its
+   own again after every frame. */
+static void test_framebuffer_fetch(void **state)
+{
+    static run_out on, off, nocap, fail;
+    const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
+    glu_ctx g;
+    int ti, si, f, n;
+    GLboolean mask[4];
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    glColorMaski(1, GL_TRUE, GL_FALSE, GL_TRUE, GL_FALSE);
+    for (ti = 0; ti < 3; ++ti)
+        for (si = 0; si < 2; ++si) {
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            unsigned keep = g_tiers[ti] == FOGVOL_TIER_PS13 ? (unsigned)FOGVOL_SPEEDUP_DEPTH_TEST : 0u;
+            int faces = g_tiers[ti] == FOGVOL_TIER_FLOAT ? 1 : 2; /* sum passes reading O */
+            run_frames(s, g_tiers[ti], keep, &g, &on);
+            run_frames(s, g_tiers[ti], keep | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, &g, &off);
+            g_no_fetch_cap = 1;
+            run_frames(s, g_tiers[ti], keep, &g, &nocap);
+            g_no_fetch_cap = 0;
+            g_fail_fetch = 1;
+            run_frames(s, g_tiers[ti], keep, &g, &fail);
+            g_fail_fetch = 0;
+            assert_int_equal(on.fetch_programs, 1);
+            assert_int_equal(off.fetch_programs + nocap.fetch_programs + fail.fetch_programs, 0);
+            for (f = 0; f < NFRAMES; ++f) {
+                assert_int_equal(on.fetched[f], with_occluders(f));
+                assert_int_equal(on.read_passes[f], with_occluders(f) ? faces : 0);
+                assert_int_equal(off.fetched[f] + nocap.fetched[f] + fail.fetched[f], 0);
+                assert_int_equal(off.read_passes[f] + nocap.read_passes[f] + fail.read_passes[f], 0);
+                assert_int_equal(on.depth_tested[f], 0);
+                assert_int_equal(max_diff(on.px[f], off.px[f], &n), 0);
+                assert_int_equal(max_diff(nocap.px[f], off.px[f], &n), 0);
+                assert_int_equal(max_diff(fail.px[f], off.px[f], &n), 0);
+                assert_memory_equal(on.th[f], off.th[f], sizeof on.th[f]);
+                assert_memory_equal(nocap.th[f], off.th[f], sizeof on.th[f]);
+                assert_memory_equal(fail.th[f], off.th[f], sizeof on.th[f]);
+            }
+            /* the occluders cut the volumes: O matters in the frame that reads it */
+            assert_true(max_diff(on.px[2], on.px[0], &n) > 8);
+            glGetBooleani_v(GL_COLOR_WRITEMASK, 1, mask);
+            assert_true(mask[0] && !mask[1] && mask[2] && !mask[3]);
+            print_message("# %-5s %-22s O read from the framebuffer in %d sum pass(es) of the occluders' frame: "
+                          "the bytes and sums of the texture read, without the cap and with its program "
+                          "failing\n",
+                          g_tier_names[ti], names[si], on.read_passes[2]);
+        }
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glu_destroy(&g);
 }
 
@@ -812,7 +901,8 @@ int main(void)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_same_pixels_and_exp),
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
-                                       cmocka_unit_test(test_float_o), cmocka_unit_test(test_inline_resolve),
+                                       cmocka_unit_test(test_float_o), cmocka_unit_test(test_framebuffer_fetch),
+                                       cmocka_unit_test(test_inline_resolve),
                                        cmocka_unit_test(test_blend_color),
                                        cmocka_unit_test(test_mrt_snippet_encode),
                                        cmocka_unit_test(test_half_resolution)};
