@@ -543,7 +543,17 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
                  texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
                  about half a texture read, on tile-based GPUs it comes from tile memory
-                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off. */
+                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
+   EXACT_SUM     PS20 and MRT with FLOAT_O and FRAMEBUFFER_FETCH (not SINGLE_TARGET; single-sample;
+                 fp32 fragment shaders): a ramp group without density-textured volumes sums its faces
+                 by programmable blending: one pass over every face reads B's RGBA8 pixel as a 32-bit
+                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
+                 of it and O) for a back face and subtracts it for a front face (sign flipped for
+                 negative volumes), and writes the integer back; the composite reads that one target.
+                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
+                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
+                 overflow check pass (fewer than 256 volumes of a group can overlap a pixel:
+                 fogvol_frame_stats.exact_sum). Not the digits' bytes: closer to the true thickness. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -558,7 +568,8 @@ enum {
     FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
     FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
     FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
-    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13
+    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
+    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -746,6 +757,7 @@ typedef struct fogvol_frame_stats {
     int depth_tested;        /* 1: the faces were depth-tested against the occluders and counted (the
                                 COUNT variant, or FOGVOL_SPEEDUP_DEPTH_TEST took this frame) */
     int fetched_o;           /* 1: a face pass read O from the framebuffer (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
+    int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
 } fogvol_frame_stats;
@@ -1573,8 +1585,12 @@ typedef struct fogvol_shader_desc {
    see FOGVOL_SPEEDUP_FLOAT_O). FACE, dialects GLSL 330 and 300 es, single-sample, reading O (not
    NO_OPAQUE, COUNT, WIDE, or FLOAT with ENGINE_DEPTH): FETCH_O (O is read from colour location 1,
    "inout vec4 fv_ofb" with EXT_shader_framebuffer_fetch, where the pass binds it:
-   fogvol_pass.read_target; the output is at location 0). Other bits, EXP with RAMP, L > 8, or bits
-   for another program: FOGVOL_ERROR_UNSUPPORTED. */
+   fogvol_pass.read_target; the output is at location 0). FACE (with NO_DENSITY), COMPOSITE and
+   COMPOSITE_MESH of PS20 and MRT with FLOAT_O, the same dialects (FACE: single-sample): EXACT_SUM
+   (FOGVOL_SPEEDUP_EXACT_SUM: the face reads and writes its target's pixel as a 32-bit integer,
+   "inout" at location 0, and adds or subtracts round(d 2^24); the composite decodes that integer
+   times fv_rampmap.w = (far - near) / 2^24). Other bits, EXP with RAMP, L > 8, or bits for another
+   program: FOGVOL_ERROR_UNSUPPORTED. */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1594,7 +1610,8 @@ enum {
     FOGVOL_SPECIALIZE_BLEND_COLOR = 1u << 18,
     FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19,
     FOGVOL_SPECIALIZE_FLOAT_O = 1u << 20,
-    FOGVOL_SPECIALIZE_FETCH_O = 1u << 21
+    FOGVOL_SPECIALIZE_FETCH_O = 1u << 21,
+    FOGVOL_SPECIALIZE_EXACT_SUM = 1u << 22
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -3047,15 +3064,16 @@ static const char fogvol__fs_es100[] =
     "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\nprecision highp sampler2D;\n#else\n"
     "precision mediump float;\nprecision mediump sampler2D;\n#endif\n"
     "#define FV_VARYING_IN varying\n#define FV_TEXTURE texture2D\n#define FV_FRAGCOLOR gl_FragColor\n";
-/* FOGVOL_SPECIALIZE_FETCH_O: the extension before any declaration, the output at location 0 and O
-   read from location 1 (FV_FETCH_O) */
-#define FOGVOL__FS_FETCH                                                                                       \
-    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_fragcolor;\n"     \
-    "#define FV_FRAGCOLOR fv_fragcolor\nlayout(location = 1) inout vec4 fv_ofb;\n#define FV_FETCH_O\n"
+/* FOGVOL_SPECIALIZE_FETCH_O and EXACT_SUM: the extension before any declaration, then (fogvol_shader_strings)
+   the output at location 0 (EXACT_SUM: read too) and O read from location 1 (FV_FETCH_O) */
+#define FOGVOL__FS_FETCH "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
 static const char fogvol__fs_fetch_330[] = "#extension GL_EXT_shader_framebuffer_fetch : require\n" FOGVOL__FS_FETCH;
 static const char fogvol__fs_fetch_es300[] = "#extension GL_EXT_shader_framebuffer_fetch : require\n"
                                              "precision highp float;\nprecision highp sampler2D;\n" FOGVOL__FS_FETCH;
 #undef FOGVOL__FS_FETCH
+static const char fogvol__fs_fetch_out[] = "layout(location = 0) out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_fetch_sum[] = "layout(location = 0) inout vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_fetch_o[] = "layout(location = 1) inout vec4 fv_ofb;\n#define FV_FETCH_O\n";
 static const char fogvol__fs_es300[] =
     "precision highp float;\nprecision highp sampler2D;\n#define FV_VARYING_IN in\n#define FV_TEXTURE texture\n"
     "out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
@@ -5478,6 +5496,22 @@ static const char fogvol__fs_face[] =
     "    FV_OUT0 = behind ? ohi : hi;\n"
     "    FV_OUT1 = behind ? olo : lo;\n"
     "}\n"
+    ;
+/* (the face program's second string: C99 compilers need take no string over 4095 characters) */
+static const char fogvol__fs_face_rgba8[] =
+    "#elif defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: the pixel as a 32-bit integer, +- d 2^24 */
+    "uniform float fv_sign;\n"
+    "void main() {\n"
+    "    float d = clamp(fv_d, 0.0, 1.0);\n"
+    "#ifndef FV_NO_OPAQUE\n"
+    "    d = min(d, FV_OREAD(fv_opaque).r);\n"
+    "#endif\n"
+    "    highp uint q = uint(d * 16777216.0 + 0.5);\n" /* (GLSL ES: ints are mediump by default) */
+    "    highp uvec4 c = uvec4(FV_FRAGCOLOR * 255.0 + 0.5);\n"
+    "    highp uint u = c.r | (c.g << 8) | (c.b << 16) | (c.a << 24);\n"
+    "    u = gl_FrontFacing == (fv_sign > 0.0) ? u - q : u + q;\n"
+    "    FV_FRAGCOLOR = vec4(uvec4(u, u >> 8, u >> 16, u >> 24) & 255u) / 255.0;\n"
+    "}\n"
     "#else\n"
     "void main() {\n"
     "#ifdef FV_DENSITY\n"                        /* decoded opaque depth, then v re-encoded */
@@ -5601,6 +5635,9 @@ static const char fogvol__fs_composite[] =
     "#endif\n"
     "}\n"
     "#endif\n"
+    ;
+/* (the composite's main: C99 compilers need take no string over 4095 characters) */
+static const char fogvol__fs_composite_main[] =
     "void main() {\n"
     "    vec2 st = fv_st();\n"
     "#ifdef FV_DOWNSAMPLE\n"
@@ -5609,7 +5646,12 @@ static const char fogvol__fs_composite[] =
     "    vec4 b = FV_SCREEN(fv_back);\n"
     "#endif\n"
     "    float sat = 0.0, t;\n"
-    "#if defined(FV_FLOAT)\n"
+    "#if defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: a 32-bit integer, 2^24 per depth range */
+    "    highp uvec4 cu = uvec4(b * 255.0 + 0.5);\n"
+    "    highp uint u = cu.r | (cu.g << 8) | (cu.b << 16) | (cu.a << 24);\n"
+    "    if (u == 0u) discard;\n"
+    "    t = float(int(u)) * fv_rampmap.w;\n"
+    "#elif defined(FV_FLOAT)\n"
     "    if (b.r == 0.0) discard;\n"
     "    t = b.r * fv_dec.x;\n"
     "#elif defined(FV_PS13) && defined(FV_INLINE_RESOLVE)\n"  /* T's digits (clamped to 255) */
@@ -5905,12 +5947,18 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
         strings[n++] = fogvol__fs_resolve_fn;
     switch (d->program) {
     case FOGVOL_PROGRAM_ENCODE: strings[n++] = fogvol__fs_encode; break;
-    case FOGVOL_PROGRAM_FACE: strings[n++] = fogvol__fs_face; break;
+    case FOGVOL_PROGRAM_FACE:
+        strings[n++] = fogvol__fs_face;
+        strings[n++] = fogvol__fs_face_rgba8;
+        break;
     case FOGVOL_PROGRAM_RESOLVE: strings[n++] = fogvol__fs_resolve; break;
     case FOGVOL_PROGRAM_LIGHT: strings[n++] = fogvol__fs_light; break;
     case FOGVOL_PROGRAM_COLOR_FACE: strings[n++] = fogvol__fs_color_face; break;
     case FOGVOL_PROGRAM_COLOR_COMPOSITE: strings[n++] = fogvol__fs_color_composite; break;
-    default: strings[n++] = fogvol__fs_composite; break;
+    default:
+        strings[n++] = fogvol__fs_composite;
+        strings[n++] = fogvol__fs_composite_main;
+        break;
     }
     return n;
 }
@@ -5919,9 +5967,10 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
 {
     unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE |
-                    FOGVOL_SPECIALIZE_FETCH_O;
+                    FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXACT_SUM;
     unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
-                    FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP;
+                    FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_EXACT_SUM;
+    if ((bits & FOGVOL_SPECIALIZE_EXACT_SUM) && (bits & FOGVOL_SPECIALIZE_COUNT)) return 0; /* (one target) */
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_FETCH_O) && (bits & (FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_COUNT)))
@@ -5986,6 +6035,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_BLEND_COLOR) strings[n++] = "#define FV_BLEND_COLOR\n";
     if (d->specialize & FOGVOL_SPECIALIZE_DEPTH_FROM_Z) strings[n++] = "#define FV_DEPTH_FROM_Z\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) strings[n++] = "#define FV_O_FLOAT\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) strings[n++] = "#define FV_XSUM\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -6013,6 +6063,12 @@ static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
 {
     return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
            !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
+}
+
+/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20 and MRT whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
+static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
+{
+    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
 }
 
 static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
@@ -6056,6 +6112,10 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     di = fogvol__dialect(d->dialect);
     if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__fetch_o_ok(d->tier, v) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) &&
+        (!fogvol__exact_sum_ok(d->tier, v) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
+         (d->program == FOGVOL_PROGRAM_FACE && (d->samples > 1 || !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))))
+        return FOGVOL_ERROR_UNSUPPORTED;
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
     strings[n++] = per_sample ? di->version_msaa : di->version;
     if (d->stage == FOGVOL_STAGE_VERTEX)
@@ -6064,8 +6124,12 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
               (d->program == FOGVOL_PROGRAM_ENCODE || d->program == FOGVOL_PROGRAM_FACE)) ||
              d->program == FOGVOL_PROGRAM_COLOR_FACE)
         n = fogvol__prelude(strings, n, di->fs_two);
-    else
-        strings[n++] = (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) ? di->fs_fetch : di->fs;
+    else if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & (FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXACT_SUM))) {
+        strings[n++] = di->fs_fetch;
+        strings[n++] = (d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) ? fogvol__fs_fetch_sum : fogvol__fs_fetch_out;
+        if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
+    } else
+        strings[n++] = di->fs;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
@@ -6463,6 +6527,7 @@ struct fogvol_context {
     int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
     int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (MRT, PS20) */
     int fetch_o;            /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O from the framebuffer */
+    int exact_sum;          /* FOGVOL_SPEEDUP_EXACT_SUM: groups may sum as 32-bit integers */
 };
 
 /* column-major 4x4 helpers in double */
@@ -7001,6 +7066,11 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         ctx->fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
                        !(ctx->speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
                        fogvol__fetch_o_ok(ctx->tier, ctx->variants);
+        ctx->exact_sum = ctx->float_o && (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
+                         (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
+                         !(ctx->speedups_off & (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH |
+                                                FOGVOL_SPEEDUP_SPECIALIZE)) &&
+                         fogvol__exact_sum_ok(ctx->tier, ctx->variants);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
@@ -7953,7 +8023,7 @@ static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double 
 
 /* Decoded thickness per pixel (world units) from the sum targets, and the
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
-static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int *overflow)
+static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int xsum, int *overflow)
 {
     size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
     unsigned char *b, *f, *o;
@@ -7974,6 +8044,16 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
         if (r == FOGVOL_SUCCESS && ctx->frame.downsample == 2) fogvol__debug_upsample(ctx, fl, range);
         else
             for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->frame.debug_thickness[i] = (float)(fl[i] * range);
+        fogvol__free(&ctx->alloc, b);
+        return r;
+    }
+    if (xsum) { /* FOGVOL_SPEEDUP_EXACT_SUM: a 32-bit integer (two's complement), 2^24 per depth range */
+        for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) {
+            const unsigned char *p = b + 4 * i;
+            uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+            double v = u >= 0x80000000u ? (double)u - 4294967296.0 : (double)u;
+            ctx->frame.debug_thickness[i] = (float)(v / 16777216.0 * range);
+        }
         fogvol__free(&ctx->alloc, b);
         return r;
     }
@@ -8418,6 +8498,7 @@ typedef struct fogvol__run {
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
     fogvol_result r;            /* the last error that did not stop the frame */
     int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
+    int xsum;                   /* FOGVOL_SPEEDUP_EXACT_SUM: the current group sums as 32-bit integers */
     int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
 } fogvol__run;
 
@@ -8958,10 +9039,22 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
 static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, unsigned spec)
 {
     fogvol_handle h;
+    int fetch = ctx->fetch_o && !run->no_opaque && !run->count && ctx->samples <= 1 && ctx->tgt_o &&
+                !(spec & FOGVOL_SPECIALIZE_NO_OPAQUE);
     ps->read_target = 0;
-    if (!ctx->fetch_o || run->no_opaque || run->count || ctx->samples > 1 || !ctx->tgt_o ||
-        (spec & FOGVOL_SPECIALIZE_NO_OPAQUE))
-        return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
+    if (run->xsum) { /* FOGVOL_SPEEDUP_EXACT_SUM */
+        unsigned x = spec | FOGVOL_SPECIALIZE_EXACT_SUM | (fetch ? (unsigned)FOGVOL_SPECIALIZE_FETCH_O : 0u);
+        h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, x);
+        if (h && h != ctx->prog[FOGVOL_PROGRAM_FACE]) {
+            ps->read_target = fetch ? ctx->tgt_o : 0;
+            run->st.fetched_o |= fetch;
+            return h;
+        }
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no face program summing in integers (it did not "
+                                                   "build): the faces sum digits (FOGVOL_SPEEDUP_EXACT_SUM off)");
+        ctx->exact_sum = run->xsum = 0;
+    }
+    if (!fetch) return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
     h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec | FOGVOL_SPECIALIZE_FETCH_O);
     if (h && h != ctx->prog[FOGVOL_PROGRAM_FACE]) {
         ps->read_target = ctx->tgt_o;
@@ -8996,14 +9089,15 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
         ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     else if (!ps.read_target) ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
     ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->tgt_o2;
-    if (ctx->tier == FOGVOL_TIER_FLOAT) { /* every face, signed by gl_FrontFacing */
+    if (ctx->tier == FOGVOL_TIER_FLOAT || run->xsum) { /* every face, signed by gl_FrontFacing */
         ps.target = ctx->tgt_b;
         ps.clear = 1;
-        ps.blend = FOGVOL_PASS_BLEND_ADD;
+        ps.blend = run->xsum ? FOGVOL_PASS_BLEND_NONE : FOGVOL_PASS_BLEND_ADD; /* (EXACT_SUM: the program adds) */
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         fogvol__draw_group(ctx, ramp, -1);
         fogvol__end_pass(ctx);
         run->st.passes += 1 + fogvol__draw_textured(ctx, &ps, ramp, -1);
+        run->st.exact_sum += run->xsum;
     } else if (run->single) {
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
         run->st.passes +=
@@ -9023,7 +9117,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
             fogvol__sum_pass(ctx, &ps, ctx->tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
     }
     if (fogvol__want_debug(ctx, ramp, run->captured)) {
-        r = fogvol__debug_capture(ctx, peak, &run->overflow);
+        r = fogvol__debug_capture(ctx, peak, run->xsum, &run->overflow);
         run->captured = 1;
         if (r != FOGVOL_SUCCESS) run->r = r;
     }
@@ -9108,7 +9202,8 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
-    spec |= fogvol__origin_bit(ctx) | ctx->count_bit;
+    spec |= fogvol__origin_bit(ctx) | ctx->count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
+    ps->uniforms[FOGVOL_U_RAMP][3] = run->xsum ? (float)((double)(fd->zfar - fd->znear) / 16777216.0) : 0.0f;
     fogvol__blend_color(ctx, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
         spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
@@ -9120,8 +9215,15 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         ps->blend_constant = 0;
         ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec & ~(unsigned)FOGVOL_SPECIALIZE_BLEND_COLOR);
     }
+    if (run->xsum && ps->program == ctx->prog[FOGVOL_PROGRAM_COMPOSITE]) { /* the general one reads digits */
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no composite program for integer sums: group not drawn "
+                                                 "(FOGVOL_SPEEDUP_EXACT_SUM off from the next frame)");
+        ctx->exact_sum = 0;
+        ps->program = 0;
+    }
     if (!ps->program) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no half-resolution composite program: group not drawn");
+        if (!run->xsum)
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no half-resolution composite program: group not drawn");
         run->r = FOGVOL_ERROR_BACKEND;
         return;
     }
@@ -9264,7 +9366,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
 {
     const fogvol_ramp *ramp = ctx->vols[g].ramp;
     fogvol_pass ps;
-    int i, has_pos = 0, has_neg = 0, n = 0, convex = 1;
+    int i, has_pos = 0, has_neg = 0, n = 0, convex = 1, density = 0;
     if (fogvol__color_member(ctx, ramp)) {
         fogvol__color_group(ctx, run, g);
         return;
@@ -9276,16 +9378,19 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
             if (ctx->vols[i].negative) has_neg = 1;
             else has_pos = 1;
             convex &= ctx->vols[i].mesh->convex == 1;
+            density |= ctx->vols[i].density != NULL;
             ++n;
         }
     if (!has_pos) return;
+    /* FOGVOL_SPEEDUP_EXACT_SUM: fewer than 256 volumes keep the integer sum below 2^32 */
+    run->xsum = ctx->exact_sum && !run->count && ctx->samples <= 1 && !density && n < 256;
     run->st.groups++;
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
     if (run->single) {
         if (run->counted) fogvol__check_pass(ctx, run, &ps, 0, &run->st); /* after the subtractions */
-    } else if (run->counted && !fogvol__unsaturable(ctx, n, convex)) {
+    } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, n, convex)) { /* (integers cannot saturate) */
         fogvol__group_check(ctx, run, &ps);
     }
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */

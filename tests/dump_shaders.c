@@ -11,7 +11,10 @@
    NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by the programs that write or read
    O (ENCODE, FACE, LIGHT) of MRT and PS20 without WIDE, ENGINE_DEPTH and COUNT only;
    FOGVOL_SPECIALIZE_FETCH_O by single-sample FACE programs in GLSL 330 and 300 es that read O (not
-   with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH). */
+   with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH);
+   FOGVOL_SPECIALIZE_EXACT_SUM in GLSL 330 and 300 es by PS20's and MRT's FACE (with NO_DENSITY,
+   single-sample), COMPOSITE and COMPOSITE_MESH where FLOAT_O could be (not WIDE, ENGINE_DEPTH, COUNT,
+   SINGLE_TARGET), not with COUNT. */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -45,6 +48,15 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if (bits & FOGVOL_SPECIALIZE_EXACT_SUM)
+        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20) &&
+               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT |
+                      FOGVOL_VARIANT_SINGLE_TARGET)) &&
+               !(bits & FOGVOL_SPECIALIZE_COUNT) &&
+               (d == FOGVOL_GLSL_330 || d == FOGVOL_GLSL_300ES) &&
+               (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
+                (p == FOGVOL_PROGRAM_FACE && !ms && (bits & FOGVOL_SPECIALIZE_NO_DENSITY))) &&
+               variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_EXACT_SUM, ms);
     if (bits & FOGVOL_SPECIALIZE_FETCH_O)
         return p == FOGVOL_PROGRAM_FACE && !ms && (d == FOGVOL_GLSL_330 || d == FOGVOL_GLSL_300ES) &&
                !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
@@ -167,6 +179,17 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_NO_OPAQUE,
                                      FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_EXACT_SUM,
+                                     FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE |
+                                         FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_FLOAT_O |
+                                         FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN |
+                                         FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_EXP |
+                                         FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_BLEND_COLOR,
+                                     FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     const char *dir = argc > 1 ? argv[1] : ".";

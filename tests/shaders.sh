@@ -10,10 +10,10 @@ mkdir -p "$b/shaders"
 rm -f "$b/shaders"/*.vert "$b/shaders"/*.frag "$b/shaders"/batch_*
 "$b/dump_shaders" "$b/shaders" || { echo "not ok 1 - dump_shaders"; exit 1; }
 # glslangValidator (Debian 12's) does not know EXT_shader_framebuffer_fetch: it checks those fragment
-# shaders (FOGVOL_SPECIALIZE_FETCH_O) with the extension line left out and the fetched input as a
-# plain output, which it reads; gl_compile compiles them as written with a driver that has it
+# shaders (FOGVOL_SPECIALIZE_FETCH_O, EXACT_SUM) with the extension line left out and the fetched
+# inputs as plain outputs, which it reads; gl_compile compiles them as written with a driver that has it
 grep -l "^#extension GL_EXT_shader_framebuffer_fetch" "$b/shaders"/*.frag |
-  xargs -r sed -i -e '/^#extension GL_EXT_shader_framebuffer_fetch/d' -e 's/^layout(location = 1) inout /layout(location = 1) out /'
+  xargs -r sed -i -e '/^#extension GL_EXT_shader_framebuffer_fetch/d' -e 's/^layout(location = \([01]\)) inout /layout(location = \1) out /'
 ls "$b/shaders"/*.vert "$b/shaders"/*.frag | LC_ALL=C sort > "$b/shaders/batch_list"
 # batches of 100 files; each writes its output and exit status to its own files
 split -l 100 -d -a 4 "$b/shaders/batch_list" "$b/shaders/batch_in_"

@@ -486,6 +486,7 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     fogvol_frame_desc fd;
     fogvol_volume_desc vd;
     fogvol_mrt_info mrt;
+    fogvol_frame_stats st;
     depth_state before, after;
     const fogvol_encoding *enc = fogvol_context_encoding(fv);
     result res;
@@ -566,7 +567,8 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     vd.ramp = ramp;
     assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
     for (i = 0; i < W * H; ++i) thick[i] = -1e30f;
-    res.r = fogvol_end_frame(fv, NULL);
+    memset(&st, 0, sizeof st);
+    res.r = fogvol_end_frame(fv, &st);
     glFinish();
     get_depth_state(&after);
     res.state_ok = before.origin == after.origin && before.mode == after.mode && before.func == after.func &&
@@ -576,10 +578,11 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, fogged);
     assert_int_equal(glGetError(), GL_NO_ERROR);
 
-    /* RGBA8 encodings clamp d to 1 - 1.5 LSB (fogvol_constants.depth_max): their far end */
-    far_end = cb->tier == FOGVOL_TIER_FLOAT ? s.zfar
+    /* RGBA8 encodings clamp d to 1 - 1.5 LSB (fogvol_constants.depth_max): their far end; integer sums
+       (FOGVOL_SPEEDUP_EXACT_SUM, PS20 and MRT on this GL) and FLOAT clamp it to 1 */
+    far_end = cb->tier == FOGVOL_TIER_FLOAT || st.exact_sum ? s.zfar
                                             : s.znear + range * (1.0 - 1.5 / ((double)enc->levels * enc->levels * enc->levels));
-    res.bound = cb->tier == FOGVOL_TIER_FLOAT ? 3e-5 * range
+    res.bound = cb->tier == FOGVOL_TIER_FLOAT || st.exact_sum ? 3e-5 * range
                                               : range / (double)(1 << enc->precision_bits) + 1e-6 * range;
     for (j = 0; j < H; ++j)
         for (i = 0; i < W; ++i) {

@@ -11,7 +11,9 @@
    two targets but not one, 20 fit neither. WIDE (L = 3) sums 32: 24 and 40.
    Ground truth: the thickness ray-cast from the very triangles
    (tests/raycast.h: exact ray/triangle chords of the drawn shells). A pixel is
-   wrong when |error| > 1 LSB per pair of faces (the tiers' bound). */
+   wrong when |error| > 1 LSB per pair of faces (the tiers' bound). PS20 and MRT run their digits
+   here (FOGVOL_SPEEDUP_EXACT_SUM off: this GL would sum them as 32-bit integers, which cannot
+   saturate); exact_sum: those integer sums over 20 shells, no overflow, against the ray cast. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -232,6 +234,7 @@ static void run_combo(int ci, int which)
     cd.variants = c->variants;
     cd.encoding_bits = c->bits;
     cd.disable_dither = 1;
+    cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM; /* the digits */
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
     limit = single ? fogvol_context_encoding(fv)->max_faces_single : fogvol_context_encoding(fv)->max_faces;
     upload_meshes(fv, s, meshes);
@@ -323,6 +326,7 @@ typedef struct shellrig {
     fogvol_mesh *meshes[MAX_OBJ];
     fogvol_ramp *ramp;
 } shellrig;
+static int g_rig_exact; /* 1: rig_open leaves FOGVOL_SPEEDUP_EXACT_SUM on (else the digits) */
 
 static void rig_open(shellrig *r, fogvol_context_desc *cd)
 {
@@ -334,6 +338,7 @@ static void rig_open(shellrig *r, fogvol_context_desc *cd)
     if (!cd->tier) cd->tier = FOGVOL_TIER_PS20;
     cd->logger.func = logger;
     cd->logger.user_data = &r->lc;
+    if (!g_rig_exact) cd->disable_speedups |= FOGVOL_SPEEDUP_EXACT_SUM; /* the digits */
     assert_int_equal(fogvol_create_context(cd, &r->fv), FOGVOL_SUCCESS);
     upload_meshes(r->fv, r->t->s, r->meshes);
     memset(&rd, 0, sizeof rd);
@@ -411,6 +416,53 @@ static void test_lower_bits(void **state)
     assert_true(max_before > 16);
     assert_int_equal(glGetError(), GL_NO_ERROR);
     rig_close(&rig);
+    free(thick);
+}
+
+/* FOGVOL_SPEEDUP_EXACT_SUM: PS20 and MRT sum the 20 shells (40 faces on the innermost rays, which
+   overflow both targets' digits at L = 4) as 32-bit integers: no overflow reported, no check pass,
+   and the debug thickness within 1e-5 of the depth range plus vertex snapping of the ray-cast
+   chords (the digits' bound is an LSB of 2^-12 per pair of faces). */
+static void test_exact_sum(void **state)
+{
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    int tier;
+    (void)state;
+    g_rig_exact = 1;
+    for (tier = 0; tier < 2; ++tier) {
+        shellrig rig;
+        fogvol_context_desc cd;
+        fogvol_frame_stats st;
+        double range, snap = snap_pixels(), max = 0;
+        int frame, i, bad = 0, n = 0;
+        memset(&cd, 0, sizeof cd);
+        cd.tier = tier ? FOGVOL_TIER_MRT : FOGVOL_TIER_PS20;
+        cd.encoding_bits = 4;
+        rig_open(&rig, &cd);
+        range = rig.t->s->cam.zfar - rig.t->s->cam.znear;
+        for (frame = 0; frame < 3; ++frame) {
+            assert_int_equal(rig_frame(&rig, thick, &st), FOGVOL_SUCCESS);
+            assert_int_equal(st.exact_sum, 1);
+            assert_int_equal(st.overflow_pixels, 0);
+            assert_int_equal(st.overflow_pixels_late, 0);
+            assert_int_equal(st.overflow_passes, 0);
+        }
+        for (i = 0; i < W * H; ++i) {
+            double err;
+            if (!rig.t->interior[i]) continue;
+            ++n;
+            err = fabs(thick[i] - rig.t->gt[i]);
+            if (err > max) max = err;
+            if (err > 1e-5 * range + rig.t->slope[i] * snap) ++bad;
+        }
+        print_message("  exact_sum %s: 20 shells, %d interior pixels, max |error| %.2e of the depth range, no "
+                      "overflow, no check pass\n", tier ? "MRT" : "PS20", n, max / range);
+        assert_true(n > W * H / 8);
+        assert_int_equal(bad, 0);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        rig_close(&rig);
+    }
+    g_rig_exact = 0;
     free(thick);
 }
 
@@ -564,6 +616,7 @@ static void test_gles3_any_samples(void **state)
         cd.logger.func = logger;
         cd.logger.user_data = &lc;
         cd.tier = FOGVOL_TIER_PS20;
+        cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM; /* the digits */
         assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
         upload_meshes(fv, t->s, meshes);
         memset(&rd, 0, sizeof rd);
@@ -926,7 +979,7 @@ static void gl_spheres(int k, unsigned off, unsigned char *px, float *thick, fog
     cd.logger.func = logger;
     cd.tier = FOGVOL_TIER_PS20;
     cd.encoding_bits = 6;
-    cd.disable_speedups = FOGVOL_SPEEDUP_OVERFLOW_BANDS | off;
+    cd.disable_speedups = FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_EXACT_SUM | off;
     assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
     fx_mesh_desc(&md, &sph, 0);
     assert_int_equal(fogvol_create_mesh(fv, &md, &m, &rep), FOGVOL_SUCCESS);
@@ -1038,7 +1091,7 @@ static void test_bad_policy(void **state)
 int main(void)
 {
     static int params[NCOMBO * 3][2];
-    static struct CMUnitTest tests[NCOMBO * 3 + 9]; /* zeroed: the unused entries are skipped */
+    static struct CMUnitTest tests[NCOMBO * 3 + 10]; /* zeroed: the unused entries are skipped */
     int n = 0, i, j, fails;
     char *names[NCOMBO * 3];
     build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
@@ -1060,7 +1113,7 @@ int main(void)
             cmocka_unit_test(test_null_plumbing),   cmocka_unit_test(test_null_bands),
             cmocka_unit_test(test_bands),           cmocka_unit_test(test_bad_policy),
             cmocka_unit_test(test_skip_check),
-            cmocka_unit_test(test_lower_bits),      cmocka_unit_test(test_warn_once),
+            cmocka_unit_test(test_lower_bits), cmocka_unit_test(test_exact_sum), cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {

@@ -71,6 +71,8 @@ static void setup(const tscene *s, int core, fogvol_blend blend, glu_ctx *g, fog
     cd.logger.func = logger;
     cd.encoding_bits = s->bits;
     cd.tier = FOGVOL_TIER_PS20; /* the other tiers: test_tiers.c */
+    cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM; /* the digits and their dither (integer sums: test_overflow,
+                                                       test_speedups, test_tiers) */
     if (!core) {
         cd.gl.version_major = 2;
         cd.gl.version_minor = 1;

@@ -20,7 +20,9 @@
    FRAMEBUFFER_FETCH (the faces read O from a write-masked colour attachment beside the sum) gives
    the bytes and sums of the texture read, on FLOAT, PS20 and PS13 comparing, with the backend's cap
    off and with a backend whose fetching programs fail; O itself is never written there, and the
-   engine's per-buffer colour masks survive.
+   engine's per-buffer colour masks survive. EXACT_SUM (PS20's faces add their depth into B as a 32-bit
+   integer by framebuffer fetch) gives the FLOAT tier's sums within 2^-24 of the range per face and
+   the ray-cast fog, in one sum pass without F; without the cap, or when its programs fail, the digits.
    Accuracy against ray-cast ground truth with the defaults is tested in test_render.c,
    test_tiers.c and test_engine_depth.c. */
 #include <stdarg.h>
@@ -70,6 +72,7 @@ typedef struct run_out {
     int fetched[NFRAMES];        /* fogvol_frame_stats.fetched_o */
     int read_passes[NFRAMES];    /* passes with fogvol_pass.read_target (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
     int fetch_programs;          /* programs built reading O from the framebuffer */
+    int exact[NFRAMES];          /* fogvol_frame_stats.exact_sum */
 } run_out;
 
 /* NFRAMES frames of scene s on tier t with these speed-ups off, into out; the viewport starts at
@@ -86,6 +89,7 @@ static int g_light;             /* 1: the ramp blends as FOGVOL_BLEND_LIGHT */
 static int g_fail_blend_color;  /* 1: the backend fails to build FOGVOL_SPECIALIZE_BLEND_COLOR programs */
 static int g_no_fetch_cap;      /* 1: the backend reports no FOGVOL_CAP_FRAMEBUFFER_FETCH */
 static int g_fail_fetch;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_FETCH_O programs */
+static int g_fail_exact;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_EXACT_SUM programs */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
@@ -110,6 +114,7 @@ static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol
 {
     int i;
     for (i = 0; i < d->fs_count; ++i) {
+        if (g_fail_exact && strcmp(d->fs[i], "#define FV_XSUM\n") == 0) return FOGVOL_ERROR_BACKEND;
         if (strstr(d->fs[i], "#define FV_FETCH_O\n")) {
             if (g_fail_fetch) return FOGVOL_ERROR_BACKEND;
             g_fetch_programs++;
@@ -202,6 +207,7 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         out->read_passes[f] = g_read_passes;
         g_blend_constant = g_read_passes = 0;
         out->fetched[f] = st.fetched_o;
+        out->exact[f] = st.exact_sum;
         for (y = 0; y < g->height; ++y)
             for (x = 0; x < g->width; ++x) {
                 const unsigned char *p = g->pixels + 4 * ((size_t)y * g->width + x);
@@ -286,7 +292,8 @@ static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
     (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
      FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O | \
-     FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH)
+     FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_EXACT_SUM)
+#define XS FOGVOL_SPEEDUP_EXACT_SUM /* off where a test compares PS20's digits (test_exact_sum) */
 #define FO FOGVOL_SPEEDUP_FLOAT_O /* off where a test looks at DEPTH_TEST's count, which PS20 with an R32F O
                                      does not take (test_float_o) */
 
@@ -432,7 +439,7 @@ static void test_encoding_constants(void **state)
             run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FO, &g, &tex); /* ramps */
             if (g_tiers[ti] == FOGVOL_TIER_PS20) { /* the R32F O, compiled in; against the RGBA8 O's compare
                                                       (at L = 8 the count saturates apart from it) */
-                run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP, &g, &fo);
+                run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP | XS, &g, &fo);
                 run_frames(s, g_tiers[ti], FOGVOL_SPEEDUP_FAST_EXP | FOGVOL_SPEEDUP_DEPTH_TEST | FO, &g, &mc);
                 assert_true(fo.enc_programs >= 2 && fo.o_format == FOGVOL_FORMAT_R32F);
                 for (f = 0; f < NFRAMES; ++f) {
@@ -481,7 +488,7 @@ static void test_float_o(void **state)
     for (ti = 1; ti < 3; ++ti)
         for (si = 0; si < 2; ++si) {
             const tscene *s = &g_scenes[scene_index(names[si])];
-            run_frames(s, g_tiers[ti], 0, &g, &on);
+            run_frames(s, g_tiers[ti], XS, &g, &on);
             run_frames(s, g_tiers[ti], FO, &g, &rgba);
             run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
             int ps20 = g_tiers[ti] == FOGVOL_TIER_PS20;
@@ -524,7 +531,7 @@ static void test_framebuffer_fetch(void **state)
     for (ti = 0; ti < 3; ++ti)
         for (si = 0; si < 2; ++si) {
             const tscene *s = &g_scenes[scene_index(names[si])];
-            unsigned keep = g_tiers[ti] == FOGVOL_TIER_PS13 ? (unsigned)FOGVOL_SPEEDUP_DEPTH_TEST : 0u;
+            unsigned keep = (g_tiers[ti] == FOGVOL_TIER_PS13 ? (unsigned)FOGVOL_SPEEDUP_DEPTH_TEST : 0u) | XS;
             int faces = g_tiers[ti] == FOGVOL_TIER_FLOAT ? 1 : 2; /* sum passes reading O */
             run_frames(s, g_tiers[ti], keep, &g, &on);
             run_frames(s, g_tiers[ti], keep | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, &g, &off);
@@ -559,6 +566,56 @@ static void test_framebuffer_fetch(void **state)
                           g_tier_names[ti], names[si], on.read_passes[2]);
         }
     glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_EXACT_SUM (this GL has framebuffer fetch and fp32): PS20 sums every face of a group
+   into B as a 32-bit integer in one pass. Its sums are the FLOAT tier's within 2^-24 of the range per
+   face plus FLOAT's own rounding, with and without occluders; its fog is the ray-cast fog's within
+   2/255; it draws one sum pass instead of B and F; a backend without the cap, or whose integer-sum
+   programs fail (a warning), draws the digits (their bytes). */
+static void test_exact_sum(void **state)
+{
+    static run_out on, flt, digits, nocap, fail;
+    const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
+    glu_ctx g;
+    int si, f, n, i;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (si = 0; si < 2; ++si) {
+        const tscene *s = &g_scenes[scene_index(names[si])];
+        double range = s->cam.zfar - s->cam.znear, worst = 0.0;
+        int e;
+        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &on);
+        run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &flt);
+        run_frames(s, FOGVOL_TIER_PS20, XS, &g, &digits);
+        g_no_fetch_cap = 1;
+        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &nocap);
+        g_no_fetch_cap = 0;
+        g_fail_exact = 1;
+        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &fail);
+        g_fail_exact = 0;
+        for (f = 0; f < NFRAMES; ++f) {
+            assert_int_equal(on.exact[f], 1);
+            assert_int_equal(digits.exact[f] + nocap.exact[f] + fail.exact[f], 0);
+            assert_int_equal(on.passes[f], digits.passes[f] - 1); /* one sum pass for B and F */
+            for (i = 0; i < W * H; ++i) {
+                double d = fabs((double)on.th[f][i] - (double)flt.th[f][i]);
+                if (d > worst) worst = d;
+            }
+            assert_int_equal(max_diff(nocap.px[f], digits.px[f], &n), 0);
+            assert_int_equal(max_diff(fail.px[f], digits.px[f], &n), 0);
+            assert_memory_equal(nocap.th[f], digits.th[f], sizeof on.th[f]);
+            assert_memory_equal(fail.th[f], digits.th[f], sizeof on.th[f]);
+        }
+        e = check_ground_truth(s, on.px[2]);
+        print_message("# PS20  %-22s integer sums: max |PS20 - FLOAT| %.2e of the range over %d frames; fog "
+                      "with occluders vs ray-cast %d/255; passes %d (digits %d)\n",
+                      names[si], worst / range, NFRAMES, e, on.passes[2], digits.passes[2]);
+        assert_true(worst <= 4e-7 * range);
+        assert_true(e <= 2);
+        write_png("PS20_exact", on.px[2]);
+    }
     glu_destroy(&g);
 }
 
@@ -902,6 +959,7 @@ int main(void)
                                        cmocka_unit_test(test_viewport_offset), cmocka_unit_test(test_wide_alu),
                                        cmocka_unit_test(test_encoding_constants),
                                        cmocka_unit_test(test_float_o), cmocka_unit_test(test_framebuffer_fetch),
+                                       cmocka_unit_test(test_exact_sum),
                                        cmocka_unit_test(test_inline_resolve),
                                        cmocka_unit_test(test_blend_color),
                                        cmocka_unit_test(test_mrt_snippet_encode),

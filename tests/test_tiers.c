@@ -262,7 +262,14 @@ static void run(int ci, int di)
         /* passes as the tier info says: +1 per sum pass for the negative volumes */
         assert_int_equal(fogvol_tier_costs(c->tier, c->variants, &ti), FOGVOL_SUCCESS);
         j = ti.library_passes;
-        if (has_neg && c->tier != FOGVOL_TIER_FLOAT) j += 2;
+        /* PS20 and MRT summing in integers (FOGVOL_SPEEDUP_EXACT_SUM: this GL has framebuffer fetch in
+           GLSL 330 and 300 es): one sum pass for every face, negative volumes' too */
+        assert_int_equal(st.exact_sum, (c->tier == FOGVOL_TIER_PS20 || c->tier == FOGVOL_TIER_MRT) &&
+                                           !(c->variants & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
+                                                            FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ENGINE_DEPTH)) &&
+                                           (dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES));
+        j -= st.exact_sum;
+        if (has_neg && c->tier != FOGVOL_TIER_FLOAT && !st.exact_sum) j += 2;
         /* PS13 on a backend with fp32 fragment shaders (the GL backend on desktop GL: every dialect
            here) resolves B - F in its composite: no resolve pass (FOGVOL_SPEEDUP_INLINE_RESOLVE) */
         assert_int_equal(st.inline_resolved, c->tier == FOGVOL_TIER_PS13);
