@@ -376,7 +376,9 @@ typedef struct fogvol_tier_info {
     int paper_passes;    /* as the white paper counts them, the engine's opaque pass included */
     int library_passes; /* passes fogvol issues per frame for one colour-ramp group
                            (+1 per negative group pass in the RGBA8 tiers; PS13: 1 fewer with
-                           FOGVOL_SPEEDUP_INLINE_RESOLVE, fogvol_frame_stats.inline_resolved) */
+                           FOGVOL_SPEEDUP_INLINE_RESOLVE, fogvol_frame_stats.inline_resolved; PS20
+                           and MRT: 1 fewer with FOGVOL_SPEEDUP_EXACT_SUM, fogvol_frame_stats.exact_sum,
+                           whose one sum pass draws the negative volumes too) */
     int targets;        /* render targets fogvol allocates (PS13: T not with INLINE_RESOLVE) */
     const char *name;
 } fogvol_tier_info;
