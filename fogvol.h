@@ -554,8 +554,9 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  negative volumes), and writes the integer back; the composite reads that one target.
                  Modular arithmetic, so the order of the faces does not matter, and the result is exact
                  to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
-                 overflow check pass (fewer than 256 volumes of a group can overlap a pixel:
-                 fogvol_frame_stats.exact_sum). Not the digits' bytes: closer to the true thickness. */
+                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
+                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
+                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum). Not the digits' bytes: closer to the true thickness. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -9384,8 +9385,8 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
             ++n;
         }
     if (!has_pos) return;
-    /* FOGVOL_SPEEDUP_EXACT_SUM: fewer than 256 volumes keep the integer sum below 2^32 */
-    run->xsum = ctx->exact_sum && !run->count && ctx->samples <= 1 && !density && n < 256;
+    /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
+    run->xsum = ctx->exact_sum && !run->count && ctx->samples <= 1 && !density && n < 128;
     run->st.groups++;
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
