@@ -546,8 +546,8 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
                  about half a texture read, on tile-based GPUs it comes from tile memory
                  (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
-   EXACT_SUM     PS20 and MRT with FLOAT_O and FRAMEBUFFER_FETCH (not SINGLE_TARGET; single-sample;
-                 fp32 fragment shaders): a ramp group without density-textured volumes sums its faces
+   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
+                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group without density-textured volumes sums its faces
                  by programmable blending: one pass over every face reads B's RGBA8 pixel as a 32-bit
                  integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
                  of it and O) for a back face and subtracts it for a front face (sign flipped for
@@ -1582,14 +1582,14 @@ typedef struct fogvol_shader_desc {
    DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
    position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
    jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
-   that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT and PS20 (not WIDE,
+   that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT, PS20 and PS13 (not WIDE,
    ENGINE_DEPTH or COUNT, nor with FOGVOL_SPECIALIZE_COUNT): FLOAT_O (fv_opaque is an R32F O holding
    the normalised view depth, which ENCODE writes, encoded by the program where it needs O's digits;
    see FOGVOL_SPEEDUP_FLOAT_O). FACE, dialects GLSL 330 and 300 es, single-sample, reading O (not
    NO_OPAQUE, COUNT, WIDE, or FLOAT with ENGINE_DEPTH): FETCH_O (O is read from colour location 1,
    "inout vec4 fv_ofb" with EXT_shader_framebuffer_fetch, where the pass binds it:
    fogvol_pass.read_target; the output is at location 0). FACE (with NO_DENSITY), COMPOSITE and
-   COMPOSITE_MESH of PS20 and MRT with FLOAT_O, the same dialects (FACE: single-sample): EXACT_SUM
+   COMPOSITE_MESH of PS20, MRT and PS13 with FLOAT_O, the same dialects (FACE: single-sample): EXACT_SUM
    (FOGVOL_SPEEDUP_EXACT_SUM: the face reads and writes its target's pixel as a 32-bit integer,
    "inout" at location 0, and adds or subtracts round(d 2^24); the composite decodes that integer
    times fv_rampmap.w = (far - near) / 2^24). Other bits, EXP with RAMP, L > 8, or bits for another
@@ -6054,7 +6054,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
    comparing with an R32F O than counting with its RGBA8 O) */
 static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
 {
-    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20) &&
+    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
            !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
 }
 
@@ -7011,14 +7011,25 @@ static void fogvol__default_inline_resolve(fogvol_context *ctx)
                           !(ctx->speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
 }
 
+/* FOGVOL_SPEEDUP_EXACT_SUM: what it needs besides the R32F O */
+static int fogvol__exact_sum_can(const fogvol_context *ctx)
+{
+    return (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
+           !(ctx->speedups_off &
+             (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
+           fogvol__exact_sum_ok(ctx->tier, ctx->variants);
+}
+
 /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
-   fragment shaders have fp32 (the faces encode O's float); not WIDE, ENGINE_DEPTH or COUNT
+   fragment shaders have fp32 (the faces encode O's float), and PS13's where it sums in integers
+   (FOGVOL_SPEEDUP_EXACT_SUM; its digits measured slower with it); not WIDE, ENGINE_DEPTH or COUNT
    (fogvol__float_o_ok). */
 static void fogvol__default_float_o(fogvol_context *ctx)
 {
     ctx->float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
                    fogvol__float_o_ok(ctx->tier, ctx->variants) &&
-                   (ctx->tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT));
+                   (ctx->tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
+                   (ctx->tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
@@ -7069,11 +7080,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         ctx->fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
                        !(ctx->speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
                        fogvol__fetch_o_ok(ctx->tier, ctx->variants);
-        ctx->exact_sum = ctx->float_o && (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
-                         (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-                         !(ctx->speedups_off & (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH |
-                                                FOGVOL_SPEEDUP_SPECIALIZE)) &&
-                         fogvol__exact_sum_ok(ctx->tier, ctx->variants);
+        ctx->exact_sum = ctx->float_o && fogvol__exact_sum_can(ctx);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);

@@ -9,10 +9,10 @@
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
    NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by the programs that write or read
-   O (ENCODE, FACE, LIGHT) of MRT and PS20 without WIDE, ENGINE_DEPTH and COUNT only;
+   O (ENCODE, FACE, LIGHT) of MRT, PS20 and PS13 without WIDE, ENGINE_DEPTH and COUNT only;
    FOGVOL_SPECIALIZE_FETCH_O by single-sample FACE programs in GLSL 330 and 300 es that read O (not
    with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH);
-   FOGVOL_SPECIALIZE_EXACT_SUM in GLSL 330 and 300 es by PS20's and MRT's FACE (with NO_DENSITY,
+   FOGVOL_SPECIALIZE_EXACT_SUM in GLSL 330 and 300 es by PS20's, MRT's and PS13's FACE (with NO_DENSITY,
    single-sample), COMPOSITE and COMPOSITE_MESH where FLOAT_O could be (not WIDE, ENGINE_DEPTH, COUNT,
    SINGLE_TARGET), not with COUNT. */
 #define FOGVOL_IMPLEMENTATION
@@ -49,7 +49,7 @@ static int spec_applies(int p, unsigned bits)
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
     if (bits & FOGVOL_SPECIALIZE_EXACT_SUM)
-        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20) &&
+        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20 || t == FOGVOL_TIER_PS13) &&
                !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT |
                       FOGVOL_VARIANT_SINGLE_TARGET)) &&
                !(bits & FOGVOL_SPECIALIZE_COUNT) &&
@@ -64,7 +64,7 @@ static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, 
                !(bits & (FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_COUNT)) &&
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FETCH_O, ms);
     if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
-        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20) &&
+        return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20 || t == FOGVOL_TIER_PS13) &&
                !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) &&
                !(bits & FOGVOL_SPECIALIZE_COUNT) &&
                (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&

@@ -569,7 +569,8 @@ static void test_framebuffer_fetch(void **state)
     glu_destroy(&g);
 }
 
-/* FOGVOL_SPEEDUP_EXACT_SUM (this GL has framebuffer fetch and fp32): PS20 sums every face of a group
+/* FOGVOL_SPEEDUP_EXACT_SUM (this GL has framebuffer fetch and fp32): PS20 and PS13 (whose O is then
+   R32F too) sum every face of a group
    into B as a 32-bit integer in one pass. Its sums are the FLOAT tier's within 2^-24 of the range per
    face plus FLOAT's own rounding, with and without occluders; its fog is the ray-cast fog's within
    2/255; it draws one sum pass instead of B and F; a backend without the cap, or whose integer-sum
@@ -579,21 +580,23 @@ static void test_exact_sum(void **state)
     static run_out on, flt, digits, nocap, fail;
     const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
     glu_ctx g;
-    int si, f, n, i;
+    int si, f, n, i, ti;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
+    for (ti = 1; ti < 3; ++ti)
     for (si = 0; si < 2; ++si) {
         const tscene *s = &g_scenes[scene_index(names[si])];
+        const fogvol_tier tier = g_tiers[ti];
         double range = s->cam.zfar - s->cam.znear, worst = 0.0;
         int e;
-        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &on);
+        run_frames(s, tier, 0, &g, &on);
         run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &flt);
-        run_frames(s, FOGVOL_TIER_PS20, XS, &g, &digits);
+        run_frames(s, tier, XS, &g, &digits);
         g_no_fetch_cap = 1;
-        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &nocap);
+        run_frames(s, tier, 0, &g, &nocap);
         g_no_fetch_cap = 0;
         g_fail_exact = 1;
-        run_frames(s, FOGVOL_TIER_PS20, 0, &g, &fail);
+        run_frames(s, tier, 0, &g, &fail);
         g_fail_exact = 0;
         for (f = 0; f < NFRAMES; ++f) {
             assert_int_equal(on.exact[f], 1);
@@ -609,12 +612,12 @@ static void test_exact_sum(void **state)
             assert_memory_equal(fail.th[f], digits.th[f], sizeof on.th[f]);
         }
         e = check_ground_truth(s, on.px[2]);
-        print_message("# PS20  %-22s integer sums: max |PS20 - FLOAT| %.2e of the range over %d frames; fog "
+        print_message("# %-5s %-22s integer sums: max |sum - FLOAT's| %.2e of the range over %d frames; fog "
                       "with occluders vs ray-cast %d/255; passes %d (digits %d)\n",
-                      names[si], worst / range, NFRAMES, e, on.passes[2], digits.passes[2]);
+                      g_tier_names[ti], names[si], worst / range, NFRAMES, e, on.passes[2], digits.passes[2]);
         assert_true(worst <= 4e-7 * range);
         assert_true(e <= 2);
-        write_png("PS20_exact", on.px[2]);
+        write_png(ti == 1 ? "PS20_exact" : "PS13_exact", on.px[2]);
     }
     glu_destroy(&g);
 }
@@ -644,10 +647,10 @@ static void test_inline_resolve(void **state)
             int covered = 0, shown = 0, late = 0;
             g_bits = k ? 8 : 0;
             g_show_overflow = k == 2;
-            run_frames(s, FOGVOL_TIER_PS13, 0, &g, &in);
-            run_frames(s, FOGVOL_TIER_PS13, FOGVOL_SPEEDUP_INLINE_RESOLVE, &g, &res);
+            run_frames(s, FOGVOL_TIER_PS13, XS, &g, &in); /* (the digits: their resolve) */
+            run_frames(s, FOGVOL_TIER_PS13, FOGVOL_SPEEDUP_INLINE_RESOLVE | XS, &g, &res);
             g_no_highp = 1;
-            run_frames(s, FOGVOL_TIER_PS13, 0, &g, &mediump);
+            run_frames(s, FOGVOL_TIER_PS13, XS, &g, &mediump);
             g_no_highp = 0;
             for (f = 0; f < NFRAMES; ++f) {
                 assert_int_equal(max_diff(in.px[f], res.px[f], &n), 0);

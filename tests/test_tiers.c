@@ -262,9 +262,9 @@ static void run(int ci, int di)
         /* passes as the tier info says: +1 per sum pass for the negative volumes */
         assert_int_equal(fogvol_tier_costs(c->tier, c->variants, &ti), FOGVOL_SUCCESS);
         j = ti.library_passes;
-        /* PS20 and MRT summing in integers (FOGVOL_SPEEDUP_EXACT_SUM: this GL has framebuffer fetch in
-           GLSL 330 and 300 es): one sum pass for every face, negative volumes' too */
-        assert_int_equal(st.exact_sum, (c->tier == FOGVOL_TIER_PS20 || c->tier == FOGVOL_TIER_MRT) &&
+        /* PS20, MRT and PS13 summing in integers (FOGVOL_SPEEDUP_EXACT_SUM: this GL has framebuffer fetch
+           in GLSL 330 and 300 es): one sum pass for every face, negative volumes' too */
+        assert_int_equal(st.exact_sum, c->tier != FOGVOL_TIER_FLOAT &&
                                            !(c->variants & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
                                                             FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ENGINE_DEPTH)) &&
                                            (dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES));
