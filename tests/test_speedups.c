@@ -476,7 +476,7 @@ static void test_encoding_constants(void **state)
    O. Frames with occluders take that compare instead of the face count (FOGVOL_SPEEDUP_DEPTH_TEST,
    which the speed-up switched off draws them with): the same bytes and sums as the RGBA8 O
    (counted), and the sums of every speed-up off (compared), in every frame. PS13 keeps its RGBA8 O
-   and the count either way. */
+   and the count either way. (Integer sums off: they take the R32F O for PS13 too, test_exact_sum.) */
 static void test_float_o(void **state)
 {
     static run_out on, rgba, off;
