@@ -9043,38 +9043,34 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
     fogvol__end_pass(ctx);
 }
 
-/* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: the face program of a group's sums reading O from the framebuffer
-   (ps->read_target: O beside the sum) where the frame's faces read fogvol's O; a program that does not
-   build turns the speed-up off and the faces sample O again. */
+/* The face program of a group's sums: summing in integers where the group does (run->xsum,
+   FOGVOL_SPEEDUP_EXACT_SUM), reading O from the framebuffer where the frame's faces read fogvol's O
+   (ps->read_target: O beside the sum; FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH). A program that does not build
+   turns its speed-up off (the integer sum first) and the next is tried: digits, O sampled. */
 static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, unsigned spec)
 {
-    fogvol_handle h;
     int fetch = ctx->fetch_o && !run->no_opaque && !run->count && ctx->samples <= 1 && ctx->tgt_o &&
                 !(spec & FOGVOL_SPECIALIZE_NO_OPAQUE);
-    ps->read_target = 0;
-    if (run->xsum) { /* FOGVOL_SPEEDUP_EXACT_SUM */
-        unsigned x = spec | FOGVOL_SPECIALIZE_EXACT_SUM | (fetch ? (unsigned)FOGVOL_SPECIALIZE_FETCH_O : 0u);
-        h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, x);
-        if (h && h != ctx->prog[FOGVOL_PROGRAM_FACE]) {
+    for (;;) { /* the integer sum (FOGVOL_SPEEDUP_EXACT_SUM), O from the framebuffer, each dropped if it fails */
+        unsigned bits = spec | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u) |
+                        (fetch ? (unsigned)FOGVOL_SPECIALIZE_FETCH_O : 0u);
+        fogvol_handle h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, bits);
+        if (bits == spec || (h && h != ctx->prog[FOGVOL_PROGRAM_FACE])) { /* (the general one: a failure) */
             ps->read_target = fetch ? ctx->tgt_o : 0;
             run->st.fetched_o |= fetch;
             return h;
         }
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no face program summing in integers (it did not "
-                                                   "build): the faces sum digits (FOGVOL_SPEEDUP_EXACT_SUM off)");
-        ctx->exact_sum = run->xsum = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no face program %s (it did not build): %s",
+                    run->xsum ? "summing in integers" : "reading O from the framebuffer",
+                    run->xsum ? "the faces sum digits (FOGVOL_SPEEDUP_EXACT_SUM off)"
+                              : "the faces sample O (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH off)");
+        if (run->xsum) {
+            ctx->exact_sum = run->xsum = 0;
+        } else {
+            ctx->fetch_o = 0;
+            fetch = 0;
+        }
     }
-    if (!fetch) return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
-    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec | FOGVOL_SPECIALIZE_FETCH_O);
-    if (h && h != ctx->prog[FOGVOL_PROGRAM_FACE]) {
-        ps->read_target = ctx->tgt_o;
-        run->st.fetched_o = 1;
-        return h;
-    }
-    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no face program reading O from the framebuffer (it did "
-                                               "not build): the faces sample O (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH off)");
-    ctx->fetch_o = 0;
-    return fogvol__program(ctx, FOGVOL_PROGRAM_FACE, spec);
 }
 
 /* The face sums of one ramp group: FLOAT one signed pass into B; SINGLE_TARGET back faces up and

@@ -89,7 +89,8 @@ static int g_light;             /* 1: the ramp blends as FOGVOL_BLEND_LIGHT */
 static int g_fail_blend_color;  /* 1: the backend fails to build FOGVOL_SPECIALIZE_BLEND_COLOR programs */
 static int g_no_fetch_cap;      /* 1: the backend reports no FOGVOL_CAP_FRAMEBUFFER_FETCH */
 static int g_fail_fetch;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_FETCH_O programs */
-static int g_fail_exact;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_EXACT_SUM programs */
+static int g_fail_exact;        /* 1: the backend fails to build FOGVOL_SPECIALIZE_EXACT_SUM programs; 2: only
+                                   the composite (frame 0 then reports FOGVOL_ERROR_BACKEND) */
 static int g_show_overflow; /* fogvol_frame_desc.show_overflow */
 static fogvol_backend g_inner;
 /* counts the targets the context creates; refuses linear ones with g_no_linear */
@@ -114,7 +115,9 @@ static fogvol_result watch_program(void *u, const fogvol_program_desc *d, fogvol
 {
     int i;
     for (i = 0; i < d->fs_count; ++i) {
-        if (g_fail_exact && strcmp(d->fs[i], "#define FV_XSUM\n") == 0) return FOGVOL_ERROR_BACKEND;
+        if (g_fail_exact && strcmp(d->fs[i], "#define FV_XSUM\n") == 0 &&
+            (g_fail_exact == 1 || strcmp(d->label, "fogvol composite") == 0))
+            return FOGVOL_ERROR_BACKEND;
         if (strstr(d->fs[i], "#define FV_FETCH_O\n")) {
             if (g_fail_fetch) return FOGVOL_ERROR_BACKEND;
             g_fetch_programs++;
@@ -200,6 +203,8 @@ static void run_frames(const tscene *s, fogvol_tier t, unsigned off, glu_ctx *g,
         r = fogvol_end_frame(fv, &st);
         if (g_bits == 8 && r == FOGVOL_ERROR_DEPTH_OVERFLOW) /* L = 8 sums one face per target */
             assert_true(st.overflow_pixels > 0);
+        else if (g_fail_exact == 2 && f == 0) /* the integer sums' composite failed: the group is not drawn */
+            assert_int_equal(r, FOGVOL_ERROR_BACKEND);
         else
             assert_int_equal(r, FOGVOL_SUCCESS);
         glu_pixels(g);
@@ -574,10 +579,11 @@ static void test_framebuffer_fetch(void **state)
    into B as a 32-bit integer in one pass. Its sums are the FLOAT tier's within 2^-24 of the range per
    face plus FLOAT's own rounding, with and without occluders; its fog is the ray-cast fog's within
    2/255; it draws one sum pass instead of B and F; a backend without the cap, or whose integer-sum
-   programs fail (a warning), draws the digits (their bytes). */
+   programs fail (a warning), draws the digits (their bytes); one whose integer-sum composite alone
+   fails reports FOGVOL_ERROR_BACKEND for that frame and draws the digits from the next. */
 static void test_exact_sum(void **state)
 {
-    static run_out on, flt, digits, nocap, fail;
+    static run_out on, flt, digits, nocap, fail, failc;
     const char *names[2] = {"plane_cuts_sphere", "layers_opaque_between"};
     glu_ctx g;
     int si, f, n, i, ti;
@@ -597,7 +603,10 @@ static void test_exact_sum(void **state)
         g_no_fetch_cap = 0;
         g_fail_exact = 1;
         run_frames(s, tier, 0, &g, &fail);
+        g_fail_exact = 2;
+        run_frames(s, tier, 0, &g, &failc);
         g_fail_exact = 0;
+        assert_int_equal(failc.exact[0], 1); /* summed, then not composited; the digits from then on */
         for (f = 0; f < NFRAMES; ++f) {
             assert_int_equal(on.exact[f], 1);
             assert_int_equal(digits.exact[f] + nocap.exact[f] + fail.exact[f], 0);
@@ -610,6 +619,9 @@ static void test_exact_sum(void **state)
             assert_int_equal(max_diff(fail.px[f], digits.px[f], &n), 0);
             assert_memory_equal(nocap.th[f], digits.th[f], sizeof on.th[f]);
             assert_memory_equal(fail.th[f], digits.th[f], sizeof on.th[f]);
+            if (f == 0) continue;
+            assert_int_equal(failc.exact[f], 0);
+            assert_int_equal(max_diff(failc.px[f], digits.px[f], &n), 0);
         }
         e = check_ground_truth(s, on.px[2]);
         print_message("# %-5s %-22s integer sums: max |sum - FLOAT's| %.2e of the range over %d frames; fog "
