@@ -1772,16 +1772,19 @@ typedef enum fogvol_fog_mix {
    sphere no ray of a block can reach, redo grazing rays of spheres,
    ellipsoids and cylinders (and every ray of such a volume seen from further
    than 64 radii) in double, and sort only the events of the volumes a ray
-   hits; they stay within 1.2e-5 of the double kernel in fog and in colour x
-   (1 - fog), and give the same results bit for bit among themselves. AVX2 and SSE2 are chosen at run time (GCC and clang on x86; the
-   CPU is asked with __builtin_cpu_supports); a level the compiler or the CPU
-   lacks falls back to the next one down (fogvol_analytic_kernel_resolve). */
+   hits (the exp() of the EXP law's stretches batched over a block's sorted
+   vertices, 8 at a time with AVX2); they stay within 1.2e-5 of the double
+   kernel in fog and in colour x (1 - fog), and give the same results bit for
+   bit among themselves. AVX2 and SSE2 are chosen at run time (GCC and clang
+   on x86; the CPU is asked with __builtin_cpu_supports); a level the compiler
+   or the CPU lacks falls back to the next one down
+   (fogvol_analytic_kernel_resolve). */
 typedef enum fogvol_analytic_kernel {
     FOGVOL_ANALYTIC_KERNEL_AUTO = 0,   /* the best float kernel this CPU runs */
     FOGVOL_ANALYTIC_KERNEL_DOUBLE = 1, /* everything in double (the reference; the batch before 2026-11) */
     FOGVOL_ANALYTIC_KERNEL_FLOAT = 2,  /* the float kernel in plain C (every compiler and architecture) */
     FOGVOL_ANALYTIC_KERNEL_SSE2 = 3,   /* the float kernel, SSE2 square roots, 4 lanes */
-    FOGVOL_ANALYTIC_KERNEL_AVX2 = 4,   /* the float kernel compiled for AVX2, 8 lanes */
+    FOGVOL_ANALYTIC_KERNEL_AVX2 = 4,   /* the float kernel compiled for AVX2, 8 lanes, exp() too */
     FOGVOL_ANALYTIC_KERNEL_COUNT = 5,
     FOGVOL_ANALYTIC_KERNEL_MAX_ENUM = 0x7fffffff
 } fogvol_analytic_kernel;
@@ -4229,6 +4232,47 @@ FOGVOL__AN_AVX2_INL __m256 fogvol__an_vol8(const fogvol_analytic_set *set, const
     return _mm256_mul_ps(FOGVOL__AN_V8(f->dens), _mm256_mul_ps(len, ch));
 }
 
+/* fogvol__an_fexp2 on 8 lanes */
+FOGVOL__AN_AVX2_INL __m256 fogvol__an_fexp8(__m256 x, __m256 *om)
+{
+    __m256 xc = _mm256_min_ps(_mm256_max_ps(x, _mm256_setzero_ps()), FOGVOL__AN_V8(87.0f)), r, r2, p, scale;
+    __m256i n = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(xc, FOGVOL__AN_V8(1.44269504f)), FOGVOL__AN_V8(0.5f)));
+    __m256 fn = _mm256_cvtepi32_ps(n), one = FOGVOL__AN_V8(1.0f);
+    scale = _mm256_castsi256_ps(_mm256_slli_epi32(_mm256_sub_epi32(_mm256_set1_epi32(127), n), 23));
+    r = _mm256_add_ps(_mm256_sub_ps(_mm256_mul_ps(fn, FOGVOL__AN_V8(0.693145751953125f)), xc),
+                      _mm256_mul_ps(fn, FOGVOL__AN_V8(1.42860677e-6f)));
+    r2 = _mm256_mul_ps(r, r);
+    p = _mm256_add_ps(
+        _mm256_add_ps(_mm256_add_ps(FOGVOL__AN_V8(5.0000001201e-1f), _mm256_mul_ps(FOGVOL__AN_V8(1.6666665459e-1f), r)),
+                      _mm256_mul_ps(r2, _mm256_add_ps(FOGVOL__AN_V8(4.1665795894e-2f),
+                                                      _mm256_mul_ps(FOGVOL__AN_V8(8.3334519073e-3f), r)))),
+        _mm256_mul_ps(_mm256_mul_ps(r2, r2), _mm256_add_ps(FOGVOL__AN_V8(1.3981999507e-3f),
+                                                           _mm256_mul_ps(FOGVOL__AN_V8(1.9875691500e-4f), r))));
+    p = _mm256_add_ps(r, _mm256_mul_ps(r2, p));
+    *om = _mm256_sub_ps(_mm256_sub_ps(one, scale), _mm256_mul_ps(p, scale));
+    return _mm256_mul_ps(_mm256_add_ps(one, p), scale);
+}
+
+/* fogvol__an_ffinish on 8 lanes */
+FOGVOL__AN_AVX2_INL void fogvol__an_ffinish8(float limit, int law, fogvol__an_fblock *k)
+{
+    const __m256 zero = _mm256_setzero_ps(), one = FOGVOL__AN_V8(1.0f), tiny = FOGVOL__AN_V8(1e-30f);
+    int i;
+    for (i = 0; i < FOGVOL__AN_BLOCK; i += 8) {
+        __m256 tau = _mm256_loadu_ps(k->tau + i), om, ex, big = _mm256_cmp_ps(tau, tiny, _CMP_GT_OQ);
+        __m256 inv = _mm256_div_ps(one, _mm256_add_ps(tau, _mm256_and_ps(_mm256_cmp_ps(tau, tiny, _CMP_LE_OQ), one)));
+        __m256 need = _mm256_and_ps(_mm256_cmp_ps(_mm256_loadu_ps(k->hits + i), one, _CMP_GT_OQ),
+                                    _mm256_cmp_ps(tau, FOGVOL__AN_V8(limit), _CMP_GT_OQ));
+        inv = _mm256_and_ps(big, inv);
+        ex = fogvol__an_fexp8(tau, &om);
+        _mm256_storeu_ps(k->fog + i, law == FOGVOL_FOG_EXP ? ex : _mm256_max_ps(_mm256_sub_ps(one, tau), zero));
+        _mm256_storeu_ps(k->r + i, _mm256_mul_ps(_mm256_loadu_ps(k->r + i), inv));
+        _mm256_storeu_ps(k->g + i, _mm256_mul_ps(_mm256_loadu_ps(k->g + i), inv));
+        _mm256_storeu_ps(k->bl + i, _mm256_mul_ps(_mm256_loadu_ps(k->bl + i), inv));
+        _mm256_storeu_ps(k->need + i, _mm256_and_ps(need, one));
+    }
+}
+
 /* The block's 4 groups of 8 outside, the volumes inside: a group's sums and
    hit mask stay in registers. */
 FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, const fogvol__an_eye *pe,
@@ -4267,7 +4311,7 @@ FOGVOL__AN_AVX2_FN void fogvol__an_fblock_avx2(const fogvol_analytic_set *set, c
     for (v = 0; v < (set->count + 31) / 32; ++v)
         for (i = 0; i < FOGVOL__AN_BLOCK; ++i)
             k->hits[i] += (float)(k->hit[v][i] != 0u) + (float)((k->hit[v][i] & (k->hit[v][i] - 1u)) != 0u);
-    fogvol__an_ffinish(limit, law, k);
+    fogvol__an_ffinish8(limit, law, k);
 }
 #endif
 
@@ -4388,12 +4432,11 @@ typedef struct fogvol__an_fcarry {
    zeros whenever no volume is open, so rounding never leaves a ghost density
    behind), or each volume whole at its entry (SEPARATE; t2: the exits, one
    volume every FOGVOL__AN_BLOCK). Stretches outside every volume are left out.
-   Returns the stretch count; also each stretch's exp(-tau) and
-   (1 - exp(-tau)) / sig (q), here where they hang off no chain of the walk
-   (tau = 0: q = 0). The EXP law's; the LINEAR laws walk the events
+   Returns the stretch count; also each stretch's optical depth tau (for
+   fogvol__an_fexpq). The EXP law's; the LINEAR laws walk the events
    themselves (fogvol__an_flinear_events). */
 static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, const uint64_t *key, const float *t2,
-                                 int m, float (*rgb)[3], float *sig, float *ex, float *q)
+                                 int m, float (*rgb)[3], float *sig, float *tau)
 {
     float ar = 0.0f, ag = 0.0f, ab = 0.0f, ad = 0.0f, last = 0.0f; /* scalars: kept in registers */
     int k, open = 0, n = 0;
@@ -4401,7 +4444,7 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
         int e = (int)(key[k] & 0xffu);
         const fogvol__an_fvol *f = &fv[e >> 1];
         uint32_t u = (uint32_t)(key[k] >> 32);
-        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln, om;
+        float t, sd = (e & 1) ? -f->dens : f->dens, sg, ln;
         memcpy(&t, &u, sizeof t);
         if (mix == FOGVOL_MIX_SEPARATE) {
             if (e & 1) continue;
@@ -4418,11 +4461,28 @@ static int fogvol__an_fstretches(const fogvol__an_fvol *fv, int mix, float len, 
             if (was == 0) continue; /* outside every volume (the first stretch, gaps): nothing to add */
         }
         sig[n] = sg;
-        ex[n] = fogvol__an_fexp2(sg * ln, &om);
-        q[n] = om / (sg + (float)(sg == 0.0f));
+        tau[n] = sg * ln;
         ++n;
     }
     return n;
+}
+
+/* The stretches' exp(-tau) and q = (1 - exp(-tau)) / sig (tau = 0: q = 0)
+   from tau (in ex on entry) and sig, n of them (the arrays padded to a
+   multiple of 8 entries, which the SIMD levels read and write): apart from
+   the event walk, where they hang off none of its chains, and over all the
+   sorted vertices of a block at once (fogvol__an_fstr), so AVX2 runs them 8
+   at a time (the same operations in the same order: the same bits). */
+typedef void (*fogvol__an_fexpq_fn)(float *ex, float *q, const float *sig, int n);
+
+static void fogvol__an_fexpq_c(float *ex, float *q, const float *sig, int n)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        float om, sg = sig[k];
+        ex[k] = fogvol__an_fexp2(ex[k], &om);
+        q[k] = om / (sg + (float)(sg == 0.0f));
+    }
 }
 
 /* The EXP law over n stretches: each stretch of optical depth tau covers
@@ -4496,20 +4556,17 @@ static void fogvol__an_flinear_events(const fogvol__an_fvol *fv, int mix, float 
     col[0] = n0 * inv, col[1] = n1 * inv, col[2] = n2 * inv;
 }
 
-/* The sorted walk of the float kernels: only the events of the volumes on
-   the ray (hit: the block's mask words of the vertex, FOGVOL__AN_BLOCK apart)
-   are sorted, by insertion from the order of the previous sorted vertex
-   (carry): its events still on the ray in that order, then those of the
-   volumes new to the ray in volume order. The keys are t bits << 32 | event
-   index (t >= 0, so the integer order is the order of t, ties by event index). */
-static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol__an_fvol *fv, int law, int mix,
-                                      float len, const float *t1, const float *t2, const unsigned int *hit,
-                                      fogvol__an_fcarry *carry, int64_t *moves, float *fog, float col[3])
+/* The sort of the float kernels' sorted walk: only the events of the
+   volumes on the ray (hit: the block's mask words of the vertex,
+   FOGVOL__AN_BLOCK apart) are sorted, by insertion from the order of the
+   previous sorted vertex (carry): its events still on the ray in that order,
+   then those of the volumes new to the ray in volume order. The keys are
+   t bits << 32 | event index (t >= 0, so the integer order is the order of t,
+   ties by event index). Returns the event count. */
+static int fogvol__an_fsort_events(const fogvol_analytic_set *s, const float *t1, const float *t2,
+                                   const unsigned int *hit, fogvol__an_fcarry *carry, int64_t *moves, uint64_t *key)
 {
-    uint64_t key[FOGVOL__AN_EVENTS];
-    float rgb[FOGVOL__AN_EVENTS][3], sig[FOGVOL__AN_EVENTS];
-    float ex[FOGVOL__AN_EVENTS], q[FOGVOL__AN_EVENTS];
-    int m = 0, n, w, k, j, nw = (s->count + 31) / 32;
+    int m = 0, w, k, j, nw = (s->count + 31) / 32;
     for (k = 0; k < carry->m; ++k) { /* kept without a branch: m advances for the volumes on the ray */
         int e = carry->ev[k], v = e >> 1;
         float t = ((e & 1) ? t2 : t1)[v * FOGVOL__AN_BLOCK] + 0.0f; /* + 0: no -0, whose bits would sort last */
@@ -4539,12 +4596,33 @@ static void fogvol__an_fsorted_vertex(const fogvol_analytic_set *s, const fogvol
     }
     for (k = 0; k < m; ++k) carry->ev[k] = (unsigned char)(key[k] & 0xffu);
     carry->m = m;
-    if (law != FOGVOL_FOG_EXP) {
-        fogvol__an_flinear_events(fv, mix, len, key, t2, m, law, fog, col);
-        return;
+    return m;
+}
+
+/* The EXP law's stretches of a block's sorted vertices, gathered so that
+   their exp() runs in one loop over all of them (fogvol__an_fexpq: 8 at a
+   time with AVX2, where one vertex's 3 to 9 would leave the lanes idle and
+   wait on the loop's latency); flushed when full and at the end of a block.
+   sig, ex and q have room for the padding to a multiple of 8. */
+#define FOGVOL__AN_SCAP (FOGVOL__AN_EVENTS + 128)
+typedef struct fogvol__an_fstr {
+    float rgb[FOGVOL__AN_SCAP][3], sig[FOGVOL__AN_SCAP + 8], ex[FOGVOL__AN_SCAP + 8], q[FOGVOL__AN_SCAP + 8];
+    int first[FOGVOL__AN_BLOCK], count[FOGVOL__AN_BLOCK], vert[FOGVOL__AN_BLOCK];
+    int n, verts;
+} fogvol__an_fstr;
+
+/* exp() of the gathered stretches, then each vertex's walk into fog[vert], col[vert] */
+static void fogvol__an_fstr_flush(fogvol__an_fstr *st, fogvol__an_fexpq_fn expq, float *fog, float (*col)[3])
+{
+    int j;
+    for (j = st->n; j & 7; ++j) st->ex[j] = st->sig[j] = 0.0f;
+    expq(st->ex, st->q, st->sig, st->n);
+    for (j = 0; j < st->verts; ++j) {
+        int a = st->first[j];
+        fogvol__an_fexp_walk((const float(*)[3])st->rgb + a, st->sig + a, st->ex + a, st->q + a, st->count[j],
+                             &fog[st->vert[j]], col[st->vert[j]]);
     }
-    n = fogvol__an_fstretches(fv, mix, len, key, t2, m, rgb, sig, ex, q);
-    fogvol__an_fexp_walk((const float(*)[3])rgb, sig, ex, q, n, fog, col);
+    st->n = st->verts = 0;
 }
 
 /* What a batch call works on, for the float kernels' loop. */
@@ -4710,6 +4788,17 @@ __attribute__((target("sse2"))) static void fogvol__an_fcone_sse2(const fogvol__
     fogvol__an_fcone_min(sc, sl, out);
 }
 
+/* fogvol__an_fexpq_c with 8 lanes (the padding included) */
+FOGVOL__AN_AVX2_FN void fogvol__an_fexpq_avx2(float *ex, float *q, const float *sig, int n)
+{
+    int k;
+    for (k = 0; k < n; k += 8) {
+        __m256 om, e = fogvol__an_fexp8(_mm256_loadu_ps(ex + k), &om);
+        _mm256_storeu_ps(ex + k, e);
+        _mm256_storeu_ps(q + k, _mm256_div_ps(om, fogvol__an_nz8(_mm256_loadu_ps(sig + k))));
+    }
+}
+
 /* fogvol__an_fcone_c with 8 lanes */
 FOGVOL__AN_AVX2_FN void fogvol__an_fcone_avx2(const fogvol__an_fblock *k, float out[5])
 {
@@ -4776,18 +4865,23 @@ typedef struct fogvol__an_flevel {
     fogvol__an_fgather_fn gather;
     fogvol__an_fcone_fn cone;
     fogvol__an_fblock_fn block;
+    fogvol__an_fexpq_fn expq;
 } fogvol__an_flevel;
 
 /* Returns 0 (nothing written) when the set needs the DOUBLE kernel. */
 static int fogvol__an_fbatch(fogvol__an_call *c, const fogvol__an_flevel *lv)
 {
     fogvol__an_fblock blk;
+    fogvol__an_fstr st;
     fogvol__an_fvol fv[FOGVOL_ANALYTIC_CAPACITY];
     unsigned char valid[FOGVOL__AN_BLOCK], skip[FOGVOL_ANALYTIC_CAPACITY];
+    uint64_t key[FOGVOL__AN_EVENTS];
+    float bf[FOGVOL__AN_BLOCK], bc[FOGVOL__AN_BLOCK][3]; /* the block's results */
     int base, i;
     float cn[5], limit = c->limit > 1e30 ? 1e30f : (float)c->limit;
     c->dlim = fogvol__an_fvols(c->set, c->pe, c->e, fv);
     if (c->dlim == 0.0f) return 0;
+    st.n = st.verts = 0;
     for (base = 0; base < c->count; base += FOGVOL__AN_BLOCK) {
         int nb = c->count - base < FOGVOL__AN_BLOCK ? c->count - base : FOGVOL__AN_BLOCK;
         lv->gather(c, base, nb, valid, &blk);
@@ -4795,27 +4889,40 @@ static int fogvol__an_fbatch(fogvol__an_call *c, const fogvol__an_flevel *lv)
         fogvol__an_fcull(c->set->count, fv, cn, skip);
         lv->block(c->set, c->pe, c->e, fv, skip, limit, c->law, &blk);
         for (i = 0; i < nb; ++i) {
-            size_t idx = (size_t)(base + i);
-            float f = 1.0f, col[3] = {0.0f, 0.0f, 0.0f};
+            float *f = &bf[i], *col = bc[i];
+            *f = 1.0f, col[0] = col[1] = col[2] = 0.0f;
             if (!valid[i]) {
                 /* fog 1, colour 0 */
             } else if (valid[i] == 2) {
-                const float *p = (const float *)(const void *)(c->src + idx * (size_t)c->stride);
-                fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, &f, col);
+                const float *p = (const float *)(const void *)(c->src + (size_t)(base + i) * (size_t)c->stride);
+                fogvol__an_vertex(c->set, c->pe, c->e, p, c->law, c->mix, f, col);
             } else if (blk.need[i] != 0.0f) {
-                fogvol__an_fsorted_vertex(c->set, fv, c->law, c->mix, blk.len[i],
-                                          (const float *)(const void *)blk.t1 + i,
-                                          (const float *)(const void *)blk.t2 + i,
-                                          (const unsigned int *)(const void *)blk.hit + i, &c->fcarry, &c->moves, &f, col);
+                const float *t2 = (const float *)(const void *)blk.t2 + i;
+                int m = fogvol__an_fsort_events(c->set, (const float *)(const void *)blk.t1 + i, t2,
+                                                (const unsigned int *)(const void *)blk.hit + i, &c->fcarry,
+                                                &c->moves, key);
                 ++c->sorted;
+                if (c->law != FOGVOL_FOG_EXP) {
+                    fogvol__an_flinear_events(fv, c->mix, blk.len[i], key, t2, m, c->law, f, col);
+                    continue;
+                }
+                if (st.n + FOGVOL__AN_EVENTS > FOGVOL__AN_SCAP) fogvol__an_fstr_flush(&st, lv->expq, bf, bc);
+                st.first[st.verts] = st.n, st.vert[st.verts] = i; /* fog and colour at the flush */
+                st.count[st.verts] =
+                    fogvol__an_fstretches(fv, c->mix, blk.len[i], key, t2, m, st.rgb + st.n, st.sig + st.n, st.ex + st.n);
+                st.n += st.count[st.verts++];
             } else {
-                f = blk.fog[i];
+                *f = blk.fog[i];
                 col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
             }
-            if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = f;
+        }
+        fogvol__an_fstr_flush(&st, lv->expq, bf, bc);
+        for (i = 0; i < nb; ++i) {
+            size_t idx = (size_t)(base + i);
+            if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = bf[i];
             if (c->color_out) {
                 float *out = (float *)(void *)((unsigned char *)c->color_out + idx * (size_t)c->color_stride);
-                out[0] = col[0], out[1] = col[1], out[2] = col[2];
+                out[0] = bc[i][0], out[1] = bc[i][1], out[2] = bc[i][2];
             }
         }
     }
@@ -4827,9 +4934,12 @@ static fogvol__an_flevel fogvol__an_flevel_of(fogvol_analytic_kernel k)
 {
     fogvol__an_flevel lv;
     lv.gather = fogvol__an_fgather, lv.cone = fogvol__an_fcone_c, lv.block = fogvol__an_fblock_c;
+    lv.expq = fogvol__an_fexpq_c;
 #if FOGVOL__AN_X86
-    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2)
+    if (k == FOGVOL_ANALYTIC_KERNEL_AVX2) {
         lv.gather = fogvol__an_fgather_avx2, lv.cone = fogvol__an_fcone_avx2, lv.block = fogvol__an_fblock_avx2;
+        lv.expq = fogvol__an_fexpq_avx2;
+    }
     if (k == FOGVOL_ANALYTIC_KERNEL_SSE2) lv.cone = fogvol__an_fcone_sse2, lv.block = fogvol__an_fblock_sse2;
 #else
     (void)k;
