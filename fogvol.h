@@ -4908,8 +4908,8 @@ static int fogvol__an_fbatch(fogvol__an_call *c, const fogvol__an_flevel *lv)
                 }
                 if (st.n + FOGVOL__AN_EVENTS > FOGVOL__AN_SCAP) fogvol__an_fstr_flush(&st, lv->expq, bf, bc);
                 st.first[st.verts] = st.n, st.vert[st.verts] = i; /* fog and colour at the flush */
-                st.count[st.verts] =
-                    fogvol__an_fstretches(fv, c->mix, blk.len[i], key, t2, m, st.rgb + st.n, st.sig + st.n, st.ex + st.n);
+                st.count[st.verts] = fogvol__an_fstretches(fv, c->mix, blk.len[i], key, t2, m, st.rgb + st.n,
+                                                           st.sig + st.n, st.ex + st.n);
                 st.n += st.count[st.verts++];
             } else {
                 *f = blk.fog[i];
