@@ -4916,7 +4916,7 @@ static int fogvol__an_fbatch(fogvol__an_call *c, const fogvol__an_flevel *lv)
                 col[0] = blk.r[i], col[1] = blk.g[i], col[2] = blk.bl[i];
             }
         }
-        fogvol__an_fstr_flush(&st, lv->expq, bf, bc);
+        if (st.verts) fogvol__an_fstr_flush(&st, lv->expq, bf, bc); /* (none: no sorted EXP vertex) */
         for (i = 0; i < nb; ++i) {
             size_t idx = (size_t)(base + i);
             if (c->fog_out) *(float *)(void *)((unsigned char *)c->fog_out + idx * (size_t)c->fog_stride) = bf[i];

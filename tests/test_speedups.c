@@ -590,47 +590,47 @@ static void test_exact_sum(void **state)
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
     for (ti = 1; ti < 3; ++ti)
-    for (si = 0; si < 2; ++si) {
-        const tscene *s = &g_scenes[scene_index(names[si])];
-        const fogvol_tier tier = g_tiers[ti];
-        double range = s->cam.zfar - s->cam.znear, worst = 0.0;
-        int e;
-        run_frames(s, tier, 0, &g, &on);
-        run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &flt);
-        run_frames(s, tier, XS, &g, &digits);
-        g_no_fetch_cap = 1;
-        run_frames(s, tier, 0, &g, &nocap);
-        g_no_fetch_cap = 0;
-        g_fail_exact = 1;
-        run_frames(s, tier, 0, &g, &fail);
-        g_fail_exact = 2;
-        run_frames(s, tier, 0, &g, &failc);
-        g_fail_exact = 0;
-        assert_int_equal(failc.exact[0], 1); /* summed, then not composited; the digits from then on */
-        for (f = 0; f < NFRAMES; ++f) {
-            assert_int_equal(on.exact[f], 1);
-            assert_int_equal(digits.exact[f] + nocap.exact[f] + fail.exact[f], 0);
-            assert_int_equal(on.passes[f], digits.passes[f] - 1); /* one sum pass for B and F */
-            for (i = 0; i < W * H; ++i) {
-                double d = fabs((double)on.th[f][i] - (double)flt.th[f][i]);
-                if (d > worst) worst = d;
+        for (si = 0; si < 2; ++si) {
+            const tscene *s = &g_scenes[scene_index(names[si])];
+            const fogvol_tier tier = g_tiers[ti];
+            double range = s->cam.zfar - s->cam.znear, worst = 0.0;
+            int e;
+            run_frames(s, tier, 0, &g, &on);
+            run_frames(s, FOGVOL_TIER_FLOAT, 0, &g, &flt);
+            run_frames(s, tier, XS, &g, &digits);
+            g_no_fetch_cap = 1;
+            run_frames(s, tier, 0, &g, &nocap);
+            g_no_fetch_cap = 0;
+            g_fail_exact = 1;
+            run_frames(s, tier, 0, &g, &fail);
+            g_fail_exact = 2;
+            run_frames(s, tier, 0, &g, &failc);
+            g_fail_exact = 0;
+            assert_int_equal(failc.exact[0], 1); /* summed, then not composited; the digits from then on */
+            for (f = 0; f < NFRAMES; ++f) {
+                assert_int_equal(on.exact[f], 1);
+                assert_int_equal(digits.exact[f] + nocap.exact[f] + fail.exact[f], 0);
+                assert_int_equal(on.passes[f], digits.passes[f] - 1); /* one sum pass for B and F */
+                for (i = 0; i < W * H; ++i) {
+                    double d = fabs((double)on.th[f][i] - (double)flt.th[f][i]);
+                    if (d > worst) worst = d;
+                }
+                assert_int_equal(max_diff(nocap.px[f], digits.px[f], &n), 0);
+                assert_int_equal(max_diff(fail.px[f], digits.px[f], &n), 0);
+                assert_memory_equal(nocap.th[f], digits.th[f], sizeof on.th[f]);
+                assert_memory_equal(fail.th[f], digits.th[f], sizeof on.th[f]);
+                if (f == 0) continue;
+                assert_int_equal(failc.exact[f], 0);
+                assert_int_equal(max_diff(failc.px[f], digits.px[f], &n), 0);
             }
-            assert_int_equal(max_diff(nocap.px[f], digits.px[f], &n), 0);
-            assert_int_equal(max_diff(fail.px[f], digits.px[f], &n), 0);
-            assert_memory_equal(nocap.th[f], digits.th[f], sizeof on.th[f]);
-            assert_memory_equal(fail.th[f], digits.th[f], sizeof on.th[f]);
-            if (f == 0) continue;
-            assert_int_equal(failc.exact[f], 0);
-            assert_int_equal(max_diff(failc.px[f], digits.px[f], &n), 0);
+            e = check_ground_truth(s, on.px[2]);
+            print_message("# %-5s %-22s integer sums: max |sum - FLOAT's| %.2e of the range over %d frames; fog "
+                          "with occluders vs ray-cast %d/255; passes %d (digits %d)\n",
+                          g_tier_names[ti], names[si], worst / range, NFRAMES, e, on.passes[2], digits.passes[2]);
+            assert_true(worst <= 4e-7 * range);
+            assert_true(e <= 2);
+            write_png(ti == 1 ? "PS20_exact" : "PS13_exact", on.px[2]);
         }
-        e = check_ground_truth(s, on.px[2]);
-        print_message("# %-5s %-22s integer sums: max |sum - FLOAT's| %.2e of the range over %d frames; fog "
-                      "with occluders vs ray-cast %d/255; passes %d (digits %d)\n",
-                      g_tier_names[ti], names[si], worst / range, NFRAMES, e, on.passes[2], digits.passes[2]);
-        assert_true(worst <= 4e-7 * range);
-        assert_true(e <= 2);
-        write_png(ti == 1 ? "PS20_exact" : "PS13_exact", on.px[2]);
-    }
     glu_destroy(&g);
 }
 
