@@ -547,8 +547,9 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  about half a texture read, on tile-based GPUs it comes from tile memory
                  (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
    EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
-                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group without density-textured volumes sums its faces
-                 by programmable blending: one pass over every face reads B's RGBA8 pixel as a 32-bit
+                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
+                 without density-textured volumes sums its faces by programmable blending: one pass
+                 over every face reads B's RGBA8 pixel as a 32-bit
                  integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
                  of it and O) for a back face and subtracts it for a front face (sign flipped for
                  negative volumes), and writes the integer back; the composite reads that one target.
@@ -556,7 +557,8 @@ typedef struct fogvol_context_desc fogvol_context_desc;
                  to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
                  overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
                  to 127 times the depth range, 127 layers each as deep as the whole range (groups of
-                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum). Not the digits' bytes: closer to the true thickness. */
+                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
+                 Not the digits' bytes: closer to the true thickness. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -6178,7 +6180,7 @@ static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
            !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
 }
 
-/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20 and MRT whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
+/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
 static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
 {
     return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
