@@ -168,10 +168,25 @@
    the uniforms of fogvol_analytic_pack_uniforms; fogvol_fold_fog folds fog into
    diffuse/specular. Details next to the declarations.
 
-   SECTIONS (search for the markers)
+   SECTIONS (search for the markers; the implementation in this order)
    ========
-       >>declarations  >>cpu  >>analytic  >>shaders  >>null backend  >>renderer  >>image-space effects
-       >>gl backend
+       >>declarations   the public API (its parts are listed under WHERE TO FIND WHAT)
+       >>cpu            results, allocation, logging; encoding; lookup textures; mesh validation
+       >>dialects       the GLSL dialect table and the preludes
+       >>analytic       analytic fog volumes (JCAB): prepare, evaluate, batch, GLSL
+       >>tiers          what each tier supports (variants, speed-ups, features) and costs
+       >>shaders        the GLSL bodies of every program, shader strings, engine snippets
+       >>null backend   the recording backend (no GPU)
+       >>context        the renderer's objects and the context: configuration, targets, programs
+       >>resources      meshes (upload, bounds, convexity), colour ramps, volume textures
+       >>frame input    camera, begin_frame, volumes, occluders, MRT and engine-drawn O
+       >>passes         opaque O, the face sums, composite, debug read-back
+       >>overflow       overflow check passes, occlusion queries, what a count changes
+       >>lights         volume lights by compare
+       >>colour groups  one-pass colours (FOGVOL_VARIANT_COLORS)
+       >>end frame      fogvol_end_frame: set-up, groups in turn, lights, stats
+       >>post effects   image-space effects: depth of field, outlines, distance fog
+       >>gl backend     the default backend on OpenGL / GLES through function pointers
 */
 
 #ifndef FOGVOL_H
@@ -5312,7 +5327,162 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
 
 #endif /* FOGVOL_NO_ANALYTIC */
 
+/* >>tiers ================================================================= */
+/* What each tier can do: the variants, speed-ups and features it supports and what it costs. */
+
+FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
+{
+    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
+    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
+    return names[tier];
+}
+
+/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
+static int fogvol__density_ok(fogvol_tier tier, unsigned v)
+{
+    if (tier == FOGVOL_TIER_FLOAT) return 1;
+    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
+           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
+}
+
+static int fogvol__light_ok(fogvol_tier tier, unsigned v)
+{
+    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
+                                         !(v & FOGVOL_VARIANT_WIDE));
+}
+
+FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
+{
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int modern; /* float targets, multiple outputs */
+    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
+    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
+    modern = !di->legacy;
+    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
+                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
+        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
+    switch (tier) {
+    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
+                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
+        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
+                   ? FOGVOL_ERROR_UNSUPPORTED
+                   : FOGVOL_SUCCESS;
+    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
+        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return FOGVOL_SUCCESS;
+    case FOGVOL_TIER_MRT:
+        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
+        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
+    case FOGVOL_TIER_FLOAT:
+        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
+            return FOGVOL_ERROR_UNSUPPORTED;
+        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
+    default: return FOGVOL_ERROR_UNSUPPORTED;
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
+{
+    if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
+    if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
+    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
+        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
+    if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
+        return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
+    return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
+}
+
+FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
+{
+    switch (program) {
+    case FOGVOL_PROGRAM_ENCODE:
+        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
+    case FOGVOL_PROGRAM_FACE:
+    case FOGVOL_PROGRAM_COMPOSITE:
+    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
+    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
+    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
+    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
+    case FOGVOL_PROGRAM_COLOR_FACE:
+    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
+    default: return 0;
+    }
+}
+
+FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
+{
+    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    out->name = fogvol_tier_name(tier);
+    switch (tier) {
+    case FOGVOL_TIER_PS13:
+        out->paper_passes = 6;
+        out->library_passes = 5;
+        out->targets = single ? 3 : 4; /* O, B, F, T */
+        break;
+    case FOGVOL_TIER_PS20:
+        out->paper_passes = 5;
+        out->library_passes = 4;
+        out->targets = single ? 2 : 3;
+        break;
+    case FOGVOL_TIER_MRT:
+        out->paper_passes = 4;
+        out->library_passes = 3;
+        out->targets = single ? 2 : 3; /* O is written by the engine */
+        break;
+    case FOGVOL_TIER_FLOAT:
+        out->paper_passes = 3;
+        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
+        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
+        break;
+    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    return FOGVOL_SUCCESS;
+}
+
+/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
+   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
+   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
+   comparing with an R32F O than counting with its RGBA8 O) */
+static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
+{
+    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
+           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
+}
+
+/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
+   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
+/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
+   FLOAT's engine depth texture, nor COLORS' faces) */
+static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
+{
+    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
+}
+
+/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
+static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
+{
+    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
+}
+
+static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
+{
+    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
+           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
+                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
+}
+
 /* >>shaders =============================================================== */
+/* The GLSL of every program: one body per program, the dialect's prelude (>>dialects) and the
+   defines of the tier, variant and specialisation in front; the snippets engines paste in. */
+
 /* One body per program, written with small compatibility macros; one prelude
    per dialect defines FV_ATTRIB, FV_VARYING_OUT (vertex), FV_VARYING_IN,
    FV_TEXTURE, FV_FRAGCOLOR (fragment). Tiers and variants select code with
@@ -5334,13 +5504,17 @@ static const char fogvol__fs_msaa[] =
 
 static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
                                                                    "#define FV_FLOAT\n"};
+
 static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
                                                       "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n",
                                                       "#define FV_COLORS\n"};
+
 #define FOGVOL__VARIANT_COUNT (int)(sizeof fogvol__variant_define / sizeof fogvol__variant_define[0])
+
 /* one #define per bit of FOGVOL_VARIANT_ALL */
 typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__VARIANT_COUNT) - 1u ? 1 : -1];
+
 /* Mesh vertex shader: clip position and normalised depth d = (w - near) /
    (far - near). With fv_misc.y = 1 clip z is replaced by k*d - w: the near
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
@@ -5612,6 +5786,7 @@ static const char fogvol__fs_face[] =
     "    FV_OUT1 = behind ? olo : lo;\n"
     "}\n"
     ;
+
 /* (the face program's second string: C99 compilers need take no string over 4095 characters) */
 static const char fogvol__fs_face_rgba8[] =
     "#elif defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: the pixel as a 32-bit integer, +- d 2^24 */
@@ -5751,6 +5926,7 @@ static const char fogvol__fs_composite[] =
     "}\n"
     "#endif\n"
     ;
+
 /* (the composite's main: C99 compilers need take no string over 4095 characters) */
 static const char fogvol__fs_composite_main[] =
     "void main() {\n"
@@ -5877,20 +6053,6 @@ static const char fogvol__fs_light[] =
     "    }\n"
     "}\n";
 
-/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
-static int fogvol__density_ok(fogvol_tier tier, unsigned v)
-{
-    if (tier == FOGVOL_TIER_FLOAT) return 1;
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
-}
-static int fogvol__light_ok(fogvol_tier tier, unsigned v)
-{
-    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-                                         !(v & FOGVOL_VARIANT_WIDE));
-}
-
-/* >>one-pass colours (FOGVOL_VARIANT_COLORS) */
 /* Faces of every volume of the colour group: the signed, opaque-clamped depth s (as the FLOAT face
    program) times the volume's per-channel extinction (target 0: optical depth tau) and times its
    extinction * colour (target 1: emission sum E). */
@@ -5934,114 +6096,11 @@ static const char fogvol__fs_color_composite[] =
     "    else if (fv_rampmap.z < 1.5) FV_FRAGCOLOR = vec4(tr, m);\n"
     "    else FV_FRAGCOLOR = vec4(c * (1.0 - tr), 1.0 - m);\n"
     "}\n";
-/* <<one-pass colours */
 
 FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect)
 {
     if ((int)dialect < 0 || (int)dialect >= FOGVOL_GLSL_COUNT) return "invalid";
     return fogvol__dialects[dialect].name;
-}
-
-FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
-{
-    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
-    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
-    return names[tier];
-}
-
-FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
-{
-    const fogvol__dialect_info *di = fogvol__dialect(dialect);
-    int modern; /* float targets, multiple outputs */
-    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = !di->legacy;
-    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
-                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
-        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
-    switch (tier) {
-    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
-                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
-        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
-                   ? FOGVOL_ERROR_UNSUPPORTED
-                   : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
-        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return FOGVOL_SUCCESS;
-    case FOGVOL_TIER_MRT:
-        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
-    case FOGVOL_TIER_FLOAT:
-        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
-    default: return FOGVOL_ERROR_UNSUPPORTED;
-    }
-}
-
-FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
-{
-    if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
-    if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
-        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
-    if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
-        return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
-    return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
-}
-
-FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
-{
-    switch (program) {
-    case FOGVOL_PROGRAM_ENCODE:
-        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-    case FOGVOL_PROGRAM_FACE:
-    case FOGVOL_PROGRAM_COMPOSITE:
-    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
-    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
-    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
-    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
-    case FOGVOL_PROGRAM_COLOR_FACE:
-    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
-    default: return 0;
-    }
-}
-
-FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
-{
-    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
-    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    out->name = fogvol_tier_name(tier);
-    switch (tier) {
-    case FOGVOL_TIER_PS13:
-        out->paper_passes = 6;
-        out->library_passes = 5;
-        out->targets = single ? 3 : 4; /* O, B, F, T */
-        break;
-    case FOGVOL_TIER_PS20:
-        out->paper_passes = 5;
-        out->library_passes = 4;
-        out->targets = single ? 2 : 3;
-        break;
-    case FOGVOL_TIER_MRT:
-        out->paper_passes = 4;
-        out->library_passes = 3;
-        out->targets = single ? 2 : 3; /* O is written by the engine */
-        break;
-    case FOGVOL_TIER_FLOAT:
-        out->paper_passes = 3;
-        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
-        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
-        break;
-    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    return FOGVOL_SUCCESS;
 }
 
 /* The fragment or vertex shader's program body and its program's #defines. */
@@ -6158,39 +6217,6 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->program != FOGVOL_PROGRAM_FACE && comp[(d->specialize >> 2) & 7u][0])
         strings[n++] = comp[(d->specialize >> 2) & 7u];
     return n;
-}
-
-/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
-   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
-   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
-   comparing with an R32F O than counting with its RGBA8 O) */
-static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
-}
-
-/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
-   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
-/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
-   FLOAT's engine depth texture, nor COLORS' faces) */
-static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
-{
-    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-}
-
-/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
-static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
-{
-    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
-}
-
-static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
-                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
 }
 
 FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, const char **strings, int *count)
@@ -6310,12 +6336,14 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "}\n" \
     "#endif\n"
 static const char fogvol__mrt_snippet[] = FOGVOL__MRT_SNIPPET_TEXT;
+
 /* Occluders drawn by the engine: fogvol_mrt[0].z (N) = 0 marks an R32F target (the FLOAT tier's O,
    and PS20's as MRT's with FOGVOL_SPEEDUP_FLOAT_O) */
 static const char fogvol__occluder_snippet[] = FOGVOL__MRT_SNIPPET_TEXT
     "vec4 fogvol_occluder_color(float view_depth) { return fogvol_encode_view_depth(view_depth); }\n";
 
 FOGVOL_API const char *fogvol_mrt_snippet(void) { return fogvol__mrt_snippet; }
+
 FOGVOL_API const char *fogvol_occluder_snippet(void) { return fogvol__occluder_snippet; }
 
 FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
@@ -6330,6 +6358,7 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u)
 }
 
 /* >>null backend ========================================================== */
+/* A recording backend that needs no GPU: every entry counts its calls (tests, tools). */
 
 static fogvol_result fogvol__null_create(void *u, fogvol_handle *out)
 {
@@ -6340,10 +6369,12 @@ static fogvol_result fogvol__null_create(void *u, fogvol_handle *out)
     s->creates++;
     return FOGVOL_SUCCESS;
 }
+
 static void fogvol__null_destroy(void *u, fogvol_handle h)
 {
     if (h) ((fogvol_null_backend *)u)->destroys++;
 }
+
 static fogvol_result fogvol__null_begin_frame(void *u, fogvol_frame_info *info)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6353,22 +6384,27 @@ static fogvol_result fogvol__null_begin_frame(void *u, fogvol_frame_info *info)
     info->samples = s->samples;
     return FOGVOL_SUCCESS;
 }
+
 static void fogvol__null_end_frame(void *u) { ((fogvol_null_backend *)u)->frames_ended++; }
+
 static fogvol_result fogvol__null_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
 {
     (void)d;
     return fogvol__null_create(u, out);
 }
+
 static fogvol_result fogvol__null_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     (void)d;
     return fogvol__null_create(u, out);
 }
+
 static fogvol_result fogvol__null_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     (void)d;
     return fogvol__null_create(u, out);
 }
+
 static fogvol_result fogvol__null_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
 {
     /* the layout fields as fogvol_create_mesh hands them (FOGVOL_CAP_MESH_LAYOUT) */
@@ -6378,6 +6414,7 @@ static fogvol_result fogvol__null_create_mesh(void *u, const fogvol_mesh_data *d
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     return fogvol__null_create(u, out);
 }
+
 static void fogvol__null_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6389,11 +6426,13 @@ static void fogvol__null_begin_pass(void *u, const fogvol_pass *p)
     s->pass_count++;
     s->in_pass = 1;
 }
+
 static void fogvol__null_set_draw(void *u, const fogvol_draw *d)
 {
     (void)u;
     (void)d;
 }
+
 static void fogvol__null_draw_mesh(void *u, fogvol_handle m, const fogvol_draw *d)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6401,22 +6440,27 @@ static void fogvol__null_draw_mesh(void *u, fogvol_handle m, const fogvol_draw *
     (void)d;
     if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->draws[s->pass_count - 1]++;
 }
+
 static void fogvol__null_draw_fullscreen(void *u)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
     if (s->pass_count > 0 && s->pass_count <= FOGVOL_NULL_MAX_PASSES) s->fullscreen[s->pass_count - 1]++;
 }
+
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
+
 static uintptr_t fogvol__null_native(void *u, fogvol_handle h)
 {
     (void)u;
     return (uintptr_t)h;
 }
+
 static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
 {
     (void)u;
     return t ? t + ((fogvol_handle)index << 20) : 0; /* a distinct handle, never created or destroyed */
 }
+
 static fogvol_result fogvol__null_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
 {
     (void)u;
@@ -6430,6 +6474,7 @@ static fogvol_result fogvol__null_create_query(void *u, fogvol_handle *out)
     if (!((fogvol_null_backend *)u)->queries) return FOGVOL_ERROR_UNSUPPORTED;
     return fogvol__null_create(u, out);
 }
+
 static int fogvol__null_begin_query(void *u, fogvol_handle q)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6438,6 +6483,7 @@ static int fogvol__null_begin_query(void *u, fogvol_handle q)
     s->query_active++;
     return 1;
 }
+
 static void fogvol__null_end_query(void *u, fogvol_handle q)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6445,6 +6491,7 @@ static void fogvol__null_end_query(void *u, fogvol_handle q)
     s->queries_ended++;
     s->query_active--;
 }
+
 static int fogvol__null_query_result(void *u, fogvol_handle q, uint64_t *samples)
 {
     fogvol_null_backend *s = (fogvol_null_backend *)u;
@@ -6492,7 +6539,8 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     table->query_result = fogvol__null_query_result;
 }
 
-/* >>renderer ============================================================== */
+/* >>context =============================================================== */
+/* The renderer's objects and the context: resolved configuration, targets, programs. */
 
 struct fogvol_mesh {
     fogvol_handle handle;
@@ -6503,29 +6551,10 @@ struct fogvol_mesh {
                                geometry composite's scissor) */
 };
 
-/* The bounding box of the positions (finite: validated before). */
-static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
-{
-    size_t stride = (size_t)fogvol__mesh_stride(desc);
-    const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
-    int i, c;
-    for (c = 0; c < 3; ++c) {
-        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
-        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
-    }
-    for (i = 0; i < desc->vertex_count; ++i) {
-        float p[3];
-        memcpy(p, base + (size_t)i * stride, sizeof p);
-        for (c = 0; c < 3; ++c) {
-            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
-            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
-        }
-    }
-}
-
 /* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
    it failed to build and the general program stands in. */
 #define FOGVOL__SPEC_MAX 128
+
 typedef struct fogvol__spec_program {
     fogvol_program program;
     unsigned bits;
@@ -6577,7 +6606,9 @@ typedef struct fogvol__occluder {
 
 /* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
 #define FOGVOL__QFRAMES 4
+
 #define FOGVOL__QPER 32
+
 typedef struct fogvol__qframe {
     fogvol_handle q[FOGVOL__QPER]; /* created on first use, reused */
     int64_t frame;
@@ -6644,6 +6675,27 @@ struct fogvol_context {
     int fetch_o;            /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O from the framebuffer */
     int exact_sum;          /* FOGVOL_SPEEDUP_EXACT_SUM: groups may sum as 32-bit integers */
 };
+
+/* One fogvol_end_frame: what its passes share. */
+typedef struct fogvol__run {
+    fogvol_frame_stats st;
+    fogvol_frame_info info;
+    fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
+    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    int w, h, single, count, rgba8;
+    int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
+    int captured, overflow;     /* debug read-back done; its overflow pixel count */
+    fogvol_result r;            /* the last error that did not stop the frame */
+    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
+    int xsum;                   /* FOGVOL_SPEEDUP_EXACT_SUM: the current group sums as 32-bit integers */
+    int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
+} fogvol__run;
+
+/* The overflow section's entry points, which the context and the passes call before it. */
+static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy);
+static fogvol_result fogvol__ensure_checks(fogvol_context *ctx);
+static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base, int first,
+                               fogvol_frame_stats *st);
 
 /* column-major 4x4 helpers in double */
 static void fogvol__mul4(double *out, const double *a, const double *b)
@@ -6887,6 +6939,7 @@ enum {
     FOGVOL__UNIT_DENSITY = 6, /* fv_density: FACE, the volume's density texture */
     FOGVOL__UNIT_LFRONT = 7   /* fv_lfront: LIGHT, the light's front depth L */
 };
+
 enum {
     FOGVOL__UNIT_BACK = 0,    /* fv_back: sum of back faces B (PS13: the resolved difference T) */
     FOGVOL__UNIT_FRONT = 1,   /* fv_front: sum of front faces F (SINGLE_TARGET: the overflow mask V) */
@@ -7026,8 +7079,6 @@ static fogvol_result fogvol__resolve_bits(const fogvol_context_desc *desc, int *
     *bits = b;
     return FOGVOL_SUCCESS;
 }
-
-static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy);
 
 /* The context desc checked and its defaults resolved (encoding bits); logged when refused. */
 static fogvol_result fogvol__context_desc(const fogvol_context_desc *desc, int *bits)
@@ -7236,6 +7287,111 @@ FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
     return FOGVOL_SUCCESS;
 }
 
+/* Make ctx->prog the per-sample set (ms = 1) or the single-sample set, building
+   the per-sample programs on first use. */
+static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
+{
+    fogvol_handle t[FOGVOL_PROGRAM_COUNT];
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
+    if (ms == ctx->prog_ms) return FOGVOL_SUCCESS;
+    memcpy(t, ctx->prog, sizeof t);
+    memcpy(ctx->prog, ctx->prog_alt, sizeof t);
+    memcpy(ctx->prog_alt, t, sizeof t);
+    ctx->prog_ms = ms;
+    ctx->compile_samples = ms ? 2 : 0;
+    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
+        if (!ctx->prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
+            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
+    ctx->compile_samples = 0;
+    return r;
+}
+
+/* The program p built for this configuration (fogvol_shader_desc.specialize = bits) in the current
+   sample set, made on first use (the GL backend builds programs inside a frame without disturbing
+   it); the general program when specialising is off or the build failed (logged once). COUNT and
+   DOWNSAMPLE are not options but other programs, built with SPECIALIZE off too. If COUNT cannot
+   be, the frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged); if
+   DOWNSAMPLE cannot be, 0 (the caller skips the pass). */
+static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
+{
+    /* programs that have no general stand-in: 0 (DOWNSAMPLE: the pass is skipped; BLEND_COLOR: the
+       caller asks again without it) */
+    const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR;
+    fogvol__spec_program *sp;
+    int i;
+    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
+        bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
+                FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
+    else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->tier != FOGVOL_TIER_FLOAT)
+        bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->enc.bits); /* the context's encoding compiled in */
+    if (!bits) return ctx->prog[p];
+    for (i = 0; i < ctx->nspec; ++i) {
+        sp = &ctx->spec[i];
+        if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
+            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->prog[p];
+    }
+    if (ctx->nspec == FOGVOL__SPEC_MAX) {
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->count_broken = 1;
+        return (bits & none) ? 0 : ctx->prog[p];
+    }
+    sp = &ctx->spec[ctx->nspec++];
+    sp->program = p;
+    sp->bits = bits;
+    sp->ms = ctx->prog_ms;
+    ctx->compile_samples = ctx->prog_ms ? 2 : 0;
+    if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
+        int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
+        sp->handle = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: the specialised program (0x%x) did not build; %s", bits,
+                    retried ? "the composite takes its colour from the program instead of the blend unit"
+                    : (bits & FOGVOL_SPECIALIZE_COUNT)
+                        ? "the general program draws instead (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off "
+                          "from now on)"
+                        : "the general program draws instead");
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !retried) ctx->count_broken = 1;
+    }
+    ctx->compile_samples = 0;
+    if (!sp->handle && (bits & none)) return 0;
+    return sp->handle ? sp->handle : ctx->prog[p];
+}
+
+/* >>resources ============================================================= */
+/* Meshes (upload, bounds, convexity), colour ramps and volume textures. */
+
+/* A mesh destroyed inside a frame: the lights that use it leave the frame. */
+static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
+{
+    int i, n = 0;
+    if (!ctx->in_frame) return;
+    for (i = 0; i < ctx->nlight; ++i)
+        if (ctx->lights[i].mesh != mesh) ctx->lights[n++] = ctx->lights[i];
+    if (n != ctx->nlight)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh destroyed inside a frame: %d lights that use it "
+                    "are dropped from the frame", ctx->nlight - n);
+    ctx->nlight = n;
+}
+
+/* The bounding box of the positions (finite: validated before). */
+static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
+{
+    size_t stride = (size_t)fogvol__mesh_stride(desc);
+    const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
+    int i, c;
+    for (c = 0; c < 3; ++c) {
+        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
+        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
+    }
+    for (i = 0; i < desc->vertex_count; ++i) {
+        float p[3];
+        memcpy(p, base + (size_t)i * stride, sizeof p);
+        for (c = 0; c < 3; ++c) {
+            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
+            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
+        }
+    }
+}
+
 /* Hands the mesh to the backend: the engine's layout as it is to backends with
    FOGVOL_CAP_MESH_LAYOUT, else packed xyz and 32-bit indices (idx: the welded or
    widened indices, NULL = desc->indices). */
@@ -7270,8 +7426,6 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     fogvol__free(&ctx->alloc, packed);
     return r;
 }
-
-/* >>texlight (convexity of light volumes) ================================ */
 
 static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3])
 {
@@ -7325,19 +7479,6 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
         }
     }
     return 1;
-}
-
-/* A mesh destroyed inside a frame: the lights that use it leave the frame. */
-static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
-{
-    int i, n = 0;
-    if (!ctx->in_frame) return;
-    for (i = 0; i < ctx->nlight; ++i)
-        if (ctx->lights[i].mesh != mesh) ctx->lights[n++] = ctx->lights[i];
-    if (n != ctx->nlight)
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh destroyed inside a frame: %d lights that use it "
-                    "are dropped from the frame", ctx->nlight - n);
-    ctx->nlight = n;
 }
 
 FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
@@ -7512,6 +7653,51 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     ctx->live_ramps--;
     fogvol__free(&ctx->alloc, ramp);
 }
+
+FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
+                                                      fogvol_volume_texture **out)
+{
+    fogvol_volume_texture *t;
+    fogvol_texture_desc td;
+    fogvol_result r;
+    if (out) *out = NULL;
+    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
+                    "(got %dx%d)", desc->width, desc->height);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
+    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    td = *desc;
+    if (!td.label) td.label = "fogvol volume texture";
+    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    if (r != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        fogvol__free(&ctx->alloc, t);
+        return r;
+    }
+    *out = t;
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture)
+{
+    int i, n = 0;
+    if (!ctx || !texture) return;
+    for (i = 0; ctx->in_frame && i < ctx->nvol; ++i)
+        if (ctx->vols[i].density != texture && ctx->vols[i].color != texture) ctx->vols[n++] = ctx->vols[i];
+    if (ctx->in_frame && n != ctx->nvol) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: volume texture destroyed inside a frame: %d volumes "
+                    "that use it are dropped from the frame", ctx->nvol - n);
+        ctx->nvol = n;
+    }
+    ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    fogvol__free(&ctx->alloc, texture);
+}
+
+/* >>frame input =========================================================== */
+/* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
 
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
@@ -7774,50 +7960,6 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     return FOGVOL_SUCCESS;
 }
 
-/* >>texlight (volume textures) ============================================ */
-
-FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const fogvol_texture_desc *desc,
-                                                      fogvol_volume_texture **out)
-{
-    fogvol_volume_texture *t;
-    fogvol_texture_desc td;
-    fogvol_result r;
-    if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
-                    "(got %dx%d)", desc->width, desc->height);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
-    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    td = *desc;
-    if (!td.label) td.label = "fogvol volume texture";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
-    if (r != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
-        fogvol__free(&ctx->alloc, t);
-        return r;
-    }
-    *out = t;
-    return FOGVOL_SUCCESS;
-}
-
-FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume_texture *texture)
-{
-    int i, n = 0;
-    if (!ctx || !texture) return;
-    for (i = 0; ctx->in_frame && i < ctx->nvol; ++i)
-        if (ctx->vols[i].density != texture && ctx->vols[i].color != texture) ctx->vols[n++] = ctx->vols[i];
-    if (ctx->in_frame && n != ctx->nvol) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: volume texture destroyed inside a frame: %d volumes "
-                    "that use it are dropped from the frame", ctx->nvol - n);
-        ctx->nvol = n;
-    }
-    ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
-    fogvol__free(&ctx->alloc, texture);
-}
-
 static int fogvol__all_zero(const float *v, int n)
 {
     int i;
@@ -7931,6 +8073,289 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
     return FOGVOL_SUCCESS;
 }
 
+/* The engine framebuffer's samples decide this frame's targets and programs
+   (see fogvol_msaa): per sample, the opt-in single-sample fallback, or refused. */
+static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_frame_info *info,
+                                           fogvol_frame_stats *st)
+{
+    int n = info->samples > 1 ? info->samples : 0;
+    const char *why = NULL;
+    if (n && ctx->msaa == FOGVOL_MSAA_SINGLE_SAMPLE) {
+        if (!ctx->msaa_warned)
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                        "fogvol: %d-sample engine framebuffer drawn with single-sample targets "
+                        "(FOGVOL_MSAA_SINGLE_SAMPLE): one fog value per pixel",
+                        n);
+        ctx->msaa_warned = 1;
+        st->msaa_fallback = 1;
+        n = 0;
+    } else if (n) {
+        if (!(ctx->be.caps & FOGVOL_CAP_MULTISAMPLE))
+            why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
+        else if (fogvol_msaa_supported(ctx->tier, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS)
+            why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
+                  "or ENGINE_DEPTH)";
+        else if (ctx->frame.debug_thickness)
+            why = "debug_thickness cannot read multisampled targets";
+        if (why) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                        "fogvol: %d-sample engine framebuffer, tier %s, variants 0x%x, GLSL %s: %s; "
+                        "FOGVOL_MSAA_SINGLE_SAMPLE draws one fog value per pixel instead",
+                        n, fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect), why);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+    }
+    ctx->samples = n;
+    st->samples = n ? n : 1;
+    return fogvol__msaa_programs(ctx, n > 1);
+}
+
+static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_frame_info *info)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    memset(info, 0, sizeof *info);
+    info->draw_buffer = ctx->frame.draw_buffer;
+    if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    return r;
+}
+
+/* For the *_prepare calls: fogvol's targets sized to the frame (touches the
+   GPU, state restored), the frame's constants and O's API object. */
+static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
+{
+    fogvol_frame_info fi;
+    fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
+    if (r != FOGVOL_SUCCESS) return r;
+    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3], 0);
+    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    if (r != FOGVOL_SUCCESS) return r;
+    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, k);
+    *texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    return FOGVOL_SUCCESS;
+}
+
+FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info)
+{
+    fogvol_constants k;
+    fogvol_result r;
+    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    if (ctx->tier != FOGVOL_TIER_MRT || !ctx->in_frame || !ctx->be.native_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
+                                                 "backend with native_texture");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    r = fogvol__prepare_o(ctx, &k, &info->texture);
+    if (r != FOGVOL_SUCCESS) return r;
+    info->format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (ctx->float_o) { /* d = 1, the far plane; fogvol_mrt[0].z = N = 0 marks the R32F target */
+        info->clear_color[0] = 1.0f;
+    } else {
+        info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+        info->uniforms[2] = (float)ctx->enc.levels;
+        info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    }
+    info->uniforms[0] = k.near_far[0];
+    info->uniforms[1] = k.near_far[1];
+    info->uniforms[4] = k.depth_offset;
+    info->uniforms[5] = k.depth_max;
+    info->uniforms[6] = (float)ctx->enc.dither_steps;
+    info->uniforms[7] = ctx->dither ? 1.0f : 0.0f;
+    ctx->mrt_ready = 1;
+    return FOGVOL_SUCCESS;
+}
+
+/* fv_lin, fv_lin2: the engine depth texture's window depth -> view depth, for the camera in
+   ctx (eyerow, invvp) and the depth conventions of fd (overrides) or info (reported). */
+static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
+                                 fogvol_pass *ps)
+{
+    double n[4], dn[4], a, b, sy, r0, r1;
+    int i, z01;
+    /* q = (s, t, window depth, 1) -> NDC (2s - 1, +-(2t - 1), a z + b, 1), folded into the
+       rows eyerow * invVP (numerator) and invVP row 3 (denominator) */
+    z01 = fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
+    r0 = info->depth_range[0];
+    r1 = info->depth_range[1];
+    if (fd->engine_depth_range[0] != 0.0f || fd->engine_depth_range[1] != 0.0f) {
+        r0 = fd->engine_depth_range[0];
+        r1 = fd->engine_depth_range[1];
+    } else if (r0 == 0.0 && r1 == 0.0) {
+        r1 = 1.0;
+    }
+    a = (z01 ? 1.0 : 2.0) / (r1 != r0 ? r1 - r0 : 1.0);
+    b = -r0 * a - (z01 ? 0.0 : 1.0);
+    sy = info->clip_upper_left ? -1.0 : 1.0;
+    for (i = 0; i < 4; ++i) {
+        n[i] = ctx->eyerow[0] * ctx->invvp[i * 4] + ctx->eyerow[1] * ctx->invvp[i * 4 + 1] +
+               ctx->eyerow[2] * ctx->invvp[i * 4 + 2] + ctx->eyerow[3] * ctx->invvp[i * 4 + 3];
+        dn[i] = ctx->invvp[i * 4 + 3];
+    }
+    ps->uniforms[FOGVOL_U_LINEAR][0] = (float)(2.0 * n[0]);
+    ps->uniforms[FOGVOL_U_LINEAR][1] = (float)(2.0 * sy * n[1]);
+    ps->uniforms[FOGVOL_U_LINEAR][2] = (float)(a * n[2]);
+    ps->uniforms[FOGVOL_U_LINEAR][3] = (float)(n[3] - n[0] - sy * n[1] + b * n[2]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][0] = (float)(2.0 * dn[0]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][1] = (float)(2.0 * sy * dn[1]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][2] = (float)(a * dn[2]);
+    ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
+}
+
+/* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
+   is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
+   window depth -> view depth through the inverse view-projection). */
+static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0;
+    int i, j, c;
+    if (ctx->wscale > 0.0) {
+        k = 2.0 * ctx->wscale * range; /* k d <= 2 s (e - near) <= 2 w */
+    } else {                           /* orthographic: w is constant, bound d over the volumes */
+        for (i = 0; i < ctx->nvol; ++i)
+            for (c = 0; c < 8; ++c) {
+                const fogvol__volume *v = &ctx->vols[i];
+                double e = ctx->eyerow[3], p[3];
+                p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
+                p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
+                p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
+                for (j = 0; j < 3; ++j)
+                    e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
+                                           v->model[12 + j]);
+                if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
+            }
+        if (dmax > 0.0) k = 1.98 * ctx->wconst / dmax;
+    }
+    /* the whole [0, 1] depth range: a 16-bit depth buffer (GLES2, WebGL1) orders the occluders'
+       faces as finely as a standard projection would (k = 1 left it 1 / (2 (far - near)) of it) */
+    ps->uniforms[FOGVOL_U_MISC][0] = (float)k;
+    /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
+    ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
+    fogvol__lin_uniforms(ctx, fd, info, ps);
+}
+
+FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info)
+{
+    fogvol_constants k;
+    fogvol_result r;
+    int fl;
+    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    fl = ctx->tier == FOGVOL_TIER_FLOAT;
+    if (!ctx->in_frame || ctx->nocc > 0 || !ctx->be.native_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
+                                                 "fogvol_add_occluder* calls and a backend with native_texture");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if (ctx->frame.downsample == 2) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need full-resolution sums "
+                                                 "(fogvol_frame_desc.downsample 0 or 1)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
+        fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need tier PS20 or FLOAT without the "
+                                                 "COUNT, WIDE and ENGINE_DEPTH variants (tier %s, variants 0x%x)%s",
+                    fogvol_tier_name(ctx->tier), ctx->variants,
+                    ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    r = fogvol__prepare_o(ctx, &k, &info->texture);
+    if (r != FOGVOL_SUCCESS) return r;
+    fl = fl || ctx->float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
+    info->width = ctx->target_w;
+    info->height = ctx->target_h;
+    info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (fl) info->clear_color[0] = 1.0f;
+    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    info->uniforms[0] = k.near_far[0];
+    info->uniforms[1] = k.near_far[1];
+    info->uniforms[2] = fl ? 0.0f : (float)ctx->enc.levels;
+    info->uniforms[3] = fl ? 0.0f : (float)ctx->enc.levels * (float)ctx->enc.levels;
+    info->uniforms[4] = fl ? 0.0f : k.depth_offset;
+    info->uniforms[5] = fl ? 1.0f : k.depth_max;
+    info->uniforms[6] = (float)ctx->enc.dither_steps;
+    info->uniforms[7] = ctx->dither && !fl ? 1.0f : 0.0f;
+    ctx->engine_occluders = 1;
+    return FOGVOL_SUCCESS;
+}
+
+/* The view depths of the 8 corners of volume v's bounds: their least and greatest. */
+static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volume *v, double *emin, double *emax)
+{
+    int c, j;
+    for (c = 0; c < 8; ++c) {
+        double p[3], e = ctx->eyerow[3];
+        p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
+        p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
+        p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
+        for (j = 0; j < 3; ++j)
+            e += ctx->eyerow[j] *
+                 (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
+        if (c == 0 || e < *emin) *emin = e;
+        if (c == 0 || e > *emax) *emax = e;
+    }
+}
+
+/* COUNT adds the opaque depth once per back face without its front face, so it
+   needs every front face in front of the near plane: a volume that the near
+   plane may cut (the camera inside it or within znear of it) breaks the count.
+   Decided conservatively from the view depths of the corners of each volume's
+   bounds: some corner nearer than znear and some in front of the eye. Returns
+   the first such volume, or -1. */
+static int fogvol__count_near_cut(const fogvol_context *ctx)
+{
+    int i;
+    for (i = 0; i < ctx->nvol; ++i) {
+        double emin = 0.0, emax = 0.0;
+        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
+        if (emin < ctx->frame.znear && emax > 0.0) return i;
+    }
+    return -1;
+}
+
+/* Frames fogvol refuses before touching the backend (logged; the caller cancels the frame). */
+static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
+    if (ctx->tier == FOGVOL_TIER_MRT && !ctx->mrt_ready) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: MRT tier: call fogvol_mrt_prepare and let the engine "
+                                                 "write O before fogvol_end_frame");
+        return FOGVOL_ERROR_INVALID_STATE;
+    }
+    if (engine && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE && !fd->engine_depth_texture) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (engine && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE && !ctx->be.copy_depth) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
+                                                 "pass a depth texture (engine_depth_texture)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (fd->downsample == 2 && (ctx->tier != FOGVOL_TIER_FLOAT || ctx->nlight > 0 ||
+                                fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS))) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: downsample 2 needs the FLOAT tier without ENGINE_DEPTH or COLORS and no "
+                    "fogvol_add_light (tier %s, variants 0x%x, %d lights); nothing drawn",
+                    fogvol_tier_name(ctx->tier), ctx->variants, ctx->nlight);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) && (i = fogvol__count_near_cut(ctx)) >= 0) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: COUNT variant: the near plane may cut volume %d (the camera is inside it or closer than "
+                    "znear), which breaks the face count; nothing drawn. Draw such views without COUNT",
+                    i);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    return FOGVOL_SUCCESS;
+}
+
+/* >>passes ================================================================ */
+/* The passes of fogvol_end_frame: opaque O, face sums, composite, debug read-back. */
+
 static void fogvol__end_pass(fogvol_context *ctx)
 {
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
@@ -7971,8 +8396,6 @@ static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume
     d = (sum / 8.0 - ctx->frame.znear) / range;
     return (float)(d > 1.0 ? 1.0 : d);
 }
-
-static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits);
 
 /* SPECIALIZE_DITHER where the encode computes by integer ALU with the dither on */
 static unsigned fogvol__dither_bit(const fogvol_context *ctx)
@@ -8274,804 +8697,6 @@ static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
     ps->textures[FOGVOL__UNIT_DITHER] = ctx->tex_dither;
 }
 
-/* Make ctx->prog the per-sample set (ms = 1) or the single-sample set, building
-   the per-sample programs on first use. */
-static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
-{
-    fogvol_handle t[FOGVOL_PROGRAM_COUNT];
-    fogvol_result r = FOGVOL_SUCCESS;
-    int i;
-    if (ms == ctx->prog_ms) return FOGVOL_SUCCESS;
-    memcpy(t, ctx->prog, sizeof t);
-    memcpy(ctx->prog, ctx->prog_alt, sizeof t);
-    memcpy(ctx->prog_alt, t, sizeof t);
-    ctx->prog_ms = ms;
-    ctx->compile_samples = ms ? 2 : 0;
-    for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (!ctx->prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
-            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
-    ctx->compile_samples = 0;
-    return r;
-}
-
-/* The program p built for this configuration (fogvol_shader_desc.specialize = bits) in the current
-   sample set, made on first use (the GL backend builds programs inside a frame without disturbing
-   it); the general program when specialising is off or the build failed (logged once). COUNT and
-   DOWNSAMPLE are not options but other programs, built with SPECIALIZE off too. If COUNT cannot
-   be, the frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged); if
-   DOWNSAMPLE cannot be, 0 (the caller skips the pass). */
-static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
-{
-    /* programs that have no general stand-in: 0 (DOWNSAMPLE: the pass is skipped; BLEND_COLOR: the
-       caller asks again without it) */
-    const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR;
-    fogvol__spec_program *sp;
-    int i;
-    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
-        bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
-                FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
-    else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->tier != FOGVOL_TIER_FLOAT)
-        bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->enc.bits); /* the context's encoding compiled in */
-    if (!bits) return ctx->prog[p];
-    for (i = 0; i < ctx->nspec; ++i) {
-        sp = &ctx->spec[i];
-        if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
-            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->prog[p];
-    }
-    if (ctx->nspec == FOGVOL__SPEC_MAX) {
-        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->count_broken = 1;
-        return (bits & none) ? 0 : ctx->prog[p];
-    }
-    sp = &ctx->spec[ctx->nspec++];
-    sp->program = p;
-    sp->bits = bits;
-    sp->ms = ctx->prog_ms;
-    ctx->compile_samples = ctx->prog_ms ? 2 : 0;
-    if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
-        int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
-        sp->handle = 0;
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: the specialised program (0x%x) did not build; %s", bits,
-                    retried ? "the composite takes its colour from the program instead of the blend unit"
-                    : (bits & FOGVOL_SPECIALIZE_COUNT)
-                        ? "the general program draws instead (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off "
-                          "from now on)"
-                        : "the general program draws instead");
-        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !retried) ctx->count_broken = 1;
-    }
-    ctx->compile_samples = 0;
-    if (!sp->handle && (bits & none)) return 0;
-    return sp->handle ? sp->handle : ctx->prog[p];
-}
-
-/* The engine framebuffer's samples decide this frame's targets and programs
-   (see fogvol_msaa): per sample, the opt-in single-sample fallback, or refused. */
-static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_frame_info *info,
-                                           fogvol_frame_stats *st)
-{
-    int n = info->samples > 1 ? info->samples : 0;
-    const char *why = NULL;
-    if (n && ctx->msaa == FOGVOL_MSAA_SINGLE_SAMPLE) {
-        if (!ctx->msaa_warned)
-            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                        "fogvol: %d-sample engine framebuffer drawn with single-sample targets "
-                        "(FOGVOL_MSAA_SINGLE_SAMPLE): one fog value per pixel",
-                        n);
-        ctx->msaa_warned = 1;
-        st->msaa_fallback = 1;
-        n = 0;
-    } else if (n) {
-        if (!(ctx->be.caps & FOGVOL_CAP_MULTISAMPLE))
-            why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
-        else if (fogvol_msaa_supported(ctx->tier, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS)
-            why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
-                  "or ENGINE_DEPTH)";
-        else if (ctx->frame.debug_thickness)
-            why = "debug_thickness cannot read multisampled targets";
-        if (why) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
-                        "fogvol: %d-sample engine framebuffer, tier %s, variants 0x%x, GLSL %s: %s; "
-                        "FOGVOL_MSAA_SINGLE_SAMPLE draws one fog value per pixel instead",
-                        n, fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect), why);
-            return FOGVOL_ERROR_UNSUPPORTED;
-        }
-    }
-    ctx->samples = n;
-    st->samples = n ? n : 1;
-    return fogvol__msaa_programs(ctx, n > 1);
-}
-
-static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_frame_info *info)
-{
-    fogvol_result r = FOGVOL_SUCCESS;
-    memset(info, 0, sizeof *info);
-    info->draw_buffer = ctx->frame.draw_buffer;
-    if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
-    if (r != FOGVOL_SUCCESS)
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
-    return r;
-}
-
-/* For the *_prepare calls: fogvol's targets sized to the frame (touches the
-   GPU, state restored), the frame's constants and O's API object. */
-static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
-{
-    fogvol_frame_info fi;
-    fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
-    if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3], 0);
-    if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    if (r != FOGVOL_SUCCESS) return r;
-    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, k);
-    *texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
-    return FOGVOL_SUCCESS;
-}
-
-FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info *info)
-{
-    fogvol_constants k;
-    fogvol_result r;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(info, 0, sizeof *info);
-    if (ctx->tier != FOGVOL_TIER_MRT || !ctx->in_frame || !ctx->be.native_texture) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
-                                                 "backend with native_texture");
-        return FOGVOL_ERROR_INVALID_STATE;
-    }
-    r = fogvol__prepare_o(ctx, &k, &info->texture);
-    if (r != FOGVOL_SUCCESS) return r;
-    info->format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-    if (ctx->float_o) { /* d = 1, the far plane; fogvol_mrt[0].z = N = 0 marks the R32F target */
-        info->clear_color[0] = 1.0f;
-    } else {
-        info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
-        info->uniforms[2] = (float)ctx->enc.levels;
-        info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
-    }
-    info->uniforms[0] = k.near_far[0];
-    info->uniforms[1] = k.near_far[1];
-    info->uniforms[4] = k.depth_offset;
-    info->uniforms[5] = k.depth_max;
-    info->uniforms[6] = (float)ctx->enc.dither_steps;
-    info->uniforms[7] = ctx->dither ? 1.0f : 0.0f;
-    ctx->mrt_ready = 1;
-    return FOGVOL_SUCCESS;
-}
-
-static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
-                                 fogvol_pass *ps);
-
-/* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
-   is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
-   window depth -> view depth through the inverse view-projection). */
-static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
-{
-    const fogvol_frame_desc *fd = &ctx->frame;
-    double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0;
-    int i, j, c;
-    if (ctx->wscale > 0.0) {
-        k = 2.0 * ctx->wscale * range; /* k d <= 2 s (e - near) <= 2 w */
-    } else {                           /* orthographic: w is constant, bound d over the volumes */
-        for (i = 0; i < ctx->nvol; ++i)
-            for (c = 0; c < 8; ++c) {
-                const fogvol__volume *v = &ctx->vols[i];
-                double e = ctx->eyerow[3], p[3];
-                p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
-                p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
-                p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
-                for (j = 0; j < 3; ++j)
-                    e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
-                                           v->model[12 + j]);
-                if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
-            }
-        if (dmax > 0.0) k = 1.98 * ctx->wconst / dmax;
-    }
-    /* the whole [0, 1] depth range: a 16-bit depth buffer (GLES2, WebGL1) orders the occluders'
-       faces as finely as a standard projection would (k = 1 left it 1 / (2 (far - near)) of it) */
-    ps->uniforms[FOGVOL_U_MISC][0] = (float)k;
-    /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
-    ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
-    fogvol__lin_uniforms(ctx, fd, info, ps);
-}
-
-/* fv_lin, fv_lin2: the engine depth texture's window depth -> view depth, for the camera in
-   ctx (eyerow, invvp) and the depth conventions of fd (overrides) or info (reported). */
-static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
-                                 fogvol_pass *ps)
-{
-    double n[4], dn[4], a, b, sy, r0, r1;
-    int i, z01;
-    /* q = (s, t, window depth, 1) -> NDC (2s - 1, +-(2t - 1), a z + b, 1), folded into the
-       rows eyerow * invVP (numerator) and invVP row 3 (denominator) */
-    z01 = fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
-    r0 = info->depth_range[0];
-    r1 = info->depth_range[1];
-    if (fd->engine_depth_range[0] != 0.0f || fd->engine_depth_range[1] != 0.0f) {
-        r0 = fd->engine_depth_range[0];
-        r1 = fd->engine_depth_range[1];
-    } else if (r0 == 0.0 && r1 == 0.0) {
-        r1 = 1.0;
-    }
-    a = (z01 ? 1.0 : 2.0) / (r1 != r0 ? r1 - r0 : 1.0);
-    b = -r0 * a - (z01 ? 0.0 : 1.0);
-    sy = info->clip_upper_left ? -1.0 : 1.0;
-    for (i = 0; i < 4; ++i) {
-        n[i] = ctx->eyerow[0] * ctx->invvp[i * 4] + ctx->eyerow[1] * ctx->invvp[i * 4 + 1] +
-               ctx->eyerow[2] * ctx->invvp[i * 4 + 2] + ctx->eyerow[3] * ctx->invvp[i * 4 + 3];
-        dn[i] = ctx->invvp[i * 4 + 3];
-    }
-    ps->uniforms[FOGVOL_U_LINEAR][0] = (float)(2.0 * n[0]);
-    ps->uniforms[FOGVOL_U_LINEAR][1] = (float)(2.0 * sy * n[1]);
-    ps->uniforms[FOGVOL_U_LINEAR][2] = (float)(a * n[2]);
-    ps->uniforms[FOGVOL_U_LINEAR][3] = (float)(n[3] - n[0] - sy * n[1] + b * n[2]);
-    ps->uniforms[FOGVOL_U_LINEAR_W][0] = (float)(2.0 * dn[0]);
-    ps->uniforms[FOGVOL_U_LINEAR_W][1] = (float)(2.0 * sy * dn[1]);
-    ps->uniforms[FOGVOL_U_LINEAR_W][2] = (float)(a * dn[2]);
-    ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
-}
-
-FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occluder_info *info)
-{
-    fogvol_constants k;
-    fogvol_result r;
-    int fl;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    memset(info, 0, sizeof *info);
-    fl = ctx->tier == FOGVOL_TIER_FLOAT;
-    if (!ctx->in_frame || ctx->nocc > 0 || !ctx->be.native_texture) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
-                                                 "fogvol_add_occluder* calls and a backend with native_texture");
-        return FOGVOL_ERROR_INVALID_STATE;
-    }
-    if (ctx->frame.downsample == 2) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need full-resolution sums "
-                                                 "(fogvol_frame_desc.downsample 0 or 1)");
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
-        fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need tier PS20 or FLOAT without the "
-                                                 "COUNT, WIDE and ENGINE_DEPTH variants (tier %s, variants 0x%x)%s",
-                    fogvol_tier_name(ctx->tier), ctx->variants,
-                    ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    r = fogvol__prepare_o(ctx, &k, &info->texture);
-    if (r != FOGVOL_SUCCESS) return r;
-    fl = fl || ctx->float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
-    info->width = ctx->target_w;
-    info->height = ctx->target_h;
-    info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-    if (fl) info->clear_color[0] = 1.0f;
-    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
-    info->uniforms[0] = k.near_far[0];
-    info->uniforms[1] = k.near_far[1];
-    info->uniforms[2] = fl ? 0.0f : (float)ctx->enc.levels;
-    info->uniforms[3] = fl ? 0.0f : (float)ctx->enc.levels * (float)ctx->enc.levels;
-    info->uniforms[4] = fl ? 0.0f : k.depth_offset;
-    info->uniforms[5] = fl ? 1.0f : k.depth_max;
-    info->uniforms[6] = (float)ctx->enc.dither_steps;
-    info->uniforms[7] = ctx->dither && !fl ? 1.0f : 0.0f;
-    ctx->engine_occluders = 1;
-    return FOGVOL_SUCCESS;
-}
-
-/* The view depths of the 8 corners of volume v's bounds: their least and greatest. */
-static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volume *v, double *emin, double *emax)
-{
-    int c, j;
-    for (c = 0; c < 8; ++c) {
-        double p[3], e = ctx->eyerow[3];
-        p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
-        p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
-        p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
-        for (j = 0; j < 3; ++j)
-            e += ctx->eyerow[j] *
-                 (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
-        if (c == 0 || e < *emin) *emin = e;
-        if (c == 0 || e > *emax) *emax = e;
-    }
-}
-
-/* COUNT adds the opaque depth once per back face without its front face, so it
-   needs every front face in front of the near plane: a volume that the near
-   plane may cut (the camera inside it or within znear of it) breaks the count.
-   Decided conservatively from the view depths of the corners of each volume's
-   bounds: some corner nearer than znear and some in front of the eye. Returns
-   the first such volume, or -1. */
-static int fogvol__count_near_cut(const fogvol_context *ctx)
-{
-    int i;
-    for (i = 0; i < ctx->nvol; ++i) {
-        double emin = 0.0, emax = 0.0;
-        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
-        if (emin < ctx->frame.znear && emax > 0.0) return i;
-    }
-    return -1;
-}
-
-/* FOGVOL_SPEEDUP_DEPTH_TEST: this frame drawn as COUNT (see the speed-up). Beyond the near-plane
-   condition of COUNT, no volume crosses the far plane either: there the min compare drops the
-   clipped faces while the count would add the far plane for them. */
-static int fogvol__depth_test_frame(const fogvol_context *ctx)
-{
-    int i;
-    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->float_o || ctx->nocc == 0 ||
-        ctx->engine_occluders || ctx->nlight > 0 || !fogvol__count_spec_ok(ctx->tier, ctx->variants))
-        return 0;
-    for (i = 0; i < ctx->nvol; ++i) {
-        double emin = 0.0, emax = 0.0;
-        if (ctx->vols[i].density) return 0;
-        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
-        if ((emin < ctx->frame.znear && emax > 0.0) || (emin < ctx->frame.zfar && emax > ctx->frame.zfar)) return 0;
-    }
-    return 1;
-}
-
-/* >>overflow checks ======================================================= */
-
-/* One fogvol_end_frame: what its passes share. */
-typedef struct fogvol__run {
-    fogvol_frame_stats st;
-    fogvol_frame_info info;
-    fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
-    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
-    int w, h, single, count, rgba8;
-    int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
-    int captured, overflow;     /* debug read-back done; its overflow pixel count */
-    fogvol_result r;            /* the last error that did not stop the frame */
-    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
-    int xsum;                   /* FOGVOL_SPEEDUP_EXACT_SUM: the current group sums as 32-bit integers */
-    int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
-} fogvol__run;
-
-/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: no band counted (at the start, and when L changes) */
-static void fogvol__bands_forget(fogvol_context *ctx)
-{
-    int i;
-    for (i = 0; i < FOGVOL_OVERFLOW_BANDS; ++i) ctx->band_count[i] = ctx->band_frame[i] = -1;
-}
-
-/* Counting needs the five query entries and one query that can be created. */
-static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy)
-{
-    const fogvol_backend *b = &ctx->be;
-    ctx->overflow_policy = policy;
-    ctx->overflow_late = -1;
-    ctx->overflow_frame = -1;
-    ctx->qcur = -1;
-    fogvol__bands_forget(ctx);
-    if (ctx->tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
-    if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
-        b->create_query(b->user_data, &ctx->qf[0].q[0]) != FOGVOL_SUCCESS) {
-        ctx->qf[0].q[0] = 0;
-        fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
-                    "fogvol: no occlusion queries: overflow is not counted per frame (show_overflow and the "
-                    "debug read-back still see it)");
-        return;
-    }
-    ctx->counting = 1;
-}
-
-/* A frame's count arrived (sum: its check passes' samples). Whole-picture checks give the count;
-   a band's count replaces that band's older one and the count is the sum over the bands counted.
-   A band drawn before the last change of L (an older encoding) is not kept. */
-static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f, uint64_t sum)
-{
-    int k;
-    if (f->band >= 0) {
-        if (f->frame <= ctx->band_frame[f->band] || f->frame < ctx->overflow_epoch) return 0;
-        ctx->band_frame[f->band] = f->frame;
-        ctx->band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
-        for (sum = 0, k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k)
-            if (ctx->band_count[k] > 0) sum += (uint64_t)ctx->band_count[k];
-        ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum; /* even from a late older frame */
-        if (f->frame > ctx->overflow_frame) ctx->overflow_frame = f->frame;
-        return 1;
-    }
-    if (f->frame <= ctx->overflow_frame) return 0;
-    ctx->overflow_frame = f->frame;
-    ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
-    return 1;
-}
-
-/* Reads the queries of earlier frames without waiting; a frame counts when all its queries are
-   done. Returns 1 when a newer frame's count arrived. */
-static int fogvol__overflow_poll(fogvol_context *ctx)
-{
-    int i, k, fresh = 0;
-    for (i = 0; i < FOGVOL__QFRAMES; ++i) {
-        fogvol__qframe *f = &ctx->qf[i];
-        uint64_t sum = 0, v = 0;
-        if (!f->pending) continue;
-        for (k = 0; k < f->used; ++k) {
-            if (!ctx->be.query_result(ctx->be.user_data, f->q[k], &v)) break;
-            sum += v;
-        }
-        if (k < f->used) continue;
-        f->pending = 0;
-        fresh |= fogvol__overflow_arrived(ctx, f, sum);
-    }
-    return fresh;
-}
-
-/* Picks a free record for this frame's queries; 0 when every record still waits for the GPU
-   (the frame is then not counted: nothing ever waits). Checks one band of the picture with
-   FOGVOL_SPEEDUP_OVERFLOW_BANDS, unless show_overflow wants the whole mask. */
-static int fogvol__overflow_open(fogvol_context *ctx)
-{
-    int i;
-    ctx->qcur = -1;
-    if (!ctx->counting) return 0;
-    for (i = 0; i < FOGVOL__QFRAMES; ++i)
-        if (!ctx->qf[i].pending) {
-            ctx->qcur = i;
-            ctx->qf[i].used = 0;
-            ctx->qf[i].ok = 1;
-            ctx->qf[i].frame = ctx->frame_no;
-            ctx->qf[i].band = (ctx->speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->frame.show_overflow
-                                  ? -1
-                                  : (int)(ctx->frame_no % FOGVOL_OVERFLOW_BANDS);
-            return 1;
-        }
-    return 0;
-}
-
-static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
-{
-    fogvol__qframe *f;
-    fogvol_handle *q;
-    if (ctx->qcur < 0) return 0;
-    f = &ctx->qf[ctx->qcur];
-    q = &f->q[f->used < FOGVOL__QPER ? f->used : 0];
-    if (!f->ok || f->used >= FOGVOL__QPER) {
-        f->ok = 0; /* more check passes than queries: the frame is not counted */
-        return 0;
-    }
-    if (!*q && ctx->be.create_query(ctx->be.user_data, q) != FOGVOL_SUCCESS) *q = 0;
-    if (!*q || !ctx->be.begin_query(ctx->be.user_data, *q)) {
-        f->ok = 0;
-        return 0;
-    }
-    f->used++;
-    return *q;
-}
-
-/* After the frame's passes: its queries wait for the GPU; a frame without check passes drew no
-   volume (or its band holds no pixel) and counts 0 now. */
-static void fogvol__overflow_close(fogvol_context *ctx)
-{
-    fogvol__qframe *f;
-    if (ctx->qcur < 0) return;
-    f = &ctx->qf[ctx->qcur];
-    ctx->qcur = -1;
-    if (!f->ok) return;
-    if (f->used > 0) f->pending = 1;
-    else fogvol__overflow_arrived(ctx, f, 0);
-}
-
-/* The program and the mask target of the check passes, made on first use. */
-static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
-{
-    fogvol_target_desc td;
-    fogvol_result r = FOGVOL_SUCCESS;
-    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, 0, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
-    if (r == FOGVOL_SUCCESS && !ctx->tgt_v) {
-        memset(&td, 0, sizeof td);
-        td.width = ctx->target_w;
-        td.height = ctx->target_h;
-        td.depth = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-        td.label = "fogvol V (overflow mask)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_v);
-        if (r != FOGVOL_SUCCESS) ctx->tgt_v = 0;
-    }
-    if (r != FOGVOL_SUCCESS)
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create the overflow check pass: %s",
-                    fogvol_result_string(r));
-    return r;
-}
-
-/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: scissor (target space, w = 0: the whole w x h target) narrowed
-   to rows [h b / B, h (b + 1) / B) of its rectangle, B = FOGVOL_OVERFLOW_BANDS; band -1: unchanged.
-   Returns 0 when the band holds no row. */
-static int fogvol__band_scissor(const fogvol__run *run, int band, int scissor[4])
-{
-    int y0, y1;
-    if (band < 0) return 1;
-    if (scissor[2] <= 0 || scissor[3] <= 0) {
-        scissor[0] = scissor[1] = 0;
-        scissor[2] = run->w;
-        scissor[3] = run->h;
-    }
-    y0 = (int)((int64_t)scissor[3] * band / FOGVOL_OVERFLOW_BANDS);
-    y1 = (int)((int64_t)scissor[3] * (band + 1) / FOGVOL_OVERFLOW_BANDS);
-    scissor[1] += y0;
-    scissor[3] = y1 - y0;
-    return y1 > y0 && scissor[2] > 0;
-}
-
-/* One check pass into the mask V: pixels with a saturated sum are written (and counted by a query),
-   the rest discarded. base: the pass state of the composite (target space). SINGLE runs it after the
-   additions (first: clears V and its depth) and after the subtractions, whose depth test skips the
-   pixels already marked, so each pixel counts once. */
-static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base, int first,
-                               fogvol_frame_stats *st)
-{
-    fogvol_pass cp = *base;
-    fogvol_handle q;
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    if (ctx->qcur >= 0 && !fogvol__band_scissor(run, ctx->qf[ctx->qcur].band, cp.scissor)) return;
-    cp.target = ctx->tgt_v;
-    cp.read_target = 0; /* (SINGLE_TARGET: the state of the sum passes) */
-    cp.clear = first;
-    memset(cp.clear_color, 0, sizeof cp.clear_color);
-    cp.blend = FOGVOL_PASS_BLEND_NONE;
-    cp.cull = FOGVOL_CULL_NONE;
-    cp.depth_test = cp.depth_write = single;
-    cp.stencil_guard = 0;
-    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, fogvol__origin_bit(ctx));
-    memset(cp.native_textures, 0, sizeof cp.native_textures);
-    if (single) { /* the one sum target; V is the target here, not a texture */
-        memset(cp.textures, 0, sizeof cp.textures);
-        cp.textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
-    }
-    ctx->be.begin_pass(ctx->be.user_data, &cp);
-    q = fogvol__query_begin(ctx);
-    ctx->be.draw_fullscreen(ctx->be.user_data);
-    if (q) ctx->be.end_query(ctx->be.user_data, q);
-    fogvol__end_pass(ctx);
-    st->overflow_passes++;
-}
-
-/* FOGVOL_OVERFLOW_LOWER_BITS: L - 1 and the lookup textures that depend on it (programs and
-   targets do not). Outside a frame; on failure the old encoding stays. */
-static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
-{
-    fogvol_encoding old = ctx->enc;
-    fogvol_handle t[3] = {0, 0, 0}, *cur[3];
-    fogvol_result r = FOGVOL_SUCCESS;
-    int i;
-    cur[0] = &ctx->tex_rg;
-    cur[1] = &ctx->tex_blue;
-    cur[2] = &ctx->tex_dither;
-    fogvol_encoding_init(old.bits - 1, &ctx->enc);
-    for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
-        if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
-    if (r != FOGVOL_SUCCESS) {
-        for (i = 0; i < 3; ++i)
-            if (t[i]) ctx->be.destroy_texture(ctx->be.user_data, t[i]);
-        ctx->enc = old;
-        return r;
-    }
-    for (i = 0; i < 3; ++i)
-        if (*cur[i]) {
-            ctx->be.destroy_texture(ctx->be.user_data, *cur[i]);
-            *cur[i] = t[i];
-        }
-    return FOGVOL_SUCCESS;
-}
-
-/* After a frame: the overflow policy, for a count that arrived in it (frames drawn before the last
-   change of L are not acted upon). */
-static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
-{
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), from = ctx->enc.bits;
-    int faces = single ? ctx->enc.max_faces_single : ctx->enc.max_faces;
-    if (!fresh || ctx->overflow_late <= 0 || ctx->overflow_frame < ctx->overflow_epoch) return;
-    if (ctx->overflow_policy == FOGVOL_OVERFLOW_COUNT_ONLY) return;
-    if (ctx->overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
-        fogvol_result r = fogvol__lower_bits(ctx);
-        if (r == FOGVOL_SUCCESS) {
-            fogvol__bands_forget(ctx);
-            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                        "fogvol: %d pixels of frame %lld have more than %d faces along the ray: encoding_bits "
-                        "lowered from %d to %d (%d faces) from frame %lld on",
-                        ctx->overflow_late, (long long)ctx->overflow_frame, faces, from, ctx->enc.bits,
-                        single ? ctx->enc.max_faces_single : ctx->enc.max_faces, (long long)ctx->frame_no + 1);
-            ctx->overflow_epoch = ctx->frame_no + 1;
-            return;
-        }
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot lower encoding_bits: %s", fogvol_result_string(r));
-    }
-    if (ctx->overflow_warned) return;
-    ctx->overflow_warned = 1;
-    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                "fogvol: %d pixels of frame %lld have more than %d faces along the ray (%d-bit encoding): their "
-                "thickness is wrong (show_overflow marks them; logged once)",
-                ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
-}
-
-
-/* >>texlight (volume light by compare) ====================================== */
-
-FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
-{
-    fogvol__light *l;
-    void *arr;
-    fogvol_result r;
-    float k;
-    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__light_ok(ctx->tier, ctx->variants)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
-                    "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if (desc->mesh->convex != 1) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: a light volume must be a convex closed hull: %s",
-                    !desc->mesh->volume        ? "the mesh is not a valid closed hull"
-                    : desc->mesh->convex == 0 ? "the mesh is concave (a vertex lies outside a face plane)"
-                                              : "the mesh is too large for the convexity check");
-        return FOGVOL_ERROR_INVALID_MESH;
-    }
-    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    arr = ctx->lights;
-    r = fogvol__grow(ctx, &arr, &ctx->caplight, ctx->nlight + 1, sizeof *l);
-    ctx->lights = (fogvol__light *)arr;
-    if (r != FOGVOL_SUCCESS) return r;
-    l = &ctx->lights[ctx->nlight++];
-    l->mesh = desc->mesh;
-    memcpy(l->model, desc->model, sizeof l->model);
-    k = desc->intensity != 0.0f ? desc->intensity : 1.0f;
-    l->rgb[0] = desc->color[0] * k;
-    l->rgb[1] = desc->color[1] * k;
-    l->rgb[2] = desc->color[2] * k;
-    return FOGVOL_SUCCESS;
-}
-
-/* The program and the front-depth target L, made on first use. */
-static fogvol_result fogvol__light_setup(fogvol_context *ctx)
-{
-    fogvol_target_desc td;
-    fogvol_result r = FOGVOL_SUCCESS;
-    if (!ctx->prog[FOGVOL_PROGRAM_LIGHT])
-        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, 0, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
-    if (r == FOGVOL_SUCCESS && !ctx->tgt_l) {
-        memset(&td, 0, sizeof td);
-        td.width = ctx->target_w;
-        td.height = ctx->target_h;
-        td.samples = ctx->samples;
-        td.format = ctx->tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-        td.label = "fogvol L (light front depth)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_l);
-        if (r != FOGVOL_SUCCESS) ctx->tgt_l = 0;
-    }
-    if (r != FOGVOL_SUCCESS)
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
-                    fogvol_result_string(r));
-    return r;
-}
-
-/* Per light: its front faces' depth into L (cleared to 0: the near plane, for a camera inside),
-   then its back faces over the engine framebuffer, lighting the pixels whose opaque depth lies
-   between L and the back face (convex: one front and one back face per pixel). */
-static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
-{
-    const fogvol_frame_desc *fd = &ctx->frame;
-    fogvol_pass fp = run->base, bp;
-    fogvol_draw dr;
-    fogvol_result r;
-    int i;
-    if (!ctx->nlight) return;
-    if ((r = fogvol__light_setup(ctx)) != FOGVOL_SUCCESS) {
-        run->r = r;
-        return;
-    }
-    fp.program = ctx->prog[FOGVOL_PROGRAM_LIGHT];
-    fp.target = ctx->tgt_l;
-    fp.clear = 1;
-    fp.cull = FOGVOL_CULL_BACK;
-    bp = fp;
-    bp.target = 0;
-    bp.clear = 0;
-    bp.cull = FOGVOL_CULL_FRONT;
-    bp.blend = FOGVOL_PASS_BLEND_LIGHT;
-    memcpy(bp.viewport, fd->viewport, sizeof bp.viewport);
-    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
-    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
-    bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
-    bp.draw_buffer = fd->draw_buffer;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
-        bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    else
-        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
-    bp.textures[FOGVOL__UNIT_LFRONT] = ctx->tgt_l;
-    bp.uniforms[FOGVOL_U_LIGHT][3] = 1.0f;
-    for (i = 0; i < ctx->nlight; ++i) {
-        const fogvol__light *l = &ctx->lights[i];
-        fogvol__draw_for(ctx, l->model, &dr);
-        ctx->be.begin_pass(ctx->be.user_data, &fp);
-        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
-        fogvol__end_pass(ctx);
-        memcpy(bp.uniforms[FOGVOL_U_LIGHT], l->rgb, sizeof l->rgb);
-        ctx->be.begin_pass(ctx->be.user_data, &bp);
-        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
-        fogvol__end_pass(ctx);
-        run->st.passes += 2;
-        run->st.lights++;
-    }
-}
-
-/* Frames fogvol refuses before touching the backend (logged; the caller cancels the frame). */
-static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
-{
-    const fogvol_frame_desc *fd = &ctx->frame;
-    int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
-    if (ctx->tier == FOGVOL_TIER_MRT && !ctx->mrt_ready) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: MRT tier: call fogvol_mrt_prepare and let the engine "
-                                                 "write O before fogvol_end_frame");
-        return FOGVOL_ERROR_INVALID_STATE;
-    }
-    if (engine && fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_TEXTURE && !fd->engine_depth_texture) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: ENGINE_DEPTH variant without engine_depth_texture");
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
-    if (engine && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE && !ctx->be.copy_depth) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot copy a framebuffer's depth (copy_depth); "
-                                                 "pass a depth texture (engine_depth_texture)");
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if (fd->downsample == 2 && (ctx->tier != FOGVOL_TIER_FLOAT || ctx->nlight > 0 ||
-                                fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS))) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
-                    "fogvol: downsample 2 needs the FLOAT tier without ENGINE_DEPTH or COLORS and no "
-                    "fogvol_add_light (tier %s, variants 0x%x, %d lights); nothing drawn",
-                    fogvol_tier_name(ctx->tier), ctx->variants, ctx->nlight);
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) && (i = fogvol__count_near_cut(ctx)) >= 0) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
-                    "fogvol: COUNT variant: the near plane may cut volume %d (the camera is inside it or closer than "
-                    "znear), which breaks the face count; nothing drawn. Draw such views without COUNT",
-                    i);
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    return FOGVOL_SUCCESS;
-}
-
-/* Inside the backend frame, before any pass: sample count, targets, the engine's depth, and the
-   overflow count (earlier frames' queries polled without waiting; this frame's check passes). */
-static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
-{
-    const fogvol_frame_desc *fd = &ctx->frame;
-    fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
-    if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->samples > 1) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "
-                                                 "sample (use FOGVOL_MSAA_SINGLE_SAMPLE); nothing drawn",
-                    ctx->samples);
-        r = FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if (r == FOGVOL_SUCCESS) /* downsample 2: half the width and height, rounded up */
-        r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
-                                : fogvol__ensure_targets(ctx, run->w, run->h, 0);
-    if (r != FOGVOL_SUCCESS) return r;
-    run->engine_depth = fd->engine_depth_texture;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
-        r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
-                               fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
-                               &run->engine_depth);
-        if (r != FOGVOL_SUCCESS) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
-                        fogvol_result_string(r));
-            return r;
-        }
-    }
-    run->fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
-    run->counted = run->rgba8 && fogvol__overflow_open(ctx);
-    run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
-    /* SINGLE's peak check runs inside the sum passes; the others make the checks when a group first
-       draws one (fogvol__group_check) */
-    if (run->checks && run->single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
-        run->counted = run->checks = 0;
-        ctx->qcur = -1;
-        run->r = r;
-    }
-    return FOGVOL_SUCCESS;
-}
-
 /* The uniforms every pass of the frame gets, in run->base (target space, lookup textures bound). */
 static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
 {
@@ -9351,7 +8976,428 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     fogvol__end_pass(ctx);
 }
 
-/* >>one-pass colour group (FOGVOL_VARIANT_COLORS) */
+/* >>overflow ============================================================== */
+/* Overflow checks: the check passes, their occlusion queries and what a count changes. */
+
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: no band counted (at the start, and when L changes) */
+static void fogvol__bands_forget(fogvol_context *ctx)
+{
+    int i;
+    for (i = 0; i < FOGVOL_OVERFLOW_BANDS; ++i) ctx->band_count[i] = ctx->band_frame[i] = -1;
+}
+
+/* Counting needs the five query entries and one query that can be created. */
+static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy)
+{
+    const fogvol_backend *b = &ctx->be;
+    ctx->overflow_policy = policy;
+    ctx->overflow_late = -1;
+    ctx->overflow_frame = -1;
+    ctx->qcur = -1;
+    fogvol__bands_forget(ctx);
+    if (ctx->tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
+    if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
+        b->create_query(b->user_data, &ctx->qf[0].q[0]) != FOGVOL_SUCCESS) {
+        ctx->qf[0].q[0] = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                    "fogvol: no occlusion queries: overflow is not counted per frame (show_overflow and the "
+                    "debug read-back still see it)");
+        return;
+    }
+    ctx->counting = 1;
+}
+
+/* A frame's count arrived (sum: its check passes' samples). Whole-picture checks give the count;
+   a band's count replaces that band's older one and the count is the sum over the bands counted.
+   A band drawn before the last change of L (an older encoding) is not kept. */
+static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f, uint64_t sum)
+{
+    int k;
+    if (f->band >= 0) {
+        if (f->frame <= ctx->band_frame[f->band] || f->frame < ctx->overflow_epoch) return 0;
+        ctx->band_frame[f->band] = f->frame;
+        ctx->band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
+        for (sum = 0, k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k)
+            if (ctx->band_count[k] > 0) sum += (uint64_t)ctx->band_count[k];
+        ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum; /* even from a late older frame */
+        if (f->frame > ctx->overflow_frame) ctx->overflow_frame = f->frame;
+        return 1;
+    }
+    if (f->frame <= ctx->overflow_frame) return 0;
+    ctx->overflow_frame = f->frame;
+    ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
+    return 1;
+}
+
+/* Reads the queries of earlier frames without waiting; a frame counts when all its queries are
+   done. Returns 1 when a newer frame's count arrived. */
+static int fogvol__overflow_poll(fogvol_context *ctx)
+{
+    int i, k, fresh = 0;
+    for (i = 0; i < FOGVOL__QFRAMES; ++i) {
+        fogvol__qframe *f = &ctx->qf[i];
+        uint64_t sum = 0, v = 0;
+        if (!f->pending) continue;
+        for (k = 0; k < f->used; ++k) {
+            if (!ctx->be.query_result(ctx->be.user_data, f->q[k], &v)) break;
+            sum += v;
+        }
+        if (k < f->used) continue;
+        f->pending = 0;
+        fresh |= fogvol__overflow_arrived(ctx, f, sum);
+    }
+    return fresh;
+}
+
+/* Picks a free record for this frame's queries; 0 when every record still waits for the GPU
+   (the frame is then not counted: nothing ever waits). Checks one band of the picture with
+   FOGVOL_SPEEDUP_OVERFLOW_BANDS, unless show_overflow wants the whole mask. */
+static int fogvol__overflow_open(fogvol_context *ctx)
+{
+    int i;
+    ctx->qcur = -1;
+    if (!ctx->counting) return 0;
+    for (i = 0; i < FOGVOL__QFRAMES; ++i)
+        if (!ctx->qf[i].pending) {
+            ctx->qcur = i;
+            ctx->qf[i].used = 0;
+            ctx->qf[i].ok = 1;
+            ctx->qf[i].frame = ctx->frame_no;
+            ctx->qf[i].band = (ctx->speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->frame.show_overflow
+                                  ? -1
+                                  : (int)(ctx->frame_no % FOGVOL_OVERFLOW_BANDS);
+            return 1;
+        }
+    return 0;
+}
+
+static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
+{
+    fogvol__qframe *f;
+    fogvol_handle *q;
+    if (ctx->qcur < 0) return 0;
+    f = &ctx->qf[ctx->qcur];
+    q = &f->q[f->used < FOGVOL__QPER ? f->used : 0];
+    if (!f->ok || f->used >= FOGVOL__QPER) {
+        f->ok = 0; /* more check passes than queries: the frame is not counted */
+        return 0;
+    }
+    if (!*q && ctx->be.create_query(ctx->be.user_data, q) != FOGVOL_SUCCESS) *q = 0;
+    if (!*q || !ctx->be.begin_query(ctx->be.user_data, *q)) {
+        f->ok = 0;
+        return 0;
+    }
+    f->used++;
+    return *q;
+}
+
+/* After the frame's passes: its queries wait for the GPU; a frame without check passes drew no
+   volume (or its band holds no pixel) and counts 0 now. */
+static void fogvol__overflow_close(fogvol_context *ctx)
+{
+    fogvol__qframe *f;
+    if (ctx->qcur < 0) return;
+    f = &ctx->qf[ctx->qcur];
+    ctx->qcur = -1;
+    if (!f->ok) return;
+    if (f->used > 0) f->pending = 1;
+    else fogvol__overflow_arrived(ctx, f, 0);
+}
+
+/* The program and the mask target of the check passes, made on first use. */
+static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
+{
+    fogvol_target_desc td;
+    fogvol_result r = FOGVOL_SUCCESS;
+    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, 0, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
+    if (r == FOGVOL_SUCCESS && !ctx->tgt_v) {
+        memset(&td, 0, sizeof td);
+        td.width = ctx->target_w;
+        td.height = ctx->target_h;
+        td.depth = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+        td.label = "fogvol V (overflow mask)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_v);
+        if (r != FOGVOL_SUCCESS) ctx->tgt_v = 0;
+    }
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create the overflow check pass: %s",
+                    fogvol_result_string(r));
+    return r;
+}
+
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS: scissor (target space, w = 0: the whole w x h target) narrowed
+   to rows [h b / B, h (b + 1) / B) of its rectangle, B = FOGVOL_OVERFLOW_BANDS; band -1: unchanged.
+   Returns 0 when the band holds no row. */
+static int fogvol__band_scissor(const fogvol__run *run, int band, int scissor[4])
+{
+    int y0, y1;
+    if (band < 0) return 1;
+    if (scissor[2] <= 0 || scissor[3] <= 0) {
+        scissor[0] = scissor[1] = 0;
+        scissor[2] = run->w;
+        scissor[3] = run->h;
+    }
+    y0 = (int)((int64_t)scissor[3] * band / FOGVOL_OVERFLOW_BANDS);
+    y1 = (int)((int64_t)scissor[3] * (band + 1) / FOGVOL_OVERFLOW_BANDS);
+    scissor[1] += y0;
+    scissor[3] = y1 - y0;
+    return y1 > y0 && scissor[2] > 0;
+}
+
+/* One check pass into the mask V: pixels with a saturated sum are written (and counted by a query),
+   the rest discarded. base: the pass state of the composite (target space). SINGLE runs it after the
+   additions (first: clears V and its depth) and after the subtractions, whose depth test skips the
+   pixels already marked, so each pixel counts once. */
+static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base, int first,
+                               fogvol_frame_stats *st)
+{
+    fogvol_pass cp = *base;
+    fogvol_handle q;
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    if (ctx->qcur >= 0 && !fogvol__band_scissor(run, ctx->qf[ctx->qcur].band, cp.scissor)) return;
+    cp.target = ctx->tgt_v;
+    cp.read_target = 0; /* (SINGLE_TARGET: the state of the sum passes) */
+    cp.clear = first;
+    memset(cp.clear_color, 0, sizeof cp.clear_color);
+    cp.blend = FOGVOL_PASS_BLEND_NONE;
+    cp.cull = FOGVOL_CULL_NONE;
+    cp.depth_test = cp.depth_write = single;
+    cp.stencil_guard = 0;
+    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, fogvol__origin_bit(ctx));
+    memset(cp.native_textures, 0, sizeof cp.native_textures);
+    if (single) { /* the one sum target; V is the target here, not a texture */
+        memset(cp.textures, 0, sizeof cp.textures);
+        cp.textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
+    }
+    ctx->be.begin_pass(ctx->be.user_data, &cp);
+    q = fogvol__query_begin(ctx);
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    if (q) ctx->be.end_query(ctx->be.user_data, q);
+    fogvol__end_pass(ctx);
+    st->overflow_passes++;
+}
+
+/* FOGVOL_OVERFLOW_LOWER_BITS: L - 1 and the lookup textures that depend on it (programs and
+   targets do not). Outside a frame; on failure the old encoding stays. */
+static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
+{
+    fogvol_encoding old = ctx->enc;
+    fogvol_handle t[3] = {0, 0, 0}, *cur[3];
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
+    cur[0] = &ctx->tex_rg;
+    cur[1] = &ctx->tex_blue;
+    cur[2] = &ctx->tex_dither;
+    fogvol_encoding_init(old.bits - 1, &ctx->enc);
+    for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
+        if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
+    if (r != FOGVOL_SUCCESS) {
+        for (i = 0; i < 3; ++i)
+            if (t[i]) ctx->be.destroy_texture(ctx->be.user_data, t[i]);
+        ctx->enc = old;
+        return r;
+    }
+    for (i = 0; i < 3; ++i)
+        if (*cur[i]) {
+            ctx->be.destroy_texture(ctx->be.user_data, *cur[i]);
+            *cur[i] = t[i];
+        }
+    return FOGVOL_SUCCESS;
+}
+
+/* After a frame: the overflow policy, for a count that arrived in it (frames drawn before the last
+   change of L are not acted upon). */
+static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
+{
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), from = ctx->enc.bits;
+    int faces = single ? ctx->enc.max_faces_single : ctx->enc.max_faces;
+    if (!fresh || ctx->overflow_late <= 0 || ctx->overflow_frame < ctx->overflow_epoch) return;
+    if (ctx->overflow_policy == FOGVOL_OVERFLOW_COUNT_ONLY) return;
+    if (ctx->overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
+        fogvol_result r = fogvol__lower_bits(ctx);
+        if (r == FOGVOL_SUCCESS) {
+            fogvol__bands_forget(ctx);
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                        "fogvol: %d pixels of frame %lld have more than %d faces along the ray: encoding_bits "
+                        "lowered from %d to %d (%d faces) from frame %lld on",
+                        ctx->overflow_late, (long long)ctx->overflow_frame, faces, from, ctx->enc.bits,
+                        single ? ctx->enc.max_faces_single : ctx->enc.max_faces, (long long)ctx->frame_no + 1);
+            ctx->overflow_epoch = ctx->frame_no + 1;
+            return;
+        }
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot lower encoding_bits: %s", fogvol_result_string(r));
+    }
+    if (ctx->overflow_warned) return;
+    ctx->overflow_warned = 1;
+    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                "fogvol: %d pixels of frame %lld have more than %d faces along the ray (%d-bit encoding): their "
+                "thickness is wrong (show_overflow marks them; logged once)",
+                ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
+}
+
+/* FOGVOL_SPEEDUP_SKIP_CHECK: no pixel of the group's sums can saturate, so its check pass would find
+   nothing: every volume of the group is convex (at most one front and one back face on a ray; half
+   of what a target sums leaves a margin for a mesh convex only within fogvol__convexity's tolerance,
+   which a grazing ray could cross again), the faces are not folded onto the near plane
+   (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
+static int fogvol__unsaturable(const fogvol_context *ctx, int volumes, int all_convex)
+{
+    return all_convex && 2 * volumes <= ctx->enc.max_faces && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
+           !fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET);
+}
+
+/* The group's overflow check pass, its program and mask target made on first use (none while every
+   group skips it); when they cannot be made the frame is not counted. */
+static void fogvol__group_check(fogvol_context *ctx, fogvol__run *run, const fogvol_pass *ps)
+{
+    fogvol_result r = fogvol__ensure_checks(ctx);
+    if (r == FOGVOL_SUCCESS) {
+        fogvol__check_pass(ctx, run, ps, 1, &run->st);
+        return;
+    }
+    run->counted = 0; /* (no query begun this frame: any earlier check would have made them) */
+    ctx->qcur = -1;
+    run->r = r;
+}
+
+/* After the groups: close this frame's overflow queries; the debug read-back's overflow count. */
+static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol_result r = run->r;
+    if (run->counted) fogvol__overflow_close(ctx);
+    if (!run->rgba8) { /* float sums cannot saturate */
+        ctx->overflow_late = 0;
+        ctx->overflow_frame = ctx->frame_no;
+    }
+    run->st.overflow_pixels = run->overflow;
+    if (run->overflow > 0 && r == FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)",
+                    run->overflow, ctx->enc.precision_bits,
+                    run->single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
+        r = FOGVOL_ERROR_DEPTH_OVERFLOW;
+    }
+    return r;
+}
+
+/* >>lights ================================================================ */
+/* Volume lights by compare (fogvol_add_light). */
+
+FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
+{
+    fogvol__light *l;
+    void *arr;
+    fogvol_result r;
+    float k;
+    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!fogvol__light_ok(ctx->tier, ctx->variants)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
+                    "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    if (desc->mesh->convex != 1) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: a light volume must be a convex closed hull: %s",
+                    !desc->mesh->volume        ? "the mesh is not a valid closed hull"
+                    : desc->mesh->convex == 0 ? "the mesh is concave (a vertex lies outside a face plane)"
+                                              : "the mesh is too large for the convexity check");
+        return FOGVOL_ERROR_INVALID_MESH;
+    }
+    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
+        !fogvol__finite_n(&desc->intensity, 1)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    arr = ctx->lights;
+    r = fogvol__grow(ctx, &arr, &ctx->caplight, ctx->nlight + 1, sizeof *l);
+    ctx->lights = (fogvol__light *)arr;
+    if (r != FOGVOL_SUCCESS) return r;
+    l = &ctx->lights[ctx->nlight++];
+    l->mesh = desc->mesh;
+    memcpy(l->model, desc->model, sizeof l->model);
+    k = desc->intensity != 0.0f ? desc->intensity : 1.0f;
+    l->rgb[0] = desc->color[0] * k;
+    l->rgb[1] = desc->color[1] * k;
+    l->rgb[2] = desc->color[2] * k;
+    return FOGVOL_SUCCESS;
+}
+
+/* The program and the front-depth target L, made on first use. */
+static fogvol_result fogvol__light_setup(fogvol_context *ctx)
+{
+    fogvol_target_desc td;
+    fogvol_result r = FOGVOL_SUCCESS;
+    if (!ctx->prog[FOGVOL_PROGRAM_LIGHT])
+        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, 0, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
+    if (r == FOGVOL_SUCCESS && !ctx->tgt_l) {
+        memset(&td, 0, sizeof td);
+        td.width = ctx->target_w;
+        td.height = ctx->target_h;
+        td.samples = ctx->samples;
+        td.format = ctx->tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+        td.label = "fogvol L (light front depth)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_l);
+        if (r != FOGVOL_SUCCESS) ctx->tgt_l = 0;
+    }
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
+                    fogvol_result_string(r));
+    return r;
+}
+
+/* Per light: its front faces' depth into L (cleared to 0: the near plane, for a camera inside),
+   then its back faces over the engine framebuffer, lighting the pixels whose opaque depth lies
+   between L and the back face (convex: one front and one back face per pixel). */
+static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
+{
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_pass fp = run->base, bp;
+    fogvol_draw dr;
+    fogvol_result r;
+    int i;
+    if (!ctx->nlight) return;
+    if ((r = fogvol__light_setup(ctx)) != FOGVOL_SUCCESS) {
+        run->r = r;
+        return;
+    }
+    fp.program = ctx->prog[FOGVOL_PROGRAM_LIGHT];
+    fp.target = ctx->tgt_l;
+    fp.clear = 1;
+    fp.cull = FOGVOL_CULL_BACK;
+    bp = fp;
+    bp.target = 0;
+    bp.clear = 0;
+    bp.cull = FOGVOL_CULL_FRONT;
+    bp.blend = FOGVOL_PASS_BLEND_LIGHT;
+    memcpy(bp.viewport, fd->viewport, sizeof bp.viewport);
+    bp.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
+    bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
+    bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
+    bp.draw_buffer = fd->draw_buffer;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+        bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    else
+        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
+    bp.textures[FOGVOL__UNIT_LFRONT] = ctx->tgt_l;
+    bp.uniforms[FOGVOL_U_LIGHT][3] = 1.0f;
+    for (i = 0; i < ctx->nlight; ++i) {
+        const fogvol__light *l = &ctx->lights[i];
+        fogvol__draw_for(ctx, l->model, &dr);
+        ctx->be.begin_pass(ctx->be.user_data, &fp);
+        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
+        fogvol__end_pass(ctx);
+        memcpy(bp.uniforms[FOGVOL_U_LIGHT], l->rgb, sizeof l->rgb);
+        ctx->be.begin_pass(ctx->be.user_data, &bp);
+        ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
+        fogvol__end_pass(ctx);
+        run->st.passes += 2;
+        run->st.lights++;
+    }
+}
+
+/* >>colour groups ========================================================= */
+/* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
+
 static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
     return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
@@ -9450,31 +9496,67 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
 }
-/* <<one-pass colour group */
 
-/* FOGVOL_SPEEDUP_SKIP_CHECK: no pixel of the group's sums can saturate, so its check pass would find
-   nothing: every volume of the group is convex (at most one front and one back face on a ray; half
-   of what a target sums leaves a margin for a mesh convex only within fogvol__convexity's tolerance,
-   which a grazing ray could cross again), the faces are not folded onto the near plane
-   (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
-static int fogvol__unsaturable(const fogvol_context *ctx, int volumes, int all_convex)
+/* >>end frame ============================================================= */
+/* fogvol_end_frame: the frame checked and set up, each group summed and composited in turn (or
+   checked for overflow, or drawn as a colour group), the lights, the stats. */
+
+/* FOGVOL_SPEEDUP_DEPTH_TEST: this frame drawn as COUNT (see the speed-up). Beyond the near-plane
+   condition of COUNT, no volume crosses the far plane either: there the min compare drops the
+   clipped faces while the count would add the far plane for them. */
+static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
-    return all_convex && 2 * volumes <= ctx->enc.max_faces && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
-           !fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET);
+    int i;
+    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->float_o || ctx->nocc == 0 ||
+        ctx->engine_occluders || ctx->nlight > 0 || !fogvol__count_spec_ok(ctx->tier, ctx->variants))
+        return 0;
+    for (i = 0; i < ctx->nvol; ++i) {
+        double emin = 0.0, emax = 0.0;
+        if (ctx->vols[i].density) return 0;
+        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
+        if ((emin < ctx->frame.znear && emax > 0.0) || (emin < ctx->frame.zfar && emax > ctx->frame.zfar)) return 0;
+    }
+    return 1;
 }
 
-/* The group's overflow check pass, its program and mask target made on first use (none while every
-   group skips it); when they cannot be made the frame is not counted. */
-static void fogvol__group_check(fogvol_context *ctx, fogvol__run *run, const fogvol_pass *ps)
+/* Inside the backend frame, before any pass: sample count, targets, the engine's depth, and the
+   overflow count (earlier frames' queries polled without waiting; this frame's check passes). */
+static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
 {
-    fogvol_result r = fogvol__ensure_checks(ctx);
-    if (r == FOGVOL_SUCCESS) {
-        fogvol__check_pass(ctx, run, ps, 1, &run->st);
-        return;
+    const fogvol_frame_desc *fd = &ctx->frame;
+    fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
+    if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->samples > 1) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "
+                                                 "sample (use FOGVOL_MSAA_SINGLE_SAMPLE); nothing drawn",
+                    ctx->samples);
+        r = FOGVOL_ERROR_UNSUPPORTED;
     }
-    run->counted = 0; /* (no query begun this frame: any earlier check would have made them) */
-    ctx->qcur = -1;
-    run->r = r;
+    if (r == FOGVOL_SUCCESS) /* downsample 2: half the width and height, rounded up */
+        r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
+                                : fogvol__ensure_targets(ctx, run->w, run->h, 0);
+    if (r != FOGVOL_SUCCESS) return r;
+    run->engine_depth = fd->engine_depth_texture;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
+        r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
+                               fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
+                               &run->engine_depth);
+        if (r != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
+                        fogvol_result_string(r));
+            return r;
+        }
+    }
+    run->fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
+    run->counted = run->rgba8 && fogvol__overflow_open(ctx);
+    run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
+    /* SINGLE's peak check runs inside the sum passes; the others make the checks when a group first
+       draws one (fogvol__group_check) */
+    if (run->checks && run->single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
+        run->counted = run->checks = 0;
+        ctx->qcur = -1;
+        run->r = r;
+    }
+    return FOGVOL_SUCCESS;
 }
 
 /* The passes of the colour-ramp group of volume g, unless an earlier volume shares its ramp (the
@@ -9513,26 +9595,6 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     }
     if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
-}
-
-/* After the groups: close this frame's overflow queries; the debug read-back's overflow count. */
-static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *run)
-{
-    fogvol_result r = run->r;
-    if (run->counted) fogvol__overflow_close(ctx);
-    if (!run->rgba8) { /* float sums cannot saturate */
-        ctx->overflow_late = 0;
-        ctx->overflow_frame = ctx->frame_no;
-    }
-    run->st.overflow_pixels = run->overflow;
-    if (run->overflow > 0 && r == FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)",
-                    run->overflow, ctx->enc.precision_bits,
-                    run->single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
-        r = FOGVOL_ERROR_DEPTH_OVERFLOW;
-    }
-    return r;
 }
 
 /* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
@@ -9589,7 +9651,9 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     return fogvol__frame_finish(ctx, &run, r, stats);
 }
 
-/* >>image-space effects ==================================================== */
+/* >>post effects ========================================================== */
+/* Image-space effects after Baker: depth of field, outlines, distance fog. */
+
 /* Full-screen passes over the engine's depth texture: depth of field, outlines,
    distance fog. fv_view_depth(o): view depth of the pixel at offset o (whole
    pixels, clamped to the viewport), from the depth texture's window depth
