@@ -412,7 +412,6 @@ typedef struct fogvol_gl_desc {
     int version_major;        /* 0 = from the context; else treat the context as this GL version */
     int version_minor;
     int gles;                 /* with version_major: 1 = treat as OpenGL ES */
-    int stencil_bits;         /* > 0: stencil bits of the engine framebuffer (else queried) */
     int mrt_highp;            /* OpenGL ES: 1 = the engine declares the output it writes fogvol's O with
                                  highp (layout(location = 1) out highp vec4, or precision highp float):
                                  on GLES 3 with EXT_color_buffer_float the backend then reports
@@ -825,8 +824,6 @@ typedef struct fogvol_frame_desc {
                                depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
     int viewport[4];        /* x, y, width, height in the engine framebuffer */
     fogvol_composite composite;
-    unsigned stencil_bit;   /* unused: no composite touches the engine's stencil buffer (kept for
-                               source compatibility) */
     /* The engine's draw buffer the composite writes (index into its
        glDrawBuffers list; 0 = the first, the only one for most engines); the
        other draw buffers stay byte-identical. GL: an index past
@@ -1263,9 +1260,6 @@ typedef struct fogvol_pass {
     fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
     int depth_test;         /* LESS (against the target's own or shared depth buffer) */
     int depth_write;
-    int stencil_guard;      /* draw each pixel at most once using stencil_bit of the engine's
-                               stencil buffer; the bit is zero before and after the pass */
-    unsigned stencil_bit;
     int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
                                every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
     int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
@@ -1320,7 +1314,6 @@ enum {
 };
 
 typedef struct fogvol_frame_info {
-    int stencil_bits; /* stencil bits of the engine framebuffer (0 = none) */
     int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
                          GL_SAMPLE_BUFFERS is 1); 0 or 1 = single-sample */
     /* How the engine maps NDC z to window depth (read for the ENGINE_DEPTH variant; all 0 =
@@ -1398,7 +1391,6 @@ typedef struct fogvol_null_backend {
     fogvol_handle next_handle;
     int fail_create_at;     /* >0: the n-th create call fails (fault injection) */
     int create_calls;
-    int stencil_bits;       /* reported by begin_frame */
     int samples;            /* reported by begin_frame (engine framebuffer samples) */
     /* occlusion queries: with queries = 0 (the default) create_query fails, as on a GPU without them;
        with 1 every query reports query_samples, after query_not_ready polls that answer "not yet" */
@@ -6380,7 +6372,6 @@ static fogvol_result fogvol__null_begin_frame(void *u, fogvol_frame_info *info)
     fogvol_null_backend *s = (fogvol_null_backend *)u;
     s->frames_begun++;
     s->pass_count = 0;
-    info->stencil_bits = s->stencil_bits;
     info->samples = s->samples;
     return FOGVOL_SUCCESS;
 }
@@ -6510,7 +6501,6 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     if (!state || !table) return;
     memset(state, 0, sizeof *state);
     memset(table, 0, sizeof *table);
-    state->stencil_bits = 8;
     table->user_data = state;
     table->dialect = FOGVOL_GLSL_330;
     table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT;
@@ -6616,31 +6606,48 @@ typedef struct fogvol__qframe {
     int band; /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: the band checked, 0 .. FOGVOL_OVERFLOW_BANDS-1; -1: all */
 } fogvol__qframe;
 
-struct fogvol_context {
-    fogvol_allocator alloc;
-    fogvol_logger log;
-    fogvol_backend be;
-    int owns_backend;
+/* The configuration resolved at fogvol_create_context (count_broken: learned when a COUNT program
+   fails to build). */
+typedef struct fogvol__config {
     fogvol_encoding enc;
     fogvol_tier tier;
     unsigned variants;
     int dither;
+    fogvol_msaa msaa;
+    unsigned speedups_off;  /* fogvol_context_desc.disable_speedups */
+    int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
+    int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (MRT, PS20) */
+    int fetch_o;            /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O from the framebuffer */
+    int exact_sum;          /* FOGVOL_SPEEDUP_EXACT_SUM: groups may sum as 32-bit integers */
+    fogvol_overflow_policy overflow_policy;
+    int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
+} fogvol__config;
+
+/* What the context holds on the GPU: lookup textures, programs, render targets (and what O holds). */
+typedef struct fogvol__gpu {
     fogvol_handle tex_rg, tex_blue, tex_dither;
     fogvol_handle prog[FOGVOL_PROGRAM_COUNT];
+    fogvol_handle prog_alt[FOGVOL_PROGRAM_COUNT]; /* the other set (single-sample or per-sample), 0 = not built */
+    int prog_ms, compile_samples;    /* prog holds the per-sample set; samples for fogvol__make_program */
+    fogvol__spec_program spec[FOGVOL__SPEC_MAX];  /* specialised programs (FOGVOL_SPEEDUP_SPECIALIZE), first use */
+    int nspec;
+    fogvol_handle post_prog[FOGVOL__POST_PROGRAMS]; /* image-space effects, built on first use */
     fogvol_handle tgt_o, tgt_b, tgt_f, tgt_t; /* SINGLE: B is the one sum target; PS13: T resolved;
                                                  FLOAT: B is the float sum */
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
+    fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
+    fogvol_handle tgt_l; /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
     int target_w, target_h;
     int target_half;      /* the targets are for fogvol_frame_desc.downsample 2 (FLOAT: B made linear) */
     int target_filtered;  /* ... and B is filtered by the backend (else the composite reads four texels) */
-    fogvol_msaa msaa;
-    int samples, target_samples;     /* this frame's / the targets' samples per pixel (0: single-sample) */
-    int prog_ms, compile_samples;    /* prog holds the per-sample set; samples for fogvol__make_program */
-    int msaa_warned;
-    fogvol_handle prog_alt[FOGVOL_PROGRAM_COUNT]; /* the other set (single-sample or per-sample), 0 = not built */
-    fogvol__spec_program spec[FOGVOL__SPEC_MAX];  /* specialised programs (FOGVOL_SPEEDUP_SPECIALIZE), first use */
-    int nspec;
+    int target_samples;   /* the targets' samples per pixel (0: single-sample) */
+    int o_far;            /* O holds the far plane only (cleared, nothing drawn since) */
+} fogvol__gpu;
+
+/* The frame between fogvol_begin_frame and fogvol_end_frame / fogvol_cancel_frame: its desc, camera,
+   volumes, occluders and lights. */
+typedef struct fogvol__frame_state {
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -6650,30 +6657,36 @@ struct fogvol_context {
     double wscale;     /* perspective: clip w = wscale * e; 0 for orthographic */
     double wconst;     /* orthographic: clip w (constant > 0) */
     int mirrored;      /* the projection mirrors the screen: front faces come out clockwise */
+    int samples;       /* this frame's samples per pixel (0: single-sample) */
     fogvol__volume *vols;
     int nvol, capvol;
     fogvol__occluder *occ;
     int nocc, capocc;
-    int live_meshes, live_ramps;
-    fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
-    fogvol_overflow_policy overflow_policy;
+    fogvol__light *lights;  /* fogvol_add_light, this frame */
+    int nlight, caplight;
+    int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
+    unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
+} fogvol__frame_state;
+
+/* Overflow counting across frames: the queries in flight, the last count, the bands. */
+typedef struct fogvol__overflow_state {
     int counting, overflow_late, overflow_warned, qcur;
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
-    fogvol_handle post_prog[FOGVOL__POST_PROGRAMS]; /* image-space effects, built on first use */
-    fogvol__light *lights;  /* fogvol_add_light, this frame */
-    int nlight, caplight;
-    fogvol_handle tgt_l;    /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
-    unsigned speedups_off;  /* fogvol_context_desc.disable_speedups */
-    int o_far;              /* O holds the far plane only (cleared, nothing drawn since) */
-    int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
-    unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
-    int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
-    int inline_resolve;     /* FOGVOL_SPEEDUP_INLINE_RESOLVE: no RESOLVE pass, no T */
-    int float_o;            /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (MRT, PS20) */
-    int fetch_o;            /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O from the framebuffer */
-    int exact_sum;          /* FOGVOL_SPEEDUP_EXACT_SUM: groups may sum as 32-bit integers */
+} fogvol__overflow_state;
+
+struct fogvol_context {
+    fogvol_allocator alloc;
+    fogvol_logger log;
+    fogvol_backend be;
+    int owns_backend;
+    int live_meshes, live_ramps;
+    int msaa_warned;
+    fogvol__config cfg;       /* resolved configuration */
+    fogvol__gpu gpu;          /* GPU resources */
+    fogvol__frame_state cur;  /* the frame being built */
+    fogvol__overflow_state ovf; /* overflow counters */
 };
 
 /* One fogvol_end_frame: what its passes share. */
@@ -6770,89 +6783,89 @@ static int fogvol__inv4(const double *m, double *out)
 static void fogvol__destroy_targets(fogvol_context *ctx)
 {
     /* targets that share O's depth go first */
-    if (ctx->tgt_b) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_b);
-    if (ctx->tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_f);
-    if (ctx->tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_t);
-    if (ctx->tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_v);
-    if (ctx->tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_l);
-    if (ctx->tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_c);
-    ctx->tgt_v = ctx->tgt_l = ctx->tgt_c = ctx->tgt_c2 = 0;
-    if (ctx->tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->tgt_o);
-    ctx->tgt_o = ctx->tgt_b = ctx->tgt_f = ctx->tgt_t = 0;
-    ctx->tgt_o2 = ctx->tgt_b2 = ctx->tgt_f2 = 0;
-    ctx->target_w = ctx->target_h = 0;
-    ctx->o_far = 0;
+    if (ctx->gpu.tgt_b) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_b);
+    if (ctx->gpu.tgt_f) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_f);
+    if (ctx->gpu.tgt_t) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_t);
+    if (ctx->gpu.tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_v);
+    if (ctx->gpu.tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_l);
+    if (ctx->gpu.tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_c);
+    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = 0;
+    if (ctx->gpu.tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_o);
+    ctx->gpu.tgt_o = ctx->gpu.tgt_b = ctx->gpu.tgt_f = ctx->gpu.tgt_t = 0;
+    ctx->gpu.tgt_o2 = ctx->gpu.tgt_b2 = ctx->gpu.tgt_f2 = 0;
+    ctx->gpu.target_w = ctx->gpu.target_h = 0;
+    ctx->gpu.o_far = 0;
 }
 
-static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->variants & variant) != 0; }
+static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
 
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
     fogvol_result r;
-    if (ctx->tgt_b && ctx->target_w == w && ctx->target_h == h && ctx->target_samples == ctx->samples &&
-        ctx->target_half == half) /* (B: every tier has it; FLOAT + ENGINE_DEPTH has no O) */
+    if (ctx->gpu.tgt_b && ctx->gpu.target_w == w && ctx->gpu.target_h == h && ctx->gpu.target_samples == ctx->cur.samples &&
+        ctx->gpu.target_half == half) /* (B: every tier has it; FLOAT + ENGINE_DEPTH has no O) */
         return FOGVOL_SUCCESS;
     fogvol__destroy_targets(ctx);
-    ctx->target_half = half;
-    ctx->target_filtered = 0;
+    ctx->gpu.target_half = half;
+    ctx->gpu.target_filtered = 0;
     memset(&td, 0, sizeof td);
     td.width = w;
     td.height = h;
-    td.samples = ctx->samples;
+    td.samples = ctx->cur.samples;
     r = FOGVOL_SUCCESS;
-    if (ctx->tier == FOGVOL_TIER_FLOAT) {
+    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) {
         td.format = FOGVOL_FORMAT_R32F;
         if (!fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) {
             td.depth = 1;
             td.label = "fogvol O (opaque depth, float)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
         }
         td.depth = 0;
         td.label = "fogvol signed depth sum (float)";
         td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
-        ctx->target_filtered = r == FOGVOL_SUCCESS && td.linear;
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+        ctx->gpu.target_filtered = r == FOGVOL_SUCCESS && td.linear;
         if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
             fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
                                                     "the composite reads four texels instead");
             td.linear = 0;
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
         }
         td.linear = 0;
         if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_COLORS)) {
             td.format = FOGVOL_FORMAT_RGBA32F;
             td.color_count = 2;
             td.label = "fogvol optical depth + emission sums (float, two attachments)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_c);
-            if (r == FOGVOL_SUCCESS && !(ctx->tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_c, 1)))
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
+            if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
                 r = FOGVOL_ERROR_BACKEND;
         }
     } else {
-        td.depth = ctx->tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
+        td.depth = ctx->cfg.tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
         td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
-        td.label = ctx->float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
-        td.format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_o);
+        td.label = ctx->cfg.float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
+        td.format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
         td.format = FOGVOL_FORMAT_RGBA8;
         td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->tier, ctx->variants))
-            td.share_depth = ctx->tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+            td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
         td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_b);
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
         td.label = "fogvol F (front faces)";
         if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_f);
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_f);
         td.share_depth = 0;
         td.color_count = 1;
         td.label = "fogvol T (resolved thickness)";
-        if (r == FOGVOL_SUCCESS && ctx->tier == FOGVOL_TIER_PS13 && !ctx->inline_resolve)
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_t);
+        if (r == FOGVOL_SUCCESS && ctx->cfg.tier == FOGVOL_TIER_PS13 && !ctx->cfg.inline_resolve)
+            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_t);
         if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
-            ctx->tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_o, 1);
-            ctx->tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_b, 1);
-            ctx->tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->tgt_f, 1);
-            if (!ctx->tgt_o2 || !ctx->tgt_b2 || !ctx->tgt_f2) r = FOGVOL_ERROR_BACKEND;
+            ctx->gpu.tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_o, 1);
+            ctx->gpu.tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_b, 1);
+            ctx->gpu.tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_f, 1);
+            if (!ctx->gpu.tgt_o2 || !ctx->gpu.tgt_b2 || !ctx->gpu.tgt_f2) r = FOGVOL_ERROR_BACKEND;
         }
     }
     if (r != FOGVOL_SUCCESS) {
@@ -6861,9 +6874,9 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         fogvol__destroy_targets(ctx);
         return r;
     }
-    ctx->target_w = w;
-    ctx->target_h = h;
-    ctx->target_samples = ctx->samples;
+    ctx->gpu.target_w = w;
+    ctx->gpu.target_h = h;
+    ctx->gpu.target_samples = ctx->cur.samples;
     return FOGVOL_SUCCESS;
 }
 
@@ -6872,7 +6885,7 @@ static void fogvol__query_free(fogvol_context *ctx)
     int i, k;
     for (i = 0; i < FOGVOL__QFRAMES; ++i)
         for (k = 0; k < FOGVOL__QPER; ++k)
-            if (ctx->qf[i].q[k]) ctx->be.destroy_query(ctx->be.user_data, ctx->qf[i].q[k]);
+            if (ctx->ovf.qf[i].q[k]) ctx->be.destroy_query(ctx->be.user_data, ctx->ovf.qf[i].q[k]);
 }
 
 static void fogvol__release(fogvol_context *ctx)
@@ -6881,19 +6894,19 @@ static void fogvol__release(fogvol_context *ctx)
     fogvol__query_free(ctx);
     fogvol__destroy_targets(ctx);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
-        if (ctx->prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog[i]);
+        if (ctx->gpu.prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->gpu.prog[i]);
     for (i = 0; i < FOGVOL_PROGRAM_COUNT; ++i)
-        if (ctx->prog_alt[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->prog_alt[i]);
-    for (i = 0; i < ctx->nspec; ++i)
-        if (ctx->spec[i].handle) ctx->be.destroy_program(ctx->be.user_data, ctx->spec[i].handle);
+        if (ctx->gpu.prog_alt[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->gpu.prog_alt[i]);
+    for (i = 0; i < ctx->gpu.nspec; ++i)
+        if (ctx->gpu.spec[i].handle) ctx->be.destroy_program(ctx->be.user_data, ctx->gpu.spec[i].handle);
     for (i = 0; i < FOGVOL__POST_PROGRAMS; ++i)
-        if (ctx->post_prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->post_prog[i]);
-    if (ctx->tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_rg);
-    if (ctx->tex_blue) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_blue);
-    if (ctx->tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->tex_dither);
-    fogvol__free(&ctx->alloc, ctx->vols);
-    fogvol__free(&ctx->alloc, ctx->occ);
-    fogvol__free(&ctx->alloc, ctx->lights);
+        if (ctx->gpu.post_prog[i]) ctx->be.destroy_program(ctx->be.user_data, ctx->gpu.post_prog[i]);
+    if (ctx->gpu.tex_rg) ctx->be.destroy_texture(ctx->be.user_data, ctx->gpu.tex_rg);
+    if (ctx->gpu.tex_blue) ctx->be.destroy_texture(ctx->be.user_data, ctx->gpu.tex_blue);
+    if (ctx->gpu.tex_dither) ctx->be.destroy_texture(ctx->be.user_data, ctx->gpu.tex_dither);
+    fogvol__free(&ctx->alloc, ctx->cur.vols);
+    fogvol__free(&ctx->alloc, ctx->cur.occ);
+    fogvol__free(&ctx->alloc, ctx->cur.lights);
     if (ctx->owns_backend && ctx->be.destroy) ctx->be.destroy(ctx->be.user_data);
 }
 
@@ -6904,15 +6917,15 @@ static fogvol_result fogvol__make_texture(fogvol_context *ctx, int which, fogvol
     unsigned char *px;
     fogvol_result r;
     const char *const labels[3] = {"fogvol red+green ramp", "fogvol blue dither ramp", "fogvol dither index"};
-    r = which == 0 ? fogvol_make_rg_ramp(&ctx->enc, NULL, 0, &info)
-                   : which == 1 ? fogvol_make_blue_ramp(&ctx->enc, NULL, 0, &info)
-                                : fogvol_make_dither_index(&ctx->enc, NULL, 0, &info);
+    r = which == 0 ? fogvol_make_rg_ramp(&ctx->cfg.enc, NULL, 0, &info)
+                   : which == 1 ? fogvol_make_blue_ramp(&ctx->cfg.enc, NULL, 0, &info)
+                                : fogvol_make_dither_index(&ctx->cfg.enc, NULL, 0, &info);
     if (r != FOGVOL_SUCCESS) return r;
     px = (unsigned char *)fogvol__alloc(&ctx->alloc, info.size);
     if (!px) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    r = which == 0 ? fogvol_make_rg_ramp(&ctx->enc, px, info.size, &info)
-                   : which == 1 ? fogvol_make_blue_ramp(&ctx->enc, px, info.size, &info)
-                                : fogvol_make_dither_index(&ctx->enc, px, info.size, &info);
+    r = which == 0 ? fogvol_make_rg_ramp(&ctx->cfg.enc, px, info.size, &info)
+                   : which == 1 ? fogvol_make_blue_ramp(&ctx->cfg.enc, px, info.size, &info)
+                                : fogvol_make_dither_index(&ctx->cfg.enc, px, info.size, &info);
     if (r == FOGVOL_SUCCESS) {
         memset(&td, 0, sizeof td);
         td.width = info.width;
@@ -6953,7 +6966,7 @@ enum {
 /* fogvol_tier_uses_program for this context: no RESOLVE with FOGVOL_SPEEDUP_INLINE_RESOLVE */
 static int fogvol__uses_program(const fogvol_context *ctx, fogvol_program p)
 {
-    return fogvol_tier_uses_program(ctx->tier, ctx->variants, p) && !(p == FOGVOL_PROGRAM_RESOLVE && ctx->inline_resolve);
+    return fogvol_tier_uses_program(ctx->cfg.tier, ctx->cfg.variants, p) && !(p == FOGVOL_PROGRAM_RESOLVE && ctx->cfg.inline_resolve);
 }
 
 static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p, unsigned specialize,
@@ -6972,22 +6985,22 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     fogvol_result r;
     int i;
     memset(&pd, 0, sizeof pd);
-    sd.tier = ctx->tier;
-    sd.variants = ctx->variants;
+    sd.tier = ctx->cfg.tier;
+    sd.variants = ctx->cfg.variants;
     sd.program = p;
     sd.dialect = ctx->be.dialect;
-    sd.samples = ctx->compile_samples;
+    sd.samples = ctx->gpu.compile_samples;
     sd.specialize = specialize;
-    if (ctx->inline_resolve && (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
+    if (ctx->cfg.inline_resolve && (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
                                 p == FOGVOL_PROGRAM_CHECK))
         sd.specialize |= FOGVOL_SPECIALIZE_INLINE_RESOLVE; /* the general programs too: there is no T */
-    if (ctx->float_o && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT || p == FOGVOL_PROGRAM_ENCODE))
+    if (ctx->cfg.float_o && (p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT || p == FOGVOL_PROGRAM_ENCODE))
         sd.specialize |= FOGVOL_SPECIALIZE_FLOAT_O; /* the general programs too: O is R32F */
     sd.stage = FOGVOL_STAGE_VERTEX;
     r = fogvol_shader_strings(&sd, pd.vs, &pd.vs_count);
     sd.stage = FOGVOL_STAGE_FRAGMENT;
     if (r == FOGVOL_SUCCESS) r = fogvol_shader_strings(&sd, pd.fs, &pd.fs_count);
-    if (r == FOGVOL_SUCCESS && (ctx->speedups_off & FOGVOL_SPEEDUP_TEXEL_FETCH) &&
+    if (r == FOGVOL_SUCCESS && (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_TEXEL_FETCH) &&
         pd.fs_count < FOGVOL_MAX_SHADER_STRINGS) { /* after the #version line: filtered target reads */
         memmove(pd.fs + 2, pd.fs + 1, (size_t)(pd.fs_count - 1) * sizeof pd.fs[0]);
         pd.fs[1] = "#define FV_NO_FETCH\n";
@@ -6995,7 +7008,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     }
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s shader for tier %s, variants 0x%x, GLSL %s",
-                    labels[p], fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect));
+                    labels[p], fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect));
         return r;
     }
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i)
@@ -7019,38 +7032,38 @@ static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_conte
     fogvol_tier t = desc->tier;
     if (t == FOGVOL_TIER_AUTO) {
         if ((caps & FOGVOL_CAP_FLOAT_BLEND) &&
-            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->variants, ctx->be.dialect) == FOGVOL_SUCCESS)
+            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
             t = FOGVOL_TIER_FLOAT;
         else if (desc->engine_mrt && (caps & FOGVOL_CAP_MRT) &&
-                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->variants, ctx->be.dialect) == FOGVOL_SUCCESS)
+                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
             t = FOGVOL_TIER_MRT;
         else if (caps & FOGVOL_CAP_HIGHP_FRAGMENT)
             t = FOGVOL_TIER_PS20;
         else
             t = FOGVOL_TIER_PS13;
     }
-    if (fogvol_combination_supported(t, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
+    if (fogvol_combination_supported(t, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: tier %s with variants 0x%x does not exist in GLSL %s",
-                    fogvol_tier_name(t), ctx->variants, fogvol_dialect_name(ctx->be.dialect));
+                    fogvol_tier_name(t), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect));
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
         (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
-        ((ctx->variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+        ((ctx->cfg.variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
          (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
-        ((ctx->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
+        ((ctx->cfg.variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
                     fogvol_tier_name(t), caps);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    ctx->tier = t;
+    ctx->cfg.tier = t;
     return FOGVOL_SUCCESS;
 }
 
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants)
 {
-    if (variants) *variants = ctx ? ctx->variants : 0;
-    return ctx ? ctx->tier : FOGVOL_TIER_AUTO;
+    if (variants) *variants = ctx ? ctx->cfg.variants : 0;
+    return ctx ? ctx->cfg.tier : FOGVOL_TIER_AUTO;
 }
 
 /* encoding_bits: 0 = the default (FOGVOL_DEFAULT_BITS; WIDE: FOGVOL_WIDE_EXACT_BITS, the most precise
@@ -7136,29 +7149,29 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
 {
     fogvol_result r = FOGVOL_SUCCESS;
     int i;
-    if (ctx->tier != FOGVOL_TIER_FLOAT) {
+    if (ctx->cfg.tier != FOGVOL_TIER_FLOAT) {
         if (!fogvol__has(ctx, FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_WIDE)) {
-            r = fogvol__make_texture(ctx, 0, &ctx->tex_rg);
-            if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->tex_blue);
+            r = fogvol__make_texture(ctx, 0, &ctx->gpu.tex_rg);
+            if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 1, &ctx->gpu.tex_blue);
         }
-        if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->tex_dither);
+        if (r == FOGVOL_SUCCESS) r = fogvol__make_texture(ctx, 2, &ctx->gpu.tex_dither);
     }
     /* COMPOSITE_MESH: for engines only (the geometry composite is scissored); CHECK: made when a
        frame first runs a check pass; LIGHT: when a frame first draws a light */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
         if (fogvol__uses_program(ctx, (fogvol_program)i) && i != FOGVOL_PROGRAM_COMPOSITE_MESH &&
             i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT) {
-            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
-            if (r != FOGVOL_SUCCESS && ctx->float_o) { /* the programs made so far again, for an RGBA8 O */
+            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->gpu.prog[i]);
+            if (r != FOGVOL_SUCCESS && ctx->cfg.float_o) { /* the programs made so far again, for an RGBA8 O */
                 int j;
                 fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: a program for an R32F O did not build (%s); "
                                                            "O stays RGBA8 (FOGVOL_SPEEDUP_FLOAT_O off)",
                             fogvol_result_string(r));
-                ctx->float_o = 0; /* (no target exists yet, and no specialised program) */
+                ctx->cfg.float_o = 0; /* (no target exists yet, and no specialised program) */
                 for (j = 0; j < i; ++j)
-                    if (ctx->prog[j]) {
-                        ctx->be.destroy_program(ctx->be.user_data, ctx->prog[j]);
-                        ctx->prog[j] = 0;
+                    if (ctx->gpu.prog[j]) {
+                        ctx->be.destroy_program(ctx->be.user_data, ctx->gpu.prog[j]);
+                        ctx->gpu.prog[j] = 0;
                     }
                 r = FOGVOL_SUCCESS;
                 i = -1;
@@ -7170,17 +7183,17 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
 /* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13 resolves B - F in its composite where fragment shaders have fp32. */
 static void fogvol__default_inline_resolve(fogvol_context *ctx)
 {
-    ctx->inline_resolve = ctx->tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-                          !(ctx->speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
+    ctx->cfg.inline_resolve = ctx->cfg.tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
+                          !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
 }
 
 /* FOGVOL_SPEEDUP_EXACT_SUM: what it needs besides the R32F O */
 static int fogvol__exact_sum_can(const fogvol_context *ctx)
 {
     return (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-           !(ctx->speedups_off &
+           !(ctx->cfg.speedups_off &
              (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-           fogvol__exact_sum_ok(ctx->tier, ctx->variants);
+           fogvol__exact_sum_ok(ctx->cfg.tier, ctx->cfg.variants);
 }
 
 /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
@@ -7189,22 +7202,22 @@ static int fogvol__exact_sum_can(const fogvol_context *ctx)
    (fogvol__float_o_ok). */
 static void fogvol__default_float_o(fogvol_context *ctx)
 {
-    ctx->float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
-                   fogvol__float_o_ok(ctx->tier, ctx->variants) &&
-                   (ctx->tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
-                   (ctx->tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
+    ctx->cfg.float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
+                   fogvol__float_o_ok(ctx->cfg.tier, ctx->cfg.variants) &&
+                   (ctx->cfg.tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
+                   (ctx->cfg.tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
 }
 
 /* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
    no lookup texture reads) unless the variant set or dialect cannot take it. */
 static void fogvol__default_alu(fogvol_context *ctx)
 {
-    unsigned v = ctx->variants | FOGVOL_VARIANT_ALU;
-    if ((ctx->tier == FOGVOL_TIER_PS20 || ctx->tier == FOGVOL_TIER_MRT || ctx->tier == FOGVOL_TIER_PS13) &&
-        !(ctx->speedups_off & FOGVOL_SPEEDUP_ALU) &&
+    unsigned v = ctx->cfg.variants | FOGVOL_VARIANT_ALU;
+    if ((ctx->cfg.tier == FOGVOL_TIER_PS20 || ctx->cfg.tier == FOGVOL_TIER_MRT || ctx->cfg.tier == FOGVOL_TIER_PS13) &&
+        !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_ALU) &&
         !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
-        fogvol_combination_supported(ctx->tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
-        ctx->variants = v;
+        fogvol_combination_supported(ctx->cfg.tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
+        ctx->cfg.variants = v;
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -7225,11 +7238,11 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     memset(ctx, 0, sizeof *ctx);
     ctx->alloc = desc->allocator;
     ctx->log = desc->logger;
-    ctx->dither = !desc->disable_dither;
-    ctx->speedups_off = desc->disable_speedups;
-    ctx->variants = desc->variants;
-    ctx->msaa = desc->msaa;
-    fogvol_encoding_init(bits, &ctx->enc);
+    ctx->cfg.dither = !desc->disable_dither;
+    ctx->cfg.speedups_off = desc->disable_speedups;
+    ctx->cfg.variants = desc->variants;
+    ctx->cfg.msaa = desc->msaa;
+    fogvol_encoding_init(bits, &ctx->cfg.enc);
     r = fogvol__attach_backend(ctx, desc);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&desc->allocator, ctx);
@@ -7240,10 +7253,10 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         fogvol__default_alu(ctx);
         fogvol__default_inline_resolve(ctx);
         fogvol__default_float_o(ctx);
-        ctx->fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
-                       !(ctx->speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-                       fogvol__fetch_o_ok(ctx->tier, ctx->variants);
-        ctx->exact_sum = ctx->float_o && fogvol__exact_sum_can(ctx);
+        ctx->cfg.fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
+                       !(ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
+                       fogvol__fetch_o_ok(ctx->cfg.tier, ctx->cfg.variants);
+        ctx->cfg.exact_sum = ctx->cfg.float_o && fogvol__exact_sum_can(ctx);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
@@ -7255,9 +7268,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     }
     fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
                 "fogvol: tier %s, variants 0x%x, %d-bit encoding (%d faces), GLSL %s, dither %s",
-                fogvol_tier_name(ctx->tier), ctx->variants, ctx->enc.precision_bits,
-                fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? ctx->enc.max_faces_single : ctx->enc.max_faces,
-                fogvol_dialect_name(ctx->be.dialect), ctx->dither ? "on" : "off");
+                fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants, ctx->cfg.enc.precision_bits,
+                fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces,
+                fogvol_dialect_name(ctx->be.dialect), ctx->cfg.dither ? "on" : "off");
     *out = ctx;
     return FOGVOL_SUCCESS;
 }
@@ -7277,33 +7290,33 @@ FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx)
 
 FOGVOL_API const fogvol_encoding *fogvol_context_encoding(const fogvol_context *ctx)
 {
-    return ctx ? &ctx->enc : NULL;
+    return ctx ? &ctx->cfg.enc : NULL;
 }
 
 FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    ctx->dither = enabled != 0;
+    ctx->cfg.dither = enabled != 0;
     return FOGVOL_SUCCESS;
 }
 
-/* Make ctx->prog the per-sample set (ms = 1) or the single-sample set, building
+/* Make ctx->gpu.prog the per-sample set (ms = 1) or the single-sample set, building
    the per-sample programs on first use. */
 static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
 {
     fogvol_handle t[FOGVOL_PROGRAM_COUNT];
     fogvol_result r = FOGVOL_SUCCESS;
     int i;
-    if (ms == ctx->prog_ms) return FOGVOL_SUCCESS;
-    memcpy(t, ctx->prog, sizeof t);
-    memcpy(ctx->prog, ctx->prog_alt, sizeof t);
-    memcpy(ctx->prog_alt, t, sizeof t);
-    ctx->prog_ms = ms;
-    ctx->compile_samples = ms ? 2 : 0;
+    if (ms == ctx->gpu.prog_ms) return FOGVOL_SUCCESS;
+    memcpy(t, ctx->gpu.prog, sizeof t);
+    memcpy(ctx->gpu.prog, ctx->gpu.prog_alt, sizeof t);
+    memcpy(ctx->gpu.prog_alt, t, sizeof t);
+    ctx->gpu.prog_ms = ms;
+    ctx->gpu.compile_samples = ms ? 2 : 0;
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (!ctx->prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
-            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->prog[i]);
-    ctx->compile_samples = 0;
+        if (!ctx->gpu.prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
+            r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->gpu.prog[i]);
+    ctx->gpu.compile_samples = 0;
     return r;
 }
 
@@ -7320,26 +7333,26 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR;
     fogvol__spec_program *sp;
     int i;
-    if (ctx->speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
+    if (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
         bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
                 FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
-    else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->tier != FOGVOL_TIER_FLOAT)
-        bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->enc.bits); /* the context's encoding compiled in */
-    if (!bits) return ctx->prog[p];
-    for (i = 0; i < ctx->nspec; ++i) {
-        sp = &ctx->spec[i];
-        if (sp->program == p && sp->bits == bits && sp->ms == ctx->prog_ms)
-            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->prog[p];
+    else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->cfg.tier != FOGVOL_TIER_FLOAT)
+        bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->cfg.enc.bits); /* the context's encoding compiled in */
+    if (!bits) return ctx->gpu.prog[p];
+    for (i = 0; i < ctx->gpu.nspec; ++i) {
+        sp = &ctx->gpu.spec[i];
+        if (sp->program == p && sp->bits == bits && sp->ms == ctx->gpu.prog_ms)
+            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->gpu.prog[p];
     }
-    if (ctx->nspec == FOGVOL__SPEC_MAX) {
-        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->count_broken = 1;
-        return (bits & none) ? 0 : ctx->prog[p];
+    if (ctx->gpu.nspec == FOGVOL__SPEC_MAX) {
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->cfg.count_broken = 1;
+        return (bits & none) ? 0 : ctx->gpu.prog[p];
     }
-    sp = &ctx->spec[ctx->nspec++];
+    sp = &ctx->gpu.spec[ctx->gpu.nspec++];
     sp->program = p;
     sp->bits = bits;
-    sp->ms = ctx->prog_ms;
-    ctx->compile_samples = ctx->prog_ms ? 2 : 0;
+    sp->ms = ctx->gpu.prog_ms;
+    ctx->gpu.compile_samples = ctx->gpu.prog_ms ? 2 : 0;
     if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
         int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
         sp->handle = 0;
@@ -7349,11 +7362,11 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
                         ? "the general program draws instead (this frame is wrong; FOGVOL_SPEEDUP_DEPTH_TEST is off "
                           "from now on)"
                         : "the general program draws instead");
-        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !retried) ctx->count_broken = 1;
+        if ((bits & FOGVOL_SPECIALIZE_COUNT) && !retried) ctx->cfg.count_broken = 1;
     }
-    ctx->compile_samples = 0;
+    ctx->gpu.compile_samples = 0;
     if (!sp->handle && (bits & none)) return 0;
-    return sp->handle ? sp->handle : ctx->prog[p];
+    return sp->handle ? sp->handle : ctx->gpu.prog[p];
 }
 
 /* >>resources ============================================================= */
@@ -7363,13 +7376,13 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
 static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
 {
     int i, n = 0;
-    if (!ctx->in_frame) return;
-    for (i = 0; i < ctx->nlight; ++i)
-        if (ctx->lights[i].mesh != mesh) ctx->lights[n++] = ctx->lights[i];
-    if (n != ctx->nlight)
+    if (!ctx->cur.in_frame) return;
+    for (i = 0; i < ctx->cur.nlight; ++i)
+        if (ctx->cur.lights[i].mesh != mesh) ctx->cur.lights[n++] = ctx->cur.lights[i];
+    if (n != ctx->cur.nlight)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh destroyed inside a frame: %d lights that use it "
-                    "are dropped from the frame", ctx->nlight - n);
-    ctx->nlight = n;
+                    "are dropped from the frame", ctx->cur.nlight - n);
+    ctx->cur.nlight = n;
 }
 
 /* The bounding box of the positions (finite: validated before). */
@@ -7548,15 +7561,15 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
 static void fogvol__forget(fogvol_context *ctx, const fogvol_mesh *mesh, const fogvol_ramp *ramp)
 {
     int i, n = 0, dv, doc;
-    if (!ctx->in_frame) return;
-    for (i = 0; i < ctx->nvol; ++i)
-        if (!((mesh && ctx->vols[i].mesh == mesh) || (ramp && ctx->vols[i].ramp == ramp))) ctx->vols[n++] = ctx->vols[i];
-    dv = ctx->nvol - n;
-    ctx->nvol = n;
-    for (i = n = 0; i < ctx->nocc; ++i)
-        if (!mesh || ctx->occ[i].fn || ctx->occ[i].mesh != mesh) ctx->occ[n++] = ctx->occ[i];
-    doc = ctx->nocc - n;
-    ctx->nocc = n;
+    if (!ctx->cur.in_frame) return;
+    for (i = 0; i < ctx->cur.nvol; ++i)
+        if (!((mesh && ctx->cur.vols[i].mesh == mesh) || (ramp && ctx->cur.vols[i].ramp == ramp))) ctx->cur.vols[n++] = ctx->cur.vols[i];
+    dv = ctx->cur.nvol - n;
+    ctx->cur.nvol = n;
+    for (i = n = 0; i < ctx->cur.nocc; ++i)
+        if (!mesh || ctx->cur.occ[i].fn || ctx->cur.occ[i].mesh != mesh) ctx->cur.occ[n++] = ctx->cur.occ[i];
+    doc = ctx->cur.nocc - n;
+    ctx->cur.nocc = n;
     if (dv || doc)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: %s destroyed inside a frame: %d volumes and %d occluders that use it are dropped from "
@@ -7685,12 +7698,12 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 {
     int i, n = 0;
     if (!ctx || !texture) return;
-    for (i = 0; ctx->in_frame && i < ctx->nvol; ++i)
-        if (ctx->vols[i].density != texture && ctx->vols[i].color != texture) ctx->vols[n++] = ctx->vols[i];
-    if (ctx->in_frame && n != ctx->nvol) {
+    for (i = 0; ctx->cur.in_frame && i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].density != texture && ctx->cur.vols[i].color != texture) ctx->cur.vols[n++] = ctx->cur.vols[i];
+    if (ctx->cur.in_frame && n != ctx->cur.nvol) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: volume texture destroyed inside a frame: %d volumes "
-                    "that use it are dropped from the frame", ctx->nvol - n);
-        ctx->nvol = n;
+                    "that use it are dropped from the frame", ctx->cur.nvol - n);
+        ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
     fogvol__free(&ctx->alloc, texture);
@@ -7702,9 +7715,9 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    ctx->in_frame = 0;
-    ctx->nvol = ctx->nocc = 0;
-    ctx->engine_occluders = 0;
+    ctx->cur.in_frame = 0;
+    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -7718,7 +7731,7 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
         if (!fogvol__finite_n(d->view_projection, 16) || !fogvol__finite_n(d->eye, 3) ||
             !fogvol__finite_n(d->forward, 3))
             return "non-finite view_projection, eye or forward";
-        fogvol__tod(ctx->viewproj, d->view_projection);
+        fogvol__tod(ctx->cur.viewproj, d->view_projection);
         l = FOGVOL_SQRT((double)d->forward[0] * d->forward[0] + (double)d->forward[1] * d->forward[1] +
                         (double)d->forward[2] * d->forward[2]);
         if (!(l > 0.0)) return "forward is zero";
@@ -7734,8 +7747,8 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
         ax[2][0] = ax[1][1] * ax[3][2] - ax[1][2] * ax[3][1];
         ax[2][1] = ax[1][2] * ax[3][0] - ax[1][0] * ax[3][2];
         ax[2][2] = ax[1][0] * ax[3][1] - ax[1][1] * ax[3][0];
-        for (i = 0; i < 3; ++i) ctx->eyerow[i] = ax[3][i];
-        ctx->eyerow[3] = -(ax[3][0] * ax[0][0] + ax[3][1] * ax[0][1] + ax[3][2] * ax[0][2]);
+        for (i = 0; i < 3; ++i) ctx->cur.eyerow[i] = ax[3][i];
+        ctx->cur.eyerow[3] = -(ax[3][0] * ax[0][0] + ax[3][1] * ax[0][1] + ax[3][2] * ax[0][2]);
         return NULL;
     }
     if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
@@ -7743,16 +7756,16 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
         return "non-finite view or projection matrix";
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
-    fogvol__mul4(ctx->viewproj, p, v);
+    fogvol__mul4(ctx->cur.viewproj, p, v);
     if (!fogvol__inv4(v, iv) || !(iv[15] != 0.0)) return "the view matrix is singular";
     for (i = 0; i < 3; ++i) {
         ax[0][i] = iv[12 + i] / iv[15];
         ax[1][i] = iv[i];
         ax[2][i] = iv[4 + i];
         ax[3][i] = -iv[8 + i];
-        ctx->eyerow[i] = -v[i * 4 + 2];
+        ctx->cur.eyerow[i] = -v[i * 4 + 2];
     }
-    ctx->eyerow[3] = -v[14];
+    ctx->cur.eyerow[3] = -v[14];
     return NULL;
 }
 
@@ -7765,21 +7778,21 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
     double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
     const char *why = fogvol__camera_axes(ctx, d, ax);
     int i, k;
-    for (i = 0; i < 4 && !why; ++i) wr[i] = ctx->viewproj[i * 4 + 3];
+    for (i = 0; i < 4 && !why; ++i) wr[i] = ctx->cur.viewproj[i * 4 + 3];
     if (!why) {
-        sc = (wr[0] * ctx->eyerow[0] + wr[1] * ctx->eyerow[1] + wr[2] * ctx->eyerow[2]) /
-             (ctx->eyerow[0] * ctx->eyerow[0] + ctx->eyerow[1] * ctx->eyerow[1] + ctx->eyerow[2] * ctx->eyerow[2]);
+        sc = (wr[0] * ctx->cur.eyerow[0] + wr[1] * ctx->cur.eyerow[1] + wr[2] * ctx->cur.eyerow[2]) /
+             (ctx->cur.eyerow[0] * ctx->cur.eyerow[0] + ctx->cur.eyerow[1] * ctx->cur.eyerow[1] + ctx->cur.eyerow[2] * ctx->cur.eyerow[2]);
         for (i = 0; i < 4; ++i) {
-            rr += (wr[i] - sc * ctx->eyerow[i]) * (wr[i] - sc * ctx->eyerow[i]);
+            rr += (wr[i] - sc * ctx->cur.eyerow[i]) * (wr[i] - sc * ctx->cur.eyerow[i]);
             wn += wr[i] * wr[i];
         }
-        ctx->wscale = ctx->wconst = 0.0;
-        if (sc > 0.0 && rr <= 1e-10 * wn) ctx->wscale = sc;
-        else if (wr[3] > 0.0 && wn - wr[3] * wr[3] <= 1e-12 * wr[3] * wr[3]) ctx->wconst = wr[3];
+        ctx->cur.wscale = ctx->cur.wconst = 0.0;
+        if (sc > 0.0 && rr <= 1e-10 * wn) ctx->cur.wscale = sc;
+        else if (wr[3] > 0.0 && wn - wr[3] * wr[3] <= 1e-12 * wr[3] * wr[3]) ctx->cur.wconst = wr[3];
         else why = "the projection's clip w is neither the view depth times a positive constant (perspective) "
                    "nor a positive constant (orthographic)";
     }
-    if (!why && !fogvol__inv4(ctx->viewproj, ctx->invvp)) why = "the view-projection is singular";
+    if (!why && !fogvol__inv4(ctx->cur.viewproj, ctx->cur.invvp)) why = "the view-projection is singular";
     if (!why) { /* clip (x, y, w) of eye + F e, + X e, + Y e: the sign of their determinant is the
                    orientation on screen (every w > 0) */
         for (k = 0; k < 3; ++k) {
@@ -7787,14 +7800,14 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
             for (i = 0; i < 3; ++i) pt[i] = ax[0][i] + ax[3][i] * e + (k ? ax[k][i] * e : 0.0);
             for (i = 0; i < 3; ++i) {
                 int row = i == 2 ? 3 : i;
-                q[k][i] = ctx->viewproj[row] * pt[0] + ctx->viewproj[4 + row] * pt[1] +
-                          ctx->viewproj[8 + row] * pt[2] + ctx->viewproj[12 + row];
+                q[k][i] = ctx->cur.viewproj[row] * pt[0] + ctx->cur.viewproj[4 + row] * pt[1] +
+                          ctx->cur.viewproj[8 + row] * pt[2] + ctx->cur.viewproj[12 + row];
             }
         }
         det = q[0][0] * (q[1][1] * q[2][2] - q[2][1] * q[1][2]) - q[0][1] * (q[1][0] * q[2][2] - q[2][0] * q[1][2]) +
               q[0][2] * (q[1][0] * q[2][1] - q[2][0] * q[1][1]);
         if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
-        else ctx->mirrored = det < 0.0;
+        else ctx->cur.mirrored = det < 0.0;
     }
     if (why) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
@@ -7844,7 +7857,7 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
 {
     fogvol_result r;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (ctx->in_frame) {
+    if (ctx->cur.in_frame) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: begin_frame without end_frame: the open frame is discarded");
         fogvol_cancel_frame(ctx);
@@ -7884,10 +7897,10 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown engine_depth_source %d", (int)d->engine_depth_source);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    ctx->frame = *d;
-    ctx->nvol = ctx->nocc = 0;
-    ctx->in_frame = 1;
-    ctx->nlight = 0;
+    ctx->cur.frame = *d;
+    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.in_frame = 1;
+    ctx->cur.nlight = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -7916,8 +7929,8 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
     void *arr;
     fogvol_result r;
     if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (ctx->engine_occluders) {
+    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
@@ -7926,11 +7939,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    arr = ctx->occ;
-    r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
-    ctx->occ = (fogvol__occluder *)arr;
+    arr = ctx->cur.occ;
+    r = fogvol__grow(ctx, &arr, &ctx->cur.capocc, ctx->cur.nocc + 1, sizeof *o);
+    ctx->cur.occ = (fogvol__occluder *)arr;
     if (r != FOGVOL_SUCCESS) return r;
-    o = &ctx->occ[ctx->nocc++];
+    o = &ctx->cur.occ[ctx->cur.nocc++];
     memset(o, 0, sizeof *o);
     o->mesh = mesh;
     memcpy(o->model, model, sizeof o->model);
@@ -7943,17 +7956,17 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     void *arr;
     fogvol_result r;
     if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (ctx->engine_occluders) {
+    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    arr = ctx->occ;
-    r = fogvol__grow(ctx, &arr, &ctx->capocc, ctx->nocc + 1, sizeof *o);
-    ctx->occ = (fogvol__occluder *)arr;
+    arr = ctx->cur.occ;
+    r = fogvol__grow(ctx, &arr, &ctx->cur.capocc, ctx->cur.nocc + 1, sizeof *o);
+    ctx->cur.occ = (fogvol__occluder *)arr;
     if (r != FOGVOL_SUCCESS) return r;
-    o = &ctx->occ[ctx->nocc++];
+    o = &ctx->cur.occ[ctx->cur.nocc++];
     memset(o, 0, sizeof *o);
     o->fn = fn;
     o->user_data = user_data;
@@ -7984,13 +7997,13 @@ static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_vo
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite density_map or color_map");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->density && !fogvol__density_ok(ctx->tier, ctx->variants)) {
+    if (desc->density && !fogvol__density_ok(ctx->cfg.tier, ctx->cfg.variants)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: density textures need tier FLOAT, PS20 or MRT without the "
-                    "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
+                    "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    for (i = 0; desc->color && i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; desc->color && i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         float map[6];
         fogvol__color_map(desc, map);
         if (v->ramp == desc->ramp && v->color && (v->color != desc->color || memcmp(v->color_map, map, sizeof map))) {
@@ -8017,7 +8030,7 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     void *arr;
     fogvol_result r;
     if (!ctx || !desc || !desc->mesh || !desc->ramp) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
     if (!desc->mesh->volume) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
@@ -8028,11 +8041,11 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     }
     r = fogvol__check_textures(ctx, desc);
     if (r != FOGVOL_SUCCESS) return r;
-    arr = ctx->vols;
-    r = fogvol__grow(ctx, &arr, &ctx->capvol, ctx->nvol + 1, sizeof *v);
-    ctx->vols = (fogvol__volume *)arr;
+    arr = ctx->cur.vols;
+    r = fogvol__grow(ctx, &arr, &ctx->cur.capvol, ctx->cur.nvol + 1, sizeof *v);
+    ctx->cur.vols = (fogvol__volume *)arr;
     if (r != FOGVOL_SUCCESS) return r;
-    v = &ctx->vols[ctx->nvol++];
+    v = &ctx->cur.vols[ctx->cur.nvol++];
     v->mesh = desc->mesh;
     v->ramp = desc->ramp;
     memcpy(v->model, desc->model, sizeof v->model);
@@ -8044,29 +8057,29 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
 /* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
 static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
 {
-    double m[16], mvp[16], range = (double)ctx->frame.zfar - ctx->frame.znear;
+    double m[16], mvp[16], range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
     int j;
     dr->sign = 1.0f;
     memset(dr->extinction, 0, sizeof dr->extinction);
     memset(dr->emission, 0, sizeof dr->emission);
     fogvol__tod(m, model);
-    fogvol__mul4(mvp, ctx->viewproj, m);
+    fogvol__mul4(mvp, ctx->cur.viewproj, m);
     for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
     /* view depth e = eyerow . (M p);  d = (e - near) / (far - near) */
     for (j = 0; j < 4; ++j)
-        dr->depth[j] = (float)((ctx->eyerow[0] * m[j * 4] + ctx->eyerow[1] * m[j * 4 + 1] +
-                                ctx->eyerow[2] * m[j * 4 + 2] + ctx->eyerow[3] * m[j * 4 + 3] -
-                                (j == 3 ? ctx->frame.znear : 0.0)) /
+        dr->depth[j] = (float)((ctx->cur.eyerow[0] * m[j * 4] + ctx->cur.eyerow[1] * m[j * 4 + 1] +
+                                ctx->cur.eyerow[2] * m[j * 4 + 2] + ctx->cur.eyerow[3] * m[j * 4 + 3] -
+                                (j == 3 ? ctx->cur.frame.znear : 0.0)) /
                                range);
     /* a mirroring model matrix or projection flips the winding */
-    dr->front_cw = (fogvol__det3(m) < 0) != (ctx->mirrored != 0);
+    dr->front_cw = (fogvol__det3(m) < 0) != (ctx->cur.mirrored != 0);
 }
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
     fogvol_draw dr;
     if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
     if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
@@ -8080,7 +8093,7 @@ static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_fra
 {
     int n = info->samples > 1 ? info->samples : 0;
     const char *why = NULL;
-    if (n && ctx->msaa == FOGVOL_MSAA_SINGLE_SAMPLE) {
+    if (n && ctx->cfg.msaa == FOGVOL_MSAA_SINGLE_SAMPLE) {
         if (!ctx->msaa_warned)
             fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                         "fogvol: %d-sample engine framebuffer drawn with single-sample targets "
@@ -8092,20 +8105,20 @@ static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_fra
     } else if (n) {
         if (!(ctx->be.caps & FOGVOL_CAP_MULTISAMPLE))
             why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
-        else if (fogvol_msaa_supported(ctx->tier, ctx->variants, ctx->be.dialect) != FOGVOL_SUCCESS)
+        else if (fogvol_msaa_supported(ctx->cfg.tier, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS)
             why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
                   "or ENGINE_DEPTH)";
-        else if (ctx->frame.debug_thickness)
+        else if (ctx->cur.frame.debug_thickness)
             why = "debug_thickness cannot read multisampled targets";
         if (why) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                         "fogvol: %d-sample engine framebuffer, tier %s, variants 0x%x, GLSL %s: %s; "
                         "FOGVOL_MSAA_SINGLE_SAMPLE draws one fog value per pixel instead",
-                        n, fogvol_tier_name(ctx->tier), ctx->variants, fogvol_dialect_name(ctx->be.dialect), why);
+                        n, fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect), why);
             return FOGVOL_ERROR_UNSUPPORTED;
         }
     }
-    ctx->samples = n;
+    ctx->cur.samples = n;
     st->samples = n ? n : 1;
     return fogvol__msaa_programs(ctx, n > 1);
 }
@@ -8114,7 +8127,7 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
 {
     fogvol_result r = FOGVOL_SUCCESS;
     memset(info, 0, sizeof *info);
-    info->draw_buffer = ctx->frame.draw_buffer;
+    info->draw_buffer = ctx->cur.frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
     if (r != FOGVOL_SUCCESS)
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
@@ -8128,11 +8141,11 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     fogvol_frame_info fi;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
     if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->frame.viewport[2], ctx->frame.viewport[3], 0);
+    r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     if (r != FOGVOL_SUCCESS) return r;
-    fogvol_compute_constants(&ctx->enc, ctx->frame.znear, ctx->frame.zfar, 0.0f, k);
-    *texture = ctx->be.native_texture(ctx->be.user_data, ctx->tgt_o);
+    fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
+    *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
     return FOGVOL_SUCCESS;
 }
 
@@ -8142,28 +8155,28 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     fogvol_result r;
     if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(info, 0, sizeof *info);
-    if (ctx->tier != FOGVOL_TIER_MRT || !ctx->in_frame || !ctx->be.native_texture) {
+    if (ctx->cfg.tier != FOGVOL_TIER_MRT || !ctx->cur.in_frame || !ctx->be.native_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
                                                  "backend with native_texture");
         return FOGVOL_ERROR_INVALID_STATE;
     }
     r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
-    info->format = ctx->float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-    if (ctx->float_o) { /* d = 1, the far plane; fogvol_mrt[0].z = N = 0 marks the R32F target */
+    info->format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    if (ctx->cfg.float_o) { /* d = 1, the far plane; fogvol_mrt[0].z = N = 0 marks the R32F target */
         info->clear_color[0] = 1.0f;
     } else {
-        info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
-        info->uniforms[2] = (float)ctx->enc.levels;
-        info->uniforms[3] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+        info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->cfg.enc.levels - 1) / 255.0f;
+        info->uniforms[2] = (float)ctx->cfg.enc.levels;
+        info->uniforms[3] = (float)ctx->cfg.enc.levels * (float)ctx->cfg.enc.levels;
     }
     info->uniforms[0] = k.near_far[0];
     info->uniforms[1] = k.near_far[1];
     info->uniforms[4] = k.depth_offset;
     info->uniforms[5] = k.depth_max;
-    info->uniforms[6] = (float)ctx->enc.dither_steps;
-    info->uniforms[7] = ctx->dither ? 1.0f : 0.0f;
-    ctx->mrt_ready = 1;
+    info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
+    info->uniforms[7] = ctx->cfg.dither ? 1.0f : 0.0f;
+    ctx->cur.mrt_ready = 1;
     return FOGVOL_SUCCESS;
 }
 
@@ -8189,9 +8202,9 @@ static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_d
     b = -r0 * a - (z01 ? 0.0 : 1.0);
     sy = info->clip_upper_left ? -1.0 : 1.0;
     for (i = 0; i < 4; ++i) {
-        n[i] = ctx->eyerow[0] * ctx->invvp[i * 4] + ctx->eyerow[1] * ctx->invvp[i * 4 + 1] +
-               ctx->eyerow[2] * ctx->invvp[i * 4 + 2] + ctx->eyerow[3] * ctx->invvp[i * 4 + 3];
-        dn[i] = ctx->invvp[i * 4 + 3];
+        n[i] = ctx->cur.eyerow[0] * ctx->cur.invvp[i * 4] + ctx->cur.eyerow[1] * ctx->cur.invvp[i * 4 + 1] +
+               ctx->cur.eyerow[2] * ctx->cur.invvp[i * 4 + 2] + ctx->cur.eyerow[3] * ctx->cur.invvp[i * 4 + 3];
+        dn[i] = ctx->cur.invvp[i * 4 + 3];
     }
     ps->uniforms[FOGVOL_U_LINEAR][0] = (float)(2.0 * n[0]);
     ps->uniforms[FOGVOL_U_LINEAR][1] = (float)(2.0 * sy * n[1]);
@@ -8208,31 +8221,31 @@ static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_d
    window depth -> view depth through the inverse view-projection). */
 static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0;
     int i, j, c;
-    if (ctx->wscale > 0.0) {
-        k = 2.0 * ctx->wscale * range; /* k d <= 2 s (e - near) <= 2 w */
+    if (ctx->cur.wscale > 0.0) {
+        k = 2.0 * ctx->cur.wscale * range; /* k d <= 2 s (e - near) <= 2 w */
     } else {                           /* orthographic: w is constant, bound d over the volumes */
-        for (i = 0; i < ctx->nvol; ++i)
+        for (i = 0; i < ctx->cur.nvol; ++i)
             for (c = 0; c < 8; ++c) {
-                const fogvol__volume *v = &ctx->vols[i];
-                double e = ctx->eyerow[3], p[3];
+                const fogvol__volume *v = &ctx->cur.vols[i];
+                double e = ctx->cur.eyerow[3], p[3];
                 p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
                 p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
                 p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
                 for (j = 0; j < 3; ++j)
-                    e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
+                    e += ctx->cur.eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
                                            v->model[12 + j]);
                 if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
             }
-        if (dmax > 0.0) k = 1.98 * ctx->wconst / dmax;
+        if (dmax > 0.0) k = 1.98 * ctx->cur.wconst / dmax;
     }
     /* the whole [0, 1] depth range: a 16-bit depth buffer (GLES2, WebGL1) orders the occluders'
        faces as finely as a standard projection would (k = 1 left it 1 / (2 (far - near)) of it) */
     ps->uniforms[FOGVOL_U_MISC][0] = (float)k;
     /* near clamp: clip w of the near plane for perspective projections, none for orthographic */
-    ps->uniforms[FOGVOL_U_MISC][2] = ctx->wscale > 0.0 ? (float)(ctx->wscale * fd->znear) : -1e30f;
+    ps->uniforms[FOGVOL_U_MISC][2] = ctx->cur.wscale > 0.0 ? (float)(ctx->cur.wscale * fd->znear) : -1e30f;
     fogvol__lin_uniforms(ctx, fd, info, ps);
 }
 
@@ -8243,42 +8256,42 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     int fl;
     if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(info, 0, sizeof *info);
-    fl = ctx->tier == FOGVOL_TIER_FLOAT;
-    if (!ctx->in_frame || ctx->nocc > 0 || !ctx->be.native_texture) {
+    fl = ctx->cfg.tier == FOGVOL_TIER_FLOAT;
+    if (!ctx->cur.in_frame || ctx->cur.nocc > 0 || !ctx->be.native_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_prepare needs an open frame without "
                                                  "fogvol_add_occluder* calls and a backend with native_texture");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (ctx->frame.downsample == 2) {
+    if (ctx->cur.frame.downsample == 2) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need full-resolution sums "
                                                  "(fogvol_frame_desc.downsample 0 or 1)");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    if ((ctx->tier != FOGVOL_TIER_PS20 && !fl) ||
+    if ((ctx->cfg.tier != FOGVOL_TIER_PS20 && !fl) ||
         fogvol__has(ctx, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: engine-drawn occluders need tier PS20 or FLOAT without the "
                                                  "COUNT, WIDE and ENGINE_DEPTH variants (tier %s, variants 0x%x)%s",
-                    fogvol_tier_name(ctx->tier), ctx->variants,
-                    ctx->tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
+                    fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants,
+                    ctx->cfg.tier == FOGVOL_TIER_MRT ? "; the MRT tier has fogvol_mrt_prepare" : "");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     r = fogvol__prepare_o(ctx, &k, &info->texture);
     if (r != FOGVOL_SUCCESS) return r;
-    fl = fl || ctx->float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
-    info->width = ctx->target_w;
-    info->height = ctx->target_h;
+    fl = fl || ctx->cfg.float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
+    info->width = ctx->gpu.target_w;
+    info->height = ctx->gpu.target_h;
     info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
     if (fl) info->clear_color[0] = 1.0f;
-    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->cfg.enc.levels - 1) / 255.0f;
     info->uniforms[0] = k.near_far[0];
     info->uniforms[1] = k.near_far[1];
-    info->uniforms[2] = fl ? 0.0f : (float)ctx->enc.levels;
-    info->uniforms[3] = fl ? 0.0f : (float)ctx->enc.levels * (float)ctx->enc.levels;
+    info->uniforms[2] = fl ? 0.0f : (float)ctx->cfg.enc.levels;
+    info->uniforms[3] = fl ? 0.0f : (float)ctx->cfg.enc.levels * (float)ctx->cfg.enc.levels;
     info->uniforms[4] = fl ? 0.0f : k.depth_offset;
     info->uniforms[5] = fl ? 1.0f : k.depth_max;
-    info->uniforms[6] = (float)ctx->enc.dither_steps;
-    info->uniforms[7] = ctx->dither && !fl ? 1.0f : 0.0f;
-    ctx->engine_occluders = 1;
+    info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
+    info->uniforms[7] = ctx->cfg.dither && !fl ? 1.0f : 0.0f;
+    ctx->cur.engine_occluders = 1;
     return FOGVOL_SUCCESS;
 }
 
@@ -8287,12 +8300,12 @@ static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volum
 {
     int c, j;
     for (c = 0; c < 8; ++c) {
-        double p[3], e = ctx->eyerow[3];
+        double p[3], e = ctx->cur.eyerow[3];
         p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
         p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
         p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
         for (j = 0; j < 3; ++j)
-            e += ctx->eyerow[j] *
+            e += ctx->cur.eyerow[j] *
                  (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
         if (c == 0 || e < *emin) *emin = e;
         if (c == 0 || e > *emax) *emax = e;
@@ -8308,10 +8321,10 @@ static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volum
 static int fogvol__count_near_cut(const fogvol_context *ctx)
 {
     int i;
-    for (i = 0; i < ctx->nvol; ++i) {
+    for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
-        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
-        if (emin < ctx->frame.znear && emax > 0.0) return i;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &emin, &emax);
+        if (emin < ctx->cur.frame.znear && emax > 0.0) return i;
     }
     return -1;
 }
@@ -8319,9 +8332,9 @@ static int fogvol__count_near_cut(const fogvol_context *ctx)
 /* Frames fogvol refuses before touching the backend (logged; the caller cancels the frame). */
 static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
-    if (ctx->tier == FOGVOL_TIER_MRT && !ctx->mrt_ready) {
+    if (ctx->cfg.tier == FOGVOL_TIER_MRT && !ctx->cur.mrt_ready) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: MRT tier: call fogvol_mrt_prepare and let the engine "
                                                  "write O before fogvol_end_frame");
         return FOGVOL_ERROR_INVALID_STATE;
@@ -8335,12 +8348,12 @@ static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
                                                  "pass a depth texture (engine_depth_texture)");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    if (fd->downsample == 2 && (ctx->tier != FOGVOL_TIER_FLOAT || ctx->nlight > 0 ||
+    if (fd->downsample == 2 && (ctx->cfg.tier != FOGVOL_TIER_FLOAT || ctx->cur.nlight > 0 ||
                                 fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS))) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: downsample 2 needs the FLOAT tier without ENGINE_DEPTH or COLORS and no "
                     "fogvol_add_light (tier %s, variants 0x%x, %d lights); nothing drawn",
-                    fogvol_tier_name(ctx->tier), ctx->variants, ctx->nlight);
+                    fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants, ctx->cur.nlight);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) && (i = fogvol__count_near_cut(ctx)) >= 0) {
@@ -8367,8 +8380,8 @@ static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int 
 {
     int i, n = 0;
     fogvol_draw dr;
-    for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || v->density) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
@@ -8382,25 +8395,25 @@ static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int 
    bounds, 0 when the bounds reach nearer than znear (a front face may be clipped away there). */
 static float fogvol__density_ref(const fogvol_context *ctx, const fogvol__volume *v)
 {
-    double emin = 1e300, sum = 0.0, range = (double)ctx->frame.zfar - ctx->frame.znear, d;
+    double emin = 1e300, sum = 0.0, range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear, d;
     int c, j;
     for (c = 0; c < 8; ++c) {
-        double p[3], e = ctx->eyerow[3];
+        double p[3], e = ctx->cur.eyerow[3];
         for (j = 0; j < 3; ++j) p[j] = (c >> j & 1) ? v->mesh->bmax[j] : v->mesh->bmin[j];
         for (j = 0; j < 3; ++j)
-            e += ctx->eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
+            e += ctx->cur.eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
         if (e < emin) emin = e;
         sum += e;
     }
-    if (emin < ctx->frame.znear) return 0.0f;
-    d = (sum / 8.0 - ctx->frame.znear) / range;
+    if (emin < ctx->cur.frame.znear) return 0.0f;
+    d = (sum / 8.0 - ctx->cur.frame.znear) / range;
     return (float)(d > 1.0 ? 1.0 : d);
 }
 
 /* SPECIALIZE_DITHER where the encode computes by integer ALU with the dither on */
 static unsigned fogvol__dither_bit(const fogvol_context *ctx)
 {
-    return ctx->dither && fogvol__has(ctx, FOGVOL_VARIANT_ALU) ? (unsigned)FOGVOL_SPECIALIZE_DITHER : 0u;
+    return ctx->cfg.dither && fogvol__has(ctx, FOGVOL_VARIANT_ALU) ? (unsigned)FOGVOL_SPECIALIZE_DITHER : 0u;
 }
 
 /* SPECIALIZE_DEPTH_FROM_Z where the pass's fv_lin and fv_lin2 (fogvol__lin_uniforms) do not depend on
@@ -8422,7 +8435,7 @@ static unsigned fogvol__depth_from_z_bit(const fogvol_pass *ps)
    every read of fogvol's targets and of the engine's depth, is 0) */
 static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 {
-    return ctx->frame.viewport[0] == 0 && ctx->frame.viewport[1] == 0 ? (unsigned)FOGVOL_SPECIALIZE_ORIGIN : 0u;
+    return ctx->cur.frame.viewport[0] == 0 && ctx->cur.frame.viewport[1] == 0 ? (unsigned)FOGVOL_SPECIALIZE_ORIGIN : 0u;
 }
 
 /* After a sum pass (its state in *base): each density-textured volume of the group in a pass of
@@ -8431,8 +8444,8 @@ static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
-    for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         fogvol_pass ps;
         fogvol_draw dr;
         if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
@@ -8448,7 +8461,7 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
         ps.uniforms[FOGVOL_U_DENSITY][0] = fogvol__density_ref(ctx, v);
         ps.uniforms[FOGVOL_U_DENSITY][1] = 1.0f;
-        ps.uniforms[FOGVOL_U_DENSITY][2] = 1.0f / (ctx->frame.zfar - ctx->frame.znear);
+        ps.uniforms[FOGVOL_U_DENSITY][2] = 1.0f / (ctx->cur.frame.zfar - ctx->cur.frame.znear);
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
@@ -8463,8 +8476,8 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
 static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
     int i;
-    for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         if (v->ramp != ramp || !v->color) continue;
         ps->textures[FOGVOL__UNIT_CTEX] = v->color->texture;
         memcpy(ps->uniforms[FOGVOL_U_COLOR_U], v->color_map, 3 * sizeof(float));
@@ -8504,13 +8517,13 @@ static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, fogvol_handle 
    also looks at S after the additions. Marks saturated pixels in sat. */
 static fogvol_result fogvol__single_peak(fogvol_context *ctx, unsigned char *sat)
 {
-    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    size_t n = (size_t)ctx->gpu.target_w * (size_t)ctx->gpu.target_h, i;
     unsigned char *px;
     fogvol_result r;
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
     px = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 4u);
     if (!px) return FOGVOL_ERROR_OUT_OF_MEMORY;
-    r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, px, n * 4u);
+    r = ctx->be.read_target(ctx->be.user_data, ctx->gpu.tgt_b, px, n * 4u);
     for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i)
         sat[i] = px[4 * i] == 255 || px[4 * i + 1] == 255 || px[4 * i + 2] == 255 || px[4 * i + 3] == 255;
     fogvol__free(&ctx->alloc, px);
@@ -8520,16 +8533,16 @@ static fogvol_result fogvol__single_peak(fogvol_context *ctx, unsigned char *sat
 /* WIDE: six digits over two attachments per sum. */
 static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overflow)
 {
-    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    size_t n = (size_t)ctx->gpu.target_w * (size_t)ctx->gpu.target_h, i;
     unsigned char *px[4];
     fogvol_handle t[4];
     fogvol_result r = FOGVOL_SUCCESS;
-    double range = (double)ctx->frame.zfar - ctx->frame.znear, n3 = (double)ctx->enc.levels * ctx->enc.levels * ctx->enc.levels;
+    double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear, n3 = (double)ctx->cfg.enc.levels * ctx->cfg.enc.levels * ctx->cfg.enc.levels;
     int k;
-    t[0] = ctx->tgt_b;
-    t[1] = ctx->tgt_f;
-    t[2] = ctx->tgt_b2;
-    t[3] = ctx->tgt_f2;
+    t[0] = ctx->gpu.tgt_b;
+    t[1] = ctx->gpu.tgt_f;
+    t[2] = ctx->gpu.tgt_b2;
+    t[3] = ctx->gpu.tgt_f2;
     px[0] = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 16u);
     if (!px[0]) return FOGVOL_ERROR_OUT_OF_MEMORY;
     for (k = 1; k < 4; ++k) px[k] = px[0] + n * 4u * (size_t)k;
@@ -8540,8 +8553,8 @@ static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overfl
         for (k = 0; k < 4; ++k)
             for (c = 0; c < 4; ++c) sat |= px[k][4 * i + c] == 255;
         *overflow += sat;
-        ctx->frame.debug_thickness[i] = (float)((fogvol_decode_difference(&ctx->enc, px[0] + 4 * i, px[1] + 4 * i) +
-                                                 fogvol_decode_difference(&ctx->enc, px[2] + 4 * i, px[3] + 4 * i) / n3) *
+        ctx->cur.frame.debug_thickness[i] = (float)((fogvol_decode_difference(&ctx->cfg.enc, px[0] + 4 * i, px[1] + 4 * i) +
+                                                 fogvol_decode_difference(&ctx->cfg.enc, px[2] + 4 * i, px[3] + 4 * i) / n3) *
                                                 range);
     }
     fogvol__free(&ctx->alloc, px[0]);
@@ -8552,7 +8565,7 @@ static fogvol_result fogvol__debug_capture_wide(fogvol_context *ctx, int *overfl
    bilinear as the composite reads them (FV_DOWNSAMPLE: the tw x th texels span the w x h pixels) */
 static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double range)
 {
-    int w = ctx->frame.viewport[2], h = ctx->frame.viewport[3], tw = ctx->target_w, th = ctx->target_h, x, y;
+    int w = ctx->cur.frame.viewport[2], h = ctx->cur.frame.viewport[3], tw = ctx->gpu.target_w, th = ctx->gpu.target_h, x, y;
     for (y = 0; y < h; ++y) {
         double py = (y + 0.5) * th / h - 0.5, iy = floor(py), fy = py - iy;
         int y0 = iy < 0 ? 0 : iy > th - 1 ? th - 1 : (int)iy, y1 = iy + 1 > th - 1 ? th - 1 : (int)iy + 1;
@@ -8561,7 +8574,7 @@ static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double 
             int x0 = ix < 0 ? 0 : ix > tw - 1 ? tw - 1 : (int)ix, x1 = ix + 1 > tw - 1 ? tw - 1 : (int)ix + 1;
             double a = lo[y0 * tw + x0] + (lo[y0 * tw + x1] - (double)lo[y0 * tw + x0]) * fx;
             double c = lo[y1 * tw + x0] + (lo[y1 * tw + x1] - (double)lo[y1 * tw + x0]) * fx;
-            ctx->frame.debug_thickness[(size_t)y * (size_t)w + (size_t)x] = (float)((a + (c - a) * fy) * range);
+            ctx->cur.frame.debug_thickness[(size_t)y * (size_t)w + (size_t)x] = (float)((a + (c - a) * fy) * range);
         }
     }
 }
@@ -8570,25 +8583,25 @@ static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double 
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
 static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int xsum, int *overflow)
 {
-    size_t n = (size_t)ctx->target_w * (size_t)ctx->target_h, i;
+    size_t n = (size_t)ctx->gpu.target_w * (size_t)ctx->gpu.target_h, i;
     unsigned char *b, *f, *o;
     float *fl;
     fogvol_result r;
-    double range = (double)ctx->frame.zfar - ctx->frame.znear;
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = ctx->count_frame;
+    double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = ctx->cur.count_frame;
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
-    if (ctx->tgt_b2) return fogvol__debug_capture_wide(ctx, overflow);
+    if (ctx->gpu.tgt_b2) return fogvol__debug_capture_wide(ctx, overflow);
     b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 12u);
     if (!b) return FOGVOL_ERROR_OUT_OF_MEMORY;
     f = b + n * 4u;
     o = f + n * 4u;
     *overflow = 0;
-    r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_b, b, n * 4u);
-    if (ctx->tier == FOGVOL_TIER_FLOAT) {
+    r = ctx->be.read_target(ctx->be.user_data, ctx->gpu.tgt_b, b, n * 4u);
+    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) {
         fl = (float *)(void *)b;
-        if (r == FOGVOL_SUCCESS && ctx->frame.downsample == 2) fogvol__debug_upsample(ctx, fl, range);
+        if (r == FOGVOL_SUCCESS && ctx->cur.frame.downsample == 2) fogvol__debug_upsample(ctx, fl, range);
         else
-            for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->frame.debug_thickness[i] = (float)(fl[i] * range);
+            for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) ctx->cur.frame.debug_thickness[i] = (float)(fl[i] * range);
         fogvol__free(&ctx->alloc, b);
         return r;
     }
@@ -8597,13 +8610,13 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
             const unsigned char *p = b + 4 * i;
             uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
             double v = u >= 0x80000000u ? (double)u - 4294967296.0 : (double)u;
-            ctx->frame.debug_thickness[i] = (float)(v / 16777216.0 * range);
+            ctx->cur.frame.debug_thickness[i] = (float)(v / 16777216.0 * range);
         }
         fogvol__free(&ctx->alloc, b);
         return r;
     }
-    if (r == FOGVOL_SUCCESS && !single) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_f, f, n * 4u);
-    if (r == FOGVOL_SUCCESS && count) r = ctx->be.read_target(ctx->be.user_data, ctx->tgt_o, o, n * 4u);
+    if (r == FOGVOL_SUCCESS && !single) r = ctx->be.read_target(ctx->be.user_data, ctx->gpu.tgt_f, f, n * 4u);
+    if (r == FOGVOL_SUCCESS && count) r = ctx->be.read_target(ctx->be.user_data, ctx->gpu.tgt_o, o, n * 4u);
     for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) {
         unsigned char *pb = b + 4 * i, *pf = f + 4 * i;
         int k, sat = 0;
@@ -8620,12 +8633,12 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
         if (count) { /* alpha holds face counts: add the opaque depth per missing back face */
             int missing = (int)pf[3] - (int)pb[3];
             pb[3] = pf[3] = 0;
-            t = fogvol_decode_difference(&ctx->enc, pb, pf) + missing * fogvol_decode(&ctx->enc, o + 4 * i);
+            t = fogvol_decode_difference(&ctx->cfg.enc, pb, pf) + missing * fogvol_decode(&ctx->cfg.enc, o + 4 * i);
         } else {
-            t = fogvol_decode_difference(&ctx->enc, pb, pf);
+            t = fogvol_decode_difference(&ctx->cfg.enc, pb, pf);
         }
         *overflow += sat;
-        ctx->frame.debug_thickness[i] = (float)(t * range);
+        ctx->cur.frame.debug_thickness[i] = (float)(t * range);
     }
     fogvol__free(&ctx->alloc, b);
     return r;
@@ -8633,7 +8646,7 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
 
 static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
 {
-    return ctx->frame.debug_thickness && !captured && (ctx->frame.debug_ramp == NULL || ctx->frame.debug_ramp == ramp);
+    return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
 }
 
 /* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
@@ -8643,17 +8656,17 @@ static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp
    viewport. An empty rectangle is 1x1 in the corner (nothing is drawn). */
 static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
 {
-    const int *vp = ctx->frame.viewport;
+    const int *vp = ctx->cur.frame.viewport;
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, wmin;
     int i, k, c;
-    wmin = ctx->frame.projection[15] == 0.0f ? (double)ctx->frame.znear * (1.0 - 1e-6) : 1e-12;
+    wmin = ctx->cur.frame.projection[15] == 0.0f ? (double)ctx->cur.frame.znear * (1.0 - 1e-6) : 1e-12;
     memcpy(rect, vp, 4 * sizeof(int));
-    for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         double m[16], mvp[16];
         if (v->ramp != ramp) continue;
         fogvol__tod(m, v->model);
-        fogvol__mul4(mvp, ctx->viewproj, m);
+        fogvol__mul4(mvp, ctx->cur.viewproj, m);
         for (k = 0; k < 8; ++k) {
             double p[3], clip[4];
             for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
@@ -8667,7 +8680,7 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
         }
     }
     for (c = 0; c < 2; ++c) { /* downsample 2: the bilinear read spreads a texel over 2 more pixels */
-        double m = ctx->frame.downsample == 2 ? 2.0 : 0.0;
+        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0;
         double a = FOGVOL_FLOOR(lo[c]) - 1.0 - m, b = FOGVOL_FLOOR(hi[c]) + 2.0 + m;
         if (a < vp[c]) a = vp[c];
         if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
@@ -8684,43 +8697,42 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
 static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
 {
     ps->viewport[0] = ps->viewport[1] = 0;
-    ps->viewport[2] = ctx->target_w;
-    ps->viewport[3] = ctx->target_h;
+    ps->viewport[2] = ctx->gpu.target_w;
+    ps->viewport[3] = ctx->gpu.target_h;
     ps->uniforms[FOGVOL_U_SCREEN][2] = ps->uniforms[FOGVOL_U_SCREEN][3] = 0.0f;
-    ps->stencil_guard = 0;
     memset(ps->scissor, 0, sizeof ps->scissor);
     ps->draw_buffer = ps->alpha_coverage = 0;
     memset(ps->textures, 0, sizeof ps->textures);
     memset(ps->native_textures, 0, sizeof ps->native_textures);
-    ps->textures[FOGVOL__UNIT_RG] = ctx->tex_rg;
-    ps->textures[FOGVOL__UNIT_BLUE] = ctx->tex_blue;
-    ps->textures[FOGVOL__UNIT_DITHER] = ctx->tex_dither;
+    ps->textures[FOGVOL__UNIT_RG] = ctx->gpu.tex_rg;
+    ps->textures[FOGVOL__UNIT_BLUE] = ctx->gpu.tex_blue;
+    ps->textures[FOGVOL__UNIT_DITHER] = ctx->gpu.tex_dither;
 }
 
 /* The uniforms every pass of the frame gets, in run->base (target space, lookup textures bound). */
 static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_pass *ps = &run->base;
     fogvol_constants k;
-    fogvol_compute_constants(&ctx->enc, fd->znear, fd->zfar, 0.0f, &k);
+    fogvol_compute_constants(&ctx->cfg.enc, fd->znear, fd->zfar, 0.0f, &k);
     memset(ps, 0, sizeof *ps);
-    ps->per_sample = ctx->samples > 1;
-    ps->uniforms[FOGVOL_U_ENC][0] = (float)ctx->enc.levels;
-    ps->uniforms[FOGVOL_U_ENC][1] = (float)ctx->enc.levels * (float)ctx->enc.levels;
+    ps->per_sample = ctx->cur.samples > 1;
+    ps->uniforms[FOGVOL_U_ENC][0] = (float)ctx->cfg.enc.levels;
+    ps->uniforms[FOGVOL_U_ENC][1] = (float)ctx->cfg.enc.levels * (float)ctx->cfg.enc.levels;
     ps->uniforms[FOGVOL_U_ENC][2] = k.depth_offset;
     ps->uniforms[FOGVOL_U_ENC][3] = k.depth_max;
-    ps->uniforms[FOGVOL_U_DITHER][0] = ctx->dither ? 255.0f : 0.0f;
-    ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->enc.dither_steps;
-    ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->enc.dither_steps;
-    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->target_w; /* target space (downsample: half) */
-    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->target_h;
+    ps->uniforms[FOGVOL_U_DITHER][0] = ctx->cfg.dither ? 255.0f : 0.0f;
+    ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->cfg.enc.dither_steps;
+    ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->cfg.enc.dither_steps;
+    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.target_w; /* target space (downsample: half) */
+    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.target_h;
     if (run->rgba8) {
         memcpy(ps->uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
-        if (run->count || ctx->tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
+        if (run->count || ctx->cfg.tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
             ps->uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
         if (fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) { /* u = clamp(d, 0, 1 - N^-6), no offset */
-            double n6 = (double)ctx->enc.levels * ctx->enc.levels * ctx->enc.levels;
+            double n6 = (double)ctx->cfg.enc.levels * ctx->cfg.enc.levels * ctx->cfg.enc.levels;
             n6 *= n6;
             ps->uniforms[FOGVOL_U_ENC][2] = 0.0f;
             ps->uniforms[FOGVOL_U_ENC][3] = (float)(1.0 - 1.0 / n6);
@@ -8744,29 +8756,29 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
 {
     fogvol_pass ps = run->base;
     int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
-    if (!fogvol_tier_uses_program(ctx->tier, ctx->variants, FOGVOL_PROGRAM_ENCODE) || ctx->engine_occluders) {
-        ctx->o_far = 0; /* the engine wrote O */
+    if (!fogvol_tier_uses_program(ctx->cfg.tier, ctx->cfg.variants, FOGVOL_PROGRAM_ENCODE) || ctx->cur.engine_occluders) {
+        ctx->gpu.o_far = 0; /* the engine wrote O */
         return;
     }
-    run->no_opaque = !engine && !run->count && ctx->nocc == 0 && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_OPAQUE);
-    if (run->no_opaque && ctx->o_far) return; /* O still holds the far plane of an earlier frame */
-    ctx->o_far = run->no_opaque;
-    ps.target = ctx->tgt_o;
+    run->no_opaque = !engine && !run->count && ctx->cur.nocc == 0 && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SKIP_OPAQUE);
+    if (run->no_opaque && ctx->gpu.o_far) return; /* O still holds the far plane of an earlier frame */
+    ctx->gpu.o_far = run->no_opaque;
+    ps.target = ctx->gpu.tgt_o;
     ps.clear = 1;
-    if (run->rgba8 && !ctx->float_o) /* the far plane: every digit N - 1, or d = 1 */
-        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->enc.levels - 1) / 255.0f;
+    if (run->rgba8 && !ctx->cfg.float_o) /* the far plane: every digit N - 1, or d = 1 */
+        ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->cfg.enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
     ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE,
                                  (engine ? fogvol__origin_bit(ctx) | fogvol__depth_from_z_bit(&ps) : 0u) |
-                                     fogvol__dither_bit(ctx) | ctx->count_bit);
+                                     fogvol__dither_bit(ctx) | ctx->cur.count_bit);
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
-    ctx->in_occluder_pass = 1;
+    ctx->cur.in_occluder_pass = 1;
     if (engine) ctx->be.draw_fullscreen(ctx->be.user_data);
-    for (i = 0; i < ctx->nocc && !engine; ++i) {
-        const fogvol__occluder *o = &ctx->occ[i];
+    for (i = 0; i < ctx->cur.nocc && !engine; ++i) {
+        const fogvol__occluder *o = &ctx->cur.occ[i];
         if (o->fn) {
             o->fn(ctx, o->user_data);
         } else {
@@ -8776,7 +8788,7 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
         }
         run->st.occluders++;
     }
-    ctx->in_occluder_pass = 0;
+    ctx->cur.in_occluder_pass = 0;
     fogvol__end_pass(ctx);
 }
 
@@ -8786,14 +8798,14 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
    turns its speed-up off (the integer sum first) and the next is tried: digits, O sampled. */
 static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, unsigned spec)
 {
-    int fetch = ctx->fetch_o && !run->no_opaque && !run->count && ctx->samples <= 1 && ctx->tgt_o &&
+    int fetch = ctx->cfg.fetch_o && !run->no_opaque && !run->count && ctx->cur.samples <= 1 && ctx->gpu.tgt_o &&
                 !(spec & FOGVOL_SPECIALIZE_NO_OPAQUE);
     for (;;) { /* the integer sum (FOGVOL_SPEEDUP_EXACT_SUM), O from the framebuffer, each dropped if it fails */
         unsigned bits = spec | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u) |
                         (fetch ? (unsigned)FOGVOL_SPECIALIZE_FETCH_O : 0u);
         fogvol_handle h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, bits);
-        if (bits == spec || (h && h != ctx->prog[FOGVOL_PROGRAM_FACE])) { /* (the general one: a failure) */
-            ps->read_target = fetch ? ctx->tgt_o : 0;
+        if (bits == spec || (h && h != ctx->gpu.prog[FOGVOL_PROGRAM_FACE])) { /* (the general one: a failure) */
+            ps->read_target = fetch ? ctx->gpu.tgt_o : 0;
             run->st.fetched_o |= fetch;
             return h;
         }
@@ -8802,9 +8814,9 @@ static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run,
                     run->xsum ? "the faces sum digits (FOGVOL_SPEEDUP_EXACT_SUM off)"
                               : "the faces sample O (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH off)");
         if (run->xsum) {
-            ctx->exact_sum = run->xsum = 0;
+            ctx->cfg.exact_sum = run->xsum = 0;
         } else {
-            ctx->fetch_o = 0;
+            ctx->cfg.fetch_o = 0;
             fetch = 0;
         }
     }
@@ -8820,20 +8832,20 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     fogvol_result r;
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
     if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
-    else if (ctx->tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+    else if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
         spec |= fogvol__depth_from_z_bit(&ps); /* (FLOAT faces read the engine's depth) */
-    spec |= fogvol__dither_bit(ctx) | ctx->count_bit;
+    spec |= fogvol__dither_bit(ctx) | ctx->cur.count_bit;
     ps.program = fogvol__face_program(ctx, run, &ps, spec);
     ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
-    ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
+    ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->cfg.tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
     ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
         ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    else if (!ps.read_target) ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
-    ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->tgt_o2;
-    if (ctx->tier == FOGVOL_TIER_FLOAT || run->xsum) { /* every face, signed by gl_FrontFacing */
-        ps.target = ctx->tgt_b;
+    else if (!ps.read_target) ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
+    ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->gpu.tgt_o2;
+    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT || run->xsum) { /* every face, signed by gl_FrontFacing */
+        ps.target = ctx->gpu.tgt_b;
         ps.clear = 1;
         ps.blend = run->xsum ? FOGVOL_PASS_BLEND_NONE : FOGVOL_PASS_BLEND_ADD; /* (EXACT_SUM: the program adds) */
         ctx->be.begin_pass(ctx->be.user_data, &ps);
@@ -8844,7 +8856,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     } else if (run->single) {
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
         if (run->checks) fogvol__check_pass(ctx, run, &ps, 1, &run->st); /* saturation at the peak of the sum */
         if (fogvol__want_debug(ctx, ramp, run->captured)) {
             peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)run->w * (size_t)run->h);
@@ -8852,12 +8864,12 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
             if (r != FOGVOL_SUCCESS) run->r = r;
         }
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp, has_neg);
+            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp, has_neg);
     } else {
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
     }
     if (fogvol__want_debug(ctx, ramp, run->captured)) {
         r = fogvol__debug_capture(ctx, peak, run->xsum, &run->overflow);
@@ -8873,11 +8885,11 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
    FOGVOL_SPEEDUP_INLINE_RESOLVE: they resolve it themselves). */
 static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     int *rc = run->rect;
     *ps = run->base;
     memset(rc, 0, sizeof run->rect);
-    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
+    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
         fogvol__group_rect(ctx, ramp, rc);
         if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
             rc[1] = 2 * fd->viewport[1] + fd->viewport[3] - rc[1] - rc[3];
@@ -8887,19 +8899,19 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
         ps->scissor[3] = rc[3];
     }
     memset(ps->textures, 0, sizeof ps->textures);
-    ps->textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
-    ps->textures[FOGVOL__UNIT_FRONT] = ctx->tgt_f;
-    ps->textures[FOGVOL__UNIT_COUNTS] = run->count ? ctx->tgt_o : 0;
-    ps->textures[FOGVOL__UNIT_BACK2] = ctx->tgt_b2;
-    ps->textures[FOGVOL__UNIT_FRONT2] = ctx->tgt_f2;
-    if (ctx->tier != FOGVOL_TIER_PS13 || ctx->inline_resolve) return;
-    ps->target = ctx->tgt_t;
-    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx) | ctx->count_bit);
+    ps->textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_b;
+    ps->textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_f;
+    ps->textures[FOGVOL__UNIT_COUNTS] = run->count ? ctx->gpu.tgt_o : 0;
+    ps->textures[FOGVOL__UNIT_BACK2] = ctx->gpu.tgt_b2;
+    ps->textures[FOGVOL__UNIT_FRONT2] = ctx->gpu.tgt_f2;
+    if (ctx->cfg.tier != FOGVOL_TIER_PS13 || ctx->cfg.inline_resolve) return;
+    ps->target = ctx->gpu.tgt_t;
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx) | ctx->cur.count_bit);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
     run->st.passes++;
-    ps->textures[FOGVOL__UNIT_BACK] = ctx->tgt_t;
+    ps->textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_t;
     ps->textures[FOGVOL__UNIT_FRONT] = 0;
 }
 
@@ -8910,7 +8922,7 @@ static void fogvol__blend_color(const fogvol_context *ctx, fogvol_pass *ps, unsi
     unsigned need = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW;
     ps->blend_constant = 0;
     if ((*spec & need) != need || !(ctx->be.caps & FOGVOL_CAP_BLEND_CONSTANT) ||
-        (ctx->speedups_off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE)))
+        (ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE)))
         return;
     *spec |= FOGVOL_SPECIALIZE_BLEND_COLOR;
     ps->blend_constant = 1;
@@ -8922,7 +8934,7 @@ static void fogvol__blend_color(const fogvol_context *ctx, fogvol_pass *ps, unsi
    as fog or light. ps: the state of fogvol__sum_sources. */
 static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, const fogvol_ramp *ramp)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     unsigned spec;
     ps->target = 0;
     ps->clear = 0;
@@ -8933,7 +8945,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-    if (!(ctx->speedups_off & FOGVOL_SPEEDUP_EXP_COMPOSITE))
+    if (!(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_EXP_COMPOSITE))
         memcpy(ps->uniforms[FOGVOL_U_SPEEDUP], ramp->exp_rgba, sizeof ramp->exp_rgba);
     ps->textures[FOGVOL__UNIT_RAMP] = ramp->texture;
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
@@ -8941,15 +8953,15 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
     fogvol__group_color(ctx, ramp, ps);
     spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
-    if (spec == FOGVOL_SPECIALIZE_EXP && !(ctx->speedups_off & FOGVOL_SPEEDUP_FAST_EXP))
+    if (spec == FOGVOL_SPECIALIZE_EXP && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FAST_EXP))
         spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
-    spec |= fogvol__origin_bit(ctx) | ctx->count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
+    spec |= fogvol__origin_bit(ctx) | ctx->cur.count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
     ps->uniforms[FOGVOL_U_RAMP][3] = run->xsum ? (float)((double)(fd->zfar - fd->znear) / 16777216.0) : 0.0f;
     fogvol__blend_color(ctx, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
-        spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
+        spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->gpu.target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
         ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)fd->viewport[2];
         ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)fd->viewport[3];
     }
@@ -8958,10 +8970,10 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
         ps->blend_constant = 0;
         ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE, spec & ~(unsigned)FOGVOL_SPECIALIZE_BLEND_COLOR);
     }
-    if (run->xsum && ps->program == ctx->prog[FOGVOL_PROGRAM_COMPOSITE]) { /* the general one reads digits */
+    if (run->xsum && ps->program == ctx->gpu.prog[FOGVOL_PROGRAM_COMPOSITE]) { /* the general one reads digits */
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no composite program for integer sums: group not drawn "
                                                  "(FOGVOL_SPEEDUP_EXACT_SUM off from the next frame)");
-        ctx->exact_sum = 0;
+        ctx->cfg.exact_sum = 0;
         ps->program = 0;
     }
     if (!ps->program) {
@@ -8983,28 +8995,28 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
 static void fogvol__bands_forget(fogvol_context *ctx)
 {
     int i;
-    for (i = 0; i < FOGVOL_OVERFLOW_BANDS; ++i) ctx->band_count[i] = ctx->band_frame[i] = -1;
+    for (i = 0; i < FOGVOL_OVERFLOW_BANDS; ++i) ctx->ovf.band_count[i] = ctx->ovf.band_frame[i] = -1;
 }
 
 /* Counting needs the five query entries and one query that can be created. */
 static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy policy)
 {
     const fogvol_backend *b = &ctx->be;
-    ctx->overflow_policy = policy;
-    ctx->overflow_late = -1;
-    ctx->overflow_frame = -1;
-    ctx->qcur = -1;
+    ctx->cfg.overflow_policy = policy;
+    ctx->ovf.overflow_late = -1;
+    ctx->ovf.overflow_frame = -1;
+    ctx->ovf.qcur = -1;
     fogvol__bands_forget(ctx);
-    if (ctx->tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
+    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
     if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
-        b->create_query(b->user_data, &ctx->qf[0].q[0]) != FOGVOL_SUCCESS) {
-        ctx->qf[0].q[0] = 0;
+        b->create_query(b->user_data, &ctx->ovf.qf[0].q[0]) != FOGVOL_SUCCESS) {
+        ctx->ovf.qf[0].q[0] = 0;
         fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
                     "fogvol: no occlusion queries: overflow is not counted per frame (show_overflow and the "
                     "debug read-back still see it)");
         return;
     }
-    ctx->counting = 1;
+    ctx->ovf.counting = 1;
 }
 
 /* A frame's count arrived (sum: its check passes' samples). Whole-picture checks give the count;
@@ -9014,18 +9026,18 @@ static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f
 {
     int k;
     if (f->band >= 0) {
-        if (f->frame <= ctx->band_frame[f->band] || f->frame < ctx->overflow_epoch) return 0;
-        ctx->band_frame[f->band] = f->frame;
-        ctx->band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
+        if (f->frame <= ctx->ovf.band_frame[f->band] || f->frame < ctx->ovf.overflow_epoch) return 0;
+        ctx->ovf.band_frame[f->band] = f->frame;
+        ctx->ovf.band_count[f->band] = (int64_t)(sum > 0x7fffffffu ? 0x7fffffffu : sum);
         for (sum = 0, k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k)
-            if (ctx->band_count[k] > 0) sum += (uint64_t)ctx->band_count[k];
-        ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum; /* even from a late older frame */
-        if (f->frame > ctx->overflow_frame) ctx->overflow_frame = f->frame;
+            if (ctx->ovf.band_count[k] > 0) sum += (uint64_t)ctx->ovf.band_count[k];
+        ctx->ovf.overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum; /* even from a late older frame */
+        if (f->frame > ctx->ovf.overflow_frame) ctx->ovf.overflow_frame = f->frame;
         return 1;
     }
-    if (f->frame <= ctx->overflow_frame) return 0;
-    ctx->overflow_frame = f->frame;
-    ctx->overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
+    if (f->frame <= ctx->ovf.overflow_frame) return 0;
+    ctx->ovf.overflow_frame = f->frame;
+    ctx->ovf.overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
     return 1;
 }
 
@@ -9035,7 +9047,7 @@ static int fogvol__overflow_poll(fogvol_context *ctx)
 {
     int i, k, fresh = 0;
     for (i = 0; i < FOGVOL__QFRAMES; ++i) {
-        fogvol__qframe *f = &ctx->qf[i];
+        fogvol__qframe *f = &ctx->ovf.qf[i];
         uint64_t sum = 0, v = 0;
         if (!f->pending) continue;
         for (k = 0; k < f->used; ++k) {
@@ -9055,17 +9067,17 @@ static int fogvol__overflow_poll(fogvol_context *ctx)
 static int fogvol__overflow_open(fogvol_context *ctx)
 {
     int i;
-    ctx->qcur = -1;
-    if (!ctx->counting) return 0;
+    ctx->ovf.qcur = -1;
+    if (!ctx->ovf.counting) return 0;
     for (i = 0; i < FOGVOL__QFRAMES; ++i)
-        if (!ctx->qf[i].pending) {
-            ctx->qcur = i;
-            ctx->qf[i].used = 0;
-            ctx->qf[i].ok = 1;
-            ctx->qf[i].frame = ctx->frame_no;
-            ctx->qf[i].band = (ctx->speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->frame.show_overflow
+        if (!ctx->ovf.qf[i].pending) {
+            ctx->ovf.qcur = i;
+            ctx->ovf.qf[i].used = 0;
+            ctx->ovf.qf[i].ok = 1;
+            ctx->ovf.qf[i].frame = ctx->ovf.frame_no;
+            ctx->ovf.qf[i].band = (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->cur.frame.show_overflow
                                   ? -1
-                                  : (int)(ctx->frame_no % FOGVOL_OVERFLOW_BANDS);
+                                  : (int)(ctx->ovf.frame_no % FOGVOL_OVERFLOW_BANDS);
             return 1;
         }
     return 0;
@@ -9075,8 +9087,8 @@ static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
 {
     fogvol__qframe *f;
     fogvol_handle *q;
-    if (ctx->qcur < 0) return 0;
-    f = &ctx->qf[ctx->qcur];
+    if (ctx->ovf.qcur < 0) return 0;
+    f = &ctx->ovf.qf[ctx->ovf.qcur];
     q = &f->q[f->used < FOGVOL__QPER ? f->used : 0];
     if (!f->ok || f->used >= FOGVOL__QPER) {
         f->ok = 0; /* more check passes than queries: the frame is not counted */
@@ -9096,9 +9108,9 @@ static fogvol_handle fogvol__query_begin(fogvol_context *ctx)
 static void fogvol__overflow_close(fogvol_context *ctx)
 {
     fogvol__qframe *f;
-    if (ctx->qcur < 0) return;
-    f = &ctx->qf[ctx->qcur];
-    ctx->qcur = -1;
+    if (ctx->ovf.qcur < 0) return;
+    f = &ctx->ovf.qf[ctx->ovf.qcur];
+    ctx->ovf.qcur = -1;
     if (!f->ok) return;
     if (f->used > 0) f->pending = 1;
     else fogvol__overflow_arrived(ctx, f, 0);
@@ -9109,15 +9121,15 @@ static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
 {
     fogvol_target_desc td;
     fogvol_result r = FOGVOL_SUCCESS;
-    if (!ctx->prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, 0, &ctx->prog[FOGVOL_PROGRAM_CHECK]);
-    if (r == FOGVOL_SUCCESS && !ctx->tgt_v) {
+    if (!ctx->gpu.prog[FOGVOL_PROGRAM_CHECK]) r = fogvol__make_program(ctx, FOGVOL_PROGRAM_CHECK, 0, &ctx->gpu.prog[FOGVOL_PROGRAM_CHECK]);
+    if (r == FOGVOL_SUCCESS && !ctx->gpu.tgt_v) {
         memset(&td, 0, sizeof td);
-        td.width = ctx->target_w;
-        td.height = ctx->target_h;
+        td.width = ctx->gpu.target_w;
+        td.height = ctx->gpu.target_h;
         td.depth = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
         td.label = "fogvol V (overflow mask)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_v);
-        if (r != FOGVOL_SUCCESS) ctx->tgt_v = 0;
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_v);
+        if (r != FOGVOL_SUCCESS) ctx->gpu.tgt_v = 0;
     }
     if (r != FOGVOL_SUCCESS)
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create the overflow check pass: %s",
@@ -9154,20 +9166,19 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
     fogvol_pass cp = *base;
     fogvol_handle q;
     int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    if (ctx->qcur >= 0 && !fogvol__band_scissor(run, ctx->qf[ctx->qcur].band, cp.scissor)) return;
-    cp.target = ctx->tgt_v;
+    if (ctx->ovf.qcur >= 0 && !fogvol__band_scissor(run, ctx->ovf.qf[ctx->ovf.qcur].band, cp.scissor)) return;
+    cp.target = ctx->gpu.tgt_v;
     cp.read_target = 0; /* (SINGLE_TARGET: the state of the sum passes) */
     cp.clear = first;
     memset(cp.clear_color, 0, sizeof cp.clear_color);
     cp.blend = FOGVOL_PASS_BLEND_NONE;
     cp.cull = FOGVOL_CULL_NONE;
     cp.depth_test = cp.depth_write = single;
-    cp.stencil_guard = 0;
     cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, fogvol__origin_bit(ctx));
     memset(cp.native_textures, 0, sizeof cp.native_textures);
     if (single) { /* the one sum target; V is the target here, not a texture */
         memset(cp.textures, 0, sizeof cp.textures);
-        cp.textures[FOGVOL__UNIT_BACK] = ctx->tgt_b;
+        cp.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_b;
     }
     ctx->be.begin_pass(ctx->be.user_data, &cp);
     q = fogvol__query_begin(ctx);
@@ -9181,20 +9192,20 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
    targets do not). Outside a frame; on failure the old encoding stays. */
 static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
 {
-    fogvol_encoding old = ctx->enc;
+    fogvol_encoding old = ctx->cfg.enc;
     fogvol_handle t[3] = {0, 0, 0}, *cur[3];
     fogvol_result r = FOGVOL_SUCCESS;
     int i;
-    cur[0] = &ctx->tex_rg;
-    cur[1] = &ctx->tex_blue;
-    cur[2] = &ctx->tex_dither;
-    fogvol_encoding_init(old.bits - 1, &ctx->enc);
+    cur[0] = &ctx->gpu.tex_rg;
+    cur[1] = &ctx->gpu.tex_blue;
+    cur[2] = &ctx->gpu.tex_dither;
+    fogvol_encoding_init(old.bits - 1, &ctx->cfg.enc);
     for (i = 0; i < 3 && r == FOGVOL_SUCCESS; ++i)
         if (*cur[i]) r = fogvol__make_texture(ctx, i, &t[i]);
     if (r != FOGVOL_SUCCESS) {
         for (i = 0; i < 3; ++i)
             if (t[i]) ctx->be.destroy_texture(ctx->be.user_data, t[i]);
-        ctx->enc = old;
+        ctx->cfg.enc = old;
         return r;
     }
     for (i = 0; i < 3; ++i)
@@ -9209,30 +9220,30 @@ static fogvol_result fogvol__lower_bits(fogvol_context *ctx)
    change of L are not acted upon). */
 static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
 {
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), from = ctx->enc.bits;
-    int faces = single ? ctx->enc.max_faces_single : ctx->enc.max_faces;
-    if (!fresh || ctx->overflow_late <= 0 || ctx->overflow_frame < ctx->overflow_epoch) return;
-    if (ctx->overflow_policy == FOGVOL_OVERFLOW_COUNT_ONLY) return;
-    if (ctx->overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
+    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), from = ctx->cfg.enc.bits;
+    int faces = single ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces;
+    if (!fresh || ctx->ovf.overflow_late <= 0 || ctx->ovf.overflow_frame < ctx->ovf.overflow_epoch) return;
+    if (ctx->cfg.overflow_policy == FOGVOL_OVERFLOW_COUNT_ONLY) return;
+    if (ctx->cfg.overflow_policy == FOGVOL_OVERFLOW_LOWER_BITS && from > 1) {
         fogvol_result r = fogvol__lower_bits(ctx);
         if (r == FOGVOL_SUCCESS) {
             fogvol__bands_forget(ctx);
             fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                         "fogvol: %d pixels of frame %lld have more than %d faces along the ray: encoding_bits "
                         "lowered from %d to %d (%d faces) from frame %lld on",
-                        ctx->overflow_late, (long long)ctx->overflow_frame, faces, from, ctx->enc.bits,
-                        single ? ctx->enc.max_faces_single : ctx->enc.max_faces, (long long)ctx->frame_no + 1);
-            ctx->overflow_epoch = ctx->frame_no + 1;
+                        ctx->ovf.overflow_late, (long long)ctx->ovf.overflow_frame, faces, from, ctx->cfg.enc.bits,
+                        single ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces, (long long)ctx->ovf.frame_no + 1);
+            ctx->ovf.overflow_epoch = ctx->ovf.frame_no + 1;
             return;
         }
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot lower encoding_bits: %s", fogvol_result_string(r));
     }
-    if (ctx->overflow_warned) return;
-    ctx->overflow_warned = 1;
+    if (ctx->ovf.overflow_warned) return;
+    ctx->ovf.overflow_warned = 1;
     fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                 "fogvol: %d pixels of frame %lld have more than %d faces along the ray (%d-bit encoding): their "
                 "thickness is wrong (show_overflow marks them; logged once)",
-                ctx->overflow_late, (long long)ctx->overflow_frame, faces, ctx->enc.precision_bits);
+                ctx->ovf.overflow_late, (long long)ctx->ovf.overflow_frame, faces, ctx->cfg.enc.precision_bits);
 }
 
 /* FOGVOL_SPEEDUP_SKIP_CHECK: no pixel of the group's sums can saturate, so its check pass would find
@@ -9242,7 +9253,7 @@ static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
    (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
 static int fogvol__unsaturable(const fogvol_context *ctx, int volumes, int all_convex)
 {
-    return all_convex && 2 * volumes <= ctx->enc.max_faces && !(ctx->speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
+    return all_convex && 2 * volumes <= ctx->cfg.enc.max_faces && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
            !fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET);
 }
 
@@ -9256,7 +9267,7 @@ static void fogvol__group_check(fogvol_context *ctx, fogvol__run *run, const fog
         return;
     }
     run->counted = 0; /* (no query begun this frame: any earlier check would have made them) */
-    ctx->qcur = -1;
+    ctx->ovf.qcur = -1;
     run->r = r;
 }
 
@@ -9266,15 +9277,15 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
     fogvol_result r = run->r;
     if (run->counted) fogvol__overflow_close(ctx);
     if (!run->rgba8) { /* float sums cannot saturate */
-        ctx->overflow_late = 0;
-        ctx->overflow_frame = ctx->frame_no;
+        ctx->ovf.overflow_late = 0;
+        ctx->ovf.overflow_frame = ctx->ovf.frame_no;
     }
     run->st.overflow_pixels = run->overflow;
     if (run->overflow > 0 && r == FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)",
-                    run->overflow, ctx->enc.precision_bits,
-                    run->single ? ctx->enc.max_faces_single : ctx->enc.max_faces);
+                    run->overflow, ctx->cfg.enc.precision_bits,
+                    run->single ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces);
         r = FOGVOL_ERROR_DEPTH_OVERFLOW;
     }
     return r;
@@ -9290,10 +9301,10 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     fogvol_result r;
     float k;
     if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__light_ok(ctx->tier, ctx->variants)) {
+    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!fogvol__light_ok(ctx->cfg.tier, ctx->cfg.variants)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
-                    "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->tier), ctx->variants);
+                    "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     if (desc->mesh->convex != 1) {
@@ -9308,11 +9319,11 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    arr = ctx->lights;
-    r = fogvol__grow(ctx, &arr, &ctx->caplight, ctx->nlight + 1, sizeof *l);
-    ctx->lights = (fogvol__light *)arr;
+    arr = ctx->cur.lights;
+    r = fogvol__grow(ctx, &arr, &ctx->cur.caplight, ctx->cur.nlight + 1, sizeof *l);
+    ctx->cur.lights = (fogvol__light *)arr;
     if (r != FOGVOL_SUCCESS) return r;
-    l = &ctx->lights[ctx->nlight++];
+    l = &ctx->cur.lights[ctx->cur.nlight++];
     l->mesh = desc->mesh;
     memcpy(l->model, desc->model, sizeof l->model);
     k = desc->intensity != 0.0f ? desc->intensity : 1.0f;
@@ -9327,17 +9338,17 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx)
 {
     fogvol_target_desc td;
     fogvol_result r = FOGVOL_SUCCESS;
-    if (!ctx->prog[FOGVOL_PROGRAM_LIGHT])
-        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, 0, &ctx->prog[FOGVOL_PROGRAM_LIGHT]);
-    if (r == FOGVOL_SUCCESS && !ctx->tgt_l) {
+    if (!ctx->gpu.prog[FOGVOL_PROGRAM_LIGHT])
+        r = fogvol__make_program(ctx, FOGVOL_PROGRAM_LIGHT, 0, &ctx->gpu.prog[FOGVOL_PROGRAM_LIGHT]);
+    if (r == FOGVOL_SUCCESS && !ctx->gpu.tgt_l) {
         memset(&td, 0, sizeof td);
-        td.width = ctx->target_w;
-        td.height = ctx->target_h;
-        td.samples = ctx->samples;
-        td.format = ctx->tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+        td.width = ctx->gpu.target_w;
+        td.height = ctx->gpu.target_h;
+        td.samples = ctx->cur.samples;
+        td.format = ctx->cfg.tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
         td.label = "fogvol L (light front depth)";
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->tgt_l);
-        if (r != FOGVOL_SUCCESS) ctx->tgt_l = 0;
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_l);
+        if (r != FOGVOL_SUCCESS) ctx->gpu.tgt_l = 0;
     }
     if (r != FOGVOL_SUCCESS)
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
@@ -9350,18 +9361,18 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx)
    between L and the back face (convex: one front and one back face per pixel). */
 static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_pass fp = run->base, bp;
     fogvol_draw dr;
     fogvol_result r;
     int i;
-    if (!ctx->nlight) return;
+    if (!ctx->cur.nlight) return;
     if ((r = fogvol__light_setup(ctx)) != FOGVOL_SUCCESS) {
         run->r = r;
         return;
     }
-    fp.program = ctx->prog[FOGVOL_PROGRAM_LIGHT];
-    fp.target = ctx->tgt_l;
+    fp.program = ctx->gpu.prog[FOGVOL_PROGRAM_LIGHT];
+    fp.target = ctx->gpu.tgt_l;
     fp.clear = 1;
     fp.cull = FOGVOL_CULL_BACK;
     bp = fp;
@@ -9374,14 +9385,14 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
     bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
     bp.draw_buffer = fd->draw_buffer;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->tier == FOGVOL_TIER_FLOAT)
+    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
         bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     else
-        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
-    bp.textures[FOGVOL__UNIT_LFRONT] = ctx->tgt_l;
+        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
+    bp.textures[FOGVOL__UNIT_LFRONT] = ctx->gpu.tgt_l;
     bp.uniforms[FOGVOL_U_LIGHT][3] = 1.0f;
-    for (i = 0; i < ctx->nlight; ++i) {
-        const fogvol__light *l = &ctx->lights[i];
+    for (i = 0; i < ctx->cur.nlight; ++i) {
+        const fogvol__light *l = &ctx->cur.lights[i];
         fogvol__draw_for(ctx, l->model, &dr);
         ctx->be.begin_pass(ctx->be.user_data, &fp);
         ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
@@ -9408,19 +9419,19 @@ static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ra
 static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
 {
     fogvol_pass ps = run->base;
-    double range = (double)ctx->frame.zfar - ctx->frame.znear;
+    double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
     int i, c, grey = 1;
-    ps.program = ctx->prog[FOGVOL_PROGRAM_COLOR_FACE];
+    ps.program = ctx->gpu.prog[FOGVOL_PROGRAM_COLOR_FACE];
     ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->tgt_o;
-    ps.target = ctx->tgt_c;
+    else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
+    ps.target = ctx->gpu.tgt_c;
     ps.clear = 1;
     ps.blend = FOGVOL_PASS_BLEND_ADD;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
-    for (i = 0; i < ctx->nvol; ++i) {
-        const fogvol__volume *v = &ctx->vols[i];
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
         fogvol_draw dr;
         if (!fogvol__color_member(ctx, v->ramp)) continue;
         fogvol__draw_for(ctx, v->model, &dr);
@@ -9442,9 +9453,9 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
 static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
 {
     int i, k, r[4], lo[2] = {0, 0}, hi[2] = {0, 0}, any = 0;
-    for (i = 0; i < ctx->nvol; ++i) {
-        if (!fogvol__color_member(ctx, ctx->vols[i].ramp)) continue;
-        fogvol__group_rect(ctx, ctx->vols[i].ramp, r);
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        if (!fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) continue;
+        fogvol__group_rect(ctx, ctx->cur.vols[i].ramp, r);
         for (k = 0; k < 2; ++k) {
             if (!any || r[k] < lo[k]) lo[k] = r[k];
             if (!any || r[k] + r[k + 2] > hi[k]) hi[k] = r[k] + r[k + 2];
@@ -9461,19 +9472,19 @@ static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
    member is grey, else a multiply draw (scene * T) and an emission draw. */
 static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int grey)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_pass ps = run->base;
     int step;
     memset(ps.textures, 0, sizeof ps.textures);
-    ps.textures[FOGVOL__UNIT_BACK] = ctx->tgt_c;
-    ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_c2;
+    ps.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_c;
+    ps.textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_c2;
     memcpy(ps.viewport, fd->viewport, sizeof ps.viewport);
     ps.uniforms[FOGVOL_U_SCREEN][2] = -(float)fd->viewport[0]; /* window pixel -> target pixel */
     ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps.draw_buffer = fd->draw_buffer;
     ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
     if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__color_rect(ctx, ps.scissor);
-    ps.program = ctx->prog[FOGVOL_PROGRAM_COLOR_COMPOSITE];
+    ps.program = ctx->gpu.prog[FOGVOL_PROGRAM_COLOR_COMPOSITE];
     for (step = grey ? 0 : 1; step <= (grey ? 0 : 2); ++step) {
         ps.uniforms[FOGVOL_U_RAMP][2] = (float)step;
         ps.blend = step == 0 ? FOGVOL_PASS_BLEND_FOG : step == 1 ? FOGVOL_PASS_BLEND_MULTIPLY : FOGVOL_PASS_BLEND_EMIT;
@@ -9490,8 +9501,8 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 {
     int i, has_pos = 0;
     for (i = 0; i < g; ++i)
-        if (fogvol__color_member(ctx, ctx->vols[i].ramp)) return;
-    for (i = g; i < ctx->nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->vols[i].ramp) && !ctx->vols[i].negative;
+        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) return;
+    for (i = g; i < ctx->cur.nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !ctx->cur.vols[i].negative;
     if (!has_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
@@ -9507,14 +9518,14 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
     int i;
-    if ((ctx->speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->count_broken || ctx->float_o || ctx->nocc == 0 ||
-        ctx->engine_occluders || ctx->nlight > 0 || !fogvol__count_spec_ok(ctx->tier, ctx->variants))
+    if ((ctx->cfg.speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->cfg.count_broken || ctx->cfg.float_o || ctx->cur.nocc == 0 ||
+        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
         return 0;
-    for (i = 0; i < ctx->nvol; ++i) {
+    for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
-        if (ctx->vols[i].density) return 0;
-        fogvol__volume_depths(ctx, &ctx->vols[i], &emin, &emax);
-        if ((emin < ctx->frame.znear && emax > 0.0) || (emin < ctx->frame.zfar && emax > ctx->frame.zfar)) return 0;
+        if (ctx->cur.vols[i].density) return 0;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &emin, &emax);
+        if ((emin < ctx->cur.frame.znear && emax > 0.0) || (emin < ctx->cur.frame.zfar && emax > ctx->cur.frame.zfar)) return 0;
     }
     return 1;
 }
@@ -9523,12 +9534,12 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
    overflow count (earlier frames' queries polled without waiting; this frame's check passes). */
 static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
 {
-    const fogvol_frame_desc *fd = &ctx->frame;
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
-    if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->samples > 1) {
+    if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->cur.samples > 1) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "
                                                  "sample (use FOGVOL_MSAA_SINGLE_SAMPLE); nothing drawn",
-                    ctx->samples);
+                    ctx->cur.samples);
         r = FOGVOL_ERROR_UNSUPPORTED;
     }
     if (r == FOGVOL_SUCCESS) /* downsample 2: half the width and height, rounded up */
@@ -9546,14 +9557,14 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
             return r;
         }
     }
-    run->fresh = ctx->counting ? fogvol__overflow_poll(ctx) : 0;
+    run->fresh = ctx->ovf.counting ? fogvol__overflow_poll(ctx) : 0;
     run->counted = run->rgba8 && fogvol__overflow_open(ctx);
     run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
     /* SINGLE's peak check runs inside the sum passes; the others make the checks when a group first
        draws one (fogvol__group_check) */
     if (run->checks && run->single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
         run->counted = run->checks = 0;
-        ctx->qcur = -1;
+        ctx->ovf.qcur = -1;
         run->r = r;
     }
     return FOGVOL_SUCCESS;
@@ -9564,7 +9575,7 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
    subtract from nothing). */
 static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
 {
-    const fogvol_ramp *ramp = ctx->vols[g].ramp;
+    const fogvol_ramp *ramp = ctx->cur.vols[g].ramp;
     fogvol_pass ps;
     int i, has_pos = 0, has_neg = 0, n = 0, convex = 1, density = 0;
     if (fogvol__color_member(ctx, ramp)) {
@@ -9572,18 +9583,18 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
         return;
     }
     for (i = 0; i < g; ++i)
-        if (ctx->vols[i].ramp == ramp) return;
-    for (i = g; i < ctx->nvol; ++i)
-        if (ctx->vols[i].ramp == ramp) {
-            if (ctx->vols[i].negative) has_neg = 1;
+        if (ctx->cur.vols[i].ramp == ramp) return;
+    for (i = g; i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].ramp == ramp) {
+            if (ctx->cur.vols[i].negative) has_neg = 1;
             else has_pos = 1;
-            convex &= ctx->vols[i].mesh->convex == 1;
-            density |= ctx->vols[i].density != NULL;
+            convex &= ctx->cur.vols[i].mesh->convex == 1;
+            density |= ctx->cur.vols[i].density != NULL;
             ++n;
         }
     if (!has_pos) return;
     /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
-    run->xsum = ctx->exact_sum && !run->count && ctx->samples <= 1 && !density && n < 128;
+    run->xsum = ctx->cfg.exact_sum && !run->count && ctx->cur.samples <= 1 && !density && n < 128;
     run->st.groups++;
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
@@ -9593,7 +9604,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, n, convex)) { /* (integers cannot saturate) */
         fogvol__group_check(ctx, run, &ps);
     }
-    if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->tgt_v; /* the peak check's mask, for show_overflow */
+    if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
@@ -9602,15 +9613,15 @@ static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run,
                                          fogvol_frame_stats *stats)
 {
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    run->st.frame = ctx->frame_no;
-    run->st.overflow_pixels_late = ctx->overflow_late;
-    run->st.overflow_frame = ctx->overflow_frame;
+    run->st.frame = ctx->ovf.frame_no;
+    run->st.overflow_pixels_late = ctx->ovf.overflow_late;
+    run->st.overflow_frame = ctx->ovf.overflow_frame;
     fogvol__overflow_react(ctx, run->fresh);
-    ctx->frame_no++;
-    ctx->in_frame = 0;
-    ctx->mrt_ready = 0;
-    ctx->engine_occluders = 0;
-    ctx->nvol = ctx->nocc = 0;
+    ctx->ovf.frame_no++;
+    ctx->cur.in_frame = 0;
+    ctx->cur.mrt_ready = 0;
+    ctx->cur.engine_occluders = 0;
+    ctx->cur.nvol = ctx->cur.nocc = 0;
     if (stats) *stats = run->st;
     return r;
 }
@@ -9625,27 +9636,27 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.overflow_frame = -1;
     if (stats) *stats = run.st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
     r = fogvol__frame_refusal(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__begin_backend_frame(ctx, &run.info);
     if (r != FOGVOL_SUCCESS) {
         fogvol_cancel_frame(ctx);
         return r;
     }
-    run.w = ctx->frame.viewport[2];
-    run.h = ctx->frame.viewport[3];
+    run.w = ctx->cur.frame.viewport[2];
+    run.h = ctx->cur.frame.viewport[3];
     run.single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    ctx->count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
-    run.count = ctx->count_frame = fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || ctx->count_bit;
+    ctx->cur.count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
+    run.count = ctx->cur.count_frame = fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || ctx->cur.count_bit;
     run.st.depth_tested = run.count;
-    run.st.inline_resolved = ctx->inline_resolve;
-    run.rgba8 = ctx->tier != FOGVOL_TIER_FLOAT;
+    run.st.inline_resolved = ctx->cfg.inline_resolve;
+    run.rgba8 = ctx->cfg.tier != FOGVOL_TIER_FLOAT;
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {
         fogvol__frame_uniforms(ctx, &run);
         fogvol__opaque_pass(ctx, &run);
         fogvol__light_passes(ctx, &run);
-        for (g = 0; g < ctx->nvol; ++g) fogvol__group(ctx, &run, g);
+        for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
@@ -9786,7 +9797,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
                                                 : 5;
     fogvol_program_desc pd;
     fogvol_result r;
-    if (!ctx->post_prog[slot]) {
+    if (!ctx->gpu.post_prog[slot]) {
         memset(&pd, 0, sizeof pd);
         r = fogvol_post_shader_strings(effect, variant, ctx->be.dialect, FOGVOL_STAGE_VERTEX, pd.vs, &pd.vs_count);
         if (r == FOGVOL_SUCCESS)
@@ -9798,15 +9809,15 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
                          : effect == FOGVOL_POST_OUTLINES && variant ? "fv_pnormal"
                                                                      : NULL;
         pd.label = labels[effect];
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->post_prog[slot]);
+        if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
                         labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
-            ctx->post_prog[slot] = 0;
+            ctx->gpu.post_prog[slot] = 0;
             return r;
         }
     }
-    *out = ctx->post_prog[slot];
+    *out = ctx->gpu.post_prog[slot];
     return FOGVOL_SUCCESS;
 }
 
@@ -9816,7 +9827,7 @@ static fogvol_result fogvol__post_check(fogvol_context *ctx, const fogvol_frame_
                                         const char *what)
 {
     const char *why = NULL;
-    if (ctx->in_frame) {
+    if (ctx->cur.in_frame) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s inside an open frame (call it after end_frame)", what);
         return FOGVOL_ERROR_INVALID_STATE;
     }
@@ -9876,7 +9887,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ps->uniforms[FOGVOL_U_SCREEN][3] = -(float)vp[1];
     ps->uniforms[FOGVOL_U_POST_TEXEL][0] = 1.0f / (float)tw;
     ps->uniforms[FOGVOL_U_POST_TEXEL][1] = 1.0f / (float)th;
-    ps->uniforms[FOGVOL_U_POST_TEXEL][2] = ctx->wscale > 0.0 ? 1.0f : 0.0f;
+    ps->uniforms[FOGVOL_U_POST_TEXEL][2] = ctx->cur.wscale > 0.0 ? 1.0f : 0.0f;
     ps->uniforms[FOGVOL_U_POST_RECT][0] = (float)vp[0] + 0.5f;
     ps->uniforms[FOGVOL_U_POST_RECT][1] = (float)vp[1] + 0.5f;
     ps->uniforms[FOGVOL_U_POST_RECT][2] = (float)(vp[0] + vp[2]) - 0.5f;
@@ -10418,7 +10429,6 @@ typedef struct fogvol__gl {
     fogvol_logger log;
     int major, minor, gles, core;
     int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
-    int stencil_override;
     int has_msaa; /* multisample textures and per-sample shading */
     int float_linear; /* R32F textures can be filtered (GL 3.0; GLES 3 + OES_texture_float_linear) */
     int mrt_highp;    /* fogvol_gl_desc.mrt_highp */
@@ -10433,9 +10443,7 @@ typedef struct fogvol__gl {
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
-    int in_frame, guard;
-    unsigned guard_bit;
-    int guard_box[4];
+    int in_frame;
     fogvol__gl_program *program;
     fogvol__gl_mesh fullscreen;
     fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
@@ -10970,7 +10978,6 @@ static fogvol_result fogvol__gl_check_draw_buffer(fogvol__gl *gl, int k)
 static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
-    fogvol__GLint bits = 0;
     fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
     fogvol__gl_host_enter(gl);
@@ -10982,21 +10989,6 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     }
     gl->in_frame = 1;
     fogvol__gl_pixel_defaults(gl);
-    if (gl->stencil_override > 0) {
-        bits = gl->stencil_override;
-    } else if (gl->core) {
-        fogvol__GLint type = 0;
-        gl->GetFramebufferAttachmentParameteriv(FOGVOL__GL_DRAW_FRAMEBUFFER,
-                                                gl->saved.draw_fbo ? FOGVOL__GL_STENCIL_ATTACHMENT : FOGVOL__GL_STENCIL,
-                                                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-        if (type != 0)
-            gl->GetFramebufferAttachmentParameteriv(
-                FOGVOL__GL_DRAW_FRAMEBUFFER, gl->saved.draw_fbo ? FOGVOL__GL_STENCIL_ATTACHMENT : FOGVOL__GL_STENCIL,
-                FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE, &bits);
-    } else {
-        gl->GetIntegerv(FOGVOL__GL_STENCIL_BITS, &bits);
-    }
-    info->stencil_bits = bits;
     if (gl->has_msaa) { /* of the engine's draw framebuffer, still bound */
         fogvol__GLint buffers = 0, samples = 0;
         gl->GetIntegerv(FOGVOL__GL_SAMPLE_BUFFERS, &buffers);
@@ -11490,28 +11482,6 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
         gl->BlendEquationSeparate(FOGVOL__GL_FUNC_ADD, FOGVOL__GL_FUNC_ADD);
 }
 
-/* The stencil guard of a pass: its bit cleared over the viewport, then each pixel blended once. */
-static void fogvol__gl_pass_guard(fogvol__gl *gl, const fogvol_pass *p)
-{
-    gl->guard = p->stencil_guard;
-    if (!p->stencil_guard) {
-        gl->Disable(FOGVOL__GL_STENCIL_TEST);
-        return;
-    }
-    gl->guard_bit = p->stencil_bit;
-    memcpy(gl->guard_box, p->viewport, sizeof gl->guard_box);
-    gl->Enable(FOGVOL__GL_STENCIL_TEST);
-    gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, p->stencil_bit);
-    gl->ClearStencil(0);
-    gl->Enable(FOGVOL__GL_SCISSOR_TEST);
-    gl->Scissor(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
-    gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
-    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-    gl->StencilFuncSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_NOTEQUAL, (fogvol__GLint)p->stencil_bit,
-                            p->stencil_bit);
-    gl->StencilOpSeparate(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_KEEP, FOGVOL__GL_KEEP, FOGVOL__GL_REPLACE);
-}
-
 /* The program of a pass with its uniforms, and its textures on fogvol's units. */
 static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
 {
@@ -11586,24 +11556,9 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
     gl->DepthFunc(FOGVOL__GL_LESS);
     gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
-    fogvol__gl_pass_guard(gl, p);
+    gl->Disable(FOGVOL__GL_STENCIL_TEST); /* the engine's stencil buffer is its own */
     fogvol__gl_pass_program(gl, p);
     fogvol__gl_sample_pass(gl, p);
-}
-
-static void fogvol__gl_end_pass(void *u)
-{
-    fogvol__gl *gl = (fogvol__gl *)u;
-    if (!gl->guard) return;
-    /* leave the guard bit zero, as it was before the pass */
-    gl->Enable(FOGVOL__GL_SCISSOR_TEST);
-    gl->Scissor(gl->guard_box[0], gl->guard_box[1], gl->guard_box[2], gl->guard_box[3]);
-    gl->StencilMaskSeparate(FOGVOL__GL_FRONT_AND_BACK, gl->guard_bit);
-    gl->ClearStencil(0);
-    gl->Clear(FOGVOL__GL_STENCIL_BUFFER_BIT);
-    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
-    gl->Disable(FOGVOL__GL_STENCIL_TEST);
-    gl->guard = 0;
 }
 
 static void fogvol__gl_set_draw(void *u, const fogvol_draw *d)
@@ -12146,7 +12101,6 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
     fogvol_result r;
     gl->dialect = desc->dialect;
     if (gl->dialect == FOGVOL_GLSL_AUTO) gl->dialect = fogvol__dialect_for_gl(gl->gles, gl->major, gl->minor);
-    gl->stencil_override = desc->stencil_bits;
     gl->mrt_highp = desc->mrt_highp != 0;
     gl->caps = fogvol__gl_caps(gl, ext);
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
@@ -12195,7 +12149,6 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->set_draw = fogvol__gl_set_draw;
     out->draw_mesh = fogvol__gl_draw_mesh;
     out->draw_fullscreen = fogvol__gl_draw_fullscreen;
-    out->end_pass = fogvol__gl_end_pass;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
     if (gl->has_query) {

@@ -100,7 +100,7 @@ static void engine_state(GLint s[8])
 /* begin_frame (optional). Called first by fogvol_end_frame (and fogvol_mrt_prepare),
    before any pass. Must save every piece of engine state the passes will change and
    report the engine framebuffer (the one bound now, "target 0" of the passes) in
-   info->stencil_bits. On failure it must leave everything unchanged: the frame is
+   info (its samples and depth conventions). On failure it must leave everything unchanged: the frame is
    dropped and end_frame is not called. */
 static fogvol_result rec_begin_frame(void *u, fogvol_frame_info *info)
 {
@@ -220,7 +220,7 @@ static void rec_destroy_mesh(void *u, fogvol_handle h)
 /* begin_pass. Make the pass current: render into pass->target (0 = the framebuffer that
    was bound at begin_frame), viewport, clear colour (and depth to 1 when the target has
    its own depth) if pass->clear, blend mode, culling (front faces counter-clockwise),
-   depth test LESS and depth writes as given, the stencil guard, pass->program with the
+   depth test LESS and depth writes as given, no stencil test, pass->program with the
    pass->uniforms, textures[i] (or native_textures[i]) on unit i. Everything else in a
    neutral state: no scissor, full colour mask, no dithering, filled polygons. */
 static void rec_begin_pass(void *u, const fogvol_pass *p)
@@ -263,8 +263,8 @@ static void rec_draw_fullscreen(void *u)
     r->inner.draw_fullscreen(r->inner.user_data);
 }
 
-/* end_pass (optional). The pass's draws are done; with a stencil guard, put the guard
-   bit back to 0 inside the viewport (it was 0 before the pass). */
+/* end_pass (optional). The pass's draws are done (a backend that records into command
+   buffers ends its render pass here). */
 static void rec_end_pass(void *u)
 {
     recorder *r = (recorder *)u;

@@ -10,7 +10,7 @@
  *      group in order of first appearance: B (ADD, cull FRONT, clear), [B without
  *      clear, cull BACK, negatives], F (cull BACK, clear), [F cull FRONT, negatives],
  *      composite into target 0 (FOG or LIGHT blend; full-screen: one draw_fullscreen;
- *      geometry: stencil guard, cull FRONT, one draw_mesh per positive volume).
+ *      geometry: the full-screen triangle under the group's scissor).
  *      Draw lists per pass, frame stats, viewports, fv_screen, fv_enc, fv_dith,
  *      fv_dec, fv_rampmap, per-draw depth rows (d = (w - near)/(far - near) at hand
  *      computed points), clip w, mirror winding (front_cw).
@@ -505,7 +505,7 @@ typedef struct xpass {
     float clear_color[4];
     fogvol_pass_blend blend;
     fogvol_cull cull;
-    int depth_test, depth_write, guard;
+    int depth_test, depth_write;
     fogvol_handle program;
     fogvol_handle tex[FOGVOL_MAX_TEXTURE_UNITS];
     float screen[4];
@@ -539,7 +539,7 @@ static void x_composite(xpass *x, fogvol_pass_blend blend, int geometry, fogvol_
     x->vp[2] = A_W;
     x->vp[3] = A_H;
     x->blend = blend;
-    (void)geometry; /* both composites: the full-screen program, no stencil guard (geometry adds a scissor) */
+    (void)geometry; /* both composites: the full-screen program (geometry adds a scissor) */
     x->cull = FOGVOL_CULL_NONE;
     x->program = program;
     x->tex[0] = b;
@@ -572,7 +572,6 @@ static void check_pass(const rec *r, int i, const xpass *x, const char *what)
     if (p->cull != x->cull) fail_msg("%s: cull %d, want %d", w, (int)p->cull, (int)x->cull);
     if ((p->depth_test != 0) != (x->depth_test != 0)) fail_msg("%s: depth_test %d", w, p->depth_test);
     if ((p->depth_write != 0) != (x->depth_write != 0)) fail_msg("%s: depth_write %d", w, p->depth_write);
-    if ((p->stencil_guard != 0) != (x->guard != 0)) fail_msg("%s: stencil_guard %d", w, p->stencil_guard);
     if (p->program != x->program) fail_msg("%s: program %lu, want %lu", w, (unsigned long)p->program, (unsigned long)x->program);
     for (k = 0; k < FOGVOL_MAX_TEXTURE_UNITS; ++k)
         if (x->tex[k] && p->textures[k] != x->tex[k])
@@ -668,7 +667,7 @@ static void a1_build(a1_scene *s)
     mat_ts(s->omodel[1], -2, 0, 0, 1, 1, 1);
 }
 
-static void a1_submit(a1_scene *s, fogvol_composite comp, unsigned stencil_bit, fogvol_frame_stats *st)
+static void a1_submit(a1_scene *s, fogvol_composite comp, fogvol_frame_stats *st)
 {
     static const int ramp_of[5] = {1, 0, 1, 1, 0}; /* 1 = light */
     static const int neg[5] = {0, 0, 1, 0, 0};
@@ -676,7 +675,6 @@ static void a1_submit(a1_scene *s, fogvol_composite comp, unsigned stencil_bit, 
     int i;
     a_frame_desc(&fd);
     fd.composite = comp;
-    fd.stencil_bit = stencil_bit;
     assert_int_equal(fogvol_begin_frame(s->fv, &fd), FOGVOL_SUCCESS);
     for (i = 0; i < 2; ++i) assert_int_equal(fogvol_add_occluder(s->fv, s->occ[i], s->omodel[i]), FOGVOL_SUCCESS);
     for (i = 0; i < 5; ++i) {
@@ -737,7 +735,7 @@ static fogvol_handle mh(const fogvol_mesh *m)
     return 0;
 }
 
-static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
+static void a1_check(a1_scene *s, int geometry)
 {
     rec *r = &s->r;
     fogvol_frame_stats st;
@@ -764,7 +762,7 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
     }
 
     log_reset(&s->lc);
-    a1_submit(s, geometry ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN, want_bit == 0x80 ? 0 : want_bit, &st);
+    a1_submit(s, geometry ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN, &st);
     assert_int_equal(s->lc.errors + s->lc.warnings, 0);
     assert_int_equal(r->protocol_errors, 0);
 
@@ -880,7 +878,6 @@ static void a1_check(a1_scene *s, int geometry, unsigned want_bit)
             for (c = 0; c < 4; ++c) assert_close(r->nb.passes[i].clear_color[c], 0.0, 1e-7, "B/F clear colour");
         }
     }
-    (void)want_bit; /* the stencil bit is unused: no pass has a stencil guard (check_pass) */
     for (i = 5; i < 9; i += 3) { /* a scissor inside the viewport (full-screen too: FOGVOL_SPEEDUP_SCISSOR) */
         const int *sc = r->nb.passes[i].scissor;
         (void)geometry;
@@ -938,7 +935,7 @@ static void test_a1_pass_structure_fullscreen(void **state)
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
     (void)state;
     a1_build(s);
-    a1_check(s, 0, 0x80);
+    a1_check(s, 0);
     a1_free(s);
     free(s);
 }
@@ -1046,7 +1043,7 @@ static void test_a1_pass_structure_min_compare(void **state)
     (void)state;
     g_rec_speedups_off = FOGVOL_SPEEDUP_DEPTH_TEST;
     a1_build(s);
-    a1_check(s, 0, 0x80);
+    a1_check(s, 0);
     a1_free(s);
     free(s);
     g_rec_speedups_off = 0;
@@ -1057,39 +1054,25 @@ static void test_a1_pass_structure_geometry(void **state)
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
     (void)state;
     a1_build(s);
-    a1_check(s, 1, 0x80);
+    a1_check(s, 1);
     a1_free(s);
     free(s);
 }
 
-static void test_a1_geometry_stencil_bit(void **state)
-{
-    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
-    (void)state;
-    a1_build(s);
-    a1_check(s, 1, 0x04); /* the frame's stencil_bit is ignored: no stencil guard */
-    a1_free(s);
-    free(s);
-}
-
-/* A geometry composite without an engine stencil buffer works as with one (it uses no stencil):
-   no warning, the full-screen triangle under a scissor. */
+/* A geometry composite: no warning, the full-screen triangle under a scissor. */
 static void test_a1_geometry_without_stencil(void **state)
 {
     a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
     fogvol_frame_stats st;
     (void)state;
     a1_build(s);
-    s->r.nb.stencil_bits = 0;
     log_reset(&s->lc);
-    a1_submit(s, FOGVOL_COMPOSITE_GEOMETRY, 0, &st);
+    a1_submit(s, FOGVOL_COMPOSITE_GEOMETRY, &st);
     assert_int_equal(st.passes, 9);
     assert_int_equal(s->lc.warnings, 0);
     assert_true(s->r.nb.passes[5].scissor[2] > 0);
-    assert_int_equal(s->r.nb.passes[5].stencil_guard, 0);
     assert_int_equal(s->r.nb.fullscreen[5], 1);
     assert_int_equal(s->r.nb.draws[5], 0);
-    assert_int_equal(s->r.nb.passes[8].stencil_guard, 0);
     assert_int_equal(s->r.nb.fullscreen[8], 1);
     a1_free(s);
     free(s);
@@ -2925,7 +2908,6 @@ int main(void)
         cmocka_unit_test(test_a1_pass_structure_min_compare),
         cmocka_unit_test(test_a1_depth_test_frames),
         cmocka_unit_test(test_a1_pass_structure_geometry),
-        cmocka_unit_test(test_a1_geometry_stencil_bit),
         cmocka_unit_test(test_a1_geometry_without_stencil),
         cmocka_unit_test(test_a2_negative_only_group),
         cmocka_unit_test(test_a3_frame_protocol),
