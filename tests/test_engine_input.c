@@ -656,13 +656,32 @@ static void walk_scene(tobj *o)
     o[2].sign = 0;
 }
 
-/* the ray cast of view v: thickness, interior pixels, and for a multisampled source how far the
-   nearest occluder's depth moves across each pixel (its resolve keeps one sample) */
-static void walk_truth(walk *wk, const rc_camera *c, int occluders)
+/* The ray casts of the walk's views, made once for all sources and tiers (slot frame * 2 + view). */
+static struct {
+    int have[WALK_FRAMES * 2];
+    double *gt, *spread;
+    unsigned char *interior;
+} g_walk_truth;
+
+/* the ray cast of view v: thickness, interior pixels, and how far the nearest occluder's depth moves
+   across each pixel (a multisampled source's resolve keeps one sample) */
+static void walk_truth(walk *wk, const rc_camera *c, const sq_view *v)
 {
     rc_object ro[3];
     rc_scene rs;
-    int i, x, y, n = occluders ? 3 : 1;
+    int i, x, y, n = v->occluders ? 3 : 1, slot = v->frame * 2 + v->view;
+    size_t off = (size_t)slot * SW * SH, np = (size_t)c->width * c->height;
+    if (!g_walk_truth.gt) {
+        g_walk_truth.gt = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
+        g_walk_truth.spread = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
+        g_walk_truth.interior = (unsigned char *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, 1);
+    }
+    if (g_walk_truth.have[slot]) {
+        memcpy(wk->gt, g_walk_truth.gt + off, np * sizeof(double));
+        memcpy(wk->spread, g_walk_truth.spread + off, np * sizeof(double));
+        memcpy(wk->interior, g_walk_truth.interior + off, np);
+        return;
+    }
     for (i = 0; i < n; ++i) {
         ro[i].pos = wk->o[i].m.pos;
         ro[i].vcount = wk->o[i].m.vcount;
@@ -680,7 +699,7 @@ static void walk_truth(walk *wk, const rc_camera *c, int occluders)
             wk->gt[p] = r.thickness;
             wk->interior[p] = (unsigned char)rc_interior(&rs, c, x, y);
             wk->spread[p] = 0.0;
-            if (!wk->src->samples || !wk->interior[p]) continue;
+            if (!wk->interior[p]) continue;
             ctr = r.opaque_w;
             for (k = 0; k < 4; ++k) {
                 double o = rc_trace(&rs, c, x + (k & 1), y + (k >> 1)).opaque_w;
@@ -689,6 +708,10 @@ static void walk_truth(walk *wk, const rc_camera *c, int occluders)
             }
         }
     rc_scene_free(&rs);
+    memcpy(g_walk_truth.gt + off, wk->gt, np * sizeof(double));
+    memcpy(g_walk_truth.spread + off, wk->spread, np * sizeof(double));
+    memcpy(g_walk_truth.interior + off, wk->interior, np);
+    g_walk_truth.have[slot] = 1;
 }
 
 /* the engine's depth buffer that fogvol must leave alone: the draw framebuffer's at end_frame */
@@ -772,7 +795,7 @@ static void walk_view(void *user, const sq_view *v, sq_check *out)
     wk->gl_errors += glGetError() != GL_NO_ERROR;
     walk_read_depth(wk->za); /* the depth buffer bound for drawing: the engine's, untouched */
     for (i = 0; i < SW * SH; ++i) wk->depth_changed += wk->za[i] != wk->zb[i];
-    walk_truth(wk, &c, v->occluders);
+    walk_truth(wk, &c, v);
     /* as test_engine_depth_buffers: FLOAT 1e-4 of the range, PS20 1 LSB of the 12-bit encoding
        (one pair of faces), + the depth quantum at the farthest occluder; a multisampled source's
        resolve keeps one of the pixel's samples: + the occluder's depth spread over the pixel */
@@ -781,7 +804,7 @@ static void walk_view(void *user, const sq_view *v, sq_check *out)
     for (i = 0; i < npx; ++i) {
         double err;
         if (!wk->interior[i]) continue;
-        err = fabs(wk->thick[i] - wk->gt[i]) - wk->spread[i];
+        err = fabs(wk->thick[i] - wk->gt[i]) - (wk->src->samples ? wk->spread[i] : 0.0);
         out->pixels++;
         if (r != FOGVOL_SUCCESS) { /* no fog drawn: the whole view is wrong */
             out->wrong++;
@@ -888,6 +911,10 @@ static void test_engine_depth_walk(void **state)
             walk_teardown(&wk);
         }
     glu_destroy(&g);
+    free(g_walk_truth.gt);
+    free(g_walk_truth.spread);
+    free(g_walk_truth.interior);
+    memset(&g_walk_truth, 0, sizeof g_walk_truth);
     print_message("# walk: %ld wrong pixels, %ld engine depth values changed, %d failed views\n", wrong, changed,
                   failed);
     assert_int_equal(wrong, 0);
@@ -990,6 +1017,143 @@ static void test_engine_occluders(void **state)
     free(interior);
     free(te);
     free(tf);
+}
+
+/* The engine-drawn occluders as a sequence (tests/sequence.h's default script): the camera walks
+   into the sphere and out, the engine draws its occluders into fogvol's O in the frames that have
+   them and does not call fogvol_occluder_prepare in the others (fogvol's own O, the far plane, must
+   take over), the viewport shrinks and splits (O has the viewport's size), a cancelled frame comes
+   in between. Each view against the ray cast of its own camera and occluders, 1 LSB per pair of
+   faces (FLOAT 1e-4 of the range) on interior pixels. */
+typedef struct occseq {
+    fogvol_tier tier;
+    engine e;
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    tobj *o;
+    float *thick;
+    GLuint fbo, depth;
+} occseq;
+
+static rc_camera occseq_camera(double w, const int vp[4])
+{
+    rc_camera c = camera();
+    static const double e1[3] = {0.3, 0.2, 0.5}; /* inside the sphere (radius 1.5 at the origin) */
+    int i;
+    for (i = 0; i < 3; ++i) c.eye[i] += (e1[i] - c.eye[i]) * w;
+    c.target[0] = c.eye[0] - 2.0;
+    c.target[1] = c.eye[1] - 1.5;
+    c.target[2] = c.eye[2] - 6.0;
+    c.aspect = (double)vp[2] / vp[3];
+    c.width = vp[2];
+    c.height = vp[3];
+    return c;
+}
+
+static void occseq_cancel(void *user, const sq_view *v)
+{
+    occseq *q = (occseq *)user;
+    rc_camera c = occseq_camera(1.0 - v->walk, v->viewport);
+    fogvol_frame_desc fd;
+    frame_of(&fd, &c, NULL);
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
+    assert_int_equal(fogvol_cancel_frame(q->fv), FOGVOL_SUCCESS);
+}
+
+static void occseq_view(void *user, const sq_view *v, sq_check *out)
+{
+    occseq *q = (occseq *)user;
+    rc_camera c = occseq_camera(v->walk, v->viewport);
+    fogvol_frame_desc fd;
+    fogvol_occluder_info oi;
+    rc_object ro[2];
+    rc_scene rs;
+    int i, x, y, n = v->occluders ? 2 : 1;
+    double range = c.zfar - c.znear;
+    frame_of(&fd, &c, q->thick);
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    if (v->occluders) { /* the engine's pass into fogvol's O, with its own depth buffer of O's size */
+        assert_int_equal(fogvol_occluder_prepare(q->fv, &oi), FOGVOL_SUCCESS);
+        assert_int_equal(oi.width, v->viewport[2]);
+        assert_int_equal(oi.height, v->viewport[3]);
+        glBindRenderbuffer(GL_RENDERBUFFER, q->depth);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, oi.width, oi.height);
+        glBindFramebuffer(GL_FRAMEBUFFER, q->fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, q->depth);
+        assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+        glViewport(0, 0, oi.width, oi.height);
+        glClearBufferfv(GL_COLOR, 0, oi.clear_color);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        engine_draw(&q->e, q->o, 2, fd.view, fd.projection, oi.uniforms);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+    add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
+    assert_int_equal(fogvol_end_frame(q->fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    for (i = 0; i < n; ++i) {
+        ro[i].pos = q->o[i].m.pos;
+        ro[i].vcount = q->o[i].m.vcount;
+        ro[i].idx = q->o[i].m.idx;
+        ro[i].icount = q->o[i].m.icount;
+        memcpy(ro[i].model, q->o[i].model, sizeof ro[i].model);
+        ro[i].sign = q->o[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, n));
+    out->bound = q->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0;
+    for (y = 0; y < c.height; ++y)
+        for (x = 0; x < c.width; ++x) {
+            double err;
+            if (!rc_interior(&rs, &c, x, y)) continue;
+            err = fabs(q->thick[y * c.width + x] - rc_trace(&rs, &c, x + 0.5, y + 0.5).thickness);
+            out->pixels++;
+            out->wrong += err > out->bound;
+            if (err > out->max_err) out->max_err = err;
+        }
+    rc_scene_free(&rs);
+}
+
+static void test_engine_occluders_sequence(void **state)
+{
+    static const fogvol_tier tiers[3] = {FOGVOL_TIER_PS20, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
+    tobj o[2];
+    int t;
+    glu_ctx g;
+    (void)state;
+    scene(o);
+    assert_true(glu_create(&g, W, H, 1));
+    for (t = 0; t < 3; ++t) {
+        occseq q;
+        char name[64];
+        memset(&q, 0, sizeof q);
+        q.tier = tiers[t];
+        q.o = o;
+        g_speedups_off = t == 1 ? FOGVOL_SPEEDUP_FLOAT_O : 0u; /* PS20 with an R32F O, then an RGBA8 one */
+        q.fv = make_ctx(q.tier, 0);
+        q.vol = mesh_of(q.fv, &o[0].m, 0);
+        q.ramp = ramp_of(q.fv);
+        q.thick = (float *)calloc((size_t)W * H, sizeof(float));
+        engine_init(&q.e);
+        glGenFramebuffers(1, &q.fbo);
+        glGenRenderbuffers(1, &q.depth);
+        snprintf(name, sizeof name, "engine occluders %s%s", fogvol_tier_name(q.tier), t == 1 ? " (RGBA8 O)" : "");
+        sq_run(name, W, H, sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, occseq_view, occseq_cancel, &q);
+        glDeleteFramebuffers(1, &q.fbo);
+        glDeleteRenderbuffers(1, &q.depth);
+        glDeleteProgram(q.e.prog);
+        fogvol_destroy_mesh(q.fv, q.vol);
+        fogvol_destroy_ramp(q.fv, q.ramp);
+        fogvol_destroy_context(q.fv);
+        free(q.thick);
+    }
+    g_speedups_off = 0;
+    glu_destroy(&g);
+    free_objs(o, 2);
 }
 
 static void test_engine_occluder_refusals(void **state)
@@ -1430,7 +1594,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_engine_depth_buffers),     cmocka_unit_test(test_engine_depth_refusals),
         cmocka_unit_test(test_engine_depth_walk),
-        cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluder_refusals),
+        cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluders_sequence),
+        cmocka_unit_test(test_engine_occluder_refusals),
         cmocka_unit_test(test_weld_seam_sphere),         cmocka_unit_test(test_weld_face_cube),
         cmocka_unit_test(test_interleaved_16bit),        cmocka_unit_test(test_mesh_bad_layouts),
     };
