@@ -998,5 +998,6 @@ int main(void)
         cmocka_unit_test(test_camera_refused),
         cmocka_unit_test(test_conventions),
     };
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

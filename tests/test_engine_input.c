@@ -1599,6 +1599,7 @@ int main(void)
         cmocka_unit_test(test_weld_seam_sphere),         cmocka_unit_test(test_weld_face_cube),
         cmocka_unit_test(test_interleaved_16bit),        cmocka_unit_test(test_mesh_bad_layouts),
     };
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests_name("engine input (depth buffers, engine occluders, engine meshes)", tests, NULL,
                                        NULL);
 }

@@ -1330,6 +1330,7 @@ int main(void)
     tests[n++].test_func = test_null_backend;
     tests[n].name = "cost";
     tests[n++].test_func = test_cost;
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     n = cmocka_run_group_tests_name("engine_msaa", tests, NULL, NULL); /* zeroed entries are skipped */
     free(g_truth);
     free(g_edge);
