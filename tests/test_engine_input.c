@@ -1022,9 +1022,9 @@ static void test_engine_occluders(void **state)
 /* The engine-drawn occluders as a sequence (tests/sequence.h's default script): the camera walks
    into the sphere and out, the engine draws its occluders into fogvol's O in the frames that have
    them and does not call fogvol_occluder_prepare in the others (fogvol's own O, the far plane, must
-   take over), the viewport shrinks and splits (O has the viewport's size), a cancelled frame comes
-   in between. Each view against the ray cast of its own camera and occluders, 1 LSB per pair of
-   faces (FLOAT 1e-4 of the range) on interior pixels. */
+   take over), the viewport shrinks and splits (O has the viewport's size), a cancelled frame in
+   which the engine drew its occluders comes in between. Each view against the ray cast of its own
+   camera and occluders, 1 LSB per pair of faces (FLOAT 1e-4 of the range) on interior pixels. */
 typedef struct occseq {
     fogvol_tier tier;
     engine e;
@@ -1051,6 +1051,25 @@ static rc_camera occseq_camera(double w, const int vp[4])
     return c;
 }
 
+static void occseq_engine_o(occseq *q, const fogvol_frame_desc *fd)
+{
+    fogvol_occluder_info oi;
+    assert_int_equal(fogvol_occluder_prepare(q->fv, &oi), FOGVOL_SUCCESS);
+    assert_int_equal(oi.width, fd->viewport[2]);
+    assert_int_equal(oi.height, fd->viewport[3]);
+    glBindRenderbuffer(GL_RENDERBUFFER, q->depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, oi.width, oi.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, q->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, q->depth);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glViewport(0, 0, oi.width, oi.height);
+    glClearBufferfv(GL_COLOR, 0, oi.clear_color);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    engine_draw(&q->e, q->o, 2, fd->view, fd->projection, oi.uniforms);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
 static void occseq_cancel(void *user, const sq_view *v)
 {
     occseq *q = (occseq *)user;
@@ -1059,6 +1078,7 @@ static void occseq_cancel(void *user, const sq_view *v)
     frame_of(&fd, &c, NULL);
     memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
     assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    occseq_engine_o(q, &fd); /* the engine's occluders of a frame that is given up */
     add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
     assert_int_equal(fogvol_cancel_frame(q->fv), FOGVOL_SUCCESS);
 }
@@ -1068,7 +1088,6 @@ static void occseq_view(void *user, const sq_view *v, sq_check *out)
     occseq *q = (occseq *)user;
     rc_camera c = occseq_camera(v->walk, v->viewport);
     fogvol_frame_desc fd;
-    fogvol_occluder_info oi;
     rc_object ro[2];
     rc_scene rs;
     int i, x, y, n = v->occluders ? 2 : 1;
@@ -1077,22 +1096,7 @@ static void occseq_view(void *user, const sq_view *v, sq_check *out)
     memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
-    if (v->occluders) { /* the engine's pass into fogvol's O, with its own depth buffer of O's size */
-        assert_int_equal(fogvol_occluder_prepare(q->fv, &oi), FOGVOL_SUCCESS);
-        assert_int_equal(oi.width, v->viewport[2]);
-        assert_int_equal(oi.height, v->viewport[3]);
-        glBindRenderbuffer(GL_RENDERBUFFER, q->depth);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, oi.width, oi.height);
-        glBindFramebuffer(GL_FRAMEBUFFER, q->fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, q->depth);
-        assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
-        glViewport(0, 0, oi.width, oi.height);
-        glClearBufferfv(GL_COLOR, 0, oi.clear_color);
-        glClear(GL_DEPTH_BUFFER_BIT);
-        engine_draw(&q->e, q->o, 2, fd.view, fd.projection, oi.uniforms);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    }
+    if (v->occluders) occseq_engine_o(q, &fd); /* the engine's pass into fogvol's O, its own depth buffer */
     add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
     assert_int_equal(fogvol_end_frame(q->fv, NULL), FOGVOL_SUCCESS);
     assert_int_equal(glGetError(), GL_NO_ERROR);
