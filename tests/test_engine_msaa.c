@@ -1159,6 +1159,35 @@ static void test_refusals(void **state)
     }
     fv_destroy(&s);
 
+    /* the engine's depth per sample from a single-sample framebuffer: each pixel's depth goes to all its
+       samples (desktop GL's blit replicates it). (Another sample count is refused, logged: llvmpipe
+       makes every multisampled buffer 4x, so no test here reaches it.) */
+    {
+        engine e1;
+        if (!g_truth) build_truth(&e);
+        engine_create(&e1, W, H, 1);
+        g_depth = DEPTH_BY_NAME;
+        g_engine = &e1;
+        assert_int_equal(fv_create(&s, FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_GLSL_AUTO,
+                                   FOGVOL_MSAA_AUTO), 0);
+        engine_draw(&e1);
+        engine_draw(&e);
+        assert_int_equal(fv_frame(&s, W, H, &st, NULL), FOGVOL_SUCCESS);
+        assert_int_equal(st.samples, NS);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        engine_resolve(&e, img);
+        {
+            errs er = compare(img);
+            print_message("# 4x frame, engine depth from a single-sample framebuffer: edges mean %.2f max %d, all "
+                          "max %d [/255]\n", er.mean_edge, er.max_edge, er.max_all);
+            assert_true(er.max_edge > 20); /* one depth per pixel: an edge is a pixel's, not a sample's */
+        }
+        fv_destroy(&s);
+        g_depth = DEPTH_NONE;
+        g_engine = NULL;
+        engine_destroy(&e1);
+    }
+
     /* the support table */
     assert_int_equal(fogvol_msaa_supported(FOGVOL_TIER_FLOAT, 0, FOGVOL_GLSL_330), FOGVOL_SUCCESS);
     assert_int_equal(fogvol_msaa_supported(FOGVOL_TIER_PS20, 0, FOGVOL_GLSL_150), FOGVOL_SUCCESS);
