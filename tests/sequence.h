@@ -87,9 +87,10 @@ static const sq_step sq_default_script[SQ_DEFAULT_FRAMES] = {
     {{0.25, 0.75}, 1, 2, 0, 1}, {{0.0, 0.0}, 0, 1, 0, 1}, {{0.0, 0.0}, 1, 1, 0, 0},
 };
 
-/* A walk of n frames (n <= cap): the camera goes in (walk 0 -> 1) and out again, the occluders
-   leave for 3 frames in every 8, every 10th frame is a split screen (the second view further
-   along), every 11th follows a cancelled frame, every 13th has the smaller viewport. */
+/* A walk of n frames: the camera goes in (walk 0 -> 1) and out again, the occluders leave for 3
+   frames in every 8, every 10th frame is a split screen (the second view further along), every
+   11th follows a cancelled frame, every 13th, the first included, has the smaller viewport (so
+   the frames after the first need more than it did: anything sized once must grow). */
 static inline int sq_walk_script(sq_step *out, int n)
 {
     int i;
@@ -102,7 +103,7 @@ static inline int sq_walk_script(sq_step *out, int n)
         out[i].occluders = (i % 8) < 5;
         out[i].views = (i % 10) == 9 ? 2 : 1;
         out[i].cancel = (i % 11) == 6;
-        out[i].small = (i % 13) == 12;
+        out[i].small = (i % 13) == 0;
     }
     return n;
 }
