@@ -89,17 +89,21 @@ typedef struct combo {
     fogvol_tier tier;
     unsigned variants;
     const char *name;
+    unsigned speedups_off; /* fogvol_context_desc.disable_speedups */
 } combo;
 
 static const combo g_combos[] = {
-    {FOGVOL_TIER_PS20, 0, "PS20"},
-    {FOGVOL_TIER_FLOAT, 0, "FLOAT"},
-    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth"},
-    {FOGVOL_TIER_PS13, 0, "PS13"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single"},
-    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp"},
-    {FOGVOL_TIER_MRT, 0, "MRT"},
+    {FOGVOL_TIER_PS20, 0, "PS20", 0},
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
+    {FOGVOL_TIER_PS13, 0, "PS13", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_NEAR_CLAMP, "PS20+nearclamp", 0},
+    {FOGVOL_TIER_MRT, 0, "MRT", 0},
+    /* an RGBA8 O, as GPUs without float targets have it: frames whose volumes clear the near and far
+       planes count faces with the depth test (FOGVOL_SPEEDUP_DEPTH_TEST), the others compare */
+    {FOGVOL_TIER_PS20, 0, "PS20 (RGBA8 O)", FOGVOL_SPEEDUP_FLOAT_O},
 };
 #define NCOMBO ((int)(sizeof g_combos / sizeof g_combos[0]))
 
@@ -783,6 +787,7 @@ static void test_conventions(void **state)
         cd.tier = cb->tier;
         cd.variants = cb->variants;
         cd.disable_dither = 1;
+        cd.disable_speedups = cb->speedups_off;
         assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
         cd.backend = g_inner;
         cd.backend.create_program = watch_program;
