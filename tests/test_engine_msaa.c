@@ -558,7 +558,7 @@ static unsigned char *g_edge;  /* 1: an occluder edge inside fog (the samples di
 /* What the GL's vertex snapping (2^-GL_SUBPIXEL_BITS pixels) may change in the resolved 8-bit colour
    of the sample at (x, y) of a w x h viewport: the largest channel difference between the truth there
    and at the sample moved by that much, over NS (the resolve's share of one sample). */
-static double sample_slack(double x, double y, int w, int h, const unsigned char at[3], double snap)
+static double sample_slack(double x, double y, int w, int h, const unsigned char at[3], double snap, int ns)
 {
     double m = 0;
     int k, c;
@@ -568,24 +568,27 @@ static double sample_slack(double x, double y, int w, int h, const unsigned char
         for (c = 0; c < 3; ++c)
             if (abs((int)o[c] - (int)at[c]) > m) m = abs((int)o[c] - (int)at[c]);
     }
-    return m / NS;
+    return m / ns;
 }
 
 /* The resolved truth of viewport vp (the camera of g_model and g_proj) into the W x H images truth
    and edge (1: an occluder edge inside fog; 2: a volume silhouette), at the engine framebuffer's own
-   sample positions; slack (NULL: not wanted): what vertex snapping may change there (sample_slack). */
+   sample positions (single-sample: the pixel centre); slack (NULL: not wanted): what vertex snapping
+   and the GL's choice of where it evaluates depth may change there (sample_slack, centre_slack). */
 static void truth_rect(engine *e, const int vp[4], unsigned char *truth, unsigned char *edge, double *slack)
 {
-    static float sp[NS][2];
+    static float sp4[NS][2];
+    static const float sp1[1][2] = {{0.5f, 0.5f}};
     static double snap;
     static int have_sp;
-    int i, x, y, c, k;
+    const float(*sp)[2] = e->samples > 1 ? (const float(*)[2])sp4 : sp1;
+    int i, x, y, c, k, ns = e->samples > 1 ? NS : 1;
     if (!have_sp) {
         GLint samples = 0, bits = 0;
         glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
         glGetIntegerv(GL_SAMPLES, &samples);
         assert_int_equal(samples, NS);
-        for (i = 0; i < NS; ++i) glGetMultisamplefv(GL_SAMPLE_POSITION, (GLuint)i, sp[i]);
+        for (i = 0; i < NS; ++i) glGetMultisamplefv(GL_SAMPLE_POSITION, (GLuint)i, sp4[i]);
         glGetIntegerv(GL_SUBPIXEL_BITS, &bits);
         snap = ldexp(1.0, -(bits < 4 ? 4 : bits));
         have_sp = 1;
@@ -595,21 +598,21 @@ static void truth_rect(engine *e, const int vp[4], unsigned char *truth, unsigne
             unsigned char s[NS][3];
             int sum[3] = {0, 0, 0}, any = 0, all = 3;
             if (slack) slack[y * W + x] = 0.0;
-            for (k = 0; k < NS; ++k) {
+            for (k = 0; k < ns; ++k) {
                 int f = truth_sample(x - vp[0] + sp[k][0], y - vp[1] + sp[k][1], vp[2], vp[3], s[k]);
                 any |= f;
                 all &= f;
                 for (c = 0; c < 3; ++c) sum[c] += s[k][c];
                 if (slack)
                     slack[y * W + x] +=
-                        sample_slack(x - vp[0] + sp[k][0], y - vp[1] + sp[k][1], vp[2], vp[3], s[k], snap) +
+                        sample_slack(x - vp[0] + sp[k][0], y - vp[1] + sp[k][1], vp[2], vp[3], s[k], snap, ns) +
                         centre_slack(x - vp[0] + sp[k][0], y - vp[1] + sp[k][1], x - vp[0] + 0.5, y - vp[1] + 0.5,
                                      vp[2], vp[3], s[k]);
             }
             edge[y * W + x] = 0;
             if ((any & 1) != (all & 1) && (any & 2)) edge[y * W + x] = 1;
             else if ((any & 2) != (all & 2)) edge[y * W + x] = 2;
-            for (c = 0; c < 3; ++c) truth[(y * W + x) * 4 + c] = (unsigned char)((sum[c] + NS / 2) / NS);
+            for (c = 0; c < 3; ++c) truth[(y * W + x) * 4 + c] = (unsigned char)((sum[c] + ns / 2) / ns);
             truth[(y * W + x) * 4 + 3] = 255;
         }
 }
@@ -791,14 +794,16 @@ static void test_tier(void **state)
    turns in view space) and out again, the occluder leaves and comes back (the engine stops drawing
    it; fogvol is not given it), the viewport shrinks to a rectangle at an offset, a split-screen
    frame draws two views with their own cameras into the two halves (each its own fogvol frame,
-   the engine's depth of that view), a cancelled frame comes in between. Every view's resolved
+   the engine's depth of that view; the second into a single-sample engine framebuffer, as a
+   minimap or a reflection drawn without MSAA: fogvol switches to single-sample targets and
+   programs and back), a cancelled frame comes in between. Every view's resolved
    pixels are compared with the per-sample truth of its own camera; wrong: more than the case's
    bound (3/255, the single-frame test's), and the mean over occluder edges inside fog stays within
    the single-frame bound (1.5/255). PS20+count keeps the camera outside the volume (COUNT refuses
    a volume the near plane cuts). */
 typedef struct mseq {
     const tcase *tc;
-    engine e;
+    engine e, e1; /* the 4x engine framebuffer; e1: single-sample, for the second view of split frames */
     fv_scene s;
     unsigned char *img, *truth, *edge, *sheet;
     double *slack;
@@ -815,6 +820,7 @@ static double mseq_walk(const mseq *m, double walk)
 static void mseq_cancel(void *user, const sq_view *v)
 {
     mseq *m = (mseq *)user;
+    g_engine = &m->e;
     scene_pose(mseq_walk(m, 1.0 - v->walk), v->viewport[2], v->viewport[3]);
     fv_begin(&m->s, v->viewport, 1, NULL);
     assert_int_equal(fogvol_cancel_frame(m->s.fv), FOGVOL_SUCCESS);
@@ -840,19 +846,21 @@ static void mseq_sheet(mseq *m, const sq_view *v)
 static void mseq_view(void *user, const sq_view *v, sq_check *out)
 {
     mseq *m = (mseq *)user;
+    engine *e = v->view == 1 ? &m->e1 : &m->e;
     fogvol_frame_stats st;
     fogvol_result r;
     int x, y, c;
     scene_pose(mseq_walk(m, v->walk), v->viewport[2], v->viewport[3]);
     g_occ_on = v->occluders;
-    engine_draw_view(&m->e, v->viewport, v->occluders);
+    g_engine = e;
+    engine_draw_view(e, v->viewport, v->occluders);
     fv_begin(&m->s, v->viewport, v->occluders, NULL);
     r = fogvol_end_frame(m->s.fv, &st);
     if (r != FOGVOL_SUCCESS && !m->failed++) print_message("#   end_frame: %s\n", fogvol_result_string(r));
     assert_int_equal(glGetError(), GL_NO_ERROR);
-    if (r == FOGVOL_SUCCESS) assert_int_equal(st.samples, NS);
-    engine_resolve(&m->e, m->img);
-    truth_rect(&m->e, v->viewport, m->truth, m->edge, m->slack);
+    if (r == FOGVOL_SUCCESS) assert_int_equal(st.samples, e->samples > 1 ? NS : 1);
+    engine_resolve(e, m->img);
+    truth_rect(e, v->viewport, m->truth, m->edge, m->slack);
     out->bound = m->tc->bound;
     for (y = v->viewport[1]; y < v->viewport[1] + v->viewport[3]; ++y)
         for (x = v->viewport[0]; x < v->viewport[0] + v->viewport[2]; ++x) {
@@ -892,6 +900,7 @@ static void run_mseq(const tcase *tc, const sq_step *steps, int n, const char *w
     assert_false(obox_contains(&g_occ, origin));
     scene_init(W, H);
     engine_create_ex(&m.e, W, H, NS, tc->depth == DEPTH_TEXTURE);
+    engine_create_ex(&m.e1, W, H, 1, tc->depth == DEPTH_TEXTURE);
     g_composite = tc->composite;
     g_depth = tc->depth;
     g_engine = &m.e;
@@ -917,6 +926,7 @@ static void run_mseq(const tcase *tc, const sq_step *steps, int n, const char *w
     assert_true(m.edge_sum / m.edges <= 1.5);
     fv_destroy(&m.s);
     engine_destroy(&m.e);
+    engine_destroy(&m.e1);
     glu_destroy(&g);
     g_composite = FOGVOL_COMPOSITE_FULLSCREEN;
     g_depth = DEPTH_NONE;
