@@ -1381,10 +1381,9 @@ int main(void)
         tests[n].initial_state = (void *)&g_cases[i];
         ++n;
     }
-    for (i = 0; i < NCASES; ++i) { /* the engine's depth, bound and by name */
+    for (i = 0; i < NCASES; ++i) { /* the engine's depth from the bound framebuffer, FLOAT and PS20 */
         static char names[NCASES][64];
-        if (g_cases[i].depth != DEPTH_BOUND && !(g_cases[i].depth == DEPTH_BY_NAME && g_cases[i].tier == FOGVOL_TIER_FLOAT))
-            continue;
+        if (g_cases[i].depth != DEPTH_BOUND) continue;
         snprintf(names[i], sizeof names[i], "walk %s", g_cases[i].name);
         tests[n].name = names[i];
         tests[n].test_func = test_walk;
