@@ -1036,15 +1036,22 @@ typedef struct occseq {
     GLuint fbo, depth;
 } occseq;
 
+/* The camera of walk position w: up to 0.5 it circles the sphere (60 degrees about y, looking at its
+   centre), so an O left from another frame would cut the sphere somewhere else; then it moves into
+   the sphere (radius 1.5 at the origin), looking the same way. */
 static rc_camera occseq_camera(double w, const int vp[4])
 {
     rc_camera c = camera();
-    static const double e1[3] = {0.3, 0.2, 0.5}; /* inside the sphere (radius 1.5 at the origin) */
+    static const double in[3] = {0.3, 0.2, 0.5};
+    double a = (w < 0.5 ? w : 0.5) * 2.0 * 1.0471975511965976, e[3], u = w > 0.5 ? (w - 0.5) * 2.0 : 0.0;
     int i;
-    for (i = 0; i < 3; ++i) c.eye[i] += (e1[i] - c.eye[i]) * w;
-    c.target[0] = c.eye[0] - 2.0;
-    c.target[1] = c.eye[1] - 1.5;
-    c.target[2] = c.eye[2] - 6.0;
+    e[0] = c.eye[0] * cos(a) + c.eye[2] * sin(a);
+    e[1] = c.eye[1];
+    e[2] = -c.eye[0] * sin(a) + c.eye[2] * cos(a);
+    for (i = 0; i < 3; ++i) {
+        c.eye[i] = e[i] + (in[i] - e[i]) * u;
+        c.target[i] = c.eye[i] - e[i]; /* towards the centre from the orbit point */
+    }
     c.aspect = (double)vp[2] / vp[3];
     c.width = vp[2];
     c.height = vp[3];
@@ -1073,7 +1080,7 @@ static void occseq_engine_o(occseq *q, const fogvol_frame_desc *fd)
 static void occseq_cancel(void *user, const sq_view *v)
 {
     occseq *q = (occseq *)user;
-    rc_camera c = occseq_camera(1.0 - v->walk, v->viewport);
+    rc_camera c = occseq_camera(0.5 - v->walk * 0.5, v->viewport); /* (another view than the next frame's) */
     fogvol_frame_desc fd;
     frame_of(&fd, &c, NULL);
     memcpy(fd.viewport, v->viewport, sizeof fd.viewport);

@@ -814,7 +814,7 @@ static void ovseq_view(void *user, const sq_view *v, sq_check *out)
         }
 }
 
-static void ovseq_open(ovseq *q, const combo *c, unsigned policy, glu_ctx *g)
+static void ovseq_open(ovseq *q, const combo *c, unsigned policy, glu_ctx *g, unsigned speedups_off)
 {
     fogvol_context_desc cd;
     fogvol_ramp_desc rd;
@@ -831,7 +831,7 @@ static void ovseq_open(ovseq *q, const combo *c, unsigned policy, glu_ctx *g)
     cd.variants = c->variants;
     cd.encoding_bits = c->bits;
     cd.disable_dither = 1;
-    cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM; /* the digits */
+    cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM | speedups_off; /* the digits */
     cd.overflow_policy = (fogvol_overflow_policy)policy;
     assert_int_equal(fogvol_create_context(&cd, &q->fv), FOGVOL_SUCCESS);
     upload_meshes(q->fv, get_truth(c->k[1], 0)->s, q->meshes);
@@ -865,7 +865,7 @@ static void test_overflow_sequence(void **state)
     for (i = 0; i < (int)(sizeof picks / sizeof picks[0]); ++i) {
         ovseq q;
         char name[64];
-        ovseq_open(&q, &g_combos[picks[i]], FOGVOL_OVERFLOW_COUNT_ONLY, &g);
+        ovseq_open(&q, &g_combos[picks[i]], FOGVOL_OVERFLOW_COUNT_ONLY, &g, 0);
         g_blocking_reads = 0;
         snprintf(name, sizeof name, "overflow counts %s", q.c->name);
         sq_run(name, W, H, sq_default_script, SQ_DEFAULT_FRAMES,
@@ -880,9 +880,16 @@ static void test_overflow_sequence(void **state)
     glu_destroy(&g);
 }
 
-/* LOWER_BITS over the sequence: the first overflowing frame's count lowers L once, from then on every
-   frame (overflowing shells or not, any camera and viewport) is within the new encoding's bound, and
-   the older frames' counts, arriving after the change, do not lower it again. */
+/* LOWER_BITS over a sequence whose first two frames overflow (then as the default script: fitting
+   frames, a split and a cancelled frame, overflowing ones): the first count lowers L once, from then
+   on every frame (any camera, viewport, shells) is within the new encoding's bound, and the second
+   frame's count, arriving after the change, does not lower it again. The lookup textures (ALU
+   encode off) must follow L. */
+static const sq_step g_lb_script[6] = {
+    {{0.0, 0.0}, 1, 1, 0, 0},  {{0.5, 0.0}, 1, 1, 0, 0}, {{1.0, 0.0}, 0, 1, 1, 0},
+    {{0.25, 0.75}, 1, 2, 0, 1}, {{0.0, 0.0}, 0, 1, 0, 1}, {{0.0, 0.0}, 1, 1, 0, 0},
+};
+
 static void test_lower_bits_sequence(void **state)
 {
     glu_ctx g;
@@ -890,8 +897,8 @@ static void test_lower_bits_sequence(void **state)
     int f;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
-    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_LOWER_BITS, &g);
-    sq_run("LOWER_BITS PS20", W, H, sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, ovseq_view, ovseq_cancel, &q);
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_LOWER_BITS, &g, FOGVOL_SPEEDUP_ALU);
+    sq_run("LOWER_BITS PS20 (lookup textures)", W, H, g_lb_script, 6, SQ_ALL, ovseq_view, ovseq_cancel, &q);
     print_message("#   L lowered after fogvol frame %d; L per frame:", q.lowered_at);
     for (f = 0; f < 7; ++f) print_message(" %d", q.bits_at[f]);
     print_message("\n");
@@ -905,7 +912,9 @@ static void test_lower_bits_sequence(void **state)
    20 again through a smaller viewport after a cancelled frame, 12 frames each; no show_overflow (bands
    on). Each band's count is replaced by its newest: after the 8 bands and the query latency, the
    count is the new still's read-back count, whatever the bands held before; in between it never
-   exceeds the two stills' read-backs together (the bands partition the picture). */
+   exceeds the two stills' read-backs together (the bands partition the picture). Then with
+   LOWER_BITS: the bands counted at the old L are forgotten when it changes, so it changes once and
+   the count settles at 0 (20 shells fit at L = 3). */
 static void test_bands_sequence(void **state)
 {
     static const struct {
@@ -913,14 +922,14 @@ static void test_bands_sequence(void **state)
     } stills[3] = {{20, 0}, {12, 0}, {20, 1}};
     glu_ctx g;
     ovseq q;
-    int s, f, prev = 0;
+    int s, f, prev = 0, vp[4];
+    fogvol_frame_stats st;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
-    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_COUNT_ONLY, &g);
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_COUNT_ONLY, &g, 0);
     q.show = 0;
     for (s = 0; s < 3; ++s) {
-        int vp[4], rb = -1, last = -1;
-        fogvol_frame_stats st;
+        int rb = -1, last = -1;
         sq_viewport(W, H, stills[s].small, 1, 0, vp);
         if (s == 2) assert_int_equal(ovseq_frame(&q, 20, 1, vp, NULL, NULL, 1), FOGVOL_SUCCESS);
         for (f = 0; f < FOGVOL_OVERFLOW_BANDS + 4; ++f) {
@@ -939,6 +948,19 @@ static void test_bands_sequence(void **state)
         else assert_int_equal(rb, 0);
     }
     assert_int_equal(glGetError(), GL_NO_ERROR);
+    ovseq_close(&q);
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_LOWER_BITS, &g, 0);
+    q.show = 0;
+    sq_viewport(W, H, 0, 1, 0, vp);
+    for (f = 0; f < 2 * FOGVOL_OVERFLOW_BANDS + 4; ++f) {
+        unsigned char px[4];
+        ovseq_frame(&q, 20, 0, vp, NULL, &st, 0);
+        glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    }
+    print_message("#   bands with LOWER_BITS: L %d after %d frames, count %d (frame %lld)\n",
+                  fogvol_context_encoding(q.fv)->bits, f, st.overflow_pixels_late, (long long)st.overflow_frame);
+    assert_int_equal(fogvol_context_encoding(q.fv)->bits, 3);
+    assert_int_equal(st.overflow_pixels_late, 0);
     ovseq_close(&q);
     glu_destroy(&g);
 }
