@@ -298,7 +298,13 @@ typedef enum fogvol_dialect {
     FOGVOL_GLSL_330 = 5, /* 330 core */
     FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
     FOGVOL_GLSL_300ES = 7,
-    FOGVOL_GLSL_COUNT = 8,
+    /* GLSL 450 for SPIR-V (glslangValidator -V, shaderc): samplers at layout(set = 0, binding = unit),
+       the pass uniforms in one std140 block at (set 0, binding FOGVOL_MAX_TEXTURE_UNITS), the
+       per-draw values in push constants, explicit locations; gl_FragCoord and rows as stored (row 0
+       first), depth [0, 1]. Where a backend finds each value: fogvol_program_desc.layout. No context
+       picks it: a Vulkan backend names it in fogvol_backend.dialect. */
+    FOGVOL_GLSL_VULKAN = 8,
+    FOGVOL_GLSL_COUNT = 9,
     FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
 } fogvol_dialect;
 
@@ -1215,6 +1221,36 @@ typedef struct fogvol_target_desc {
 
 #define FOGVOL_MAX_SHADER_STRINGS 20
 
+/* The per-draw values of fogvol_draw as a program reads them (fogvol_uniform_layout.draw_offsets). */
+typedef enum fogvol_draw_value {
+    FOGVOL_DRAW_MVP = 0,        /* mat4 fv_mvp: fogvol_draw.mvp */
+    FOGVOL_DRAW_DEPTH = 1,      /* vec4 fv_depth: .depth */
+    FOGVOL_DRAW_EXTINCTION = 2, /* vec4 fv_ext: .extinction */
+    FOGVOL_DRAW_EMISSION = 3,   /* vec4 fv_emit: .emission */
+    FOGVOL_DRAW_SIGN = 4,       /* float fv_sign: .sign */
+    FOGVOL_DRAW_VALUE_COUNT = 5
+} fogvol_draw_value;
+
+/* Where a program's inputs live, for backends that bind by number instead of by name (the Vulkan
+   dialect; fogvol_dialect_layout). Pass uniforms: one std140 uniform block of pass_size bytes at
+   (descriptor set 0, binding pass_binding) holding fogvol_pass.uniforms exactly as the struct holds
+   them (uniform u at pass_offsets[u] = 16 u: copy the array as it is). Per-draw values: draw_size
+   bytes of push constants, visible to the vertex and fragment stages, value i at draw_offsets[i]
+   (mvp 16 floats, column-major; depth, extinction, emission 4 floats; sign 1 float). Samplers:
+   texture unit i (fogvol_pass.textures[i]) is the combined image sampler at (set 0,
+   sampler_bindings[i] = i). Vertex input: fv_position at location 0 (3 floats). Fragment outputs
+   from location 0 (two-attachment targets: locations 0 and 1). GL dialects: all -1 (by name). */
+typedef struct fogvol_uniform_layout {
+    int pass_binding, pass_size;
+    int pass_offsets[FOGVOL_U_COUNT];
+    int draw_size;
+    int draw_offsets[FOGVOL_DRAW_VALUE_COUNT];
+    int sampler_bindings[FOGVOL_MAX_TEXTURE_UNITS];
+} fogvol_uniform_layout;
+/* The layout of a dialect's programs: FOGVOL_SUCCESS for FOGVOL_GLSL_VULKAN; the GL dialects
+   (uniforms by name) fill every field with -1 and return FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out);
+
 typedef struct fogvol_program_desc {
     const char *vs[FOGVOL_MAX_SHADER_STRINGS];
     int vs_count;
@@ -1222,6 +1258,8 @@ typedef struct fogvol_program_desc {
     int fs_count;
     const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
     const char *label;
+    fogvol_uniform_layout layout; /* the backend's dialect: where the uniforms, per-draw values and samplers
+                                     are (Vulkan), or all -1 (GL: by name) */
 } fogvol_program_desc;
 
 typedef struct fogvol_mesh_data {
@@ -3113,6 +3151,43 @@ static const char fogvol__an_fs_modern[] =
    GLSL 400 or ARB_sample_shading, declared before any other token. */
 #define FOGVOL__SAMPLE_SHADING "#extension GL_ARB_sample_shading : require\n"
 
+/* Declarations the program bodies write through macros, so that one body serves GL and Vulkan:
+   FV_UNIFORM(type, name) (a GL uniform; in Vulkan a member of the pass block or of the push
+   constants, declared here), FV_BINDING(unit) before a sampler (Vulkan: its binding in set 0),
+   FV_LOCATION(n) before a vertex input or a varying (Vulkan: its location). */
+static const char fogvol__decl_gl[] =
+    "#define FV_UNIFORM(type, name) uniform type name;\n#define FV_BINDING(unit)\n#define FV_LOCATION(n)\n";
+#define FOGVOL__VK_MACROS \
+    "#define FV_VULKAN\n#define FV_UNIFORM(type, name)\n" \
+    "#define FV_BINDING(unit) layout(set = 0, binding = unit)\n#define FV_LOCATION(n) layout(location = n)\n"
+/* the pass block: fogvol_pass.uniforms as it is (FOGVOL_UNIFORMS in order, one vec4 each), at binding
+   FOGVOL_MAX_TEXTURE_UNITS (8) after the samplers; the per-draw values: fogvol__vk_draw_offsets */
+#define FOGVOL__VK_BLOCK_MEMBER(id, name) "    vec4 " #name ";\n"
+static const char fogvol__decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "precision highp float;\nprecision highp int;\n" /* (no effect in GLSL 450: says what highp in the bodies means) */
+    "layout(std140, set = 0, binding = 8) uniform fv_pass_block {\n" FOGVOL_UNIFORMS(FOGVOL__VK_BLOCK_MEMBER) "};\n"
+    "layout(push_constant) uniform fv_draw_block {\n"
+    "    layout(offset = 0) mat4 fv_mvp;\n"
+    "    layout(offset = 64) vec4 fv_depth;\n"
+    "    layout(offset = 80) vec4 fv_ext;\n"
+    "    layout(offset = 96) vec4 fv_emit;\n"
+    "    layout(offset = 112) float fv_sign;\n"
+    "};\n";
+#undef FOGVOL__VK_BLOCK_MEMBER
+/* the analytic fog's block (what the engine fills: fv_mvp at 0, fv_model at 64, then the
+   FOGVOL_ANALYTIC_UNIFORM_VEC4S vec4 of fogvol_analytic_pack_uniforms at 128) */
+static const char fogvol__an_decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "layout(std140, set = 0, binding = 0) uniform fv_analytic_block {\n"
+    "    mat4 fv_mvp;\n    mat4 fv_model;\n    vec4 fv_analytic[42];\n};\n#define FOGVOL_ANALYTIC_IN_BLOCK\n";
+#undef FOGVOL__VK_MACROS
+static const char fogvol__fs_vulkan[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_fragcolor;\n"
+    "#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_vulkan_analytic[] =
+    "#define FV_VARYING_IN in\nlayout(location = 0) out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+
 typedef struct fogvol__dialect_info {
     const char *name;                 /* fogvol_dialect_name */
     const char *version;              /* the #version line */
@@ -3125,27 +3200,37 @@ typedef struct fogvol__dialect_info {
     const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
     const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
     const char *fs_fetch;             /* fragment prelude of FOGVOL_SPECIALIZE_FETCH_O; NULL: not in this dialect */
+    const char *decl, *an_decl;       /* after the prelude: FV_UNIFORM, FV_BINDING, FV_LOCATION (and the Vulkan
+                                         blocks) for the volume programs and for the analytic fog */
+    unsigned char vulkan;             /* SPIR-V: never chosen for a GL context */
 } fogvol__dialect_info;
 
 static const fogvol__dialect_info fogvol__dialects[] = {
-    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL},
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL, NULL, NULL, 0},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
-     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL},
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
      fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern},
-     NULL},
+     NULL, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
      {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
-     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330},
+     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
-     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL},
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL,
+     fogvol__decl_gl, fogvol__decl_gl, 0},
     {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
      {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
-     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300}};
+     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300, fogvol__decl_gl, fogvol__decl_gl, 0},
+    {"vulkan", "#version 450\n", NULL, 0, 0, 2, 4, 5, {fogvol__vs_modern, NULL}, fogvol__fs_vulkan,
+     {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__fs_vulkan_analytic}, NULL,
+     fogvol__decl_vulkan, fogvol__an_decl_vulkan, 1}};
 #undef FOGVOL__SAMPLE_SHADING
 /* one row per value of fogvol_dialect */
 typedef char
@@ -3166,6 +3251,25 @@ static int fogvol__prelude(const char **strings, int n, const char *const prelud
     return n;
 }
 
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out)
+{
+    static const int draw[FOGVOL_DRAW_VALUE_COUNT] = {0, 64, 80, 96, 112}; /* fogvol__decl_vulkan's push constants */
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int i;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0xff, sizeof *out); /* every field -1 */
+    if (!di || !di->vulkan) return FOGVOL_ERROR_UNSUPPORTED;
+    out->pass_binding = FOGVOL_MAX_TEXTURE_UNITS;
+    out->pass_size = (int)(FOGVOL_U_COUNT * 4 * sizeof(float));
+    for (i = 0; i < FOGVOL_U_COUNT; ++i) out->pass_offsets[i] = 16 * i;
+    out->draw_size = 116;
+    for (i = 0; i < FOGVOL_DRAW_VALUE_COUNT; ++i) out->draw_offsets[i] = draw[i];
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) out->sampler_bindings[i] = i;
+    return FOGVOL_SUCCESS;
+}
+/* fogvol__decl_vulkan names binding 8 for the pass block and fogvol_pass.uniforms is that block */
+typedef char fogvol__vk_pass_binding[FOGVOL_MAX_TEXTURE_UNITS == 8 ? 1 : -1];
+
 #ifndef FOGVOL_NO_GL
 /* The newest dialect of a GL (gles = 0) or GLES context of this version. */
 static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
@@ -3173,7 +3277,7 @@ static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
     int d, best = FOGVOL_GLSL_AUTO;
     for (d = 1; d < FOGVOL_GLSL_COUNT; ++d) { /* the rows of each family go from old to new */
         const fogvol__dialect_info *di = &fogvol__dialects[d];
-        if ((di->es != 0) != (gles != 0)) continue;
+        if ((di->es != 0) != (gles != 0) || di->vulkan) continue;
         if (best == FOGVOL_GLSL_AUTO || major > di->gl_major || (major == di->gl_major && minor >= di->gl_minor))
             best = d;
     }
@@ -5121,7 +5225,9 @@ FOGVOL_API fogvol_result fogvol_analytic_pack_uniforms(const fogvol_analytic_set
    gives the CPU's (t, event) order. Misses get t = 2 and sort to the end. */
 static const char fogvol__an_glsl_segment[] =
     "#define FV_AN_MAX 8\n"
+    "#ifndef FOGVOL_ANALYTIC_IN_BLOCK\n"       /* (Vulkan: a member of the engine's uniform block) */
     "uniform vec4 fv_analytic[2 + 5 * FV_AN_MAX];\n"
+    "#endif\n"
     "vec2 fv_an_slab(vec2 t, float o, float v) {\n"
     "    if (v != 0.0) {\n"
     "        float a = (-1.0 - o) / v, b = (1.0 - o) / v;\n"
@@ -5245,16 +5351,18 @@ static const char fogvol__an_glsl_main[] =
     "    fog = s.x;\n"
     "    color = law > 1.5 ? num : (s.y > 0.0 ? num / s.y : vec3(0.0));\n"
     "}\n";
+/* fogvol__an_decl_vulkan declares fv_analytic[42] */
+typedef char fogvol__an_vk_block[FOGVOL_ANALYTIC_UNIFORM_VEC4S == 42 ? 1 : -1];
 static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
 
 static const char fogvol__an_vs_body[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform mat4 fv_model;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(mat4, fv_model)\n"
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_OUT vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_OUT vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5272,9 +5380,9 @@ static const char fogvol__an_vs_body[] =
 
 static const char fogvol__an_fs_body[] =
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_IN vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_IN vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "#ifdef FV_PER_PIXEL\n"
@@ -5298,6 +5406,7 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     strings[n++] = di->version;
     n = fogvol__prelude(strings, n, stage == FOGVOL_STAGE_VERTEX ? di->an_vs : di->an_fs);
+    strings[n++] = di->an_decl;
     if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
     if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
         strings[n++] = fogvol__an_glsl[0];
@@ -5358,7 +5467,8 @@ FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned
     switch (tier) {
     case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
                               where the dialect guarantees highp integers (GLSL 330, 300 es) */
-        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES &&
+            dialect != FOGVOL_GLSL_VULKAN)
             return FOGVOL_ERROR_UNSUPPORTED;
         return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
                    ? FOGVOL_ERROR_UNSUPPORTED
@@ -5512,15 +5622,15 @@ typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
    NEAR_CLAMP snaps vertices behind the near plane onto it instead (Baker). */
 static const char fogvol__vs_mesh[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform vec4 fv_depth;\n"
-    "uniform vec4 fv_misc;\n"
-    "FV_VARYING_OUT float fv_d;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(vec4, fv_depth)\n"
+    "FV_UNIFORM(vec4, fv_misc)\n"
+    "FV_LOCATION(0) FV_VARYING_OUT float fv_d;\n"
     "#ifdef FV_DENSITY\n"                        /* density texture coordinates from the model-space position */
-    "uniform vec4 fv_dens_u;\n"
-    "uniform vec4 fv_dens_v;\n"
-    "FV_VARYING_OUT vec2 fv_dtc;\n"
+    "FV_UNIFORM(vec4, fv_dens_u)\n"
+    "FV_UNIFORM(vec4, fv_dens_v)\n"
+    "FV_LOCATION(1) FV_VARYING_OUT vec2 fv_dtc;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5538,11 +5648,14 @@ static const char fogvol__vs_mesh[] =
     "#endif\n"
     "    fv_d = d;\n"
     "    c.z = mix(c.z, d * fv_misc.x - c.w, fv_misc.y);\n"
+    "#ifdef FV_VULKAN\n"                          /* clip z in [0, w]: the same window depth */
+    "    c.z = 0.5 * (c.z + c.w);\n"
+    "#endif\n"
     "    gl_Position = c;\n"
     "}\n";
 
 static const char fogvol__vs_fullscreen[] =
-    "FV_ATTRIB vec3 fv_position;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
     "void main() {\n"
     "    gl_Position = vec4(fv_position.xy, 0.0, 1.0);\n"
     "}\n";
@@ -5551,10 +5664,10 @@ static const char fogvol__vs_fullscreen[] =
    the borrow fold (normalised digits, alpha free), screen coordinates. */
 static const char fogvol__fs_common[] =
     "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
-    "uniform vec4 fv_enc;\n"    /* (N, N^2, depth offset, depth max) */
-    "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_dec;\n"
+    "FV_UNIFORM(vec4, fv_enc)\n"    /* (N, N^2, depth offset, depth max) */
+    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, 0) */
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_dec)\n"
     /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
        texture (fv_nf.zw: the viewport's origin, declared by the programs that read it); FV_ORIGIN
        (SPECIALIZE_ORIGIN, the viewport at the window origin): both offsets 0, left out */
@@ -5571,8 +5684,8 @@ static const char fogvol__fs_common[] =
     /* view depth (distance along the view axis) of an engine depth-buffer sample: st in [0,1]
        across the engine viewport, z its window depth; fv_lin / fv_lin2 hold the inverse
        view-projection rows with the window -> NDC mapping (depth range, clip control) folded in */
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
     "float fv_engine_view_depth(vec2 st, float z) {\n"
     "#ifdef FV_DEPTH_FROM_Z\n"                 /* fv_lin.xy = fv_lin2.xy = 0 (no oblique near plane) */
     "    return (fv_lin.z * z + fv_lin.w) / (fv_lin2.z * z + fv_lin2.w);\n"
@@ -5616,10 +5729,10 @@ static const char fogvol__fs_encode_common[] =
        context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
     "#ifdef FV_ENC_LN\n#define FV_N FV_ENC_N\n#define FV_DD FV_ENC_D\n#define FV_RDD (1.0 / FV_ENC_D)\n"
     "#else\n#define FV_N fv_enc.x\n#define FV_DD fv_dith.z\n#define FV_RDD fv_dith.y\n#endif\n"
-    "uniform sampler2D fv_dither;\n"
+    "FV_BINDING(2) uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
-    "uniform sampler2D fv_rg;\n"
-    "uniform sampler2D fv_blue;\n"
+    "FV_BINDING(0) uniform sampler2D fv_rg;\n"
+    "FV_BINDING(1) uniform sampler2D fv_blue;\n"
     "#endif\n"
     /* FV_IALU: the ALU encode in integers (FOGVOL__IALU_TEXT) */
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
@@ -5700,14 +5813,14 @@ static const char fogvol__fs_encode_common[] =
 
 static const char fogvol__fs_encode[] =
     "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
-    "uniform sampler2D fv_opaque;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_BINDING(3) uniform sampler2D fv_opaque;\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
     "    float depth = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
-    "FV_VARYING_IN float fv_d;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
     "#if defined(FV_WIDE)\n"
     "    vec4 hi, lo;\n"
@@ -5729,8 +5842,8 @@ static const char fogvol__fs_encode[] =
    with COUNT rely on the depth test and count faces in alpha. FLOAT: signed
    depth of every face in one pass, the sign from gl_FrontFacing. */
 static const char fogvol__fs_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_FETCH_O\n" /* O from the framebuffer (FOGVOL_SPECIALIZE_FETCH_O) */
     "#define FV_OREAD(s) fv_ofb\n"
     "#undef FV_O_DIGITS\n"
@@ -5739,17 +5852,17 @@ static const char fogvol__fs_face[] =
     "#define FV_OREAD(s) FV_SCREEN(s)\n"
     "#endif\n"
     "#ifdef FV_DENSITY\n"                        /* v = c + rho (min(d, o) - c), c = min(o, fv_dens.x) */
-    "uniform sampler2D fv_density;\n"
-    "uniform vec4 fv_dens;\n"
-    "FV_VARYING_IN vec2 fv_dtc;\n"
+    "FV_BINDING(6) uniform sampler2D fv_density;\n"
+    "FV_UNIFORM(vec4, fv_dens)\n"
+    "FV_LOCATION(1) FV_VARYING_IN vec2 fv_dtc;\n"
     "float fv_density_apply(float d, float o) {\n"
     "    return mix(min(o, fv_dens.x), d, FV_TEXTURE(fv_density, fv_dtc).r);\n"
     "}\n"
     "#endif\n"
     "#ifdef FV_FLOAT\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_speed;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
@@ -5769,7 +5882,7 @@ static const char fogvol__fs_face[] =
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
     "}\n"
     "#elif defined(FV_WIDE)\n"
-    "uniform sampler2D fv_opaque2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_opaque2;\n"
     "void main() {\n"
     "    vec4 hi, lo, ohi = FV_SCREEN(fv_opaque), olo = FV_SCREEN(fv_opaque2);\n"
     "    fv_encode_wide(fv_d, hi, lo);\n"
@@ -5782,7 +5895,7 @@ static const char fogvol__fs_face[] =
 /* (the face program's second string: C99 compilers need take no string over 4095 characters) */
 static const char fogvol__fs_face_rgba8[] =
     "#elif defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: the pixel as a 32-bit integer, +- d 2^24 */
-    "uniform float fv_sign;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
     "void main() {\n"
     "    float d = clamp(fv_d, 0.0, 1.0);\n"
     "#ifndef FV_NO_OPAQUE\n"
@@ -5853,9 +5966,9 @@ static const char fogvol__fs_resolve_fn[] =
 
 /* PS13 resolve into T: the digits (0 where B - F < 0), alpha marks covered pixels (2: saturated). */
 static const char fogvol__fs_resolve[] =
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "void main() {\n"
     "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
     "    vec3 d = fv_resolve(b, f, FV_RESOLVE_O(fv_opaque));\n"
@@ -5871,7 +5984,7 @@ static const char fogvol__fs_resolve[] =
    where a check pass marked the channels that hit 255 before the subtraction
    brought them down. FV_CHECK (the check pass) keeps only saturated pixels. */
 static const char fogvol__fs_composite[] =
-    "uniform vec4 fv_rampmap;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
     /* exp(-x), x >= 0; FV_FAST_EXP (FOGVOL_SPEEDUP_FAST_EXP): 2^y = 2^n (1 + g (a + (1 - a) g)),
        n = floor(y), g = y - n, the minimax a with p(0) = 1, p(1) = 2 (relative error 0.0027) */
     "float fv_transmit(float x) {\n"
@@ -5883,17 +5996,17 @@ static const char fogvol__fs_composite[] =
     "    return exp(-x);\n"
     "#endif\n"
     "}\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform sampler2D fv_colors;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
-    "uniform vec4 fv_speed;\n"
-    "uniform vec4 fv_ctex_u;\n"
-    "uniform vec4 fv_ctex_v;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(6) uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
+    "FV_UNIFORM(vec4, fv_speed)\n"
+    "FV_UNIFORM(vec4, fv_ctex_u)\n"
+    "FV_UNIFORM(vec4, fv_ctex_v)\n"
     "#ifdef FV_WIDE\n"
-    "uniform sampler2D fv_back2;\n"
-    "uniform sampler2D fv_front2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_back2;\n"
+    "FV_BINDING(5) uniform sampler2D fv_front2;\n"
     "#endif\n"
     /* FV_DOWNSAMPLE (FLOAT, GLSL 130+): the sum at half resolution, bilinear between the four
        nearest low-resolution texel centres, clamped at the edges. The tw texels span the w pixels of
@@ -6008,11 +6121,11 @@ static const char fogvol__fs_composite_main[] =
    (FLOAT: d; RGBA8: encoded). 1: its back faces light the pixels whose opaque depth o lies
    between L's front depth and their own depth, in the engine framebuffer. */
 static const char fogvol__fs_light[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform FV_TARGET_SAMPLER fv_lfront;\n"
-    "uniform vec4 fv_light;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(7) uniform FV_TARGET_SAMPLER fv_lfront;\n"
+    "FV_UNIFORM(vec4, fv_light)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "float fv_light_depth(vec4 v) {\n"
     "#ifdef FV_FLOAT\n"
     "    return v.r;\n"
@@ -6049,12 +6162,12 @@ static const char fogvol__fs_light[] =
    program) times the volume's per-channel extinction (target 0: optical depth tau) and times its
    extinction * colour (target 1: emission sum E). */
 static const char fogvol__fs_color_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_ext;\n"
-    "uniform vec4 fv_emit;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_ext)\n"
+    "FV_UNIFORM(vec4, fv_emit)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
@@ -6073,9 +6186,9 @@ static const char fogvol__fs_color_face[] =
    scene * T + c * (1 - T). fv_rampmap.z picks the step: 0 one FOG-blended draw (every extinction
    grey: T the same in each channel), 1 the multiply draw (scene * T), 2 the emission draw. */
 static const char fogvol__fs_color_composite[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
     "    vec3 tau = max(FV_TEXTURE(fv_back, st).rgb, vec3(0.0));\n"
@@ -6263,6 +6376,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
     } else
         strings[n++] = di->fs;
+    strings[n++] = di->decl;
     if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
@@ -7020,6 +7134,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH))
         pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
     pd.label = labels[p];
+    (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout); /* (GL dialects: all -1) */
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
 
@@ -9670,13 +9785,13 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
    pixels, clamped to the viewport), from the depth texture's window depth
    through fv_lin / fv_lin2 as in the ENGINE_DEPTH variant. */
 static const char fogvol__fs_post_common[] =
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
-    "uniform vec4 fv_ptexel;\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
-    "uniform vec4 fv_prect;\n"  /* first and last pixel centres of the viewport */
-    "uniform vec4 fv_pparams;\n"
-    "uniform sampler2D fv_pdepth;\n"
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
+    "FV_UNIFORM(vec4, fv_ptexel)\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
+    "FV_UNIFORM(vec4, fv_prect)\n"  /* first and last pixel centres of the viewport */
+    "FV_UNIFORM(vec4, fv_pparams)\n"
+    "FV_BINDING(1) uniform sampler2D fv_pdepth;\n"
     "vec2 fv_ppix(vec2 o) { return clamp(gl_FragCoord.xy + o, fv_prect.xy, fv_prect.zw); }\n"
     "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
     "float fv_view_depth(vec2 o) {\n"
@@ -9687,7 +9802,7 @@ static const char fogvol__fs_post_common[] =
 
 /* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
 static const char fogvol__fs_post_dof[] =
-    "uniform sampler2D fv_pscene;\n"
+    "FV_BINDING(0) uniform sampler2D fv_pscene;\n"
     "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
     "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
     "    vec2 o = floor(dir * r + 0.5);\n"
@@ -9718,7 +9833,7 @@ static const char fogvol__fs_post_dof[] =
 
 /* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
 static const char fogvol__fs_post_outlines[] =
-    "uniform vec4 fv_pcolor;\n"
+    "FV_UNIFORM(vec4, fv_pcolor)\n"
     "float fv_pg(vec2 o) { float e = fv_view_depth(o); return fv_ptexel.z > 0.5 ? 1.0 / e : e; }\n"
     "float fv_pline(vec2 o, float g0) {\n" /* second difference along a line of three, both ends inside */
     "    vec2 a = gl_FragCoord.xy + o, b = gl_FragCoord.xy - o;\n"
@@ -9726,7 +9841,7 @@ static const char fogvol__fs_post_outlines[] =
     "    return abs(fv_pg(o) + fv_pg(-o) - 2.0 * g0);\n"
     "}\n"
     "#ifdef FV_NORMALS\n"
-    "uniform sampler2D fv_pnormal;\n"
+    "FV_BINDING(2) uniform sampler2D fv_pnormal;\n"
     "vec3 fv_pn(vec2 o) { return normalize(fv_ptex(fv_pnormal, o).rgb * 2.0 - 1.0); }\n"
     "#endif\n"
     "void main() {\n"
@@ -9747,8 +9862,8 @@ static const char fogvol__fs_post_outlines[] =
 
 /* Distance fog: fv_pparams.x = start, fv_rampmap as in the volume composite. */
 static const char fogvol__fs_post_fog[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform sampler2D fv_colors;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
     "void main() {\n"
     "    float t = max(fv_view_depth(vec2(0.0)) - fv_pparams.x, 0.0);\n"
     "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
@@ -9772,9 +9887,11 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
     strings[n++] = di->version;
     if (stage == FOGVOL_STAGE_VERTEX) {
         n = fogvol__prelude(strings, n, di->vs);
+        strings[n++] = di->decl;
         strings[n++] = fogvol__vs_fullscreen;
     } else {
         strings[n++] = di->fs;
+        strings[n++] = di->decl;
         strings[n++] = fogvol__fs_post_common;
         if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
@@ -9809,6 +9926,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
                          : effect == FOGVOL_POST_OUTLINES && variant ? "fv_pnormal"
                                                                      : NULL;
         pd.label = labels[effect];
+        (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout);
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
@@ -12176,6 +12294,7 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (desc->dialect == FOGVOL_GLSL_VULKAN) return FOGVOL_ERROR_UNSUPPORTED; /* SPIR-V, not GL */
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(gl, 0, sizeof *gl);
