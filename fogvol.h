@@ -1005,7 +1005,9 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
    writes to its second colour output (fogvol_encode_depth's bytes; computed in
    integers where the engine's GLSL has bit operations and floatBitsToInt: 330+,
    300 es; with an R32F O, fogvol_mrt[0].z = 0: the normalised view depth in
-   red). Insert after the #version line and the engine's precision statements. */
+   red). Insert after the #version line and the engine's precision statements.
+   GLSL for Vulkan (no loose uniforms): declare vec4 fogvol_mrt[2] in one of the engine's own
+   uniform blocks or push constants and #define FOGVOL_MRT_IN_BLOCK before the snippet. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 
 /* Occluders drawn by the engine with its own programs, pipelines and vertex
@@ -1752,7 +1754,9 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
    their own shaders paste the strings of fogvol_analytic_snippet(): the
    uniform, void fogvol_analytic(vec3 world_pos, out float fog, out vec3 color)
    and fogvol_fold_fog(inout vec4 diffuse, inout vec4 specular, float fog,
-   vec3 color).
+   vec3 color) (GLSL for Vulkan: declare vec4 fv_analytic[42] in a block of your own and #define
+   FOGVOL_ANALYTIC_IN_BLOCK before them). FOGVOL_GLSL_VULKAN's own programs read one std140 block at
+   (set 0, binding 0): fv_mvp at byte 0, fv_model at 64, fv_analytic at 128; fv_position at location 0.
    Fragment shaders need highp and 42 uniform vectors (GLES2 promises 16 only).
 
    Degenerate input never gives NaN: invalid volumes are left out of a set (and
@@ -6409,7 +6413,9 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
    (the same 8x8 ordered pattern as fogvol_make_dither_index); in integers where the dialect has
    floatBitsToInt and bit operations (GLSL 330+, 300 es), by FV_IALU's FOGVOL__IALU_TEXT. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
+    "#ifndef FOGVOL_MRT_IN_BLOCK\n" /* Vulkan: vec4 fogvol_mrt[2] is a member of the engine's own block */ \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "#endif\n" \
     "vec4 fogvol_view_depth_r32f(float view_depth) {\n" /* N = 0: an R32F target */ \
     "    return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n" \
     "}\n" \
