@@ -282,6 +282,12 @@ typedef enum fogvol_format {
                                  EXT_color_buffer_float + EXT_float_blend) */
 } fogvol_format;
 
+/* An object of the backend's graphics API that the engine and fogvol hand each other (engine depth
+   textures and framebuffers, fogvol's O texture for the engine's MRT and occluder passes, the post
+   effects' inputs): GL a texture or framebuffer name, Vulkan a non-dispatchable handle such as a
+   VkImageView (64 bits on every platform), D3D12 or Metal a pointer or descriptor handle. */
+typedef uint64_t fogvol_native;
+
 /* ---- context: handles, tiers, variants, dialects, the GL backend's desc ---- */
 typedef struct fogvol_context fogvol_context;
 typedef struct fogvol_mesh fogvol_mesh;
@@ -854,7 +860,7 @@ typedef struct fogvol_frame_desc {
        to view depth through the inverse of projection * view (any projection above) and
        the depth conventions the backend reports (fogvol_frame_info) unless overridden by
        the two fields below */
-    uintptr_t engine_depth_texture;
+    fogvol_native engine_depth_texture;
     int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
     float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
     /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
@@ -872,7 +878,7 @@ typedef struct fogvol_frame_desc {
        needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
        FOGVOL_ERROR_UNSUPPORTED). */
     fogvol_depth_source engine_depth_source;
-    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+    fogvol_native engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
     /* 0 or 1: fogvol's sums at the viewport's resolution. 2: at half its width and height
        (rounded up): the O and face passes shade a quarter of the fragments and the composite
@@ -993,7 +999,7 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
    nothing). The engine's framebuffer must be viewport-sized with origin (0,0),
    and its pass must not blend into the attachment. */
 typedef struct fogvol_mrt_info {
-    uintptr_t texture;
+    fogvol_native texture;
     float clear_color[4];
     float uniforms[8];
     fogvol_format format;
@@ -1024,7 +1030,7 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
    uniforms. end_frame then uses what the engine drew instead of its own O
    pass; fogvol_add_occluder* in the same frame is refused. */
 typedef struct fogvol_occluder_info {
-    uintptr_t texture;        /* backend API object (GL: texture name) */
+    fogvol_native texture;        /* backend API object (GL: texture name) */
     int width, height;
     fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT, and PS20 with
                                  FOGVOL_SPEEDUP_FLOAT_O: d = (view depth - near)/(far - near)) */
@@ -1078,7 +1084,7 @@ typedef enum fogvol_post_effect {
    without blending (in-focus pixels keep their colour exactly). */
 typedef struct fogvol_dof_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    fogvol_native color_texture; /* the scene's colour (GL texture name), required */
     int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
     float focus_distance;    /* view depth in focus (> 0) */
     float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
@@ -1098,7 +1104,7 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
    (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
 typedef struct fogvol_outline_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    fogvol_native normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
     int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
     float color[4];           /* rgb, a = opacity; all 0 = opaque black */
     float depth_threshold;    /* relative second difference, 0 = 0.05 */
@@ -1317,7 +1323,7 @@ typedef struct fogvol_pass {
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
-    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+    fogvol_native native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
                                                             backend's own API (GL: a texture name) */
     float uniforms[FOGVOL_U_COUNT][4];
 } fogvol_pass;
@@ -1393,7 +1399,7 @@ typedef struct fogvol_backend {
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
     /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
-    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    fogvol_native (*native_texture)(void *user_data, fogvol_handle texture);
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
@@ -1402,8 +1408,8 @@ typedef struct fogvol_backend {
        bound at begin_frame; else framebuffer, an API object) into a
        single-sample depth texture the backend owns, with the same texel
        coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
-                                uintptr_t *texture);
+    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4],
+                                fogvol_native *texture);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
        the samples passing between begin_query and end_query, which fogvol calls around the draws of
        one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
@@ -6560,10 +6566,10 @@ static void fogvol__null_draw_fullscreen(void *u)
 
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
 
-static uintptr_t fogvol__null_native(void *u, fogvol_handle h)
+static fogvol_native fogvol__null_native(void *u, fogvol_handle h)
 {
     (void)u;
-    return (uintptr_t)h;
+    return (fogvol_native)h;
 }
 
 static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
@@ -6814,7 +6820,7 @@ typedef struct fogvol__run {
     fogvol_frame_stats st;
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
-    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
     int w, h, single, count, rgba8;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
@@ -8257,7 +8263,7 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
 
 /* For the *_prepare calls: fogvol's targets sized to the frame (touches the
    GPU, state restored), the frame's constants and O's API object. */
-static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
+static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, fogvol_native *texture)
 {
     fogvol_frame_info fi;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
@@ -11355,10 +11361,10 @@ static fogvol_handle fogvol__gl_target_attachment(void *u, fogvol_handle h, int 
     return index == 0 ? h : index == 1 ? (fogvol_handle)t->second : 0;
 }
 
-static uintptr_t fogvol__gl_native_texture(void *u, fogvol_handle h)
+static fogvol_native fogvol__gl_native_texture(void *u, fogvol_handle h)
 {
     (void)u;
-    return h ? (uintptr_t)((const fogvol__gl_texture *)h)->tex : 0;
+    return h ? (fogvol_native)((const fogvol__gl_texture *)h)->tex : 0;
 }
 
 static fogvol__GLuint fogvol__gl_shader(fogvol__gl *gl, fogvol__GLenum type, const char *const *src, int n,
@@ -11782,8 +11788,8 @@ static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w
     gl->depth_h = h;
 }
 
-static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int bound, const int rect[4],
-                                           uintptr_t *texture)
+static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+                                           fogvol_native *texture)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
