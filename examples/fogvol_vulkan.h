@@ -90,6 +90,12 @@ void fogvk_set_frame(fogvol_backend *backend, const fogvk_frame *frame);
 VkCommandBuffer fogvk_frame_command(const fogvol_backend *backend);
 /* the layout a fogvol target's colour image is in now (after what has been recorded) */
 VkImageLayout fogvk_target_layout(const fogvol_backend *backend, fogvol_handle target);
+/* Before the engine renders into one of fogvol's targets itself (the MRT tier's O,
+   fogvol_mrt_info.texture; fogvol_occluder_info.texture): records into cmd the barrier that makes
+   that image a colour attachment in VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, after fogvol's last use
+   of it, and notes that the engine writes it there (fogvol's passes then wait for those writes).
+   FOGVOL_ERROR_INVALID_ARGUMENT when no target of the backend has this view. */
+fogvol_result fogvk_engine_attachment(fogvol_backend *backend, VkCommandBuffer cmd, fogvol_native view);
 
 #endif /* FOGVOL_VULKAN_H */
 
@@ -132,6 +138,7 @@ typedef struct fogvk_target {
     fogvk_image depth;           /* own depth buffer (depth.image != 0) */
     struct fogvk_target *share;  /* or the depth buffer of this target */
     fogvol_format format;
+    struct fogvk_target *next;   /* the backend's list of targets (fogvk_engine_attachment) */
 } fogvk_target;
 
 typedef struct fogvk_program {
@@ -184,6 +191,7 @@ typedef struct fogvk {
     unsigned char query_used[FOGVK_QUERIES];
     fogvk_texture *dummy;     /* bound to the units a pass leaves empty */
     fogvk_texture *uploads;   /* textures whose pixels wait for a command buffer */
+    fogvk_target *targets;    /* every target (attachments 1 too) */
     fogvk_mesh fullscreen;
     fogvk_pipeline *pipes;
     int npipes, pipe_cap;
@@ -481,6 +489,20 @@ VkImageLayout fogvk_target_layout(const fogvol_backend *backend, fogvol_handle t
     return target ? ((const fogvk_target *)target)->color.img.layout : VK_IMAGE_LAYOUT_UNDEFINED;
 }
 
+fogvol_result fogvk_engine_attachment(fogvol_backend *backend, VkCommandBuffer cmd, fogvol_native view)
+{
+    fogvk *vk = (fogvk *)backend->user_data;
+    fogvk_target *t;
+    for (t = vk->targets; t; t = t->next)
+        if ((fogvol_native)t->color.img.view == view) {
+            fogvk__use(cmd, &t->color.img, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                       VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                       VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+            return FOGVOL_SUCCESS;
+        }
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
+}
+
 static fogvol_result fogvk__begin_frame(void *u, fogvol_frame_info *info)
 {
     fogvk *vk = (fogvk *)u;
@@ -575,14 +597,21 @@ static fogvk_target *fogvk__new_target(fogvk *vk, const fogvol_target_desc *d)
         return NULL;
     }
     t->color.sampler = vk->samplers[d->linear ? 3 : 1];
+    t->next = vk->targets;
+    vk->targets = t;
     return t;
 }
 
 static void fogvk__destroy_target(void *u, fogvol_handle h)
 {
     fogvk *vk = (fogvk *)u;
-    fogvk_target *t = (fogvk_target *)h;
+    fogvk_target *t = (fogvk_target *)h, **p;
     if (!t) return;
+    for (p = &vk->targets; *p; p = &(*p)->next)
+        if (*p == t) {
+            *p = t->next;
+            break;
+        }
     if (t->second) fogvk__destroy_target(u, (fogvol_handle)t->second);
     fogvk__defer_image(vk, &t->depth);
     fogvk__defer_image(vk, &t->color.img);

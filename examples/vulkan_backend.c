@@ -59,6 +59,8 @@ typedef struct engine {
     unsigned char *readback_map;
     VkPipelineLayout layout;
     VkPipeline pipeline;          /* flat colour, depth test */
+    VkPipeline pipeline_o;        /* the same, and fogvol's O as a second output (the MRT tier) */
+    VkFormat o_format;
     int validation;               /* the layers are on */
     int messages;                 /* validation messages received */
 } engine;
@@ -272,22 +274,41 @@ static VkShaderModule engine_shader(engine *e, shaderc_compiler_t sc, const char
     return m;
 }
 
-/* The engine's own pipeline: position in, flat colour out (push constants: mvp, colour). */
-static void create_pipeline(engine *e)
+/* The engine's own pipelines: position in, flat colour out (push constants: mvp, colour, the view-space
+   z row for the view depth, and fogvol's MRT values); o_format != UNDEFINED: the MRT tier's second
+   output, fogvol's O, written with fogvol_mrt_snippet() (its uniforms in the engine's push constants). */
+#define ENGINE_DRAW_BLOCK "layout(push_constant) uniform draw { mat4 mvp; vec4 color; vec4 view_z; vec4 fogvol_mrt[2]; };\n"
+static VkPipeline create_pipeline(engine *e, VkFormat o_format)
 {
-    static const char *vs = "#version 450\n"
-                            "layout(location = 0) in vec3 pos;\n"
-                            "layout(push_constant) uniform draw { mat4 mvp; vec4 color; };\n"
-                            "void main() { gl_Position = mvp * vec4(pos, 1.0); }\n";
-    static const char *fs = "#version 450\n"
-                            "layout(push_constant) uniform draw { mat4 mvp; vec4 color; };\n"
+    static const char *vs = "layout(location = 0) in vec3 pos;\n" ENGINE_DRAW_BLOCK
+                            "#ifdef WITH_O\n"
+                            "layout(location = 0) out float view_depth;\n"
+                            "#endif\n"
+                            "void main() {\n"
+                            "    gl_Position = mvp * vec4(pos, 1.0);\n"
+                            "#ifdef WITH_O\n"
+                            "    view_depth = -dot(view_z, vec4(pos, 1.0));\n"
+                            "#endif\n"
+                            "}\n";
+    static const char *fs = "#version 450\n" ENGINE_DRAW_BLOCK
                             "layout(location = 0) out vec4 frag;\n"
                             "void main() { frag = color; }\n";
-    const VkFormat cf = VK_FORMAT_R8G8B8A8_UNORM;
+    static const char *fs_mrt_head = "#version 450\n" ENGINE_DRAW_BLOCK "#define FOGVOL_MRT_IN_BLOCK\n";
+    static const char *fs_mrt_tail = "layout(location = 0) in float view_depth;\n"
+                                     "layout(location = 0) out vec4 frag;\n"
+                                     "layout(location = 1) out vec4 fogvol_o;\n"
+                                     "void main() {\n"
+                                     "    frag = color;\n"
+                                     "    fogvol_o = fogvol_encode_view_depth(view_depth);\n"
+                                     "}\n";
+    const VkFormat cf[2] = {VK_FORMAT_R8G8B8A8_UNORM, o_format};
     const VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     shaderc_compiler_t sc = shaderc_compiler_initialize();
-    VkPushConstantRange pc = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, 80};
+    VkPushConstantRange pc = {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, 128};
     VkPipelineLayoutCreateInfo li;
+    VkPipeline pipeline;
+    char fs_mrt[8192], vs_text[2048];
+    int mrt = o_format != VK_FORMAT_UNDEFINED;
     VkPipelineShaderStageCreateInfo st[2];
     VkVertexInputBindingDescription vb = {0, 12, VK_VERTEX_INPUT_RATE_VERTEX};
     VkVertexInputAttributeDescription va = {0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
@@ -297,7 +318,7 @@ static void create_pipeline(engine *e)
     VkPipelineRasterizationStateCreateInfo rs;
     VkPipelineMultisampleStateCreateInfo ms;
     VkPipelineDepthStencilStateCreateInfo ds;
-    VkPipelineColorBlendAttachmentState ba;
+    VkPipelineColorBlendAttachmentState ba[2];
     VkPipelineColorBlendStateCreateInfo cb;
     VkPipelineDynamicStateCreateInfo dy;
     VkPipelineRenderingCreateInfo ri;
@@ -306,13 +327,15 @@ static void create_pipeline(engine *e)
     li.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
     li.pushConstantRangeCount = 1;
     li.pPushConstantRanges = &pc;
-    VK_CHECK(vkCreatePipelineLayout(e->dev, &li, NULL, &e->layout));
+    if (!e->layout) VK_CHECK(vkCreatePipelineLayout(e->dev, &li, NULL, &e->layout));
+    snprintf(fs_mrt, sizeof fs_mrt, "%s%s%s", fs_mrt_head, fogvol_mrt_snippet(), fs_mrt_tail);
+    snprintf(vs_text, sizeof vs_text, "#version 450\n%s%s", mrt ? "#define WITH_O\n" : "", vs);
     memset(st, 0, sizeof st);
     st[0].sType = st[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     st[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    st[0].module = engine_shader(e, sc, vs, shaderc_vertex_shader);
+    st[0].module = engine_shader(e, sc, vs_text, shaderc_vertex_shader);
     st[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    st[1].module = engine_shader(e, sc, fs, shaderc_fragment_shader);
+    st[1].module = engine_shader(e, sc, mrt ? fs_mrt : fs, shaderc_fragment_shader);
     st[0].pName = st[1].pName = "main";
     memset(&vi, 0, sizeof vi);
     vi.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
@@ -337,20 +360,20 @@ static void create_pipeline(engine *e)
     ds.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
     ds.depthTestEnable = ds.depthWriteEnable = VK_TRUE;
     ds.depthCompareOp = VK_COMPARE_OP_LESS;
-    memset(&ba, 0, sizeof ba);
-    ba.colorWriteMask = 0xf;
+    memset(ba, 0, sizeof ba);
+    ba[0].colorWriteMask = ba[1].colorWriteMask = 0xf; /* (no blending into fogvol's O) */
     memset(&cb, 0, sizeof cb);
     cb.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
-    cb.attachmentCount = 1;
-    cb.pAttachments = &ba;
+    cb.attachmentCount = mrt ? 2 : 1;
+    cb.pAttachments = ba;
     memset(&dy, 0, sizeof dy);
     dy.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
     dy.dynamicStateCount = 2;
     dy.pDynamicStates = dyn;
     memset(&ri, 0, sizeof ri);
     ri.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO;
-    ri.colorAttachmentCount = 1;
-    ri.pColorAttachmentFormats = &cf;
+    ri.colorAttachmentCount = mrt ? 2 : 1;
+    ri.pColorAttachmentFormats = cf;
     ri.depthAttachmentFormat = VK_FORMAT_D32_SFLOAT;
     memset(&pi, 0, sizeof pi);
     pi.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
@@ -366,10 +389,11 @@ static void create_pipeline(engine *e)
     pi.pColorBlendState = &cb;
     pi.pDynamicState = &dy;
     pi.layout = e->layout;
-    VK_CHECK(vkCreateGraphicsPipelines(e->dev, VK_NULL_HANDLE, 1, &pi, NULL, &e->pipeline));
+    VK_CHECK(vkCreateGraphicsPipelines(e->dev, VK_NULL_HANDLE, 1, &pi, NULL, &pipeline));
     vkDestroyShaderModule(e->dev, st[0].module, NULL);
     vkDestroyShaderModule(e->dev, st[1].module, NULL);
     shaderc_compiler_release(sc);
+    return pipeline;
 }
 
 static void engine_init(engine *e, int width, int height, int validation)
@@ -407,7 +431,7 @@ static void engine_init(engine *e, int width, int height, int validation)
                VK_IMAGE_ASPECT_DEPTH_BIT, &e->depth, &e->depth_mem, &e->depth_view);
     make_buffer(e, (VkDeviceSize)width * height * 12, VK_BUFFER_USAGE_TRANSFER_DST_BIT, NULL, &e->readback,
                 &e->readback_mem, (void **)&e->readback_map);
-    create_pipeline(e);
+    e->pipeline = create_pipeline(e, VK_FORMAT_UNDEFINED);
 }
 
 static void engine_mesh_upload(engine *e, const shp_mesh *m, engine_mesh *out)
@@ -498,13 +522,29 @@ typedef struct engine_draw {
     const engine_mesh *mesh;
     float mvp[16];
     float color[4];
+    float view_z[4]; /* row 2 of view * model: the view depth is -dot(view_z, (pos, 1)) */
 } engine_draw;
 
-/* The opaque scene: clear, draw flat-coloured meshes with depth. Leaves the colour image in
-   COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL (what fogvk_frame says). */
-static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw *draws, int n, const float sky[4])
+/* The MRT tier: fogvol's O as the engine pass's second colour attachment (fogvol_mrt_prepare). */
+typedef struct engine_mrt {
+    VkImageView view;
+    VkFormat format;
+    float clear[4];
+    float uniforms[8];
+} engine_mrt;
+
+static VkFormat fogvol_vk_format(fogvol_format f)
 {
-    VkRenderingAttachmentInfo ca, da;
+    return f == FOGVOL_FORMAT_R32F ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_R8G8B8A8_UNORM;
+}
+
+/* The opaque scene: clear, draw flat-coloured meshes with depth (and fogvol's O: mrt != NULL). Leaves
+   the colour image in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL (what
+   fogvk_frame says). */
+static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw *draws, int n, const float sky[4],
+                              const engine_mrt *mrt)
+{
+    VkRenderingAttachmentInfo ca[2], da;
     VkRenderingInfo ri;
     VkViewport vp;
     VkRect2D sc;
@@ -516,14 +556,24 @@ static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw 
             VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0,
             VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
             VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-    memset(&ca, 0, sizeof ca);
-    ca.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-    ca.imageView = e->color_view;
-    ca.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    ca.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    ca.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    memcpy(ca.clearValue.color.float32, sky, 16);
-    da = ca;
+    memset(ca, 0, sizeof ca);
+    ca[0].sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+    ca[0].imageView = e->color_view;
+    ca[0].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    ca[0].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    ca[0].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    memcpy(ca[0].clearValue.color.float32, sky, 16);
+    da = ca[0];
+    if (mrt) { /* fogvol's O, cleared to "far" (fogvk_engine_attachment made it an attachment) */
+        ca[1] = ca[0];
+        ca[1].imageView = mrt->view;
+        memcpy(ca[1].clearValue.color.float32, mrt->clear, 16);
+        if (e->o_format != mrt->format) {
+            if (e->pipeline_o) vkDestroyPipeline(e->dev, e->pipeline_o, NULL);
+            e->pipeline_o = create_pipeline(e, mrt->format);
+            e->o_format = mrt->format;
+        }
+    }
     da.imageView = e->depth_view;
     da.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
     da.clearValue.depthStencil.depth = 1.0f;
@@ -532,11 +582,11 @@ static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw 
     ri.renderArea.extent.width = (uint32_t)e->width;
     ri.renderArea.extent.height = (uint32_t)e->height;
     ri.layerCount = 1;
-    ri.colorAttachmentCount = 1;
-    ri.pColorAttachments = &ca;
+    ri.colorAttachmentCount = mrt ? 2 : 1;
+    ri.pColorAttachments = ca;
     ri.pDepthAttachment = &da;
     vkCmdBeginRendering(cmd, &ri);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, e->pipeline);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mrt ? e->pipeline_o : e->pipeline);
     vp.x = vp.y = 0.0f;
     vp.width = (float)e->width;
     vp.height = (float)e->height;
@@ -549,10 +599,13 @@ static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw 
     vkCmdSetScissor(cmd, 0, 1, &sc);
     for (i = 0; i < n; ++i) {
         VkDeviceSize zero = 0;
-        float pc[20];
+        float pc[32];
+        memset(pc, 0, sizeof pc);
         memcpy(pc, draws[i].mvp, 64);
         memcpy(pc + 16, draws[i].color, 16);
-        vkCmdPushConstants(cmd, e->layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, 80, pc);
+        memcpy(pc + 20, draws[i].view_z, 16);
+        if (mrt) memcpy(pc + 24, mrt->uniforms, 32);
+        vkCmdPushConstants(cmd, e->layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, 128, pc);
         vkCmdBindVertexBuffers(cmd, 0, 1, &draws[i].mesh->vbuf, &zero);
         vkCmdBindIndexBuffer(cmd, draws[i].mesh->ibuf, 0, VK_INDEX_TYPE_UINT32);
         vkCmdDrawIndexed(cmd, draws[i].mesh->count, 1, 0, 0, 0);
@@ -629,6 +682,7 @@ static void engine_destroy(engine *e)
     int i;
     vkDeviceWaitIdle(e->dev);
     vkDestroyPipeline(e->dev, e->pipeline, NULL);
+    if (e->pipeline_o) vkDestroyPipeline(e->dev, e->pipeline_o, NULL);
     vkDestroyPipelineLayout(e->dev, e->layout, NULL);
     vkDestroyBuffer(e->dev, e->readback, NULL);
     vkFreeMemory(e->dev, e->readback_mem, NULL);

@@ -90,16 +90,18 @@ typedef struct config {
     const char *name;
     fogvol_tier tier;
     unsigned variants;
+    fogvol_tier gl_tier; /* the GL picture's tier (0: the same; MRT: PS20, the GL engine here writes no O) */
 } config;
 
 static const config g_configs[] = {
-    {"FLOAT", FOGVOL_TIER_FLOAT, 0},
-    {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH},
-    {"PS20", FOGVOL_TIER_PS20, 0},
-    {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH},
-    {"PS20+single target", FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET},
-    {"PS20+wide", FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE},
-    {"PS13", FOGVOL_TIER_PS13, 0},
+    {"FLOAT", FOGVOL_TIER_FLOAT, 0, FOGVOL_TIER_AUTO},
+    {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO},
+    {"PS20", FOGVOL_TIER_PS20, 0, FOGVOL_TIER_AUTO},
+    {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO},
+    {"PS20+single target", FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_TIER_AUTO},
+    {"PS20+wide", FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, FOGVOL_TIER_AUTO},
+    {"PS13", FOGVOL_TIER_PS13, 0, FOGVOL_TIER_AUTO},
+    {"MRT (the engine's pass writes O)", FOGVOL_TIER_MRT, 0, FOGVOL_TIER_PS20},
 };
 #define NCONFIGS ((int)(sizeof g_configs / sizeof g_configs[0]))
 
@@ -115,6 +117,7 @@ static int fog_create(fog *f, fogvol_context_desc *cd, const config *c, const sc
     int i;
     memset(f, 0, sizeof *f);
     cd->tier = c->tier;
+    cd->engine_mrt = c->tier == FOGVOL_TIER_MRT;
     cd->variants = c->variants;
     cd->disable_dither = 1; /* the thickness bound of test_tiers is for undithered sums */
     cd->logger.func = on_fogvol_log;
@@ -146,13 +149,15 @@ static void fog_destroy(fog *f)
     memset(f, 0, sizeof *f);
 }
 
-/* One fogvol frame of the scene: proj is the engine's projection; depth_texture non-zero: the
-   engine's depth as a texture (GL), else with ENGINE_DEPTH the bound framebuffer's (Vulkan). */
-static fogvol_result fog_frame(fog *f, const scene *s, const float proj[16], fogvol_native depth_texture,
-                               float *thickness, fogvol_frame_stats *st)
+/* fogvol_begin_frame and the occluders: proj is the engine's projection; depth_texture non-zero: the
+   engine's depth as a texture (GL), else with ENGINE_DEPTH the bound framebuffer's (Vulkan). The MRT
+   tier draws no occluders: the engine's pass writes O. */
+static fogvol_result fog_begin(fog *f, const scene *s, const float proj[16], fogvol_native depth_texture,
+                               float *thickness)
 {
     fogvol_frame_desc fd;
     unsigned variants = 0;
+    fogvol_tier tier = fogvol_context_tier(f->fv, &variants);
     int i;
     fogvol_result r;
     memset(&fd, 0, sizeof fd);
@@ -170,8 +175,18 @@ static fogvol_result fog_frame(fog *f, const scene *s, const float proj[16], fog
         fd.engine_depth_zero_to_one = 1; /* the engine's projection maps depth to [0, 1] */
     }
     r = fogvol_begin_frame(f->fv, &fd);
-    for (i = OBJ_PILLAR; r == FOGVOL_SUCCESS && i < NOBJ && !(variants & FOGVOL_VARIANT_ENGINE_DEPTH); ++i)
+    for (i = OBJ_PILLAR; r == FOGVOL_SUCCESS && i < NOBJ && !(variants & FOGVOL_VARIANT_ENGINE_DEPTH) &&
+                         tier != FOGVOL_TIER_MRT;
+         ++i)
         r = fogvol_add_occluder(f->fv, f->mesh[i], s->model[i]);
+    return r;
+}
+
+/* The volumes and fogvol_end_frame. */
+static fogvol_result fog_finish(fog *f, const scene *s, fogvol_frame_stats *st)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    int i;
     for (i = 0; r == FOGVOL_SUCCESS && i < NVOLUMES; ++i) {
         fogvol_volume_desc vd;
         memset(&vd, 0, sizeof vd);
@@ -217,28 +232,49 @@ static void vk_side_free(vk_side *v)
 }
 
 /* The engine's frame: its scene (copied to read-back region 0, with its depth), then fogvol (f NULL:
-   no fog), then the picture (region 1); submitted and waited for. */
+   no fog), then the picture (region 1); submitted and waited for. The MRT tier: fogvol_begin_frame and
+   fogvol_mrt_prepare come before the engine's pass, which writes fogvol's O as its second output. */
 static fogvol_result vk_frame(vk_side *v, fog *f, const scene *s, float *thickness, fogvol_frame_stats *st)
 {
     engine *e = &v->e;
     VkCommandBuffer cmd = engine_begin(e);
     engine_draw draws[2];
+    engine_mrt mrt;
     fogvk_frame fr;
     fogvol_result r = FOGVOL_SUCCESS;
-    int i;
+    int i, is_mrt = f && fogvol_context_tier(f->fv, NULL) == FOGVOL_TIER_MRT;
     for (i = 0; i < 2; ++i) {
-        float vp[16];
+        float vp[16], mv[16];
         draws[i].mesh = &v->mesh[OBJ_PILLAR + i];
         shp_mat_mul(vp, s->proj_vk, s->view);
         shp_mat_mul(draws[i].mvp, vp, s->model[OBJ_PILLAR + i]);
+        shp_mat_mul(mv, s->view, s->model[OBJ_PILLAR + i]);
+        draws[i].view_z[0] = mv[2];
+        draws[i].view_z[1] = mv[6];
+        draws[i].view_z[2] = mv[10];
+        draws[i].view_z[3] = mv[14];
         memcpy(draws[i].color, g_colors[OBJ_PILLAR + i], 16);
     }
-    engine_draw_scene(e, cmd, draws, 2, g_sky);
-    engine_record_readback(e, cmd, 0, 1);
     if (f) {
         engine_frame_desc(e, cmd, &fr);
         fogvk_set_frame(&v->be, &fr); /* fogvol records into cmd */
-        r = fog_frame(f, s, s->proj_vk, 0, thickness, st);
+    }
+    if (is_mrt) {
+        fogvol_mrt_info mi;
+        r = fog_begin(f, s, s->proj_vk, 0, thickness);
+        if (r == FOGVOL_SUCCESS) r = fogvol_mrt_prepare(f->fv, &mi);
+        if (r == FOGVOL_SUCCESS) r = fogvk_engine_attachment(&v->be, cmd, mi.texture);
+        if (r != FOGVOL_SUCCESS) return r;
+        mrt.view = (VkImageView)mi.texture;
+        mrt.format = fogvol_vk_format(mi.format);
+        memcpy(mrt.clear, mi.clear_color, sizeof mrt.clear);
+        memcpy(mrt.uniforms, mi.uniforms, sizeof mrt.uniforms);
+    }
+    engine_draw_scene(e, cmd, draws, 2, g_sky, is_mrt ? &mrt : NULL);
+    engine_record_readback(e, cmd, 0, 1);
+    if (f) {
+        if (!is_mrt) r = fog_begin(f, s, s->proj_vk, 0, thickness);
+        if (r == FOGVOL_SUCCESS) r = fog_finish(f, s, st);
         cmd = fogvk_frame_command(&v->be); /* (the debug read-back flushed the first one) */
     }
     engine_record_readback(e, cmd, 1, 0);
@@ -296,7 +332,8 @@ static fogvol_result gl_frame(glu_ctx *g, fog *f, const scene *s, const unsigned
     const unsigned char *px;
     fogvol_context_tier(f->fv, &variants);
     dtex = gl_engine_scene(color, (variants & FOGVOL_VARIANT_ENGINE_DEPTH) ? depth : NULL, w, h);
-    r = fog_frame(f, s, s->proj_01, dtex, NULL, NULL); /* GL's rows: the projection does not flip y */
+    r = fog_begin(f, s, s->proj_01, dtex, NULL); /* GL's rows: the projection does not flip y */
+    if (r == FOGVOL_SUCCESS) r = fog_finish(f, s, NULL);
     px = glu_pixels(g);
     for (y = 0; y < h; ++y) memcpy(out + (size_t)y * w * 4, px + (size_t)(h - 1 - y) * w * 4, (size_t)w * 4);
     if (dtex) glDeleteTextures(1, &dtex);
@@ -430,12 +467,19 @@ static int run_check(void)
         fogvol_context_desc vcd, gcd;
         fog fv, fg;
         result res;
+        config gl_c;
+        fogvol_frame_stats last;
+        unsigned variants = 0;
+        fogvol_tier tier;
         memset(&res, 0, sizeof res);
+        memset(&last, 0, sizeof last);
         memset(&vcd, 0, sizeof vcd);
         vcd.backend = v.be;
         memset(&gcd, 0, sizeof gcd);
         gcd.gl.get_proc_address = glu_proc;
-        if (!fog_create(&fv, &vcd, c, &s) || !fog_create(&fg, &gcd, c, &s)) {
+        gl_c = *c;
+        if (c->gl_tier) gl_c.tier = c->gl_tier;
+        if (!fog_create(&fv, &vcd, c, &s) || !fog_create(&fg, &gcd, &gl_c, &s)) {
             printf("not ok %d - %s: context\n", ++n, c->name);
             failed++;
             fog_destroy(&fv);
@@ -459,8 +503,15 @@ static int run_check(void)
                 continue;
             }
             compare_frame(&res, c, &s, &t[k], thick, scene_px, vk_px, gl_px, snap);
+            last = st;
             if (res.bad + res.comp_over + res.outside_bad > before) res.frames_failed++;
         }
+        tier = fogvol_context_tier(fv.fv, &variants);
+        if (tier != c->tier || (variants & c->variants) != c->variants) res.frames_failed++;
+        printf("#   %s: tier %s, variants 0x%x, %d passes in the last frame (%d depth-tested), overflow count %d "
+               "(occlusion queries, frame %d)\n",
+               c->name, fogvol_tier_name(tier), variants, last.passes, last.depth_tested, last.overflow_pixels_late,
+               (int)last.overflow_frame);
         fog_destroy(&fv);
         fog_destroy(&fg);
         printf("%s %d - %s: %d frames; thickness vs ray cast: max %.3f, mean %.3f %s (%d interior pixels, %d over "
@@ -502,7 +553,7 @@ static int render_picture(fogvol_tier tier, const char *path)
     vk_side v;
     fog f;
     fogvol_context_desc cd;
-    config c = {"picture", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH};
+    config c = {"picture", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO};
     int rc;
     c.tier = tier;
     if (tier != FOGVOL_TIER_FLOAT && tier != FOGVOL_TIER_PS20) c.variants = 0;
