@@ -399,8 +399,8 @@ static void fogvk__use(VkCommandBuffer cmd, fogvk_image *im, VkImageLayout layou
     b.subresourceRange.aspectMask = im->aspect;
     b.subresourceRange.levelCount = 1;
     b.subresourceRange.layerCount = 1;
-    vkCmdPipelineBarrier(cmd, im->stage ? im->stage : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, stage, 0, 0, NULL, 0, NULL, 1,
-                         &b);
+    vkCmdPipelineBarrier(cmd, im->stage ? im->stage : (VkPipelineStageFlags)VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, stage, 0,
+                         0, NULL, 0, NULL, 1, &b);
     im->layout = layout;
     im->stage = stage;
     im->access = access;
@@ -466,7 +466,7 @@ void fogvk_set_frame(fogvol_backend *backend, const fogvk_frame *frame)
     vk->engine_color.height = frame->height;
     vk->engine_color.layout = frame->color_layout;
     vk->engine_color.stage = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    vk->engine_color.access = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    vk->engine_color.access = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT; /* the engine's scene, drawn before */
     memset(&vk->engine_depth, 0, sizeof vk->engine_depth);
     vk->engine_depth.image = frame->depth_image;
     vk->engine_depth.format = frame->depth_format;
@@ -525,7 +525,7 @@ static void fogvk__end_frame(void *u)
 {
     fogvk *vk = (fogvk *)u;
     fogvk__end_rendering(vk);
-    if (vk->engine_color.image)
+    if (vk->engine_color.layout != vk->frame.color_layout) /* (only where a pass drew into it) */
         fogvk__use(vk->frame.cmd, &vk->engine_color, vk->frame.color_layout, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                    VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     if (vk->engine_depth.image && vk->engine_depth.layout != vk->frame.depth_layout)
