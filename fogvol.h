@@ -1133,7 +1133,19 @@ FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fog
    may come inside or outside a frame. A backend must leave the engine's
    state as it found it at begin_frame when end_frame returns, and resource
    entries called outside a frame must not change engine state either.
-   NULL optional entries (marked) are skipped. */
+   NULL optional entries (marked) are skipped.
+   Any graphics API: the table asks for no GL concept. Programs come as GLSL of
+   the backend's dialect (fogvol_backend.dialect: a GL dialect, whose uniforms a
+   backend sets by name, or FOGVOL_GLSL_VULKAN, SPIR-V-ready GLSL whose uniforms,
+   per-draw values and samplers sit where fogvol_program_desc.layout says); the
+   objects the engine and fogvol hand each other are fogvol_native values (GL
+   names, Vulkan handles, pointers); rows of targets and read-backs are in the
+   order the API stores them, row 0 at framebuffer y 0 (GL: the bottom; Vulkan
+   with a positive viewport height: the top row of memory), and fogvol's clip z
+   is GL's [-w, w] (the Vulkan dialect maps it to [0, w]: the same window
+   depth). examples/fogvol_vulkan.h is a complete backend on Vulkan,
+   examples/custom_backend.c wraps the GL one; the README's "Other graphics
+   APIs" says what each entry must do. */
 typedef uintptr_t fogvol_handle;
 
 /* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
@@ -1207,7 +1219,9 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
    "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
    FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
-   Vertex attribute 0: "fv_position" (vec3). */
+   Vertex attribute 0: "fv_position" (vec3).
+   FOGVOL_GLSL_VULKAN: the same units as bindings of set 0, the uniforms above in one std140 block
+   and push constants, not names: fogvol_program_desc.layout (fogvol_dialect_layout). */
 #define FOGVOL_MAX_TEXTURE_UNITS 8
 
 typedef struct fogvol_target_desc {
@@ -1324,7 +1338,8 @@ typedef struct fogvol_pass {
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
     fogvol_native native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
-                                                            backend's own API (GL: a texture name) */
+                                                            backend's own API (GL: a texture name;
+                                                            Vulkan: an image view) */
     float uniforms[FOGVOL_U_COUNT][4];
 } fogvol_pass;
 
@@ -1394,11 +1409,12 @@ typedef struct fogvol_backend {
     void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
     void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
     void (*end_pass)(void *user_data);        /* optional */
-    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+    /* optional (debug read-back; may wait for the GPU): the whole target, row 0 first (GL: bottom to top), as RGBA8
        bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
-    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
+    /* optional (MRT tier, fogvol_occluder_prepare): the API object behind a texture or target
+       (GL: texture name; Vulkan: image view) */
     fogvol_native (*native_texture)(void *user_data, fogvol_handle texture);
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
@@ -3216,7 +3232,8 @@ typedef struct fogvol__dialect_info {
 } fogvol__dialect_info;
 
 static const fogvol__dialect_info fogvol__dialects[] = {
-    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL, NULL, NULL, 0},
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL, NULL, NULL,
+     0},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
      {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
      fogvol__decl_gl, 0},
