@@ -427,7 +427,7 @@ static void engine_init(engine *e, int width, int height, int validation)
     make_image(e, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                VK_IMAGE_ASPECT_COLOR_BIT, &e->color, &e->color_mem, &e->color_view);
     make_image(e, VK_FORMAT_D32_SFLOAT,
-               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                VK_IMAGE_ASPECT_DEPTH_BIT, &e->depth, &e->depth_mem, &e->depth_view);
     make_buffer(e, (VkDeviceSize)width * height * 12, VK_BUFFER_USAGE_TRANSFER_DST_BIT, NULL, &e->readback,
                 &e->readback_mem, (void **)&e->readback_map);

@@ -3,8 +3,8 @@
 
    The scene: two interlocked tori (concave volumes) and a sphere of fog, one colour ramp; a pillar
    that cuts the first torus and a ground slab as the engine's opaque scene. NFRAMES frames: the
-   camera moves round and the pillar moves through the torus; in the last frame the camera stands
-   inside the sphere of fog.
+   camera moves round and the pillar moves through the torus; in the last two the camera stands
+   inside the sphere of fog, then inside the second torus's tube, its wall just past the near plane.
 
    The check, for every tier and variant the Vulkan backend runs (CONFIGS) and every frame:
      thickness  fogvol's debug read-back (fogvol_frame_desc.debug_thickness) against the ray caster
@@ -21,7 +21,7 @@
 #include "tests/gl_util.h"
 #include "tests/raycast.h"
 
-#define NFRAMES 4
+#define NFRAMES 5
 enum { OBJ_TORUS_A, OBJ_TORUS_B, OBJ_SPHERE, OBJ_PILLAR, OBJ_GROUND, NOBJ };
 #define NVOLUMES 3 /* the first three objects */
 
@@ -55,8 +55,11 @@ static void scene_free(scene *s)
 /* Frame k's camera and models; the picture is w x h. */
 static void scene_frame(scene *s, int k, int w, int h)
 {
-    static const double eye[NFRAMES][3] = {{0.3, 2.4, 6.5}, {3.8, 2.6, 4.8}, {-4.2, 1.6, 4.4}, {-2.5, 1.35, 1.3}};
-    static const float pillar_x[NFRAMES] = {-0.35f, 0.3f, 0.85f, 0.1f};
+    /* the last two: inside the sphere of fog; inside torus B's tube, whose wall is 0.3 ahead, between
+       the near plane (0.2) and twice its distance */
+    static const double eye[NFRAMES][3] = {
+        {0.3, 2.4, 6.5}, {3.8, 2.6, 4.8}, {-4.2, 1.6, 4.4}, {-2.5, 1.35, 1.3}, {1.9, 1.2, 0.0}};
+    static const float pillar_x[NFRAMES] = {-0.35f, 0.3f, 0.85f, 0.1f, 0.5f};
     float rot[16], tr[16];
     int i;
     shp_mat_rotate(rot, 90.0f, 1.0f, 0.0f, 0.0f); /* torus A stands in the xy plane */
@@ -69,7 +72,7 @@ static void scene_frame(scene *s, int k, int w, int h)
     memset(&s->cam, 0, sizeof s->cam);
     for (i = 0; i < 3; ++i) s->cam.eye[i] = eye[k][i];
     s->cam.target[0] = 0.2;
-    s->cam.target[1] = 0.9;
+    s->cam.target[1] = k == NFRAMES - 1 ? 1.2 : 0.9;
     s->cam.up[1] = 1.0;
     s->cam.fovy_deg = 55.0;
     s->cam.aspect = (double)w / h;
@@ -91,17 +94,19 @@ typedef struct config {
     fogvol_tier tier;
     unsigned variants;
     fogvol_tier gl_tier; /* the GL picture's tier (0: the same; MRT: PS20, the GL engine here writes no O) */
+    int depth_texture;   /* ENGINE_DEPTH from the engine's depth image as a texture (its view), not copied */
 } config;
 
 static const config g_configs[] = {
-    {"FLOAT", FOGVOL_TIER_FLOAT, 0, FOGVOL_TIER_AUTO},
-    {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO},
-    {"PS20", FOGVOL_TIER_PS20, 0, FOGVOL_TIER_AUTO},
-    {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO},
-    {"PS20+single target", FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_TIER_AUTO},
-    {"PS20+wide", FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, FOGVOL_TIER_AUTO},
-    {"PS13", FOGVOL_TIER_PS13, 0, FOGVOL_TIER_AUTO},
-    {"MRT (the engine's pass writes O)", FOGVOL_TIER_MRT, 0, FOGVOL_TIER_PS20},
+    {"FLOAT", FOGVOL_TIER_FLOAT, 0, FOGVOL_TIER_AUTO, 0},
+    {"FLOAT+engine depth (copy_depth)", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO, 0},
+    {"FLOAT+engine depth (the engine's view)", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO, 1},
+    {"PS20", FOGVOL_TIER_PS20, 0, FOGVOL_TIER_AUTO, 0},
+    {"PS20+engine depth (copy_depth)", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO, 0},
+    {"PS20+single target", FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_TIER_AUTO, 0},
+    {"PS20+wide", FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, FOGVOL_TIER_AUTO, 0},
+    {"PS13", FOGVOL_TIER_PS13, 0, FOGVOL_TIER_AUTO, 0},
+    {"MRT (the engine's pass writes O)", FOGVOL_TIER_MRT, 0, FOGVOL_TIER_PS20, 0},
 };
 #define NCONFIGS ((int)(sizeof g_configs / sizeof g_configs[0]))
 
@@ -204,6 +209,7 @@ typedef struct vk_side {
     engine e;
     fogvol_backend be;
     engine_mesh mesh[NOBJ];
+    int depth_texture; /* hand fogvol the engine's depth image view (config.depth_texture) */
 } vk_side;
 
 static int vk_side_init(vk_side *v, int w, int h, int validation, const scene *s)
@@ -272,8 +278,16 @@ static fogvol_result vk_frame(vk_side *v, fog *f, const scene *s, float *thickne
     }
     engine_draw_scene(e, cmd, draws, 2, g_sky, is_mrt ? &mrt : NULL);
     engine_record_readback(e, cmd, 0, 1);
+    if (f && v->depth_texture) { /* the engine's depth as a texture: sampled, its writes visible */
+        barrier(cmd, e->depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                VK_ACCESS_SHADER_READ_BIT);
+        fr.depth_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        fogvk_set_frame(&v->be, &fr);
+    }
     if (f) {
-        if (!is_mrt) r = fog_begin(f, s, s->proj_vk, 0, thickness);
+        if (!is_mrt) r = fog_begin(f, s, s->proj_vk, v->depth_texture ? (fogvol_native)e->depth_view : 0, thickness);
         if (r == FOGVOL_SUCCESS) r = fog_finish(f, s, st);
         cmd = fogvk_frame_command(&v->be); /* (the debug read-back flushed the first one) */
     }
@@ -477,6 +491,7 @@ static int run_check(void)
         vcd.backend = v.be;
         memset(&gcd, 0, sizeof gcd);
         gcd.gl.get_proc_address = glu_proc;
+        v.depth_texture = c->depth_texture;
         gl_c = *c;
         if (c->gl_tier) gl_c.tier = c->gl_tier;
         if (!fog_create(&fv, &vcd, c, &s) || !fog_create(&fg, &gcd, &gl_c, &s)) {
@@ -553,7 +568,7 @@ static int render_picture(fogvol_tier tier, const char *path)
     vk_side v;
     fog f;
     fogvol_context_desc cd;
-    config c = {"picture", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO};
+    config c = {"picture", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_TIER_AUTO, 0};
     int rc;
     c.tier = tier;
     if (tier != FOGVOL_TIER_FLOAT && tier != FOGVOL_TIER_PS20) c.variants = 0;
