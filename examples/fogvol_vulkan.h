@@ -327,6 +327,8 @@ static VkResult fogvk__image(fogvk *vk, fogvk_image *im, int w, int h, VkFormat 
     return r;
 }
 
+static void fogvk__free_garbage(fogvk *vk, fogvk_slot *s);
+
 /* Objects fogvol lets go of: freed when their frame slot comes round again (or at destroy). */
 static void fogvk__defer(fogvk *vk, VkObjectType type, uint64_t handle)
 {
@@ -335,9 +337,17 @@ static void fogvk__defer(fogvk *vk, VkObjectType type, uint64_t handle)
     if (s->ngarbage == s->cap) {
         int cap = s->cap ? s->cap * 2 : 64;
         fogvk_garbage *g = (fogvk_garbage *)realloc(s->garbage, (size_t)cap * sizeof *g);
-        if (!g) { /* no room to wait: the device must be idle to free it now */
+        if (!g) { /* out of memory for the list: the one place that waits, to free everything now */
+            fogvk_garbage one;
+            fogvk_slot now;
+            one.type = type;
+            one.handle = handle;
+            memset(&now, 0, sizeof now);
+            now.garbage = &one;
+            now.ngarbage = 1;
             vkDeviceWaitIdle(vk->dev);
-            s->ngarbage = 0;
+            fogvk__free_garbage(vk, s);
+            fogvk__free_garbage(vk, &now);
             return;
         }
         s->garbage = g;
@@ -931,8 +941,9 @@ static void fogvk__destroy_mesh(void *u, fogvol_handle h)
 
 /* ---- passes ---- */
 
-/* The pass's samplers and uniform block, written straight into the command buffer (push descriptors). */
-static void fogvk__descriptors(fogvk *vk, const fogvol_pass *p)
+/* The pass's samplers and uniform block, written straight into the command buffer (push descriptors);
+   0 when the frame's uniform ring is full (the pass then draws nothing). */
+static int fogvk__descriptors(fogvk *vk, const fogvol_pass *p)
 {
     VkWriteDescriptorSet w[FOGVK_SAMPLERS + 1];
     VkDescriptorImageInfo img[FOGVK_SAMPLERS];
@@ -957,8 +968,8 @@ static void fogvk__descriptors(fogvk *vk, const fogvol_pass *p)
     }
     /* fogvol_pass.uniforms is the std140 block as it is (fogvol_uniform_layout) */
     if (s->used + (VkDeviceSize)vk->ul.pass_size > FOGVK_RING) {
-        fogvk__log(vk, "fogvk: more passes in a frame than the uniform ring holds; the last ones reuse its end");
-        s->used = FOGVK_RING - vk->ubo_align * ((VkDeviceSize)vk->ul.pass_size / vk->ubo_align + 1);
+        fogvk__log(vk, "fogvk: more passes in a frame than the uniform ring holds (FOGVK_RING): pass skipped");
+        return 0;
     }
     memcpy(s->ring_data + s->used, p->uniforms, (size_t)vk->ul.pass_size);
     ubo.buffer = s->ring;
@@ -972,6 +983,7 @@ static void fogvk__descriptors(fogvk *vk, const fogvol_pass *p)
     w[i].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     w[i].pBufferInfo = &ubo;
     vk->push_descriptors(vk->frame.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, vk->layout, 0, FOGVK_SAMPLERS + 1, w);
+    return 1;
 }
 
 /* Barriers: the textures a pass samples to SHADER_READ_ONLY, its attachments to ATTACHMENT. */
@@ -1099,7 +1111,7 @@ static void fogvk__begin_pass(void *u, const fogvol_pass *p)
     }
     vkCmdBindPipeline(vk->frame.cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
     fogvk__dynamic_state(vk, p, color[0]);
-    fogvk__descriptors(vk, p);
+    if (!fogvk__descriptors(vk, p)) vk->pass = NULL;
 }
 
 static void fogvk__set_draw(void *u, const fogvol_draw *d)
