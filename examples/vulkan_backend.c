@@ -105,16 +105,19 @@ static int has_layer(const char *name)
 
 static void create_instance(engine *e)
 {
-    const char *layer = "VK_LAYER_KHRONOS_validation", *ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    const char *layer = "VK_LAYER_KHRONOS_validation";
+    const char *ext[2] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
     VkApplicationInfo app;
     VkInstanceCreateInfo ii;
     VkDebugUtilsMessengerCreateInfoEXT mi;
+    VkValidationFeaturesEXT vf;
+    const VkValidationFeatureEnableEXT sync = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
     PFN_vkCreateDebugUtilsMessengerEXT create;
     memset(&app, 0, sizeof app);
     app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
     app.pApplicationName = "fogvol vulkan_backend";
     app.apiVersion = VK_API_VERSION_1_3;
-    memset(&mi, 0, sizeof mi);
+    memset(&mi, 0, sizeof mi); /* (the layers' synchronization validation is on too) */
     mi.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
     mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
@@ -124,12 +127,17 @@ static void create_instance(engine *e)
     memset(&ii, 0, sizeof ii);
     ii.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     ii.pApplicationInfo = &app;
+    memset(&vf, 0, sizeof vf); /* synchronization validation too: every missing barrier is a message */
+    vf.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+    vf.enabledValidationFeatureCount = 1;
+    vf.pEnabledValidationFeatures = &sync;
+    vf.pNext = &mi; /* messages from vkCreateInstance itself too */
     if (e->validation) {
-        ii.pNext = &mi; /* messages from vkCreateInstance itself too */
+        ii.pNext = &vf;
         ii.enabledLayerCount = 1;
         ii.ppEnabledLayerNames = &layer;
-        ii.enabledExtensionCount = 1;
-        ii.ppEnabledExtensionNames = &ext;
+        ii.enabledExtensionCount = 2;
+        ii.ppEnabledExtensionNames = ext;
     }
     VK_CHECK(vkCreateInstance(&ii, NULL, &e->instance));
     if (!e->validation) return;
@@ -549,11 +557,15 @@ static void engine_draw_scene(engine *e, VkCommandBuffer cmd, const engine_draw 
     VkViewport vp;
     VkRect2D sc;
     int i;
+    /* (after the previous frame's uses: fogvol's passes, the read-back copies, a frame still in flight) */
     barrier(cmd, e->color, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-            VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+            VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+            VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     barrier(cmd, e->depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-            VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0,
+            VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+            VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
             VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
             VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
     memset(ca, 0, sizeof ca);
@@ -619,6 +631,14 @@ static void engine_record_readback(engine *e, VkCommandBuffer cmd, int region, i
 {
     VkBufferImageCopy c;
     VkBufferMemoryBarrier bb;
+    memset(&bb, 0, sizeof bb); /* after the copies of an earlier frame into the same buffer */
+    bb.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
+    bb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bb.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bb.buffer = e->readback;
+    bb.size = VK_WHOLE_SIZE;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 1, &bb, 0, NULL);
     barrier(cmd, e->color, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
