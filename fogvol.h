@@ -63,7 +63,7 @@
    QUICK START (default GL backend, any GL 2.1+ / 3.x core / GLES2+ context)
    ===========
        fogvol_context_desc cd;  memset(&cd, 0, sizeof cd);   // 0 = default
-       cd.gl.get_proc_address = my_get_proc;                  // e.g. glfwGetProcAddress wrapper
+       cd.gl.get_proc = glfwGetProcAddress;                   // or SDL/EGL/GLX/your own loader
        fogvol_context *fv;
        if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) ...;
 
@@ -405,9 +405,14 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 typedef void (*fogvol_gl_proc)(void);
 typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
 
+/* The GL backend's loader: one of the three (get_proc_address first where several are set). */
 typedef struct fogvol_gl_desc {
-    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    fogvol_gl_get_proc_fn get_proc_address; /* a loader that takes user_data */
     void *user_data;
+    fogvol_gl_proc (*get_proc)(const char *name); /* a plain loader returning a function pointer, as it
+                                 is: glfwGetProcAddress, eglGetProcAddress, SDL3's SDL_GL_GetProcAddress */
+    void *(*get_proc_pointer)(const char *name); /* a plain loader returning void *, as it is: SDL2's
+                                 SDL_GL_GetProcAddress, glad-style loaders (GLADloadproc) */
     fogvol_dialect dialect;   /* 0 = from the context */
     int version_major;        /* 0 = from the context; else treat the context as this GL version */
     int version_minor;
@@ -1421,7 +1426,10 @@ struct fogvol_context_desc {
     fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
                               FLOAT if float blending, else MRT if engine_mrt and MRT,
                               else PS20 if highp fragment shaders, else PS13 */
-    unsigned variants;     /* FOGVOL_VARIANT_* */
+    unsigned variants;     /* FOGVOL_VARIANT_* the engine requires: refused where the tier (AUTO: every
+                              tier the backend runs) does not take them */
+    unsigned preferred_variants; /* FOGVOL_VARIANT_* used where the chosen tier, dialect and backend take
+                              them, left out (logged at INFO) where not; fogvol_context_tier says which */
     int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
     fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
@@ -5320,155 +5328,180 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
 #endif /* FOGVOL_NO_ANALYTIC */
 
 /* >>tiers ================================================================= */
-/* What each tier can do: the variants, speed-ups and features it supports and what it costs. */
+/* What each tier can do: one row of fogvol__tiers per fogvol_tier, read by every question the library
+   asks about a tier (fogvol_combination_supported, fogvol_msaa_supported, fogvol_tier_uses_program,
+   fogvol_tier_costs, fogvol_shader_strings, the context's choice of tier and speed-ups, the frame's
+   plan). A feature exists on a tier with a set of variants unless the set holds one of its bits in the
+   row's off[] (FOGVOL__NEVER there: not on this tier) and it holds all of need[].
+   To add a tier: its value in fogvol_tier, its row here, and the passes that differ in the >>passes
+   section. To add a speed-up or feature: its FOGVOL__F_ value, its off[] entry in each row, the
+   context's switch for it (>>context) and the one pass function that uses it. */
+
+enum {
+    FOGVOL__F_ENCODE,         /* fogvol draws O itself with the ENCODE program (occluders, or the engine's depth) */
+    FOGVOL__F_RESOLVE,        /* B - F is resolved into an encoded thickness T before the composite (PS13) */
+    FOGVOL__F_CHECK,          /* the sums can saturate: overflow check passes (FOGVOL_PROGRAM_CHECK) */
+    FOGVOL__F_DENSITY,        /* faces weighted by a volume's density texture */
+    FOGVOL__F_LIGHT,          /* volume lights by compare (FOGVOL_PROGRAM_LIGHT) */
+    FOGVOL__F_COLORS,         /* the one-pass colour group (FOGVOL_PROGRAM_COLOR_FACE, _COMPOSITE) */
+    FOGVOL__F_MSAA,           /* per-sample rendering into a multisampled engine framebuffer */
+    FOGVOL__F_ALU,            /* FOGVOL_SPEEDUP_ALU: FOGVOL_VARIANT_ALU added where the dialect takes it */
+    FOGVOL__F_INLINE_RESOLVE, /* FOGVOL_SPEEDUP_INLINE_RESOLVE: the composite resolves B - F itself */
+    FOGVOL__F_FLOAT_O,        /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (FOGVOL_SPECIALIZE_FLOAT_O) */
+    FOGVOL__F_FETCH_O,        /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O there (FOGVOL_SPECIALIZE_FETCH_O) */
+    FOGVOL__F_EXACT_SUM,      /* FOGVOL_SPEEDUP_EXACT_SUM: 32-bit integer sums (FOGVOL_SPECIALIZE_EXACT_SUM) */
+    FOGVOL__F_DEPTH_TEST,     /* FOGVOL_SPEEDUP_DEPTH_TEST: frames drawn as COUNT (FOGVOL_SPECIALIZE_COUNT) */
+    FOGVOL__F_COUNT
+};
+#define FOGVOL__NEVER 0x80000000u /* in off[]: the tier has no such feature (no variant uses this bit) */
+
+typedef struct fogvol__tier_row {
+    const char *name;           /* fogvol_tier_name */
+    const char *define;         /* its line in every program (fogvol_shader_strings) */
+    unsigned char paper_passes; /* fogvol_tier_costs: as the white paper counts them */
+    unsigned char passes;       /* passes fogvol issues for one group, no variant */
+    unsigned char targets;      /* targets fogvol allocates, no variant */
+    unsigned char modern;       /* needs a dialect with float targets, two outputs and texelFetch */
+    fogvol_format sum_format;   /* the format of the face sums (RGBA8: encoded digits) */
+    unsigned caps;              /* backend caps (FOGVOL_CAP_*) it needs */
+    unsigned auto_caps;         /* ... for FOGVOL_TIER_AUTO to choose it */
+    unsigned variants;          /* the variants it takes */
+    unsigned modern_variants;   /* ... those of them that need a modern dialect */
+    unsigned int_variants;      /* ... and those that need highp integers (GLSL 330, 300 es) */
+    unsigned off[FOGVOL__F_COUNT], need[FOGVOL__F_COUNT];
+} fogvol__tier_row;
+
+/* (S single target, C count, A ALU, N near clamp, E engine depth, W wide, K colours) */
+#define FOGVOL__S FOGVOL_VARIANT_SINGLE_TARGET
+#define FOGVOL__C FOGVOL_VARIANT_COUNT
+#define FOGVOL__A FOGVOL_VARIANT_ALU
+#define FOGVOL__N FOGVOL_VARIANT_NEAR_CLAMP
+#define FOGVOL__E FOGVOL_VARIANT_ENGINE_DEPTH
+#define FOGVOL__W FOGVOL_VARIANT_WIDE
+#define FOGVOL__K FOGVOL_VARIANT_COLORS
+#define FOGVOL__X FOGVOL__NEVER
+static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
+    {"auto", "", 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
+     {FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
+     {0}},
+    /* PS13: O, B, F, T resolved, composite; lowp/mediump (texture ramps, per-channel compare) */
+    {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
+     FOGVOL__A,
+     /*       ENCODE RESOLVE CHECK DENSITY LIGHT COLORS MSAA                 ALU */
+     {0, 0, 0, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W,
+      /* INLINE_RESOLVE FLOAT_O                          FETCH_O */
+      0, FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      /* EXACT_SUM                                                     DEPTH_TEST */
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* PS20: O, B, F, composite */
+    {"PS20", "", 5, 4, 3, 0, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
+     FOGVOL__S | FOGVOL__C | FOGVOL__A | FOGVOL__N | FOGVOL__E | FOGVOL__W, FOGVOL__E, 0,
+     {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
+    {"MRT", "", 4, 3, 3, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
+     {FOGVOL__X, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__X, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X},
+     {0}},
+    /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
+    {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
+     FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
+     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
+     {0, 0, 0, 0, 0, FOGVOL__K}}};
+#undef FOGVOL__S
+#undef FOGVOL__C
+#undef FOGVOL__A
+#undef FOGVOL__N
+#undef FOGVOL__E
+#undef FOGVOL__W
+#undef FOGVOL__K
+#undef FOGVOL__X
+
+/* Variants that cannot go together on any tier, and what a variant needs of every tier's backend. */
+static const unsigned fogvol__variant_conflicts[][2] = {
+    {FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_WIDE, FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE}};
+#define FOGVOL__TWO_OUTPUTS FOGVOL_VARIANT_WIDE /* variants whose programs write two colour outputs */
+
+/* The row of a tier; NULL for values out of range. */
+static const fogvol__tier_row *fogvol__tier(fogvol_tier tier)
+{
+    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return NULL;
+    return &fogvol__tiers[tier];
+}
+
+/* Whether feature f (FOGVOL__F_*) exists on the tier with variants v. */
+static int fogvol__tier_has(fogvol_tier tier, unsigned v, int f)
+{
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t && !(t->off[f] & (v | FOGVOL__NEVER)) && (t->need[f] & v) == t->need[f];
+}
 
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 {
-    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
-    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
-    return names[tier];
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t ? t->name : "invalid";
 }
 
-/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
-static int fogvol__density_ok(fogvol_tier tier, unsigned v)
+/* GLSL 330 and 300 es guarantee highp integers and bit operations (PS13's integer ALU encode) */
+static int fogvol__dialect_integers(fogvol_dialect dialect)
 {
-    if (tier == FOGVOL_TIER_FLOAT) return 1;
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
-}
-
-static int fogvol__light_ok(fogvol_tier tier, unsigned v)
-{
-    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-                                         !(v & FOGVOL_VARIANT_WIDE));
+    return dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES;
 }
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     const fogvol__dialect_info *di = fogvol__dialect(dialect);
-    int modern; /* float targets, multiple outputs */
-    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = !di->legacy;
-    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
-                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
-        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
-    switch (tier) {
-    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
-                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
-        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    size_t i;
+    if (!di || !t || tier == FOGVOL_TIER_AUTO || (v & ~t->variants)) return FOGVOL_ERROR_UNSUPPORTED;
+    for (i = 0; i < sizeof fogvol__variant_conflicts / sizeof fogvol__variant_conflicts[0]; ++i)
+        if ((v & fogvol__variant_conflicts[i][0]) && (v & fogvol__variant_conflicts[i][1]))
             return FOGVOL_ERROR_UNSUPPORTED;
-        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
-                   ? FOGVOL_ERROR_UNSUPPORTED
-                   : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
-        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return FOGVOL_SUCCESS;
-    case FOGVOL_TIER_MRT:
-        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
-    case FOGVOL_TIER_FLOAT:
-        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
-    default: return FOGVOL_ERROR_UNSUPPORTED;
-    }
+    if (di->legacy && (t->modern || (v & t->modern_variants))) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & t->int_variants) && !fogvol__dialect_integers(dialect)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL__TWO_OUTPUTS) && di->outputs < 2) return FOGVOL_ERROR_UNSUPPORTED; /* GLES2: one output */
+    return FOGVOL_SUCCESS;
 }
 
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
-        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
-    if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
-        return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
-    return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
+    return fogvol__tier_has(tier, v, FOGVOL__F_MSAA) ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
 }
 
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
 {
-    switch (program) {
-    case FOGVOL_PROGRAM_ENCODE:
-        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-    case FOGVOL_PROGRAM_FACE:
-    case FOGVOL_PROGRAM_COMPOSITE:
-    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
-    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
-    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
-    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
-    case FOGVOL_PROGRAM_COLOR_FACE:
-    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
-    default: return 0;
-    }
+    /* the feature each program belongs to; -1: every tier's */
+    static const signed char feature[FOGVOL_PROGRAM_COUNT] = {
+        FOGVOL__F_ENCODE, -1, -1, -1, FOGVOL__F_RESOLVE, FOGVOL__F_CHECK, FOGVOL__F_LIGHT, FOGVOL__F_COLORS,
+        FOGVOL__F_COLORS};
+    if ((int)program < 0 || (int)program >= FOGVOL_PROGRAM_COUNT || !fogvol__tier(tier) || tier == FOGVOL_TIER_AUTO)
+        return 0;
+    return feature[program] < 0 || fogvol__tier_has(tier, v, feature[program]);
 }
 
 FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
 {
-    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    /* a tier that draws O itself, in a variant that does not (FLOAT + ENGINE_DEPTH): no O pass, no O */
+    int no_o = t && t->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER && !fogvol__tier_has(tier, v, FOGVOL__F_ENCODE);
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     out->name = fogvol_tier_name(tier);
-    switch (tier) {
-    case FOGVOL_TIER_PS13:
-        out->paper_passes = 6;
-        out->library_passes = 5;
-        out->targets = single ? 3 : 4; /* O, B, F, T */
-        break;
-    case FOGVOL_TIER_PS20:
-        out->paper_passes = 5;
-        out->library_passes = 4;
-        out->targets = single ? 2 : 3;
-        break;
-    case FOGVOL_TIER_MRT:
-        out->paper_passes = 4;
-        out->library_passes = 3;
-        out->targets = single ? 2 : 3; /* O is written by the engine */
-        break;
-    case FOGVOL_TIER_FLOAT:
-        out->paper_passes = 3;
-        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
-        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
-        break;
-    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
+    if (!t || tier == FOGVOL_TIER_AUTO) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    out->paper_passes = t->paper_passes;
+    out->library_passes = t->passes - no_o;
+    out->targets = t->targets - no_o - ((v & FOGVOL_VARIANT_SINGLE_TARGET) ? 1 : 0); /* (S: no F) */
     return FOGVOL_SUCCESS;
-}
-
-/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
-   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
-   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
-   comparing with an R32F O than counting with its RGBA8 O) */
-static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
-}
-
-/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
-   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
-/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
-   FLOAT's engine depth texture, nor COLORS' faces) */
-static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
-{
-    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-}
-
-/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
-static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
-{
-    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
-}
-
-static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
-                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
 }
 
 /* >>shaders =============================================================== */
@@ -5493,9 +5526,6 @@ static const char fogvol__fs_msaa[] =
     "}\n"
     "#undef FV_TEXTURE\n"
     "#define FV_TEXTURE fv_tex\n";
-
-static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
-                                                                   "#define FV_FLOAT\n"};
 
 static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
@@ -6235,18 +6265,18 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
-        if (!fogvol__count_spec_ok(d->tier, v) ||
+        if (!fogvol__tier_has(d->tier, v, FOGVOL__F_DEPTH_TEST) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
             (d->program == FOGVOL_PROGRAM_FACE && !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))
             return FOGVOL_ERROR_UNSUPPORTED; /* (COUNT has no density texture) */
         v |= FOGVOL_VARIANT_COUNT;
     }
-    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__float_o_ok(d->tier, v)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__tier_has(d->tier, v, FOGVOL__F_FLOAT_O)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
-    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__fetch_o_ok(d->tier, v) || d->samples > 1))
+    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__tier_has(d->tier, v, FOGVOL__F_FETCH_O) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) &&
-        (!fogvol__exact_sum_ok(d->tier, v) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
+        (!fogvol__tier_has(d->tier, v, FOGVOL__F_EXACT_SUM) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
          (d->program == FOGVOL_PROGRAM_FACE && (d->samples > 1 || !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))))
         return FOGVOL_ERROR_UNSUPPORTED;
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
@@ -6263,11 +6293,11 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
     } else
         strings[n++] = di->fs;
-    if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
+    if (fogvol__tiers[d->tier].define[0]) strings[n++] = fogvol__tiers[d->tier].define;
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (per_sample) strings[n++] = fogvol__fs_msaa;
-    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, v) &&
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__tier_has(d->tier, v, FOGVOL__F_DENSITY) &&
         !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
     n = fogvol__specialize_defines(d, strings, n);
@@ -6849,7 +6879,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
         td.format = FOGVOL_FORMAT_RGBA8;
         td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
             td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
         td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
@@ -7023,40 +7053,53 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
 
-/* AUTO: FLOAT with float blending, MRT when the engine writes O and can,
-   PS20 with highp fragment shaders, else PS13; an explicit tier must exist in
-   the backend's dialect and caps. */
+/* Whether the backend can run tier t with variants v: the combination exists in its dialect, and it
+   has the caps the tier needs (automatic: to be chosen by FOGVOL_TIER_AUTO) and those of the
+   variants (two attachments for WIDE and COLORS, a depth texture for ENGINE_DEPTH). */
+static int fogvol__backend_runs(const fogvol_context *ctx, fogvol_tier t, unsigned v, int automatic)
+{
+    const fogvol__tier_row *row = fogvol__tier(t);
+    unsigned caps = ctx->be.caps, need = row->caps | (automatic ? row->auto_caps : 0u);
+    if (fogvol_combination_supported(t, v, ctx->be.dialect) != FOGVOL_SUCCESS || (caps & need) != need) return 0;
+    if ((v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+        (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment))
+        return 0;
+    return !(v & FOGVOL_VARIANT_ENGINE_DEPTH) || (caps & FOGVOL_CAP_DEPTH_TEXTURE);
+}
+
+/* The tier: AUTO takes the first of FLOAT, MRT (when the engine writes O: desc->engine_mrt), PS20 and
+   PS13 that the backend runs with the required variants; an explicit tier must run with them. Then
+   each preferred variant joins where the tier, dialect and backend take it, and is left out (logged)
+   where not. */
 static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_context_desc *desc)
 {
-    unsigned caps = ctx->be.caps;
+    static const fogvol_tier order[4] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_MRT, FOGVOL_TIER_PS20, FOGVOL_TIER_PS13};
     fogvol_tier t = desc->tier;
-    if (t == FOGVOL_TIER_AUTO) {
-        if ((caps & FOGVOL_CAP_FLOAT_BLEND) &&
-            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_FLOAT;
-        else if (desc->engine_mrt && (caps & FOGVOL_CAP_MRT) &&
-                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_MRT;
-        else if (caps & FOGVOL_CAP_HIGHP_FRAGMENT)
-            t = FOGVOL_TIER_PS20;
+    unsigned v = desc->variants, bit;
+    int i;
+    for (i = 0; t == FOGVOL_TIER_AUTO && i < 4; ++i)
+        if ((order[i] != FOGVOL_TIER_MRT || desc->engine_mrt) && fogvol__backend_runs(ctx, order[i], v, 1))
+            t = order[i];
+    if (t == FOGVOL_TIER_AUTO || !fogvol__backend_runs(ctx, t, v, 0)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: %s%s with variants 0x%x does not run on this backend (GLSL %s, caps 0x%x); "
+                    "variants the engine only prefers go in fogvol_context_desc.preferred_variants",
+                    desc->tier == FOGVOL_TIER_AUTO ? "no tier" : "tier ",
+                    desc->tier == FOGVOL_TIER_AUTO ? "" : fogvol_tier_name(t), v,
+                    fogvol_dialect_name(ctx->be.dialect), ctx->be.caps);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    for (bit = 1u; bit & FOGVOL_VARIANT_ALL; bit <<= 1) {
+        if (!(desc->preferred_variants & bit) || (v & bit)) continue;
+        if (fogvol__backend_runs(ctx, t, v | bit, 0))
+            v |= bit;
         else
-            t = FOGVOL_TIER_PS13;
-    }
-    if (fogvol_combination_supported(t, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: tier %s with variants 0x%x does not exist in GLSL %s",
-                    fogvol_tier_name(t), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect));
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
-        (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
-        ((ctx->cfg.variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-         (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
-        ((ctx->cfg.variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
-                    fogvol_tier_name(t), caps);
-        return FOGVOL_ERROR_UNSUPPORTED;
+            fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                        "fogvol: preferred variant 0x%x left out: tier %s with variants 0x%x does not take it here",
+                        bit, fogvol_tier_name(t), v);
     }
     ctx->cfg.tier = t;
+    ctx->cfg.variants = v;
     return FOGVOL_SUCCESS;
 }
 
@@ -7180,44 +7223,35 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     return r;
 }
 
-/* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13 resolves B - F in its composite where fragment shaders have fp32. */
-static void fogvol__default_inline_resolve(fogvol_context *ctx)
+/* Whether the context runs speed-up sp (FOGVOL_SPEEDUP_*), whose feature f is in the tier's row:
+   not turned off (disable_speedups) and on the tier with the context's variants. */
+static int fogvol__speedup(const fogvol_context *ctx, unsigned sp, int f)
 {
-    ctx->cfg.inline_resolve = ctx->cfg.tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-                          !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
+    return !(ctx->cfg.speedups_off & sp) && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, f);
 }
 
-/* FOGVOL_SPEEDUP_EXACT_SUM: what it needs besides the R32F O */
-static int fogvol__exact_sum_can(const fogvol_context *ctx)
+/* The speed-ups the context runs (after the tier): their rows in the tier table, the backend's caps
+   and the programs they need (SPECIALIZE for those that are specialised programs). ALU: the variant
+   joins where the dialect takes it. INLINE_RESOLVE: with fp32 fragment maths. FLOAT_O: where the
+   backend renders R32F targets and the faces can read its float (MRT; PS20 with fp32; PS13 only where
+   it sums in integers: its digits measured slower with it). EXACT_SUM: framebuffer fetch and fp32. */
+static void fogvol__choose_speedups(fogvol_context *ctx)
 {
-    return (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-           !(ctx->cfg.speedups_off &
-             (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-           fogvol__exact_sum_ok(ctx->cfg.tier, ctx->cfg.variants);
-}
-
-/* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
-   fragment shaders have fp32 (the faces encode O's float), and PS13's where it sums in integers
-   (FOGVOL_SPEEDUP_EXACT_SUM; its digits measured slower with it); not WIDE, ENGINE_DEPTH or COUNT
-   (fogvol__float_o_ok). */
-static void fogvol__default_float_o(fogvol_context *ctx)
-{
-    ctx->cfg.float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
-                   fogvol__float_o_ok(ctx->cfg.tier, ctx->cfg.variants) &&
-                   (ctx->cfg.tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
-                   (ctx->cfg.tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
-}
-
-/* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
-   no lookup texture reads) unless the variant set or dialect cannot take it. */
-static void fogvol__default_alu(fogvol_context *ctx)
-{
-    unsigned v = ctx->cfg.variants | FOGVOL_VARIANT_ALU;
-    if ((ctx->cfg.tier == FOGVOL_TIER_PS20 || ctx->cfg.tier == FOGVOL_TIER_MRT || ctx->cfg.tier == FOGVOL_TIER_PS13) &&
-        !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_ALU) &&
-        !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
-        fogvol_combination_supported(ctx->cfg.tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
-        ctx->cfg.variants = v;
+    unsigned caps = ctx->be.caps, unspecialised = ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE;
+    int highp = (caps & FOGVOL_CAP_HIGHP_FRAGMENT) != 0, fetch = (caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) != 0;
+    int exact;
+    if (fogvol__speedup(ctx, FOGVOL_SPEEDUP_ALU, FOGVOL__F_ALU) &&
+        fogvol_combination_supported(ctx->cfg.tier, ctx->cfg.variants | FOGVOL_VARIANT_ALU, ctx->be.dialect) ==
+            FOGVOL_SUCCESS)
+        ctx->cfg.variants |= FOGVOL_VARIANT_ALU;
+    ctx->cfg.inline_resolve = highp && fogvol__speedup(ctx, FOGVOL_SPEEDUP_INLINE_RESOLVE, FOGVOL__F_INLINE_RESOLVE);
+    exact = fetch && highp && !unspecialised && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) &&
+            fogvol__speedup(ctx, FOGVOL_SPEEDUP_EXACT_SUM, FOGVOL__F_EXACT_SUM);
+    ctx->cfg.float_o = (caps & FOGVOL_CAP_FLOAT_TARGET) &&
+                       fogvol__speedup(ctx, FOGVOL_SPEEDUP_FLOAT_O, FOGVOL__F_FLOAT_O) &&
+                       (ctx->cfg.tier == FOGVOL_TIER_MRT || highp) && (ctx->cfg.tier != FOGVOL_TIER_PS13 || exact);
+    ctx->cfg.fetch_o = fetch && !unspecialised && fogvol__speedup(ctx, FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, FOGVOL__F_FETCH_O);
+    ctx->cfg.exact_sum = ctx->cfg.float_o && exact;
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -7240,7 +7274,6 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
     ctx->cfg.speedups_off = desc->disable_speedups;
-    ctx->cfg.variants = desc->variants;
     ctx->cfg.msaa = desc->msaa;
     fogvol_encoding_init(bits, &ctx->cfg.enc);
     r = fogvol__attach_backend(ctx, desc);
@@ -7249,15 +7282,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return r;
     }
     r = fogvol__choose_tier(ctx, desc);
-    if (r == FOGVOL_SUCCESS) {
-        fogvol__default_alu(ctx);
-        fogvol__default_inline_resolve(ctx);
-        fogvol__default_float_o(ctx);
-        ctx->cfg.fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
-                       !(ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-                       fogvol__fetch_o_ok(ctx->cfg.tier, ctx->cfg.variants);
-        ctx->cfg.exact_sum = ctx->cfg.float_o && fogvol__exact_sum_can(ctx);
-    }
+    if (r == FOGVOL_SUCCESS) fogvol__choose_speedups(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
@@ -7997,7 +8022,7 @@ static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_vo
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite density_map or color_map");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->density && !fogvol__density_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (desc->density && !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DENSITY)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: density textures need tier FLOAT, PS20 or MRT without the "
                     "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -9302,7 +9327,7 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     float k;
     if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__light_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_LIGHT)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -9519,7 +9544,7 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
     int i;
     if ((ctx->cfg.speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->cfg.count_broken || ctx->cfg.float_o || ctx->cur.nocc == 0 ||
-        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
         return 0;
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
@@ -12160,19 +12185,40 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     }
 }
 
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+/* fogvol_gl_desc's plain loaders behind the get_proc_address interface (user: the desc) */
+static fogvol_gl_proc fogvol__gl_plain_proc(const char *name, void *user)
+{
+    const fogvol_gl_desc *d = (const fogvol_gl_desc *)user;
+    fogvol_gl_proc f = NULL;
+    void *p;
+    if (d->get_proc) return d->get_proc(name);
+    p = d->get_proc_pointer(name); /* (a data pointer to a function pointer: bit for bit, as POSIX dlsym) */
+    if (p && sizeof p == sizeof f) memcpy(&f, &p, sizeof f);
+    return f;
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, const fogvol_allocator *alloc,
                                                   const fogvol_logger *logger, fogvol_backend *out)
 {
     fogvol__gl *gl;
     fogvol_logger silent;
+    fogvol_gl_desc plain; /* in with a plain loader: get_proc_address calls it */
+    const fogvol_gl_desc *desc = in;
     const char *ver = NULL, *ext = NULL;
     fogvol_result r;
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     memset(&silent, 0, sizeof silent);
     if (!logger) logger = &silent;
+    if (in && !in->get_proc_address && (in->get_proc || in->get_proc_pointer)) {
+        plain = *in;
+        plain.get_proc_address = fogvol__gl_plain_proc;
+        plain.user_data = (void *)in;
+        desc = &plain;
+    }
     if (!desc || !desc->get_proc_address) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        fogvol__log(logger, FOGVOL_LOG_ERROR,
+                    "fogvol: the GL backend needs a loader (get_proc_address, get_proc or get_proc_pointer)");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
