@@ -154,8 +154,14 @@ add_executable(consumer main.c)
 target_link_libraries(consumer PRIVATE fogvol::fogvol)
 EOF
   prefix=$cm/prefix
-  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=OFF \
+  run "cmake: configure, build and install fogvol (the defaults)" bash -c "cmake -S '$root' -B '$cm/fogvol' \
     -DCMAKE_INSTALL_PREFIX='$prefix' && cmake --build '$cm/fogvol' && cmake --install '$cm/fogvol'"
+  # installing the header builds nothing: no example, no test program
+  if [ -z "$(find "$cm/fogvol" -type f -perm -u+x -newer "$root/fogvol.h" ! -path '*/CMakeFiles/*' 2> /dev/null)" ]; then
+    ok "cmake: installing builds no program (examples and tests are off by default)"
+  else
+    not_ok "cmake: installing builds no program (examples and tests are off by default)"
+  fi
   if [ -f "$prefix/include/fogvol.h" ] && [ -f "$prefix/share/cmake/fogvol/fogvolConfig.cmake" ] &&
      [ -f "$prefix/share/cmake/fogvol/fogvolConfigVersion.cmake" ] && [ -f "$prefix/share/pkgconfig/fogvol.pc" ]; then
     ok "cmake: installed fogvol.h, fogvolConfig.cmake, fogvolConfigVersion.cmake, fogvol.pc"
@@ -175,7 +181,7 @@ EOF
   # the tests through CMake: configure, build and ctest (one cmocka program, the ray-cast self-test and
   # the shader script here; `make test` runs the whole list)
   RUN_TIMEOUT=900 run "cmake -B b && cmake --build b && ctest --test-dir b (tests: $CTEST_PROGRAMS)" bash -c "cmake -S '$root' \
-    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
+    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=ON -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
     cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|shaders)\$' \
     --output-on-failure"
   expect "ctest: every test passed" '100% tests passed, 0 tests failed out of [3-9]'
