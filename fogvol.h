@@ -30,8 +30,77 @@
        encoding             the RGB encoding of depths, fogvol_context_encoding
        textures             the lookup textures and colour ramps on the CPU
        shaders              the GLSL strings of each tier, variant and dialect
+       tuning               the speed-ups (on by default) and disable_speedups
        analytic fog         the analytic volumes (left out by FOGVOL_NO_ANALYTIC)
        CPU reference        the GPU arithmetic on the CPU, for tests and tools
+
+   API INDEX (every public function, one line each, by task)
+   =========
+   context      fogvol_create_context        make a context: backend, tier, variants, encoding
+                fogvol_destroy_context       free it and everything it owns
+                fogvol_context_tier          the tier and variants it chose
+                fogvol_context_encoding      its encoding (bits, faces it sums)
+                fogvol_set_dither            dithering on or off
+   meshes       fogvol_create_mesh           upload a closed mesh (validated, optionally welded)
+                fogvol_destroy_mesh          free it
+                fogvol_validate_mesh         check a mesh without a context (the report)
+   ramps        fogvol_create_ramp           thickness -> colour and alpha (extinction or table)
+                fogvol_destroy_ramp          free it
+   frames       fogvol_begin_frame           start a frame: camera, viewport, planes, debug read-back
+                fogvol_add_volume            a volume: mesh, model matrix, ramp, sign, textures
+                fogvol_add_occluder          an opaque mesh that cuts the volumes
+                fogvol_add_occluder_callback the engine draws an occluder itself
+                fogvol_occluder_transform    inside that callback: the model matrix to draw with
+                fogvol_add_light             a volume light by compare
+                fogvol_end_frame             draw and composite; the engine's state restored
+                fogvol_cancel_frame          drop the frame
+                fogvol_projection_planes     near and far planes from a projection matrix
+   textures     fogvol_create_volume_texture a density or colour texture for volumes
+                fogvol_destroy_volume_texture  free it
+   engine       fogvol_mrt_prepare           MRT: the O texture and uniforms for the engine's pass
+                fogvol_mrt_snippet           MRT: the GLSL to paste into the engine's opaque shader
+                fogvol_occluder_prepare      occluders drawn by the engine's own shaders into O
+                fogvol_occluder_snippet      the GLSL for those shaders
+   effects      fogvol_post_dof              depth of field (edge-preserving)
+                fogvol_post_outlines         outlines from depth (and normals)
+                fogvol_post_distance_fog     distance fog from depth
+   questions    fogvol_result_string         a result code's name
+                fogvol_tier_name             a tier's name
+                fogvol_dialect_name          a GLSL dialect's name
+                fogvol_combination_supported does a tier with these variants exist in a dialect
+                fogvol_msaa_supported        ... per sample on multisampled framebuffers
+                fogvol_tier_costs            passes and targets of a tier
+                fogvol_tier_uses_program     which programs a tier draws with
+   backends     fogvol_gl_backend_create     the GL backend on its own
+                fogvol_null_backend_init     a recording backend without a GPU (tests)
+                fogvol_uniform_name          the GLSL name of a uniform slot
+   shaders      fogvol_shader_strings        the GLSL of a program (tier, variants, dialect, stage)
+                fogvol_shader_source         the same with no variant
+                fogvol_post_shader_strings   the GLSL of an image-space effect
+   encoding     fogvol_encoding_init         the encoding with L bits per digit
+                fogvol_encoding_from_faces   ... that sums at least n faces
+                fogvol_encoding_from_precision ... with at least n bits
+                fogvol_encoding_table        every encoding (bits, faces, precision)
+                fogvol_compute_constants     the shaders' constants for near/far planes
+                fogvol_encode_depth          a depth as RGBA8 digits (CPU reference)
+                fogvol_sum_rgba8             saturating 8-bit sums (CPU reference)
+                fogvol_sum_encoded           sums of encoded depths (CPU reference)
+                fogvol_decode                digits -> depth (CPU reference)
+                fogvol_decode_difference     decode(a) - decode(b) (CPU reference)
+                fogvol_make_rg_ramp          the red+green lookup texture
+                fogvol_make_blue_ramp        the dithered blue lookup texture
+                fogvol_make_dither_index     the 8x8 dither pattern texture
+                fogvol_dither_threshold      a dither row's rounding threshold
+                fogvol_make_color_ramp       a colour ramp texture on the CPU
+   analytic     fogvol_analytic_prepare      analytic volumes (JCAB): prepare a set
+                fogvol_analytic_segment      one volume's entry and exit on a ray
+                fogvol_analytic_eval         fog of one eye-to-point ray
+                fogvol_analytic_batch        fog of many vertices (SIMD kernels)
+                fogvol_analytic_kernel_resolve  which kernel a batch runs
+                fogvol_fold_fog              fold fog into diffuse and specular
+                fogvol_analytic_pack_uniforms  the uniforms of the analytic GLSL
+                fogvol_analytic_shader_strings the analytic fog's GLSL
+                fogvol_analytic_snippet      its function for the engine's shaders
 
    BUILDING
    ========
@@ -472,130 +541,6 @@ typedef enum fogvol_overflow_policy {
    table (search "---- context desc"). */
 typedef struct fogvol_context_desc fogvol_context_desc;
 
-/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
-   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
-                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
-                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
-                 O pass (same pixels).
-   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
-                 instead of a filtered lookup at computed coordinates (same pixels).
-   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
-                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
-                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
-                 interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
-                 overflow check passes likewise.
-   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
-                 no O read without occluders (and no test for it with them), no density texture
-                 outside textured volumes, exp or
-                 ramp composite, no colour texture, no overflow test without show_overflow,
-                 target and engine-depth reads without the viewport offset where the viewport
-                 starts at the window origin) instead of one program that switches on uniforms;
-                 built on first use (same pixels).
-   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
-                 the depth is encoded and the dither row computed by arithmetic instead of three
-                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
-                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
-                 (FOGVOL_SPECIALIZE_ENCODING).
-   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
-                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
-                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
-                 newest count of each band: the whole picture over 8 frames, the same count while
-                 the picture holds still. Not with show_overflow (same pixels).
-   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
-                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
-                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
-                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
-   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
-                 FLOAT_O, below) in frames with
-                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
-                 and every volume's box either wholly between the near and far planes or wholly
-                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
-                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
-                 fragment behind an occluder is not shaded, and the composite adds the opaque
-                 depth once per missing back face. Other frames (a camera inside or near a volume)
-                 take the min compare as before. The same sums: B - F equals the min compare's
-                 bytes up to the faces that lie within depth-buffer precision of an occluder.
-                 FLOAT keeps the min compare: there the count needs a second float channel, and
-                 both ways tried measured slower on llvmpipe than the O read per face fragment
-                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
-                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
-                 against 16.1 ms).
-   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
-                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
-                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
-                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
-                 its resolve pass, which is exact in mediump.
-   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
-                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
-                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
-                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
-                 through the fragment shader (the same blend equation; the same pixels where the
-                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
-                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
-                 texture holding the normalised view depth d = (view depth - near) / (far - near),
-                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
-                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
-                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
-                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
-                 O's digits: one encode per fragment and no compare in the faces, and no encode where
-                 O is written. PS20 then draws frames with occluders with that compare, not
-                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
-                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
-                 PS13 keeps its RGBA8 O and the count). The
-                 same bytes: the faces encode O as the snippet or the O pass did (the same
-                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
-                 is the encoding of the lesser depth.
-   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
-                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
-                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
-                 at most one back and one front face on a ray, so no sum can saturate (the half is
-                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
-                 their box's diagonal, which a ray grazing them could cross more than once), and the
-                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
-                 out).
-   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
-                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
-                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
-                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
-                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
-                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
-                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
-                 about half a texture read, on tile-based GPUs it comes from tile memory
-                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
-   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
-                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
-                 without density-textured volumes sums its faces by programmable blending: one pass
-                 over every face reads B's RGBA8 pixel as a 32-bit
-                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
-                 of it and O) for a back face and subtracts it for a front face (sign flipped for
-                 negative volumes), and writes the integer back; the composite reads that one target.
-                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
-                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
-                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
-                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
-                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
-                 Not the digits' bytes: closer to the true thickness. */
-enum {
-    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
-    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
-    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
-    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
-    FOGVOL_SPEEDUP_ALU = 1u << 5,
-    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
-    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
-    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
-    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
-    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
-    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
-    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
-    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
-    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
-};
-#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
@@ -1419,25 +1364,27 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
    Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
    the struct complete); fogvol_create_context is in the context section. */
 struct fogvol_context_desc {
-    fogvol_allocator allocator;
-    fogvol_logger logger;
-    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
-                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
-    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
-                              FLOAT if float blending, else MRT if engine_mrt and MRT,
-                              else PS20 if highp fragment shaders, else PS13 */
+    /* what most engines set (all 0 = the GL backend, the best tier it runs, default encoding) */
+    fogvol_gl_desc gl;     /* the GL backend: its loader (gl.get_proc = glfwGetProcAddress, ...) */
+    fogvol_logger logger;  /* where errors, warnings and shader info logs go (0 = nowhere) */
+    fogvol_tier tier;      /* 0 = the first of FLOAT, MRT (with engine_mrt), PS20, PS13 that the
+                              backend runs with the required variants */
     unsigned variants;     /* FOGVOL_VARIANT_* the engine requires: refused where the tier (AUTO: every
                               tier the backend runs) does not take them */
     unsigned preferred_variants; /* FOGVOL_VARIANT_* used where the chosen tier, dialect and backend take
                               them, left out (logged at INFO) where not; fogvol_context_tier says which */
+    int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
+                              SINGLE_TARGET: 8 refused (no face fits beside the bias) */
+    /* less often */
+    fogvol_allocator allocator; /* 0 = FOGVOL_MALLOC / FOGVOL_FREE */
     int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
     fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
-    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
-    fogvol_gl_desc gl;     /* for the GL backend */
     fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
-    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
-                                  measuring what each one gives (bench/bench.c) */
+    fogvol_backend backend;/* a custom table (backend authors); if create_texture is NULL the GL backend
+                              is used */
+    unsigned disable_speedups; /* tuning: FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on),
+                                  to measure what each gives (see "---- tuning") */
 };
 
 /* ---- encoding ------------------------------------------------------------
@@ -1652,6 +1599,137 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                                                     fogvol_stage stage, const char **strings, int *count);
 
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
+/* ---- tuning: the speed-ups (for measuring them, and for backend authors) ---------
+   Every speed-up is on by default wherever the tier, variants, dialect and backend take it (the
+   tier table in the >>tiers section says where) and gives the same pixels, or closer ones where
+   said; fogvol_context_desc.disable_speedups turns them off one by one, to measure what each gives
+   (bench/bench.c) or to rule one out on a driver. The FOGVOL_SPECIALIZE_* bits above are the
+   programs some of them draw with. */
+/* The speed-ups (bits of fogvol_context_desc.disable_speedups):
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
+                 overflow check passes likewise.
+   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
+                 no O read without occluders (and no test for it with them), no density texture
+                 outside textured volumes, exp or
+                 ramp composite, no colour texture, no overflow test without show_overflow,
+                 target and engine-depth reads without the viewport offset where the viewport
+                 starts at the window origin) instead of one program that switches on uniforms;
+                 built on first use (same pixels).
+   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
+                 the depth is encoded and the dither row computed by arithmetic instead of three
+                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
+                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
+                 (FOGVOL_SPECIALIZE_ENCODING).
+   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
+                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
+                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
+                 newest count of each band: the whole picture over 8 frames, the same count while
+                 the picture holds still. Not with show_overflow (same pixels).
+   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
+                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
+                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
+                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
+   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
+                 FLOAT_O, below) in frames with
+                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
+                 and every volume's box either wholly between the near and far planes or wholly
+                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
+                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
+                 fragment behind an occluder is not shaded, and the composite adds the opaque
+                 depth once per missing back face. Other frames (a camera inside or near a volume)
+                 take the min compare as before. The same sums: B - F equals the min compare's
+                 bytes up to the faces that lie within depth-buffer precision of an occluder.
+                 FLOAT keeps the min compare: there the count needs a second float channel, and
+                 both ways tried measured slower on llvmpipe than the O read per face fragment
+                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
+                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
+                 against 16.1 ms).
+   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
+                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
+                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
+                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
+                 its resolve pass, which is exact in mediump.
+   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
+                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
+                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
+                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
+                 through the fragment shader (the same blend equation; the same pixels where the
+                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
+   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
+                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
+                 texture holding the normalised view depth d = (view depth - near) / (far - near),
+                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
+                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
+                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
+                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
+                 O's digits: one encode per fragment and no compare in the faces, and no encode where
+                 O is written. PS20 then draws frames with occluders with that compare, not
+                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
+                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
+                 PS13 keeps its RGBA8 O and the count). The
+                 same bytes: the faces encode O as the snippet or the O pass did (the same
+                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
+                 is the encoding of the lesser depth.
+   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
+                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
+                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
+                 at most one back and one front face on a ray, so no sum can saturate (the half is
+                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
+                 their box's diagonal, which a ray grazing them could cross more than once), and the
+                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
+                 out).
+   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
+                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
+                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
+                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
+                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
+                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
+                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
+                 about half a texture read, on tile-based GPUs it comes from tile memory
+                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
+   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
+                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
+                 without density-textured volumes sums its faces by programmable blending: one pass
+                 over every face reads B's RGBA8 pixel as a 32-bit
+                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
+                 of it and O) for a back face and subtracts it for a front face (sign flipped for
+                 negative volumes), and writes the integer back; the composite reads that one target.
+                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
+                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
+                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
+                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
+                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
+                 Not the digits' bytes: closer to the true thickness. */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
+    FOGVOL_SPEEDUP_ALU = 1u << 5,
+    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
+    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
+    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
+    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
+    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
+    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
+    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
+    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
+    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
+};
+#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
+
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
    Per-vertex (or per-pixel) fog from simple analytic volumes, without render
    passes or textures: for every vertex V the ray X = eye + t (V - eye) is cut
