@@ -1,4 +1,4 @@
-/* fogvol.h - v0.1.0 - mesh-shaped fog and light volumes for real-time engines
+/* fogvol.h - v0.2.0 - mesh-shaped fog and light volumes for real-time engines
    MIT or public domain (see the end of this file).
 
    fogvol.h renders ordinary closed polygon meshes (convex or concave, animated,
@@ -262,9 +262,9 @@
 #define FOGVOL_H
 
 #define FOGVOL_VERSION_MAJOR 0
-#define FOGVOL_VERSION_MINOR 1
+#define FOGVOL_VERSION_MINOR 2
 #define FOGVOL_VERSION_PATCH 0
-#define FOGVOL_VERSION_STRING "0.1.0"
+#define FOGVOL_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -12330,14 +12330,15 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
 
 /*
    REVISION HISTORY
-     unreleased        density and colour textures on volumes, volume light by compare,
+     0.2.0  (2026-11)  density and colour textures on volumes, volume light by compare,
                        image-space effects (depth of field, outlines, distance fog), GLES and
                        WebGL tested, float SIMD analytic kernels, engine conventions (clip
                        control, reversed-Z, G-buffers, MSAA, engine depth and occluders),
                        overflow counted every frame; outputs last everywhere; programs
                        specialised per configuration, PS20/MRT encode by arithmetic by default,
-                       resolve and check passes scissored; declarations in reading order (see
-                       CHANGELOG.md)
+                       resolve and check passes scissored; declarations in reading order; one
+                       tier table, sections by what they hold, preferred variants, plain GL
+                       loaders (see CHANGELOG.md)
      0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
                        colour-ramp textures, mesh validation, PS20 renderer, GL backend,
                        recording null backend.
