@@ -49,9 +49,9 @@ CTEST_PROGRAMS=${CTEST_PROGRAMS:-glstate} # the cmocka programs the CMake test b
 flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
 # name, libraries: OSMesa for the headless ones (every GL call must reach OSMesa), GLFW + libGL for the windows
 builds="demo_headless:-lOSMesa custom_backend:-lOSMesa demo_glfw:-lglfw_-lGL engine_integration:-lglfw_-lGL"
-for b in $builds; do # in parallel; each writes its own log
+for b in $builds; do # in parallel; each writes its own log (300 s each: make test runs other jobs beside them)
   name=${b%%:*}; libs=$(echo "${b#*:}" | tr _ ' ')
-  (timeout 120 $cc $flags "examples/$name.c" -o "$out/$name" $libs -lm > "$out/build_$name.log" 2>&1
+  (timeout 300 $cc $flags "examples/$name.c" -o "$out/$name" $libs -lm > "$out/build_$name.log" 2>&1
    echo $? > "$out/build_$name.rc") &
 done
 wait
