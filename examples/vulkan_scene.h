@@ -62,10 +62,10 @@ static void scene_frame(scene *s, int k, int w, int h)
     static const float pillar_x[NFRAMES] = {-0.35f, 0.3f, 0.85f, 0.1f, 0.5f};
     float rot[16], tr[16];
     int i;
-    shp_mat_rotate(rot, 90.0f, 1.0f, 0.0f, 0.0f); /* torus A stands in the xy plane */
+    shp_mat_rotate(rot, 90.0f, 1.0f, 0.0f, 0.0f); /* torus A lies flat (shp_torus is in the xy plane) */
     shp_mat_translate(tr, 0.0f, 1.2f, 0.0f);
     shp_mat_mul(s->model[OBJ_TORUS_A], tr, rot);
-    shp_mat_translate(s->model[OBJ_TORUS_B], 1.1f, 1.2f, 0.0f); /* flat, round A's tube */
+    shp_mat_translate(s->model[OBJ_TORUS_B], 1.1f, 1.2f, 0.0f); /* upright, through A's hole, round its tube */
     shp_mat_translate(s->model[OBJ_SPHERE], -2.6f, 1.2f, 1.0f);
     shp_mat_translate(s->model[OBJ_PILLAR], pillar_x[k], 1.5f, 0.1f);
     shp_mat_translate(s->model[OBJ_GROUND], 0.0f, -0.05f, 0.0f);
