@@ -99,6 +99,8 @@ $(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)
 
 $(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
+$(BUILD)/test_raycast_san: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
+	$(CC) -std=c99 -DRC_SANITIZE $(SAN) $(WARN) $(INC) -Itests $< -o $@ -lm
 $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
 $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
@@ -106,7 +108,7 @@ $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 
 TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
-            $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
+            $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless \
             $(BUILD)/vulkan_backend
@@ -129,6 +131,7 @@ SCRIPT_RUNS = \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \
+  "raycast_selftest_asan_ubsan=$(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
   "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
   "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
