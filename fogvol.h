@@ -2669,8 +2669,8 @@ static int fogvol__winding_at(const fogvol__wind *w, const double q[3], const do
         dist = (e2[0] * qq[0] + e2[1] * qq[1] + e2[2] * qq[2]) / det;
         if (dist <= 0.0 || u < 0.0 || v < 0.0 || u + v > 1.0) continue;
         if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9) return 0;
-        /* det = (e1 x e2) . d: > 0 when the face normal points along d (leaving) */
-        n += det > 0.0 ? 1 : -1;
+        /* det = e1 . (d x e2) = -(e1 x e2) . d: < 0 when the face normal points along d (leaving) */
+        n += det < 0.0 ? 1 : -1;
     }
     *wind = n;
     return 1;
@@ -2736,7 +2736,9 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
     int u = (a + 1) % 3, v = (a + 2) % 3, i, j, i0, i1, j0, j1, k;
     double area = (p[1][u] - p[0][u]) * (p[2][v] - p[0][v]) - (p[2][u] - p[0][u]) * (p[1][v] - p[0][v]);
     double umin = p[0][u], umax = p[0][u], vmin = p[0][v], vmax = p[0][v];
-    const double off = 0.5123;
+    /* a ray's offsets in its cell differ in u and v, and do not sum to 1: a ray never lies on a
+       diagonal of a quad whose corners are on grid lines (of any whole number of steps) */
+    const double offu = 0.5123, offv = 0.4671;
     if (area == 0.0) return;
     for (k = 1; k < 3; ++k) {
         if (p[k][u] < umin) umin = p[k][u];
@@ -2744,17 +2746,17 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
         if (p[k][v] < vmin) vmin = p[k][v];
         if (p[k][v] > vmax) vmax = p[k][v];
     }
-    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - off);
-    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - off) + 1;
-    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - off);
-    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - off) + 1;
+    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - offu);
+    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - offu) + 1;
+    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - offv);
+    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - offv) + 1;
     if (i0 < 0) i0 = 0;
     if (j0 < 0) j0 = 0;
     if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
     if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
     for (j = j0; j <= j1; ++j)
         for (i = i0; i <= i1; ++i) {
-            double qu = lo[u] + (i + off) * step[u], qv = lo[v] + (j + off) * step[v], e[3];
+            double qu = lo[u] + (i + offu) * step[u], qv = lo[v] + (j + offv) * step[v], e[3];
             int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
             for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
                 const double *p0 = p[k], *p1 = p[(k + 1) % 3];
@@ -2832,7 +2834,7 @@ static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_al
             fogvol__wind_tri(w, t, p);
             for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, xs, start);
         }
-    for (r = 0; r < NR; ++r) {
+    for (r = 0; xs && r < NR; ++r) { /* xs NULL: no ray crossed a face (xs + 0 would be undefined) */
         fogvol__xing *x = xs + start[r];
         int n = (int)count[r], i, j, sum = 0;
         if (skip[r] || n == 0) continue;
