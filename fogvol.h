@@ -6564,6 +6564,8 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    int64_t textured;  /* the frame (fogvol__frame_state.serial) in which a volume of it has a density or
+                          colour texture: it leaves the one-pass colour group for that frame */
 };
 
 struct fogvol_volume_texture {
@@ -6650,6 +6652,7 @@ typedef struct fogvol__gpu {
 /* The frame between fogvol_begin_frame and fogvol_end_frame / fogvol_cancel_frame: its desc, camera,
    volumes, occluders and lights. */
 typedef struct fogvol__frame_state {
+    int64_t serial; /* fogvol_begin_frame calls (ramps mark the frame their volumes are textured in) */
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -7902,6 +7905,7 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.frame = *d;
     ctx->cur.nvol = ctx->cur.nocc = 0;
     ctx->cur.in_frame = 1;
+    ctx->cur.serial++;
     ctx->cur.nlight = 0;
     return FOGVOL_SUCCESS;
 }
@@ -8053,6 +8057,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     memcpy(v->model, desc->model, sizeof v->model);
     v->negative = desc->negative != 0;
     fogvol__set_textures(v, desc);
+    if (desc->density || desc->color) /* (a ramp of this context: its own object) */
+        ((fogvol_ramp *)(uintptr_t)desc->ramp)->textured = ctx->cur.serial;
     return FOGVOL_SUCCESS;
 }
 
@@ -8649,6 +8655,15 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
 static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
 {
     return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
+}
+
+/* After the groups: a debug read-back that no group made (the frame draws no volume of debug_ramp,
+   or no volume at all) is the thickness the frame draws for it, 0. */
+static void fogvol__debug_empty(fogvol_context *ctx, const fogvol__run *run)
+{
+    size_t n = (size_t)ctx->cur.frame.viewport[2] * (size_t)ctx->cur.frame.viewport[3], i;
+    if (!ctx->cur.frame.debug_thickness || run->captured) return;
+    for (i = 0; i < n; ++i) ctx->cur.frame.debug_thickness[i] = 0.0f;
 }
 
 /* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
@@ -9411,9 +9426,12 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 /* >>colour groups ========================================================= */
 /* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
 
+/* A ramp in the colour group this frame: a colour ramp none of whose volumes has a density or colour
+   texture this frame (the colour group's programs draw neither: such a ramp is a group of its own,
+   drawn as without COLORS). */
 static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
-    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
+    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
 }
 
 /* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
@@ -9497,6 +9515,24 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     }
 }
 
+/* The debug read-back of a colour group (its sums are optical depths of all its ramps): one more
+   pass sums the faces of the debug ramp's volumes (debug_ramp NULL: the ramp of the group's first
+   volume, g) into B as the FLOAT tier's groups do, and reads that back. */
+static void fogvol__color_debug(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    const fogvol_ramp *ramp = ctx->cur.frame.debug_ramp ? ctx->cur.frame.debug_ramp : ctx->cur.vols[g].ramp;
+    int i, has_pos = 0, has_neg = 0;
+    if (!fogvol__want_debug(ctx, ramp, run->captured) || !fogvol__color_member(ctx, ramp)) return;
+    for (i = g; i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].ramp == ramp) {
+            has_neg |= ctx->cur.vols[i].negative;
+            has_pos |= !ctx->cur.vols[i].negative;
+        }
+    if (!has_pos) return; /* (no thickness: the frame's end writes 0) */
+    run->xsum = 0;
+    fogvol__sum_passes(ctx, run, ramp, has_neg);
+}
+
 /* The colour group, drawn where its first member volume g comes in the frame's order (once), if it
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
@@ -9508,6 +9544,7 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
     if (!has_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
+    fogvol__color_debug(ctx, run, g);
 }
 
 /* >>end frame ============================================================= */
@@ -9659,6 +9696,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol__opaque_pass(ctx, &run);
         fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
+        fogvol__debug_empty(ctx, &run);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
