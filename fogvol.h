@@ -7717,12 +7717,15 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 /* >>frame input =========================================================== */
 /* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
 
+/* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
+   next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->cur.in_frame = 0;
-    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.nvol = ctx->cur.nocc = ctx->cur.nlight = 0;
     ctx->cur.engine_occluders = 0;
+    ctx->cur.mrt_ready = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -7907,6 +7910,7 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.in_frame = 1;
     ctx->cur.serial++;
     ctx->cur.nlight = 0;
+    ctx->cur.mrt_ready = ctx->cur.engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -8154,6 +8158,7 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
     *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
+    ctx->gpu.o_far = 0; /* the engine writes O from here, whether or not this frame is ended */
     return FOGVOL_SUCCESS;
 }
 
