@@ -7729,6 +7729,40 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
     return FOGVOL_SUCCESS;
 }
 
+/* Matrices as fogvol reads them (column-major: m[column * 4 + row]). */
+static void fogvol__transpose(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* An affine transform: bottom row (m[3], m[7], m[11], m[15]) = (0, 0, 0, 1) within 1e-6 (of the
+   largest coefficient of the 3x3 part for the first three). A row-major matrix copied as it is has
+   its translation there. */
+static int fogvol__affine(const float m[16])
+{
+    double big = 0.0, tol;
+    int c, k;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 3; ++k)
+            if (FOGVOL_FABS(m[c * 4 + k]) > big) big = FOGVOL_FABS(m[c * 4 + k]);
+    tol = 1e-6 * big;
+    return FOGVOL_FABS(m[3]) <= tol && FOGVOL_FABS(m[7]) <= tol && FOGVOL_FABS(m[11]) <= tol &&
+           FOGVOL_FABS(m[15] - 1.0) <= 1e-6;
+}
+
+/* A perspective projection transposed: the w row (0, 0, -1, 0) (or +1, w = z) stands in column 3, so
+   m[14] is exactly +-1 and m[11] (the near/far term) is not, m[12] = m[13] = m[15] = 0 and the w row
+   read where it belongs, (m[3], m[7], m[11], m[15]), has the same (0, 0, c, 0) form. A projection as
+   written by glFrustum, gluPerspective, glm or D3D has m[11] = +-1 (reversed and infinite ones too),
+   so it is never taken for this. */
+static int fogvol__w_at_14(const float p[16])
+{
+    return FOGVOL_FABS(p[14]) == 1.0f && FOGVOL_FABS(p[11]) != 1.0f && p[11] != 0.0f && p[12] == 0.0f &&
+           p[13] == 0.0f && p[15] == 0.0f && p[3] == 0.0f && p[7] == 0.0f;
+}
+
 /* Camera axes in world space from the frame's input: eye, right X, up Y, forward F (view
    depth grows along F, X x Y = -F), the view depth row and clip from world. */
 static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_desc *d, double ax[4][3])
@@ -7762,6 +7796,9 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
     if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
     if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16))
         return "non-finite view or projection matrix";
+    if (!fogvol__affine(d->view)) return "the view matrix's bottom row (m[3], m[7], m[11], m[15]) is not (0, 0, 0, 1)";
+    if (fogvol__w_at_14(d->projection))
+        return "the projection's clip w takes the view depth from m[14] (the z row), not m[11] (the w row)";
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
     fogvol__mul4(ctx->cur.viewproj, p, v);
@@ -7780,8 +7817,8 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
 /* The frame's camera: how clip w relates to view depth (perspective: w = s e, s > 0;
    orthographic: w constant > 0), whether the projection mirrors the screen (orientation
    of a camera-facing triangle, counter-clockwise as seen from the eye, after projection),
-   and the inverse view-projection. Logs and refuses what it cannot interpret. */
-static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+   and the inverse view-projection. Returns why it cannot interpret the camera, or NULL. */
+static const char *fogvol__camera_why(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
     const char *why = fogvol__camera_axes(ctx, d, ax);
@@ -7817,11 +7854,33 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
         if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
         else ctx->cur.mirrored = det < 0.0;
     }
-    if (why) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    return why;
+}
+
+/* The camera (fogvol__camera_why); a refusal is logged, and says which matrices transposed would be
+   accepted: row-major engine matrices (raylib's Matrix, DirectXMath) copied as they are. */
+static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    static const char *const which[4] = {"", "the view matrix", "the projection", "the view and projection matrices"};
+    const char *why = fogvol__camera_why(ctx, d);
+    fogvol_frame_desc t;
+    int k, hint = 0;
+    if (!why) return FOGVOL_SUCCESS;
+    for (k = d->camera == FOGVOL_CAMERA_VIEW_PROJECTION ? 3 : 1; k <= 3 && !hint; ++k) {
+        t = *d;
+        if (d->camera == FOGVOL_CAMERA_VIEW_PROJECTION) fogvol__transpose(t.view_projection, d->view_projection);
+        if (k & 1) fogvol__transpose(t.view, d->view);
+        if (k & 2) fogvol__transpose(t.projection, d->projection);
+        if (!fogvol__camera_why(ctx, &t)) hint = k;
     }
-    return FOGVOL_SUCCESS;
+    if (hint && d->camera == FOGVOL_CAMERA_VIEW_PROJECTION)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? view_projection "
+                    "transposed would be accepted: a row-major matrix copied as it is)", why);
+    else if (hint)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? %s transposed would be "
+                    "accepted: a row-major matrix copied as it is)", why, which[hint]);
+    else fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
 }
 
 FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
@@ -7933,8 +7992,35 @@ static fogvol_result fogvol__grow(fogvol_context *ctx, void **arr, int *cap, int
     return FOGVOL_SUCCESS;
 }
 
+/* What makes a model matrix unusable, or NULL: non-finite, all zero, not affine (a row-major matrix
+   copied as it is: transposed, told apart by its transpose being affine), and for a volume or a
+   light, singular (|det| of the 3x3 part at most 1e-7 of the product of its column lengths: a zero
+   scale, or two axes along each other, flattens the mesh to no volume). */
+static const char *fogvol__model_problem(const float m[16], int volume)
+{
+    double d[16], c[3];
+    float t[16];
+    int i, k, zero = 1;
+    if (!fogvol__finite_n(m, 16)) return "is not finite";
+    for (i = 0; i < 16; ++i) zero &= m[i] == 0.0f;
+    if (zero) return "is all zero";
+    if (!fogvol__affine(m)) {
+        fogvol__transpose(t, m);
+        return fogvol__affine(t) ? "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1) but its "
+                                   "right column is (transposed? a row-major matrix copied as it is)"
+                                 : "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1)";
+    }
+    if (!volume) return NULL;
+    fogvol__tod(d, m);
+    for (k = 0; k < 3; ++k) c[k] = FOGVOL_SQRT(d[4 * k] * d[4 * k] + d[4 * k + 1] * d[4 * k + 1] + d[4 * k + 2] * d[4 * k + 2]);
+    if (FOGVOL_FABS(fogvol__det3(d)) <= 1e-7 * c[0] * c[1] * c[2])
+        return "is singular (a zero scale or two axes along each other flatten the mesh: no volume)";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16])
 {
+    const char *why;
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
@@ -7945,8 +8031,8 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (!fogvol__finite_n(model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the occluder's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.occ;
@@ -8036,6 +8122,7 @@ static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *de
 
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
+    const char *why;
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
@@ -8045,8 +8132,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volume's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     r = fogvol__check_textures(ctx, desc);
@@ -8089,10 +8176,14 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
+    const char *why;
     fogvol_draw dr;
     if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_transform: the model matrix %s", why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
     return FOGVOL_SUCCESS;
@@ -9318,6 +9409,7 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
 
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
 {
+    const char *why;
     fogvol__light *l;
     void *arr;
     fogvol_result r;
@@ -9336,9 +9428,12 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
                                               : "the mesh is too large for the convexity check");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour or intensity");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the light's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.lights;
