@@ -779,6 +779,13 @@ typedef struct fogvol_frame_stats {
     int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
+    /* The thickness step of this frame's RGBA8 digit sums, in view depth: (zfar - znear) / 2^(3L)
+       (WIDE: 2^(6L)); every pixel's thickness is within about one step per pair of faces. 0 when no
+       group summed in digits (FLOAT, FOGVOL_SPEEDUP_EXACT_SUM). When it is coarser than 1/16 of the
+       view-depth extent of the bounds of the frame's smallest volume, a warning is logged (on the
+       first such frame, and again after a frame that was not): move znear out or zfar in, or use
+       fewer faces per target (fogvol_context_desc.encoding_bits) or the FLOAT tier. */
+    float depth_lsb;
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -6676,6 +6683,7 @@ typedef struct fogvol__frame_state {
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
 typedef struct fogvol__overflow_state {
     int counting, overflow_late, overflow_warned, qcur;
+    int coarse;        /* the last ended frame's digit step was coarse (fogvol_frame_stats.depth_lsb) */
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
@@ -9747,6 +9755,32 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
+/* fogvol_frame_stats.depth_lsb, and its warning: the step of the digit sums against the view-depth
+   extent (within znear..zfar) of the bounds of the frame's smallest positive volume. */
+static void fogvol__frame_precision(fogvol_context *ctx, fogvol__run *run)
+{
+    int bits = ctx->gpu.tgt_b2 ? 2 * ctx->cfg.enc.precision_bits : ctx->cfg.enc.precision_bits, i, coarse;
+    double n = ctx->cur.frame.znear, f = ctx->cur.frame.zfar, lsb = (f - n) / (double)(1L << bits), small = 0.0;
+    if (!run->rgba8 || run->st.exact_sum >= run->st.groups) return;
+    run->st.depth_lsb = (float)lsb;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        double lo = 0.0, hi = 0.0;
+        if (ctx->cur.vols[i].negative) continue;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &lo, &hi);
+        lo = lo < n ? n : lo > f ? f : lo;
+        hi = hi < n ? n : hi > f ? f : hi;
+        if (hi > lo && (small == 0.0 || hi - lo < small)) small = hi - lo;
+    }
+    coarse = small > 0.0 && lsb > small / 16.0;
+    if (coarse && !ctx->ovf.coarse)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the %d-bit depth sums step by %g (one LSB: (zfar - znear) / 2^%d), more than 1/16 of "
+                    "the smallest volume's depth extent %g: its thickness is quantised that coarsely (move znear "
+                    "out or zfar in, or use fewer faces per target, or the FLOAT tier)",
+                    bits, lsb, bits, small);
+    ctx->ovf.coarse = coarse;
+}
+
 /* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
 static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run, fogvol_result r,
                                          fogvol_frame_stats *stats)
@@ -9797,6 +9831,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
         fogvol__debug_empty(ctx, &run);
+        fogvol__frame_precision(ctx, &run);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);

@@ -1824,6 +1824,79 @@ static void test_a4_transposed_and_degenerate(void **state)
     shp_free(&plane);
 }
 
+/* a warning-level message containing needle */
+static int log_warning_has(const logcap *c, const char *needle)
+{
+    int i;
+    for (i = 0; i < c->count && i < LOG_MAX; ++i)
+        if (c->level[i] == FOGVOL_LOG_WARNING && strstr(c->msg[i], needle)) return 1;
+    return 0;
+}
+
+/* Issue 31 3h: RGBA8 digits over near 1e-4 / far 1e5 quantise the thickness in steps of
+   1e5 / 2^12 = 24.4 units, ten times a 2-unit box (PS20 + COUNT drew fog in 30 of its 484
+   pixels), and nothing said so. Now: fogvol_frame_stats.depth_lsb is the step (hand-computed:
+   (far - near) / 2^(3L)) and a warning is logged when it is coarser than 1/16 of the depth extent
+   of the frame's smallest volume, once until a frame is fine again. */
+static void test_a4_coarse_lsb(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_mesh *box;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh b = shp_box(1.0f, 1.0f, 1.0f); /* 2 units across */
+    int frame, tier;
+    (void)state;
+    for (tier = 0; tier < 2; ++tier) {
+        log_reset(&lc);
+        rec_init(&r);
+        memset(&cd, 0, sizeof cd);
+        cd.backend = r.table;
+        if (tier) cd.backend.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_FLOAT_TARGET;
+        cd.tier = tier ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_PS20;
+        cd.variants = tier ? 0u : (unsigned)FOGVOL_VARIANT_COUNT;
+        cd.logger = cap_logger(&lc);
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        assert_int_equal(make_mesh(fv, &b, 0, 0, &box), FOGVOL_SUCCESS);
+        assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+        for (frame = 0; frame < 4; ++frame) {
+            int coarse = frame != 2; /* frame 2: near 0.5, far 10.5: a step of 10 / 4096 */
+            a_frame_desc(&fd);
+            if (coarse) {
+                glu_perspective(fd.projection, 60.0, (double)A_W / A_H, 1e-4, 1e5);
+                fd.znear = 1e-4f;
+                fd.zfar = 1e5f;
+            }
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = box;
+            vd.ramp = ramp;
+            mat_identity(vd.model); /* 5 units in front of the camera */
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            lc.count = lc.warnings = 0;
+            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            if (tier) { /* float sums: no step, no warning */
+                assert_true(st.depth_lsb == 0.0f);
+                assert_false(log_warning_has(&lc, "LSB"));
+                continue;
+            }
+            assert_close(st.depth_lsb, ((double)fd.zfar - fd.znear) / 4096.0, 1e-6, "depth_lsb");
+            /* warned on frames 0 and 3 (the first coarse frame, and again after a fine one) */
+            if (frame == 0 || frame == 3) assert_true(log_warning_has(&lc, "LSB"));
+            else assert_false(log_warning_has(&lc, "LSB"));
+        }
+        fogvol_destroy_mesh(fv, box);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+    }
+    shp_free(&b);
+}
+
 /* ---- A5: fault injection ---- */
 
 /* n-th backend create call failing during context creation: PS20 encodes by arithmetic by default
@@ -3045,6 +3118,7 @@ int main(void)
         cmocka_unit_test(test_a4_encoding_combinations),
         cmocka_unit_test(test_a4_bad_input),
         cmocka_unit_test(test_a4_transposed_and_degenerate),
+        cmocka_unit_test(test_a4_coarse_lsb),
         cmocka_unit_test(test_a5_backend_create_faults),
         cmocka_unit_test(test_a5_alloc_faults_context),
         cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),
