@@ -421,6 +421,14 @@ typedef struct fogvol_gl_desc {
                                  must be highp as well). Left 0, a mediump output could round
                                  the depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
                                  precision). */
+    /* optional: the window system's current context as an opaque id (user_data as above), e.g.
+       eglGetCurrentContext, glfwGetCurrentContext, SDL_GL_GetCurrentContext, wglGetCurrentContext.
+       fogvol keeps what it returns at creation and refuses every call that would touch GL while it
+       returns something else (FOGVOL_ERROR_INVALID_STATE, logged; nothing is touched). Without it,
+       fogvol tells another context by its own vertex array object (GL 3 / GLES 3; on GL 2 / GLES 2 a
+       framebuffer object) not being there, which a context that does not share objects with
+       fogvol's always shows, and a context sharing them too (those objects are never shared). */
+    void *(*current_context)(void *user_data);
 } fogvol_gl_desc;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -1383,6 +1391,13 @@ typedef struct fogvol_backend {
     int (*begin_query)(void *user_data, fogvol_handle query);
     void (*end_query)(void *user_data, fogvol_handle query);
     int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+    /* optional: the first failure the backend met in its own calls since the last take_error, else
+       FOGVOL_SUCCESS, and forget it. fogvol calls it at the end of every public call that used the
+       backend and returns it when the call had no error of its own (the backend logs it). GL: a GL
+       error fogvol's own calls raised (FOGVOL_ERROR_BACKEND), read before the engine's pending errors
+       are raised again; an engine texture name that is no texture (FOGVOL_ERROR_INVALID_ARGUMENT);
+       another GL context current (FOGVOL_ERROR_INVALID_STATE). */
+    fogvol_result (*take_error)(void *user_data);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -6812,6 +6827,15 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
 
+/* After the backend calls of a public call (outside a backend frame, or after its end_frame): the
+   backend's own failure since the last take (fogvol_backend.take_error, logged by the backend) is the
+   call's result when the call had none of its own. */
+static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
+{
+    fogvol_result e = ctx->be.take_error ? ctx->be.take_error(ctx->be.user_data) : FOGVOL_SUCCESS;
+    return r == FOGVOL_SUCCESS ? e : r;
+}
+
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
@@ -7272,6 +7296,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         ctx->cfg.exact_sum = ctx->cfg.float_o && fogvol__exact_sum_can(ctx);
     }
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
+    r = fogvol__be_result(ctx, r);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
@@ -7552,10 +7577,12 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc);
-    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
+        if (m->handle) ctx->be.destroy_mesh(ctx->be.user_data, m->handle);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, m);
         return r;
     }
@@ -7595,6 +7622,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget(ctx, mesh, NULL);
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
     ctx->live_meshes--;
     fogvol__free(&ctx->alloc, mesh);
 }
@@ -7649,9 +7677,11 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     td.filter = FOGVOL_FILTER_LINEAR;
     td.wrap = FOGVOL_WRAP_CLAMP;
     td.label = "fogvol colour ramp";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture));
     fogvol__free(&ctx->alloc, px);
     if (r != FOGVOL_SUCCESS) {
+        if (rp->texture) ctx->be.destroy_texture(ctx->be.user_data, rp->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, rp);
         return r;
     }
@@ -7676,6 +7706,7 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     if (!ctx || !ramp) return;
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     ctx->live_ramps--;
     fogvol__free(&ctx->alloc, ramp);
 }
@@ -7697,9 +7728,11 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        if (t->texture) ctx->be.destroy_texture(ctx->be.user_data, t->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, t);
         return r;
     }
@@ -7719,6 +7752,7 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
         ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     fogvol__free(&ctx->alloc, texture);
 }
 
@@ -8240,8 +8274,10 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
     memset(info, 0, sizeof *info);
     info->draw_buffer = ctx->cur.frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
-    if (r != FOGVOL_SUCCESS)
+    if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    }
     return r;
 }
 
@@ -8254,6 +8290,7 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     if (r != FOGVOL_SUCCESS) return r;
     r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
     *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
@@ -9786,6 +9823,7 @@ static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run,
                                          fogvol_frame_stats *stats)
 {
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     run->st.frame = ctx->ovf.frame_no;
     run->st.overflow_pixels_late = ctx->ovf.overflow_late;
     run->st.overflow_frame = ctx->ovf.overflow_frame;
@@ -9986,6 +10024,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
         pd.label = labels[effect];
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
+            (void)fogvol__be_result(ctx, r);
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
                         labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
             ctx->gpu.post_prog[slot] = 0;
@@ -10049,6 +10088,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     info.draw_buffer = fd->draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, &info);
     if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
         return r;
     }
@@ -10072,7 +10112,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    return FOGVOL_SUCCESS;
+    return fogvol__be_result(ctx, FOGVOL_SUCCESS);
 }
 
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc)
@@ -10256,7 +10296,7 @@ enum {
     FOGVOL__GL_COLOR_ATTACHMENT0 = 0x8CE0, FOGVOL__GL_DEPTH_ATTACHMENT = 0x8D00,
     FOGVOL__GL_STENCIL_ATTACHMENT = 0x8D20, FOGVOL__GL_FRAMEBUFFER = 0x8D40, FOGVOL__GL_RENDERBUFFER = 0x8D41,
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
-    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
+    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126, FOGVOL__GL_DEBUG_OUTPUT = 0x92E0,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
@@ -10298,6 +10338,7 @@ enum {
     X(void, Enable, (fogvol__GLenum)) \
     X(void, Disable, (fogvol__GLenum)) \
     X(fogvol__GLboolean, IsEnabled, (fogvol__GLenum)) \
+    X(fogvol__GLboolean, IsTexture, (fogvol__GLuint)) \
     X(void, Viewport, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, Scissor, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, ClearColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
@@ -10359,6 +10400,7 @@ enum {
 /* Framebuffer objects: GL 3.0, ARB_framebuffer_object, GLES 2.0; EXT_framebuffer_object names as fallback. */
 #define FOGVOL__GL_FBO(X) \
     X(void, GenFramebuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsFramebuffer, (fogvol__GLuint)) \
     X(void, DeleteFramebuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindFramebuffer, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, FramebufferTexture2D, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint, fogvol__GLint)) \
@@ -10373,6 +10415,7 @@ enum {
 /* Vertex array objects: GL 3.0, GLES 3.0 (required in core profiles). */
 #define FOGVOL__GL_VAO(X) \
     X(void, GenVertexArrays, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsVertexArray, (fogvol__GLuint)) \
     X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindVertexArray, (fogvol__GLuint))
 
@@ -10614,7 +10657,13 @@ typedef struct fogvol__gl {
     int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
     int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
     fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
-    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error */
+    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error (err_fbo:
+                                                           made at creation without VAOs, the context's mark) */
+    int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
+    int skip_draws;                                     /* this pass has an engine texture that is none */
+    fogvol_result own;                                  /* fogvol's own first error since take_error */
+    void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
+    void *user_data, *context_id;                       /* and what it returned at creation */
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -10956,6 +11005,7 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
         gl->GetProgramiv(gl->err_shader, FOGVOL__GL_LINK_STATUS, &v);
         break;
     case FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION: /* clearing nothing through an FBO with no attachment */
+        if (!gl->BindFramebuffer) break; /* (a context creation that failed before loading them) */
         gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &v);
         if (!gl->err_fbo) gl->GenFramebuffers(1, &gl->err_fbo);
         gl->BindFramebuffer(fb, gl->err_fbo);
@@ -10969,14 +11019,62 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
     }
 }
 
+/* fogvol's own GL errors, read while the engine's are held: the first becomes the public call's result
+   (FOGVOL_ERROR_BACKEND, through the backend's take_error), logged. */
+static void fogvol__gl_drain(fogvol__gl *gl)
+{
+    fogvol__GLenum first = gl->GetError();
+    int more = 0;
+    if (first == FOGVOL__GL_NO_ERROR) return;
+    while (more < 8 && gl->GetError() != FOGVOL__GL_NO_ERROR) ++more; /* (a lost context repeats its code) */
+    if (gl->own != FOGVOL_SUCCESS) return;
+    gl->own = FOGVOL_ERROR_BACKEND;
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL error 0x%04x raised by fogvol's own GL calls (%d more after it)",
+                first, more);
+}
+
+/* The last exit: fogvol's errors read, then the engine's raised again with GL_DEBUG_OUTPUT off where
+   KHR_debug lets it be switched (the raising calls then reach no debug callback nor the message log;
+   the enable is put back). */
 static void fogvol__gl_host_leave(fogvol__gl *gl)
 {
-    int i;
+    int i, dbg;
     if (gl->host_depth <= 0 || --gl->host_depth > 0) return;
     if (gl->tf_paused) gl->ResumeTransformFeedback();
     gl->tf_paused = 0;
+    fogvol__gl_drain(gl);
+    dbg = gl->host_n > 0 && gl->has_debug_output && gl->IsEnabled(FOGVOL__GL_DEBUG_OUTPUT);
+    if (dbg) gl->Disable(FOGVOL__GL_DEBUG_OUTPUT);
     for (i = 0; i < gl->host_n; ++i) fogvol__gl_raise(gl, gl->host_errors[i]);
+    if (dbg) gl->Enable(FOGVOL__GL_DEBUG_OUTPUT);
     gl->host_n = 0;
+}
+
+/* Another GL context current than fogvol's: fogvol_gl_desc.current_context says so, or fogvol's own
+   per-context object is not there (its full-screen vertex array object; without VAOs a framebuffer
+   object made at creation; neither is shared between contexts). The first refusal of a call is
+   logged and is its result (INVALID_STATE, through take_error); the entry then touches nothing. */
+static int fogvol__gl_foreign(fogvol__gl *gl)
+{
+    int other = gl->current_context && gl->current_context(gl->user_data) != gl->context_id;
+    if (!other && gl->has_vao) other = gl->fullscreen.vao && !gl->IsVertexArray(gl->fullscreen.vao);
+    else if (!other) other = gl->err_fbo && !gl->IsFramebuffer(gl->err_fbo);
+    if (other && gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_STATE;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: another GL context is current than the one fogvol was "
+                                                "created in (its objects are not in it): nothing done; make "
+                                                "fogvol's context current");
+    }
+    return other;
+}
+
+/* fogvol_backend.take_error */
+static fogvol_result fogvol__gl_take_error(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol_result r = gl->own;
+    gl->own = FOGVOL_SUCCESS;
+    return r;
 }
 
 /* Vertex attribute 0 where there is no vertex array object to keep it. */
@@ -11155,6 +11253,7 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     fogvol__gl_host_enter(gl);
     fogvol__gl_save(gl, &gl->saved);
     r = fogvol__gl_check_draw_buffer(gl, info->draw_buffer);
@@ -11246,10 +11345,11 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
     fogvol__gl_texture *t;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     t = (fogvol__gl_texture *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, filt, wrap, d->pixels);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
@@ -11271,7 +11371,7 @@ static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_texture *t = (fogvol__gl_texture *)h;
     if (!t) return;
-    gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11279,9 +11379,11 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
 {
     if (!t) return;
     if (t->second) fogvol__gl_free_target(gl, t->second);
-    gl->DeleteFramebuffers(1, &t->fbo);
-    gl->DeleteTextures(1, &t->base.tex);
-    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    if (!fogvol__gl_foreign(gl)) {
+        gl->DeleteFramebuffers(1, &t->fbo);
+        gl->DeleteTextures(1, &t->base.tex);
+        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    }
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11354,7 +11456,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     t->height = d->height;
     t->format = d->format;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     if (d->samples > 1)
         t->base.tex = fogvol__gl_new_texture_ms(gl, d);
@@ -11447,10 +11549,12 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
     const char *label = d->label ? d->label : "program";
     int i;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     p = (fogvol__gl_program *)fogvol__alloc(&gl->alloc, sizeof *p);
     if (!p) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(p, 0, sizeof *p);
     fogvol__gl_enter(gl, &s);
+    fogvol__gl_drain(gl); /* (earlier calls' errors are theirs, not this program's) */
     vs = fogvol__gl_shader(gl, FOGVOL__GL_VERTEX_SHADER, d->vs, d->vs_count, label, &r);
     fs = r == FOGVOL_SUCCESS ? fogvol__gl_shader(gl, FOGVOL__GL_FRAGMENT_SHADER, d->fs, d->fs_count, label, &r) : 0;
     if (r == FOGVOL_SUCCESS) {
@@ -11502,7 +11606,7 @@ static void fogvol__gl_destroy_program(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_program *p = (fogvol__gl_program *)h;
     if (!p) return;
-    gl->DeleteProgram(p->id); /* deferred by GL while the engine's program is current: no state change */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteProgram(p->id); /* deferred while current: no state change */
     if (gl->program == p) gl->program = NULL;
     fogvol__free(&gl->alloc, p);
 }
@@ -11553,7 +11657,7 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     if (gl->has_vao) {
         gl->GenVertexArrays(1, &m->vao);
         gl->BindVertexArray(m->vao);
@@ -11600,6 +11704,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     fogvol__gl_mesh *m;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
     r = fogvol__gl_upload(gl, m, d);
@@ -11616,7 +11721,7 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_mesh *m = (fogvol__gl_mesh *)h;
     if (!m) return;
-    fogvol__gl_free_mesh(gl, m);
+    if (!fogvol__gl_foreign(gl)) fogvol__gl_free_mesh(gl, m);
     fogvol__free(&gl->alloc, m);
 }
 
@@ -11658,6 +11763,21 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
 }
 
 /* The program of a pass with its uniforms, and its textures on fogvol's units. */
+/* An engine texture of a pass (engine depth, post effect inputs): a name that is no texture of the
+   current context is not bound (in a compatibility profile binding it would make an empty one) and
+   the pass draws nothing; the call's result is INVALID_ARGUMENT, logged. */
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex)
+{
+    if (gl->IsTexture(tex)) return tex;
+    gl->skip_draws = 1;
+    if (gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: texture %u handed to fogvol (an engine depth, colour or "
+                    "normal texture) is not a texture of the current GL context: its passes draw nothing", tex);
+    }
+    return 0;
+}
+
 static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
@@ -11670,7 +11790,7 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
         if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
+        if (p->native_textures[i]) tex = fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
@@ -11693,6 +11813,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_target *t = (fogvol__gl_target *)p->target;
+    gl->skip_draws = 0;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
@@ -11752,7 +11873,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_mesh *m = (const fogvol__gl_mesh *)h;
-    if (!m) return;
+    if (!m || gl->skip_draws) return;
     fogvol__gl_set_draw(u, d);
     fogvol__gl_bind_mesh(gl, m);
     gl->DrawElements(FOGVOL__GL_TRIANGLES, m->count, m->index_type, NULL);
@@ -11761,6 +11882,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 static void fogvol__gl_draw_fullscreen(void *u)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
+    if (gl->skip_draws) return;
     fogvol__gl_bind_mesh(gl, &gl->fullscreen);
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
@@ -11852,7 +11974,12 @@ static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int b
                     rect[1]);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    gl->GetError();
+    if (src && !gl->IsFramebuffer(src)) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_framebuffer %u is not a framebuffer of the "
+                                                "current GL context", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
     format = fogvol__gl_depth_format(gl, src == 0);
     if (!format) {
@@ -11882,7 +12009,7 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     if (t->format == FOGVOL_FORMAT_R32F)
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
@@ -11900,6 +12027,7 @@ static fogvol_result fogvol__gl_create_query(void *u, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     gl->GenQueries(1, &id); /* names only: no state */
     *out = (fogvol_handle)id;
     return id ? FOGVOL_SUCCESS : FOGVOL_ERROR_BACKEND;
@@ -11909,7 +12037,7 @@ static void fogvol__gl_destroy_query(void *u, fogvol_handle q)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = (fogvol__GLuint)q;
-    gl->DeleteQueries(1, &id);
+    if (!fogvol__gl_foreign(gl)) gl->DeleteQueries(1, &id);
 }
 
 /* Not while the engine has an occlusion query running: BeginQuery would fail (and add its error to
@@ -11955,12 +12083,14 @@ static void fogvol__gl_destroy(void *u)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_allocator a;
     if (!gl) return;
-    fogvol__gl_free_mesh(gl, &gl->fullscreen);
-    if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-    if (gl->err_shader) gl->DeleteShader(gl->err_shader);
-    if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
-    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    if (!fogvol__gl_foreign(gl)) {
+        fogvol__gl_free_mesh(gl, &gl->fullscreen);
+        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader);
+        if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
+        if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+        if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    }
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -12085,7 +12215,13 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
         gl->major = desc->version_major;
         gl->minor = desc->version_minor;
         gl->gles = desc->gles != 0;
-        if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
+        if (gl->core && gl->major < 3) { /* (GL 3.x stays the core profile it is; GLES 3 has VAOs too) */
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: a core-profile context cannot be treated as %s %d.%d "
+                        "(drawn without vertex array objects, one GL_EXTENSIONS string): use a compatibility "
+                        "profile for that override", gl->gles ? "OpenGL ES" : "GL", gl->major, gl->minor);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+        if (gl->gles) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
@@ -12269,6 +12405,19 @@ static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *d
 }
 
 /* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+/* Without VAOs, the context's mark (fogvol__gl_foreign): a framebuffer object, which exists once bound
+   (also the one fogvol__gl_raise clears through); the bindings are put back. */
+static void fogvol__gl_mark(fogvol__gl *gl)
+{
+    fogvol__GLint draw = 0, read = 0;
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &read);
+    gl->GenFramebuffers(1, &gl->err_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->err_fbo);
+    gl->BindFramebuffer(gl->has_split_fbo ? FOGVOL__GL_DRAW_FRAMEBUFFER : FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)draw);
+    if (gl->has_split_fbo) gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)read);
+}
+
 static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
@@ -12294,10 +12443,15 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
+    gl->has_debug_output = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2)
+                                    : gl->major > 4 || (gl->major == 4 && gl->minor >= 3);
+    if (!gl->has_debug_output)
+        gl->has_debug_output = gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_KHR_debug") : fogvol__has_ext(ext, "GL_KHR_debug");
     memset(&tri_data, 0, sizeof tri_data);
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
+    if (r == FOGVOL_SUCCESS && !gl->has_vao) fogvol__gl_mark(gl);
     if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     return r;
 }
@@ -12326,6 +12480,7 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->draw_fullscreen = fogvol__gl_draw_fullscreen;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
+    out->take_error = fogvol__gl_take_error;
     if (gl->has_query) {
         out->create_query = fogvol__gl_create_query;
         out->destroy_query = fogvol__gl_destroy_query;
@@ -12356,11 +12511,24 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
     memset(gl, 0, sizeof *gl);
     if (alloc) gl->alloc = *alloc;
     gl->log = *logger;
+    gl->current_context = desc->current_context;
+    gl->user_data = desc->user_data;
+    if (gl->current_context) gl->context_id = gl->current_context(gl->user_data);
     r = fogvol__gl_version(gl, desc, &ver);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) { /* (the engine's pending errors held: fogvol's own are this call's) */
+        fogvol__gl_host_enter(gl);
+        r = fogvol__gl_features(gl, desc, &ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+        fogvol__gl_host_leave(gl);
+        if (r == FOGVOL_SUCCESS && fogvol__gl_take_error(gl) != FOGVOL_SUCCESS) {
+            fogvol__gl_destroy(gl);
+            return FOGVOL_ERROR_BACKEND;
+        }
+    }
     if (r != FOGVOL_SUCCESS) {
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader); /* (made to raise the engine's error) */
+        if (gl->err_fbo && gl->DeleteFramebuffers) gl->DeleteFramebuffers(1, &gl->err_fbo);
         fogvol__free(alloc, gl);
         return r;
     }
