@@ -367,7 +367,9 @@ enum {
        colour channel (extinction density * extinction_color times signed depth) and their
        emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
        pass, and one composite pass blends them all (two full-screen draws, multiply then add,
-       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       when some extinction colour is not grey). Other ramps keep their own group, and so does,
+       for a frame, a ramp one of whose volumes has a density or colour texture in it (drawn as
+       without COLORS: the group's programs draw no texture). Model and
        error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
        target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
        per sample on multisampled framebuffers (fogvol_msaa_supported: use
@@ -831,7 +833,14 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
    FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
    so the projection's depth convention does not matter to it (only to the engine depth
    texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
+   orients the screen (mirrored x or y flip it). Matrices are column-major (m[column * 4 +
+   row], as glUniformMatrix4fv with transpose = GL_FALSE): a view matrix must be affine
+   (bottom row m[3], m[7], m[11], m[15] = 0, 0, 0, 1), and a perspective projection whose
+   w row stands in column 3 (m[14] = +-1, m[11] not) is taken for a transposed one; both
+   are refused (FOGVOL_ERROR_INVALID_ARGUMENT), and the log says "transposed?" with the
+   matrices that transposed would be accepted. Row-major engine matrices (raylib's Matrix,
+   DirectXMath's XMFLOAT4X4 in a row-vector convention) must be transposed when copied
+   (raylib: MatrixToFloat gives the column-major order). */
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
@@ -854,7 +863,12 @@ typedef struct fogvol_frame_desc {
        bottom to top, for the group of debug_ramp (NULL = the first group). Set
        debug_thickness to a width*height float buffer. Units: view-space w (the
        distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
+       scale), between znear and zfar; this read-back stalls, for debugging only.
+       A frame that draws no volume of debug_ramp (or none at all) writes 0
+       everywhere. The one-pass colour group (FOGVOL_VARIANT_COLORS) sums optical
+       depths of all its ramps: its read-back is the thickness of debug_ramp's
+       volumes alone (NULL: the ramp of the group's first volume), summed in one
+       more pass. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
@@ -899,11 +913,21 @@ typedef struct fogvol_frame_desc {
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
    restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); an occlusion or PRIMITIVES_GENERATED query the engine has running
+   the engine left pending are still pending after every fogvol call, and
+   nothing else (out-of-memory and context-loss codes cannot be raised again:
+   logged as a warning); they are raised again with GL_DEBUG_OUTPUT switched off
+   where the context has KHR_debug (GL 4.3, GLES 3.2 or the extension), so the
+   engine's debug callback and message log get no message for them (without
+   KHR_debug, e.g. ARB_debug_output alone, each raise reaches its callback as
+   one message). GL errors fogvol's own calls raise are the call's result
+   (FOGVOL_ERROR_BACKEND), logged, never left pending. fogvol must be called
+   with the GL context current that it was created in (a context sharing its
+   objects is not enough: vertex array and framebuffer objects are never
+   shared); with another current every call that would touch GL returns
+   FOGVOL_ERROR_INVALID_STATE, logged, and touches nothing (see
+   fogvol_gl_desc.current_context); an active transform feedback is paused
+   during the call (GL 4.0 / GLES 3.0; on GL 3.x, where it cannot be queried,
+   do not call fogvol inside one); an occlusion or PRIMITIVES_GENERATED query the engine has running
    counts fogvol's draws too (GL cannot pause those; fogvol then skips its
    own overflow query for the frame); fogvol must not be called between
    glBeginConditionalRender and glEndConditionalRender (not queryable: its
@@ -920,7 +944,10 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
 typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
 typedef struct fogvol_volume_desc {
     const fogvol_mesh *mesh;
-    float model[16];
+    float model[16];          /* column-major, affine (bottom row 0, 0, 0, 1), not singular (a zero
+                                 scale leaves no volume): else FOGVOL_ERROR_INVALID_ARGUMENT, logged
+                                 ("transposed?" when its transpose is affine). Occluder and light
+                                 model matrices: the same (an occluder may be flat, not all zero) */
     const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
     int negative;             /* 1: subtracts thickness from the volumes of its ramp */
     /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
