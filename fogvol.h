@@ -12662,8 +12662,8 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
     memset(gl, 0, sizeof *gl);
     if (alloc) gl->alloc = *alloc;
     gl->log = *logger;
-    gl->current_context = desc->current_context;
-    gl->user_data = desc->user_data;
+    gl->current_context = in->current_context;
+    gl->user_data = in->user_data; /* (the caller's, also with a plain loader) */
     if (gl->current_context) gl->context_id = gl->current_context(gl->user_data);
     r = fogvol__gl_version(gl, desc, &ver);
     if (r == FOGVOL_SUCCESS) { /* (the engine's pending errors held: fogvol's own are this call's) */
