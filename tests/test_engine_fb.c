@@ -1164,6 +1164,7 @@ static void test_override_core(void **st)
         no_debug_errors("create_context");
         if (r == FOGVOL_SUCCESS) { /* and it draws: the sphere's chord through its centre */
             fogvol_context *own = e.fv;
+            fogvol_ramp *own_ramp = e.ramp[0];
             fogvol_frame_desc fd;
             float *thick = (float *)calloc(NPIX, sizeof(float));
             e.fv = fv;
@@ -1180,7 +1181,7 @@ static void test_override_core(void **st)
             fogvol_destroy_ramp(fv, e.ramp[0]);
             fogvol_destroy_context(fv);
             e.fv = own;
-            make_ramp(&e, 0, NULL);
+            e.ramp[0] = own_ramp;
             free(thick);
         } else {
             assert_non_null(strstr(e.lc.last, "core"));
