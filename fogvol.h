@@ -1647,7 +1647,6 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fog
 FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
                                                     fogvol_stage stage, const char **strings, int *count);
 
-#ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- tuning: the speed-ups (for measuring them, and for backend authors) ---------
    Every speed-up is on by default wherever the tier, variants, dialect and backend take it (the
    tier table in the >>tiers section says where) and gives the same pixels, or closer ones where
@@ -1779,6 +1778,7 @@ enum {
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
+#ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
    Per-vertex (or per-pixel) fog from simple analytic volumes, without render
    passes or textures: for every vertex V the ray X = eye + t (V - eye) is cut
