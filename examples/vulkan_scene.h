@@ -111,6 +111,7 @@ static const config g_configs[] = {
     {"PS20+wide", FOGVOL_TIER_PS20, FOGVOL_VARIANT_WIDE, FOGVOL_TIER_AUTO, 0, 0, 0},
     {"PS13", FOGVOL_TIER_PS13, 0, FOGVOL_TIER_AUTO, 0, 0, 0},
     {"MRT (the engine's pass writes O)", FOGVOL_TIER_MRT, 0, FOGVOL_TIER_PS20, 0, 0, 0},
+    {"MRT+the engine's depth left read-only after its pass", FOGVOL_TIER_MRT, 0, FOGVOL_TIER_PS20, 1, 0, 0},
 };
 #define NCONFIGS ((int)(sizeof g_configs / sizeof g_configs[0]))
 
