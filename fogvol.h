@@ -1,4 +1,4 @@
-/* fogvol.h - v0.1.0 - mesh-shaped fog and light volumes for real-time engines
+/* fogvol.h - v0.2.0 - mesh-shaped fog and light volumes for real-time engines
    MIT or public domain (see the end of this file).
 
    fogvol.h renders ordinary closed polygon meshes (convex or concave, animated,
@@ -30,8 +30,78 @@
        encoding             the RGB encoding of depths, fogvol_context_encoding
        textures             the lookup textures and colour ramps on the CPU
        shaders              the GLSL strings of each tier, variant and dialect
+       tuning               the speed-ups (on by default) and disable_speedups
        analytic fog         the analytic volumes (left out by FOGVOL_NO_ANALYTIC)
        CPU reference        the GPU arithmetic on the CPU, for tests and tools
+
+   API INDEX (every public function, one line each, by task)
+   =========
+   context      fogvol_create_context        make a context: backend, tier, variants, encoding
+                fogvol_destroy_context       free it and everything it owns
+                fogvol_context_tier          the tier and variants it chose
+                fogvol_context_encoding      its encoding (bits, faces it sums)
+                fogvol_set_dither            dithering on or off
+   meshes       fogvol_create_mesh           upload a closed mesh (validated, optionally welded)
+                fogvol_destroy_mesh          free it
+                fogvol_validate_mesh         check a mesh without a context (the report)
+   ramps        fogvol_create_ramp           thickness -> colour and alpha (extinction or table)
+                fogvol_destroy_ramp          free it
+   frames       fogvol_begin_frame           start a frame: camera, viewport, planes, debug read-back
+                fogvol_add_volume            a volume: mesh, model matrix, ramp, sign, textures
+                fogvol_add_occluder          an opaque mesh that cuts the volumes
+                fogvol_add_occluder_callback the engine draws an occluder itself
+                fogvol_occluder_transform    inside that callback: the model matrix to draw with
+                fogvol_add_light             a volume light by compare
+                fogvol_end_frame             draw and composite; the engine's state restored
+                fogvol_cancel_frame          drop the frame
+                fogvol_projection_planes     near and far planes from a projection matrix
+   textures     fogvol_create_volume_texture a density or colour texture for volumes
+                fogvol_destroy_volume_texture  free it
+   engine       fogvol_mrt_prepare           MRT: the O texture and uniforms for the engine's pass
+                fogvol_mrt_snippet           MRT: the GLSL to paste into the engine's opaque shader
+                fogvol_occluder_prepare      occluders drawn by the engine's own shaders into O
+                fogvol_occluder_snippet      the GLSL for those shaders
+   effects      fogvol_post_dof              depth of field (edge-preserving)
+                fogvol_post_outlines         outlines from depth (and normals)
+                fogvol_post_distance_fog     distance fog from depth
+   questions    fogvol_result_string         a result code's name
+                fogvol_tier_name             a tier's name
+                fogvol_dialect_name          a GLSL dialect's name
+                fogvol_combination_supported does a tier with these variants exist in a dialect
+                fogvol_msaa_supported        ... per sample on multisampled framebuffers
+                fogvol_tier_costs            passes and targets of a tier
+                fogvol_tier_uses_program     which programs a tier draws with
+   backends     fogvol_gl_backend_create     the GL backend on its own
+                fogvol_null_backend_init     a recording backend without a GPU (tests)
+                fogvol_uniform_name          the GLSL name of a uniform slot
+                fogvol_dialect_layout        where the Vulkan dialect puts uniforms, per-draw values, samplers
+   shaders      fogvol_shader_strings        the GLSL of a program (tier, variants, dialect, stage)
+                fogvol_shader_source         the same with no variant
+                fogvol_post_shader_strings   the GLSL of an image-space effect
+   encoding     fogvol_encoding_init         the encoding with L bits per digit
+                fogvol_encoding_from_faces   ... that sums at least n faces
+                fogvol_encoding_from_precision ... with at least n bits
+                fogvol_encoding_table        every encoding (bits, faces, precision)
+                fogvol_compute_constants     the shaders' constants for near/far planes
+                fogvol_encode_depth          a depth as RGBA8 digits (CPU reference)
+                fogvol_sum_rgba8             saturating 8-bit sums (CPU reference)
+                fogvol_sum_encoded           sums of encoded depths (CPU reference)
+                fogvol_decode                digits -> depth (CPU reference)
+                fogvol_decode_difference     decode(a) - decode(b) (CPU reference)
+                fogvol_make_rg_ramp          the red+green lookup texture
+                fogvol_make_blue_ramp        the dithered blue lookup texture
+                fogvol_make_dither_index     the 8x8 dither pattern texture
+                fogvol_dither_threshold      a dither row's rounding threshold
+                fogvol_make_color_ramp       a colour ramp texture on the CPU
+   analytic     fogvol_analytic_prepare      analytic volumes (JCAB): prepare a set
+                fogvol_analytic_segment      one volume's entry and exit on a ray
+                fogvol_analytic_eval         fog of one eye-to-point ray
+                fogvol_analytic_batch        fog of many vertices (SIMD kernels)
+                fogvol_analytic_kernel_resolve  which kernel a batch runs
+                fogvol_fold_fog              fold fog into diffuse and specular
+                fogvol_analytic_pack_uniforms  the uniforms of the analytic GLSL
+                fogvol_analytic_shader_strings the analytic fog's GLSL
+                fogvol_analytic_snippet      its function for the engine's shaders
 
    BUILDING
    ========
@@ -63,7 +133,7 @@
    QUICK START (default GL backend, any GL 2.1+ / 3.x core / GLES2+ context)
    ===========
        fogvol_context_desc cd;  memset(&cd, 0, sizeof cd);   // 0 = default
-       cd.gl.get_proc_address = my_get_proc;                  // e.g. glfwGetProcAddress wrapper
+       cd.gl.get_proc = glfwGetProcAddress;                   // or SDL/EGL/GLX/your own loader
        fogvol_context *fv;
        if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) ...;
 
@@ -193,9 +263,9 @@
 #define FOGVOL_H
 
 #define FOGVOL_VERSION_MAJOR 0
-#define FOGVOL_VERSION_MINOR 1
+#define FOGVOL_VERSION_MINOR 2
 #define FOGVOL_VERSION_PATCH 0
-#define FOGVOL_VERSION_STRING "0.1.0"
+#define FOGVOL_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -282,6 +352,12 @@ typedef enum fogvol_format {
                                  EXT_color_buffer_float + EXT_float_blend) */
 } fogvol_format;
 
+/* An object of the backend's graphics API that the engine and fogvol hand each other (engine depth
+   textures and framebuffers, fogvol's O texture for the engine's MRT and occluder passes, the post
+   effects' inputs): GL a texture or framebuffer name, Vulkan a non-dispatchable handle such as a
+   VkImageView (64 bits on every platform), D3D12 or Metal a pointer or descriptor handle. */
+typedef uint64_t fogvol_native;
+
 /* ---- context: handles, tiers, variants, dialects, the GL backend's desc ---- */
 typedef struct fogvol_context fogvol_context;
 typedef struct fogvol_mesh fogvol_mesh;
@@ -298,7 +374,13 @@ typedef enum fogvol_dialect {
     FOGVOL_GLSL_330 = 5, /* 330 core */
     FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
     FOGVOL_GLSL_300ES = 7,
-    FOGVOL_GLSL_COUNT = 8,
+    /* GLSL 450 for SPIR-V (glslangValidator -V, shaderc): samplers at layout(set = 0, binding = unit),
+       the pass uniforms in one std140 block at (set 0, binding FOGVOL_MAX_TEXTURE_UNITS), the
+       per-draw values in push constants, explicit locations; gl_FragCoord and rows as stored (row 0
+       first), depth [0, 1]. Where a backend finds each value: fogvol_program_desc.layout. No context
+       picks it: a Vulkan backend names it in fogvol_backend.dialect. */
+    FOGVOL_GLSL_VULKAN = 8,
+    FOGVOL_GLSL_COUNT = 9,
     FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
 } fogvol_dialect;
 
@@ -367,7 +449,9 @@ enum {
        colour channel (extinction density * extinction_color times signed depth) and their
        emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
        pass, and one composite pass blends them all (two full-screen draws, multiply then add,
-       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       when some extinction colour is not grey). Other ramps keep their own group, and so does,
+       for a frame, a ramp one of whose volumes has a density or colour texture in it (drawn as
+       without COLORS: the group's programs draw no texture). Model and
        error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
        target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
        per sample on multisampled framebuffers (fogvol_msaa_supported: use
@@ -406,9 +490,14 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 typedef void (*fogvol_gl_proc)(void);
 typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
 
+/* The GL backend's loader: one of the three (get_proc_address first where several are set). */
 typedef struct fogvol_gl_desc {
-    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    fogvol_gl_get_proc_fn get_proc_address; /* a loader that takes user_data */
     void *user_data;
+    fogvol_gl_proc (*get_proc)(const char *name); /* a plain loader returning a function pointer, as it
+                                 is: glfwGetProcAddress, eglGetProcAddress, SDL3's SDL_GL_GetProcAddress */
+    void *(*get_proc_pointer)(const char *name); /* a plain loader returning void *, as it is: SDL2's
+                                 SDL_GL_GetProcAddress, glad-style loaders (GLADloadproc) */
     fogvol_dialect dialect;   /* 0 = from the context */
     int version_major;        /* 0 = from the context; else treat the context as this GL version */
     int version_minor;
@@ -422,6 +511,14 @@ typedef struct fogvol_gl_desc {
                                  must be highp as well). Left 0, a mediump output could round
                                  the depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
                                  precision). */
+    /* optional: the window system's current context as an opaque id (user_data as above), e.g.
+       eglGetCurrentContext, glfwGetCurrentContext, SDL_GL_GetCurrentContext, wglGetCurrentContext.
+       fogvol keeps what it returns at creation and refuses every call that would touch GL while it
+       returns something else (FOGVOL_ERROR_INVALID_STATE, logged; nothing is touched). Without it,
+       fogvol tells another context by its own vertex array object (GL 3 / GLES 3; on GL 2 / GLES 2 a
+       framebuffer object) not being there, which a context that does not share objects with
+       fogvol's always shows, and a context sharing them too (those objects are never shared). */
+    void *(*current_context)(void *user_data);
 } fogvol_gl_desc;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -470,130 +567,6 @@ typedef enum fogvol_overflow_policy {
    table (search "---- context desc"). */
 typedef struct fogvol_context_desc fogvol_context_desc;
 
-/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
-   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
-                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
-                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
-                 O pass (same pixels).
-   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
-                 instead of a filtered lookup at computed coordinates (same pixels).
-   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
-                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
-                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
-                 interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
-                 overflow check passes likewise.
-   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
-                 no O read without occluders (and no test for it with them), no density texture
-                 outside textured volumes, exp or
-                 ramp composite, no colour texture, no overflow test without show_overflow,
-                 target and engine-depth reads without the viewport offset where the viewport
-                 starts at the window origin) instead of one program that switches on uniforms;
-                 built on first use (same pixels).
-   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
-                 the depth is encoded and the dither row computed by arithmetic instead of three
-                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
-                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
-                 (FOGVOL_SPECIALIZE_ENCODING).
-   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
-                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
-                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
-                 newest count of each band: the whole picture over 8 frames, the same count while
-                 the picture holds still. Not with show_overflow (same pixels).
-   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
-                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
-                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
-                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
-   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
-                 FLOAT_O, below) in frames with
-                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
-                 and every volume's box either wholly between the near and far planes or wholly
-                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
-                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
-                 fragment behind an occluder is not shaded, and the composite adds the opaque
-                 depth once per missing back face. Other frames (a camera inside or near a volume)
-                 take the min compare as before. The same sums: B - F equals the min compare's
-                 bytes up to the faces that lie within depth-buffer precision of an occluder.
-                 FLOAT keeps the min compare: there the count needs a second float channel, and
-                 both ways tried measured slower on llvmpipe than the O read per face fragment
-                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
-                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
-                 against 16.1 ms).
-   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
-                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
-                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
-                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
-                 its resolve pass, which is exact in mediump.
-   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
-                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
-                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
-                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
-                 through the fragment shader (the same blend equation; the same pixels where the
-                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
-                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
-                 texture holding the normalised view depth d = (view depth - near) / (far - near),
-                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
-                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
-                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
-                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
-                 O's digits: one encode per fragment and no compare in the faces, and no encode where
-                 O is written. PS20 then draws frames with occluders with that compare, not
-                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
-                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
-                 PS13 keeps its RGBA8 O and the count). The
-                 same bytes: the faces encode O as the snippet or the O pass did (the same
-                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
-                 is the encoding of the lesser depth.
-   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
-                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
-                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
-                 at most one back and one front face on a ray, so no sum can saturate (the half is
-                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
-                 their box's diagonal, which a ray grazing them could cross more than once), and the
-                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
-                 out).
-   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
-                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
-                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
-                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
-                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
-                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
-                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
-                 about half a texture read, on tile-based GPUs it comes from tile memory
-                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
-   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
-                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
-                 without density-textured volumes sums its faces by programmable blending: one pass
-                 over every face reads B's RGBA8 pixel as a 32-bit
-                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
-                 of it and O) for a back face and subtracts it for a front face (sign flipped for
-                 negative volumes), and writes the integer back; the composite reads that one target.
-                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
-                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
-                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
-                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
-                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
-                 Not the digits' bytes: closer to the true thickness. */
-enum {
-    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
-    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
-    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
-    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
-    FOGVOL_SPEEDUP_ALU = 1u << 5,
-    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
-    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
-    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
-    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
-    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
-    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
-    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
-    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
-    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
-};
-#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
@@ -782,6 +755,13 @@ typedef struct fogvol_frame_stats {
     int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
+    /* The thickness step of this frame's RGBA8 digit sums, in view depth: (zfar - znear) / 2^(3L)
+       (WIDE: 2^(6L)); every pixel's thickness is within about one step per pair of faces. 0 when no
+       group summed in digits (FLOAT, FOGVOL_SPEEDUP_EXACT_SUM). When it is coarser than 1/16 of the
+       view-depth extent of the bounds of the frame's smallest volume, a warning is logged (on the
+       first such frame, and again after a frame that was not): move znear out or zfar in, or use
+       fewer faces per target (fogvol_context_desc.encoding_bits) or the FLOAT tier. */
+    float depth_lsb;
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -819,7 +799,14 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
    FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
    so the projection's depth convention does not matter to it (only to the engine depth
    texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
+   orients the screen (mirrored x or y flip it). Matrices are column-major (m[column * 4 +
+   row], as glUniformMatrix4fv with transpose = GL_FALSE): a view matrix must be affine
+   (bottom row m[3], m[7], m[11], m[15] = 0, 0, 0, 1), and a perspective projection whose
+   w row stands in column 3 (m[14] = +-1, m[11] not) is taken for a transposed one; both
+   are refused (FOGVOL_ERROR_INVALID_ARGUMENT), and the log says "transposed?" with the
+   matrices that transposed would be accepted. Row-major engine matrices (raylib's Matrix,
+   DirectXMath's XMFLOAT4X4 in a row-vector convention) must be transposed when copied
+   (raylib: MatrixToFloat gives the column-major order). */
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
@@ -842,7 +829,12 @@ typedef struct fogvol_frame_desc {
        bottom to top, for the group of debug_ramp (NULL = the first group). Set
        debug_thickness to a width*height float buffer. Units: view-space w (the
        distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
+       scale), between znear and zfar; this read-back stalls, for debugging only.
+       A frame that draws no volume of debug_ramp (or none at all) writes 0
+       everywhere. The one-pass colour group (FOGVOL_VARIANT_COLORS) sums optical
+       depths of all its ramps: its read-back is the thickness of debug_ramp's
+       volumes alone (NULL: the ramp of the group's first volume), summed in one
+       more pass. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
@@ -854,7 +846,7 @@ typedef struct fogvol_frame_desc {
        framebuffer, FOGVOL_MSAA_AUTO) it is a multisample texture of the framebuffer's
        sample count (GL: GL_TEXTURE_2D_MULTISAMPLE), read at each sample. It is read as
        it is at each end_frame. */
-    uintptr_t engine_depth_texture;
+    fogvol_native engine_depth_texture;
     int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
     float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
     /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
@@ -877,7 +869,7 @@ typedef struct fogvol_frame_desc {
        source gives each pixel's depth to all its samples (desktop GL; OpenGL ES:
        FOGVOL_ERROR_UNSUPPORTED); another sample count: FOGVOL_ERROR_INVALID_ARGUMENT. */
     fogvol_depth_source engine_depth_source;
-    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+    fogvol_native engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
     /* 0 or 1: fogvol's sums at the viewport's resolution. 2: at half its width and height
        (rounded up): the O and face passes shade a quarter of the fragments and the composite
@@ -895,11 +887,21 @@ typedef struct fogvol_frame_desc {
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
    restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); an occlusion or PRIMITIVES_GENERATED query the engine has running
+   the engine left pending are still pending after every fogvol call, and
+   nothing else (out-of-memory and context-loss codes cannot be raised again:
+   logged as a warning); they are raised again with GL_DEBUG_OUTPUT switched off
+   where the context has KHR_debug (GL 4.3, GLES 3.2 or the extension), so the
+   engine's debug callback and message log get no message for them (without
+   KHR_debug, e.g. ARB_debug_output alone, each raise reaches its callback as
+   one message). GL errors fogvol's own calls raise are the call's result
+   (FOGVOL_ERROR_BACKEND), logged, never left pending. fogvol must be called
+   with the GL context current that it was created in (a context sharing its
+   objects is not enough: vertex array and framebuffer objects are never
+   shared); with another current every call that would touch GL returns
+   FOGVOL_ERROR_INVALID_STATE, logged, and touches nothing (see
+   fogvol_gl_desc.current_context); an active transform feedback is paused
+   during the call (GL 4.0 / GLES 3.0; on GL 3.x, where it cannot be queried,
+   do not call fogvol inside one); an occlusion or PRIMITIVES_GENERATED query the engine has running
    counts fogvol's draws too (GL cannot pause those; fogvol then skips its
    own overflow query for the frame); fogvol must not be called between
    glBeginConditionalRender and glEndConditionalRender (not queryable: its
@@ -916,7 +918,10 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
 typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
 typedef struct fogvol_volume_desc {
     const fogvol_mesh *mesh;
-    float model[16];
+    float model[16];          /* column-major, affine (bottom row 0, 0, 0, 1), not singular (a zero
+                                 scale leaves no volume): else FOGVOL_ERROR_INVALID_ARGUMENT, logged
+                                 ("transposed?" when its transpose is affine). Occluder and light
+                                 model matrices: the same (an occluder may be flat, not all zero) */
     const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
     int negative;             /* 1: subtracts thickness from the volumes of its ramp */
     /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
@@ -998,7 +1003,7 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
    nothing). The engine's framebuffer must be viewport-sized with origin (0,0),
    and its pass must not blend into the attachment. */
 typedef struct fogvol_mrt_info {
-    uintptr_t texture;
+    fogvol_native texture;
     float clear_color[4];
     float uniforms[8];
     fogvol_format format;
@@ -1010,7 +1015,9 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
    writes to its second colour output (fogvol_encode_depth's bytes; computed in
    integers where the engine's GLSL has bit operations and floatBitsToInt: 330+,
    300 es; with an R32F O, fogvol_mrt[0].z = 0: the normalised view depth in
-   red). Insert after the #version line and the engine's precision statements. */
+   red). Insert after the #version line and the engine's precision statements.
+   GLSL for Vulkan (no loose uniforms): declare vec4 fogvol_mrt[2] in one of the engine's own
+   uniform blocks or push constants and #define FOGVOL_MRT_IN_BLOCK before the snippet. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 
 /* Occluders drawn by the engine with its own programs, pipelines and vertex
@@ -1027,7 +1034,7 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
    uniforms. end_frame then uses what the engine drew instead of its own O
    pass; fogvol_add_occluder* in the same frame is refused. */
 typedef struct fogvol_occluder_info {
-    uintptr_t texture;        /* backend API object (GL: texture name) */
+    fogvol_native texture;        /* backend API object (GL: texture name) */
     int width, height;
     fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT, and PS20 with
                                  FOGVOL_SPEEDUP_FLOAT_O: d = (view depth - near)/(far - near)) */
@@ -1081,7 +1088,7 @@ typedef enum fogvol_post_effect {
    without blending (in-focus pixels keep their colour exactly). */
 typedef struct fogvol_dof_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    fogvol_native color_texture; /* the scene's colour (GL texture name), required */
     int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
     float focus_distance;    /* view depth in focus (> 0) */
     float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
@@ -1101,7 +1108,7 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
    (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
 typedef struct fogvol_outline_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    fogvol_native normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
     int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
     float color[4];           /* rgb, a = opacity; all 0 = opaque black */
     float depth_threshold;    /* relative second difference, 0 = 0.05 */
@@ -1130,7 +1137,19 @@ FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fog
    may come inside or outside a frame. A backend must leave the engine's
    state as it found it at begin_frame when end_frame returns, and resource
    entries called outside a frame must not change engine state either.
-   NULL optional entries (marked) are skipped. */
+   NULL optional entries (marked) are skipped.
+   Any graphics API: the table asks for no GL concept. Programs come as GLSL of
+   the backend's dialect (fogvol_backend.dialect: a GL dialect, whose uniforms a
+   backend sets by name, or FOGVOL_GLSL_VULKAN, SPIR-V-ready GLSL whose uniforms,
+   per-draw values and samplers sit where fogvol_program_desc.layout says); the
+   objects the engine and fogvol hand each other are fogvol_native values (GL
+   names, Vulkan handles, pointers); rows of targets and read-backs are in the
+   order the API stores them, row 0 at framebuffer y 0 (GL: the bottom; Vulkan
+   with a positive viewport height: the top row of memory), and fogvol's clip z
+   is GL's [-w, w] (the Vulkan dialect maps it to [0, w]: the same window
+   depth). examples/fogvol_vulkan.h is a complete backend on Vulkan,
+   examples/custom_backend.c wraps the GL one; the README's "Other graphics
+   APIs" says what each entry must do. */
 typedef uintptr_t fogvol_handle;
 
 /* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
@@ -1204,7 +1223,9 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
    "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
    FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
-   Vertex attribute 0: "fv_position" (vec3). */
+   Vertex attribute 0: "fv_position" (vec3).
+   FOGVOL_GLSL_VULKAN: the same units as bindings of set 0, the uniforms above in one std140 block
+   and push constants, not names: fogvol_program_desc.layout (fogvol_dialect_layout). */
 #define FOGVOL_MAX_TEXTURE_UNITS 8
 
 typedef struct fogvol_target_desc {
@@ -1226,6 +1247,36 @@ typedef struct fogvol_target_desc {
 
 #define FOGVOL_MAX_SHADER_STRINGS 20
 
+/* The per-draw values of fogvol_draw as a program reads them (fogvol_uniform_layout.draw_offsets). */
+typedef enum fogvol_draw_value {
+    FOGVOL_DRAW_MVP = 0,        /* mat4 fv_mvp: fogvol_draw.mvp */
+    FOGVOL_DRAW_DEPTH = 1,      /* vec4 fv_depth: .depth */
+    FOGVOL_DRAW_EXTINCTION = 2, /* vec4 fv_ext: .extinction */
+    FOGVOL_DRAW_EMISSION = 3,   /* vec4 fv_emit: .emission */
+    FOGVOL_DRAW_SIGN = 4,       /* float fv_sign: .sign */
+    FOGVOL_DRAW_VALUE_COUNT = 5
+} fogvol_draw_value;
+
+/* Where a program's inputs live, for backends that bind by number instead of by name (the Vulkan
+   dialect; fogvol_dialect_layout). Pass uniforms: one std140 uniform block of pass_size bytes at
+   (descriptor set 0, binding pass_binding) holding fogvol_pass.uniforms exactly as the struct holds
+   them (uniform u at pass_offsets[u] = 16 u: copy the array as it is). Per-draw values: draw_size
+   bytes of push constants, visible to the vertex and fragment stages, value i at draw_offsets[i]
+   (mvp 16 floats, column-major; depth, extinction, emission 4 floats; sign 1 float). Samplers:
+   texture unit i (fogvol_pass.textures[i]) is the combined image sampler at (set 0,
+   sampler_bindings[i] = i). Vertex input: fv_position at location 0 (3 floats). Fragment outputs
+   from location 0 (two-attachment targets: locations 0 and 1). GL dialects: all -1 (by name). */
+typedef struct fogvol_uniform_layout {
+    int pass_binding, pass_size;
+    int pass_offsets[FOGVOL_U_COUNT];
+    int draw_size;
+    int draw_offsets[FOGVOL_DRAW_VALUE_COUNT];
+    int sampler_bindings[FOGVOL_MAX_TEXTURE_UNITS];
+} fogvol_uniform_layout;
+/* The layout of a dialect's programs: FOGVOL_SUCCESS for FOGVOL_GLSL_VULKAN; the GL dialects
+   (uniforms by name) fill every field with -1 and return FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out);
+
 typedef struct fogvol_program_desc {
     const char *vs[FOGVOL_MAX_SHADER_STRINGS];
     int vs_count;
@@ -1233,6 +1284,8 @@ typedef struct fogvol_program_desc {
     int fs_count;
     const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
     const char *label;
+    fogvol_uniform_layout layout; /* the backend's dialect: where the uniforms, per-draw values and samplers
+                                     are (Vulkan), or all -1 (GL: by name) */
 } fogvol_program_desc;
 
 typedef struct fogvol_mesh_data {
@@ -1288,8 +1341,9 @@ typedef struct fogvol_pass {
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
-    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
-                                                            backend's own API (GL: a texture name) */
+    fogvol_native native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+                                                            backend's own API (GL: a texture name;
+                                                            Vulkan: an image view) */
     float uniforms[FOGVOL_U_COUNT][4];
 } fogvol_pass;
 
@@ -1359,12 +1413,13 @@ typedef struct fogvol_backend {
     void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
     void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
     void (*end_pass)(void *user_data);        /* optional */
-    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+    /* optional (debug read-back; may wait for the GPU): the whole target, row 0 first (GL: bottom to top), as RGBA8
        bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
-    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
-    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    /* optional (MRT tier, fogvol_occluder_prepare): the API object behind a texture or target
+       (GL: texture name; Vulkan: image view) */
+    fogvol_native (*native_texture)(void *user_data, fogvol_handle texture);
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
@@ -1376,8 +1431,8 @@ typedef struct fogvol_backend {
        per pixel); samples > 1 (a frame drawn per sample): a multisample texture of that many
        samples, each sample copied (GL: GL_TEXTURE_2D_MULTISAMPLE). The texture may be reused
        from frame to frame, its contents never: each call copies again. */
-    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4], int samples,
-                                uintptr_t *texture);
+    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4], int samples,
+                                fogvol_native *texture);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
        the samples passing between begin_query and end_query, which fogvol calls around the draws of
        one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
@@ -1390,6 +1445,13 @@ typedef struct fogvol_backend {
     int (*begin_query)(void *user_data, fogvol_handle query);
     void (*end_query)(void *user_data, fogvol_handle query);
     int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+    /* optional: the first failure the backend met in its own calls since the last take_error, else
+       FOGVOL_SUCCESS, and forget it. fogvol calls it at the end of every public call that used the
+       backend and returns it when the call had no error of its own (the backend logs it). GL: a GL
+       error fogvol's own calls raised (FOGVOL_ERROR_BACKEND), read before the engine's pending errors
+       are raised again; an engine texture name that is no texture (FOGVOL_ERROR_INVALID_ARGUMENT);
+       another GL context current (FOGVOL_ERROR_INVALID_STATE). */
+    fogvol_result (*take_error)(void *user_data);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -1428,22 +1490,27 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
    Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
    the struct complete); fogvol_create_context is in the context section. */
 struct fogvol_context_desc {
-    fogvol_allocator allocator;
-    fogvol_logger logger;
+    /* what most engines set (all 0 = the GL backend, the best tier it runs, default encoding) */
+    fogvol_gl_desc gl;     /* the GL backend: its loader (gl.get_proc = glfwGetProcAddress, ...) */
+    fogvol_logger logger;  /* where errors, warnings and shader info logs go (0 = nowhere) */
+    fogvol_tier tier;      /* 0 = the first of FLOAT, MRT (with engine_mrt), PS20, PS13 that the
+                              backend runs with the required variants */
+    unsigned variants;     /* FOGVOL_VARIANT_* the engine requires: refused where the tier (AUTO: every
+                              tier the backend runs) does not take them */
+    unsigned preferred_variants; /* FOGVOL_VARIANT_* used where the chosen tier, dialect and backend take
+                              them, left out (logged at INFO) where not; fogvol_context_tier says which */
     int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
                               SINGLE_TARGET: 8 refused (no face fits beside the bias) */
-    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
-                              FLOAT if float blending, else MRT if engine_mrt and MRT,
-                              else PS20 if highp fragment shaders, else PS13 */
-    unsigned variants;     /* FOGVOL_VARIANT_* */
+    /* less often */
+    fogvol_allocator allocator; /* 0 = FOGVOL_MALLOC / FOGVOL_FREE */
     int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
     fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
-    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
-    fogvol_gl_desc gl;     /* for the GL backend */
     fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
-    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
-                                  measuring what each one gives (bench/bench.c) */
+    fogvol_backend backend;/* a custom table (backend authors); if create_texture is NULL the GL backend
+                              is used */
+    unsigned disable_speedups; /* tuning: FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on),
+                                  to measure what each gives (see "---- tuning") */
 };
 
 /* ---- encoding ------------------------------------------------------------
@@ -1657,6 +1724,137 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fog
 FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
                                                     fogvol_stage stage, const char **strings, int *count);
 
+/* ---- tuning: the speed-ups (for measuring them, and for backend authors) ---------
+   Every speed-up is on by default wherever the tier, variants, dialect and backend take it (the
+   tier table in the >>tiers section says where) and gives the same pixels, or closer ones where
+   said; fogvol_context_desc.disable_speedups turns them off one by one, to measure what each gives
+   (bench/bench.c) or to rule one out on a driver. The FOGVOL_SPECIALIZE_* bits above are the
+   programs some of them draw with. */
+/* The speed-ups (bits of fogvol_context_desc.disable_speedups):
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
+                 overflow check passes likewise.
+   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
+                 no O read without occluders (and no test for it with them), no density texture
+                 outside textured volumes, exp or
+                 ramp composite, no colour texture, no overflow test without show_overflow,
+                 target and engine-depth reads without the viewport offset where the viewport
+                 starts at the window origin) instead of one program that switches on uniforms;
+                 built on first use (same pixels).
+   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
+                 the depth is encoded and the dither row computed by arithmetic instead of three
+                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
+                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
+                 (FOGVOL_SPECIALIZE_ENCODING).
+   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
+                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
+                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
+                 newest count of each band: the whole picture over 8 frames, the same count while
+                 the picture holds still. Not with show_overflow (same pixels).
+   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
+                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
+                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
+                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
+   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
+                 FLOAT_O, below) in frames with
+                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
+                 and every volume's box either wholly between the near and far planes or wholly
+                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
+                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
+                 fragment behind an occluder is not shaded, and the composite adds the opaque
+                 depth once per missing back face. Other frames (a camera inside or near a volume)
+                 take the min compare as before. The same sums: B - F equals the min compare's
+                 bytes up to the faces that lie within depth-buffer precision of an occluder.
+                 FLOAT keeps the min compare: there the count needs a second float channel, and
+                 both ways tried measured slower on llvmpipe than the O read per face fragment
+                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
+                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
+                 against 16.1 ms).
+   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
+                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
+                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
+                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
+                 its resolve pass, which is exact in mediump.
+   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
+                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
+                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
+                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
+                 through the fragment shader (the same blend equation; the same pixels where the
+                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
+   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
+                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
+                 texture holding the normalised view depth d = (view depth - near) / (far - near),
+                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
+                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
+                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
+                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
+                 O's digits: one encode per fragment and no compare in the faces, and no encode where
+                 O is written. PS20 then draws frames with occluders with that compare, not
+                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
+                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
+                 PS13 keeps its RGBA8 O and the count). The
+                 same bytes: the faces encode O as the snippet or the O pass did (the same
+                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
+                 is the encoding of the lesser depth.
+   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
+                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
+                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
+                 at most one back and one front face on a ray, so no sum can saturate (the half is
+                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
+                 their box's diagonal, which a ray grazing them could cross more than once), and the
+                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
+                 out).
+   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
+                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
+                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
+                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
+                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
+                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
+                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
+                 about half a texture read, on tile-based GPUs it comes from tile memory
+                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
+   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
+                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
+                 without density-textured volumes sums its faces by programmable blending: one pass
+                 over every face reads B's RGBA8 pixel as a 32-bit
+                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
+                 of it and O) for a back face and subtracts it for a front face (sign flipped for
+                 negative volumes), and writes the integer back; the composite reads that one target.
+                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
+                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
+                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
+                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
+                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
+                 Not the digits' bytes: closer to the true thickness. */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
+    FOGVOL_SPEEDUP_ALU = 1u << 5,
+    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
+    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
+    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
+    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
+    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
+    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
+    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
+    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
+    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
+};
+#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
+
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
    Per-vertex (or per-pixel) fog from simple analytic volumes, without render
@@ -1728,7 +1926,9 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
    their own shaders paste the strings of fogvol_analytic_snippet(): the
    uniform, void fogvol_analytic(vec3 world_pos, out float fog, out vec3 color)
    and fogvol_fold_fog(inout vec4 diffuse, inout vec4 specular, float fog,
-   vec3 color).
+   vec3 color) (GLSL for Vulkan: declare vec4 fv_analytic[42] in a block of your own and #define
+   FOGVOL_ANALYTIC_IN_BLOCK before them). FOGVOL_GLSL_VULKAN's own programs read one std140 block at
+   (set 0, binding 0): fv_mvp at byte 0, fv_model at 64, fv_analytic at 128; fv_position at location 0.
    Fragment shaders need highp and 42 uniform vectors (GLES2 promises 16 only).
 
    Degenerate input never gives NaN: invalid volumes are left out of a set (and
@@ -2683,8 +2883,8 @@ static int fogvol__winding_at(const fogvol__wind *w, const double q[3], const do
         dist = (e2[0] * qq[0] + e2[1] * qq[1] + e2[2] * qq[2]) / det;
         if (dist <= 0.0 || u < 0.0 || v < 0.0 || u + v > 1.0) continue;
         if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9) return 0;
-        /* det = (e1 x e2) . d: > 0 when the face normal points along d (leaving) */
-        n += det > 0.0 ? 1 : -1;
+        /* det = e1 . (d x e2) = -(e1 x e2) . d: < 0 when the face normal points along d (leaving) */
+        n += det < 0.0 ? 1 : -1;
     }
     *wind = n;
     return 1;
@@ -2750,7 +2950,9 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
     int u = (a + 1) % 3, v = (a + 2) % 3, i, j, i0, i1, j0, j1, k;
     double area = (p[1][u] - p[0][u]) * (p[2][v] - p[0][v]) - (p[2][u] - p[0][u]) * (p[1][v] - p[0][v]);
     double umin = p[0][u], umax = p[0][u], vmin = p[0][v], vmax = p[0][v];
-    const double off = 0.5123;
+    /* a ray's offsets in its cell differ in u and v, and do not sum to 1: a ray never lies on a
+       diagonal of a quad whose corners are on grid lines (of any whole number of steps) */
+    const double offu = 0.5123, offv = 0.4671;
     if (area == 0.0) return;
     for (k = 1; k < 3; ++k) {
         if (p[k][u] < umin) umin = p[k][u];
@@ -2758,17 +2960,17 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
         if (p[k][v] < vmin) vmin = p[k][v];
         if (p[k][v] > vmax) vmax = p[k][v];
     }
-    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - off);
-    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - off) + 1;
-    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - off);
-    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - off) + 1;
+    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - offu);
+    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - offu) + 1;
+    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - offv);
+    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - offv) + 1;
     if (i0 < 0) i0 = 0;
     if (j0 < 0) j0 = 0;
     if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
     if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
     for (j = j0; j <= j1; ++j)
         for (i = i0; i <= i1; ++i) {
-            double qu = lo[u] + (i + off) * step[u], qv = lo[v] + (j + off) * step[v], e[3];
+            double qu = lo[u] + (i + offu) * step[u], qv = lo[v] + (j + offv) * step[v], e[3];
             int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
             for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
                 const double *p0 = p[k], *p1 = p[(k + 1) % 3];
@@ -2846,7 +3048,7 @@ static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_al
             fogvol__wind_tri(w, t, p);
             for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, xs, start);
         }
-    for (r = 0; r < NR; ++r) {
+    for (r = 0; xs && r < NR; ++r) { /* xs NULL: no ray crossed a face (xs + 0 would be undefined) */
         fogvol__xing *x = xs + start[r];
         int n = (int)count[r], i, j, sum = 0;
         if (skip[r] || n == 0) continue;
@@ -3127,6 +3329,43 @@ static const char fogvol__an_fs_modern[] =
    GLSL 400 or ARB_sample_shading, declared before any other token. */
 #define FOGVOL__SAMPLE_SHADING "#extension GL_ARB_sample_shading : require\n"
 
+/* Declarations the program bodies write through macros, so that one body serves GL and Vulkan:
+   FV_UNIFORM(type, name) (a GL uniform; in Vulkan a member of the pass block or of the push
+   constants, declared here), FV_BINDING(unit) before a sampler (Vulkan: its binding in set 0),
+   FV_LOCATION(n) before a vertex input or a varying (Vulkan: its location). */
+static const char fogvol__decl_gl[] =
+    "#define FV_UNIFORM(type, name) uniform type name;\n#define FV_BINDING(unit)\n#define FV_LOCATION(n)\n";
+#define FOGVOL__VK_MACROS \
+    "#define FV_VULKAN\n#define FV_UNIFORM(type, name)\n" \
+    "#define FV_BINDING(unit) layout(set = 0, binding = unit)\n#define FV_LOCATION(n) layout(location = n)\n"
+/* the pass block: fogvol_pass.uniforms as it is (FOGVOL_UNIFORMS in order, one vec4 each), at binding
+   FOGVOL_MAX_TEXTURE_UNITS (8) after the samplers; the per-draw values: fogvol__vk_draw_offsets */
+#define FOGVOL__VK_BLOCK_MEMBER(id, name) "    vec4 " #name ";\n"
+static const char fogvol__decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "precision highp float;\nprecision highp int;\n" /* (no effect in GLSL 450: says what highp in the bodies means) */
+    "layout(std140, set = 0, binding = 8) uniform fv_pass_block {\n" FOGVOL_UNIFORMS(FOGVOL__VK_BLOCK_MEMBER) "};\n"
+    "layout(push_constant) uniform fv_draw_block {\n"
+    "    layout(offset = 0) mat4 fv_mvp;\n"
+    "    layout(offset = 64) vec4 fv_depth;\n"
+    "    layout(offset = 80) vec4 fv_ext;\n"
+    "    layout(offset = 96) vec4 fv_emit;\n"
+    "    layout(offset = 112) float fv_sign;\n"
+    "};\n";
+#undef FOGVOL__VK_BLOCK_MEMBER
+/* the analytic fog's block (what the engine fills: fv_mvp at 0, fv_model at 64, then the
+   FOGVOL_ANALYTIC_UNIFORM_VEC4S vec4 of fogvol_analytic_pack_uniforms at 128) */
+static const char fogvol__an_decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "layout(std140, set = 0, binding = 0) uniform fv_analytic_block {\n"
+    "    mat4 fv_mvp;\n    mat4 fv_model;\n    vec4 fv_analytic[42];\n};\n#define FOGVOL_ANALYTIC_IN_BLOCK\n";
+#undef FOGVOL__VK_MACROS
+static const char fogvol__fs_vulkan[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_fragcolor;\n"
+    "#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_vulkan_analytic[] =
+    "#define FV_VARYING_IN in\nlayout(location = 0) out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+
 typedef struct fogvol__dialect_info {
     const char *name;                 /* fogvol_dialect_name */
     const char *version;              /* the #version line */
@@ -3139,27 +3378,38 @@ typedef struct fogvol__dialect_info {
     const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
     const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
     const char *fs_fetch;             /* fragment prelude of FOGVOL_SPECIALIZE_FETCH_O; NULL: not in this dialect */
+    const char *decl, *an_decl;       /* after the prelude: FV_UNIFORM, FV_BINDING, FV_LOCATION (and the Vulkan
+                                         blocks) for the volume programs and for the analytic fog */
+    unsigned char vulkan;             /* SPIR-V: never chosen for a GL context */
 } fogvol__dialect_info;
 
 static const fogvol__dialect_info fogvol__dialects[] = {
-    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL},
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL, NULL, NULL,
+     0},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
-     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL},
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
      fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern},
-     NULL},
+     NULL, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
      {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
-     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330},
+     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
-     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL},
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL,
+     fogvol__decl_gl, fogvol__decl_gl, 0},
     {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
      {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
-     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300}};
+     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300, fogvol__decl_gl, fogvol__decl_gl, 0},
+    {"vulkan", "#version 450\n", NULL, 0, 0, 2, 4, 5, {fogvol__vs_modern, NULL}, fogvol__fs_vulkan,
+     {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__fs_vulkan_analytic}, NULL,
+     fogvol__decl_vulkan, fogvol__an_decl_vulkan, 1}};
 #undef FOGVOL__SAMPLE_SHADING
 /* one row per value of fogvol_dialect */
 typedef char
@@ -3180,6 +3430,25 @@ static int fogvol__prelude(const char **strings, int n, const char *const prelud
     return n;
 }
 
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out)
+{
+    static const int draw[FOGVOL_DRAW_VALUE_COUNT] = {0, 64, 80, 96, 112}; /* fogvol__decl_vulkan's push constants */
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int i;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0xff, sizeof *out); /* every field -1 */
+    if (!di || !di->vulkan) return FOGVOL_ERROR_UNSUPPORTED;
+    out->pass_binding = FOGVOL_MAX_TEXTURE_UNITS;
+    out->pass_size = (int)(FOGVOL_U_COUNT * 4 * sizeof(float));
+    for (i = 0; i < FOGVOL_U_COUNT; ++i) out->pass_offsets[i] = 16 * i;
+    out->draw_size = 116;
+    for (i = 0; i < FOGVOL_DRAW_VALUE_COUNT; ++i) out->draw_offsets[i] = draw[i];
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) out->sampler_bindings[i] = i;
+    return FOGVOL_SUCCESS;
+}
+/* fogvol__decl_vulkan names binding 8 for the pass block and fogvol_pass.uniforms is that block */
+typedef char fogvol__vk_pass_binding[FOGVOL_MAX_TEXTURE_UNITS == 8 ? 1 : -1];
+
 #ifndef FOGVOL_NO_GL
 /* The newest dialect of a GL (gles = 0) or GLES context of this version. */
 static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
@@ -3187,7 +3456,7 @@ static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
     int d, best = FOGVOL_GLSL_AUTO;
     for (d = 1; d < FOGVOL_GLSL_COUNT; ++d) { /* the rows of each family go from old to new */
         const fogvol__dialect_info *di = &fogvol__dialects[d];
-        if ((di->es != 0) != (gles != 0)) continue;
+        if ((di->es != 0) != (gles != 0) || di->vulkan) continue;
         if (best == FOGVOL_GLSL_AUTO || major > di->gl_major || (major == di->gl_major && minor >= di->gl_minor))
             best = d;
     }
@@ -5135,7 +5404,9 @@ FOGVOL_API fogvol_result fogvol_analytic_pack_uniforms(const fogvol_analytic_set
    gives the CPU's (t, event) order. Misses get t = 2 and sort to the end. */
 static const char fogvol__an_glsl_segment[] =
     "#define FV_AN_MAX 8\n"
+    "#ifndef FOGVOL_ANALYTIC_IN_BLOCK\n"       /* (Vulkan: a member of the engine's uniform block) */
     "uniform vec4 fv_analytic[2 + 5 * FV_AN_MAX];\n"
+    "#endif\n"
     "vec2 fv_an_slab(vec2 t, float o, float v) {\n"
     "    if (v != 0.0) {\n"
     "        float a = (-1.0 - o) / v, b = (1.0 - o) / v;\n"
@@ -5259,16 +5530,18 @@ static const char fogvol__an_glsl_main[] =
     "    fog = s.x;\n"
     "    color = law > 1.5 ? num : (s.y > 0.0 ? num / s.y : vec3(0.0));\n"
     "}\n";
+/* fogvol__an_decl_vulkan declares fv_analytic[42] */
+typedef char fogvol__an_vk_block[FOGVOL_ANALYTIC_UNIFORM_VEC4S == 42 ? 1 : -1];
 static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
 
 static const char fogvol__an_vs_body[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform mat4 fv_model;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(mat4, fv_model)\n"
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_OUT vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_OUT vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5286,9 +5559,9 @@ static const char fogvol__an_vs_body[] =
 
 static const char fogvol__an_fs_body[] =
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_IN vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_IN vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "#ifdef FV_PER_PIXEL\n"
@@ -5312,6 +5585,7 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     strings[n++] = di->version;
     n = fogvol__prelude(strings, n, stage == FOGVOL_STAGE_VERTEX ? di->an_vs : di->an_fs);
+    strings[n++] = di->an_decl;
     if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
     if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
         strings[n++] = fogvol__an_glsl[0];
@@ -5334,155 +5608,181 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
 #endif /* FOGVOL_NO_ANALYTIC */
 
 /* >>tiers ================================================================= */
-/* What each tier can do: the variants, speed-ups and features it supports and what it costs. */
+/* What each tier can do: one row of fogvol__tiers per fogvol_tier, read by every question the library
+   asks about a tier (fogvol_combination_supported, fogvol_msaa_supported, fogvol_tier_uses_program,
+   fogvol_tier_costs, fogvol_shader_strings, the context's choice of tier and speed-ups, the frame's
+   plan). A feature exists on a tier with a set of variants unless the set holds one of its bits in the
+   row's off[] (FOGVOL__NEVER there: not on this tier) and it holds all of need[].
+   To add a tier: its value in fogvol_tier, its row here, and the passes that differ in the >>passes
+   section. To add a speed-up or feature: its FOGVOL__F_ value, its off[] entry in each row, the
+   context's switch for it (>>context) and the one pass function that uses it. */
+
+enum {
+    FOGVOL__F_ENCODE,         /* fogvol draws O itself with the ENCODE program (occluders, or the engine's depth) */
+    FOGVOL__F_RESOLVE,        /* B - F is resolved into an encoded thickness T before the composite (PS13) */
+    FOGVOL__F_CHECK,          /* the sums can saturate: overflow check passes (FOGVOL_PROGRAM_CHECK) */
+    FOGVOL__F_DENSITY,        /* faces weighted by a volume's density texture */
+    FOGVOL__F_LIGHT,          /* volume lights by compare (FOGVOL_PROGRAM_LIGHT) */
+    FOGVOL__F_COLORS,         /* the one-pass colour group (FOGVOL_PROGRAM_COLOR_FACE, _COMPOSITE) */
+    FOGVOL__F_MSAA,           /* per-sample rendering into a multisampled engine framebuffer */
+    FOGVOL__F_ALU,            /* FOGVOL_SPEEDUP_ALU: FOGVOL_VARIANT_ALU added where the dialect takes it */
+    FOGVOL__F_INLINE_RESOLVE, /* FOGVOL_SPEEDUP_INLINE_RESOLVE: the composite resolves B - F itself */
+    FOGVOL__F_FLOAT_O,        /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (FOGVOL_SPECIALIZE_FLOAT_O) */
+    FOGVOL__F_FETCH_O,        /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O there (FOGVOL_SPECIALIZE_FETCH_O) */
+    FOGVOL__F_EXACT_SUM,      /* FOGVOL_SPEEDUP_EXACT_SUM: 32-bit integer sums (FOGVOL_SPECIALIZE_EXACT_SUM) */
+    FOGVOL__F_DEPTH_TEST,     /* FOGVOL_SPEEDUP_DEPTH_TEST: frames drawn as COUNT (FOGVOL_SPECIALIZE_COUNT) */
+    FOGVOL__F_COUNT
+};
+#define FOGVOL__NEVER 0x80000000u /* in off[]: the tier has no such feature (no variant uses this bit) */
+
+typedef struct fogvol__tier_row {
+    const char *name;           /* fogvol_tier_name */
+    const char *define;         /* its line in every program (fogvol_shader_strings) */
+    unsigned char paper_passes; /* fogvol_tier_costs: as the white paper counts them */
+    unsigned char passes;       /* passes fogvol issues for one group, no variant */
+    unsigned char targets;      /* targets fogvol allocates, no variant */
+    unsigned char modern;       /* needs a dialect with float targets, two outputs and texelFetch */
+    fogvol_format sum_format;   /* the format of the face sums (RGBA8: encoded digits) */
+    unsigned caps;              /* backend caps (FOGVOL_CAP_*) it needs */
+    unsigned auto_caps;         /* ... for FOGVOL_TIER_AUTO to choose it */
+    unsigned variants;          /* the variants it takes */
+    unsigned modern_variants;   /* ... those of them that need a modern dialect */
+    unsigned int_variants;      /* ... and those that need highp integers (GLSL 330, 300 es) */
+    unsigned off[FOGVOL__F_COUNT], need[FOGVOL__F_COUNT];
+} fogvol__tier_row;
+
+/* (S single target, C count, A ALU, N near clamp, E engine depth, W wide, K colours) */
+#define FOGVOL__S FOGVOL_VARIANT_SINGLE_TARGET
+#define FOGVOL__C FOGVOL_VARIANT_COUNT
+#define FOGVOL__A FOGVOL_VARIANT_ALU
+#define FOGVOL__N FOGVOL_VARIANT_NEAR_CLAMP
+#define FOGVOL__E FOGVOL_VARIANT_ENGINE_DEPTH
+#define FOGVOL__W FOGVOL_VARIANT_WIDE
+#define FOGVOL__K FOGVOL_VARIANT_COLORS
+#define FOGVOL__X FOGVOL__NEVER
+static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
+    {"auto", "", 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
+     {FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
+     {0}},
+    /* PS13: O, B, F, T resolved, composite; lowp/mediump (texture ramps, per-channel compare) */
+    {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
+     FOGVOL__A,
+     /*       ENCODE RESOLVE CHECK DENSITY LIGHT COLORS MSAA                 ALU */
+     {0, 0, 0, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W,
+      /* INLINE_RESOLVE FLOAT_O                          FETCH_O */
+      0, FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      /* EXACT_SUM                                                     DEPTH_TEST */
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* PS20: O, B, F, composite */
+    {"PS20", "", 5, 4, 3, 0, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
+     FOGVOL__S | FOGVOL__C | FOGVOL__A | FOGVOL__N | FOGVOL__E | FOGVOL__W, FOGVOL__E, 0,
+     {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
+    {"MRT", "", 4, 3, 3, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
+     {FOGVOL__X, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__X, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X},
+     {0}},
+    /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
+    {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
+     FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
+     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
+     {0, 0, 0, 0, 0, FOGVOL__K}}};
+#undef FOGVOL__S
+#undef FOGVOL__C
+#undef FOGVOL__A
+#undef FOGVOL__N
+#undef FOGVOL__E
+#undef FOGVOL__W
+#undef FOGVOL__K
+#undef FOGVOL__X
+
+/* Variants that cannot go together on any tier, and what a variant needs of every tier's backend. */
+static const unsigned fogvol__variant_conflicts[][2] = {
+    {FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_WIDE, FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE}};
+#define FOGVOL__TWO_OUTPUTS FOGVOL_VARIANT_WIDE /* variants whose programs write two colour outputs */
+
+/* The row of a tier; NULL for values out of range. */
+static const fogvol__tier_row *fogvol__tier(fogvol_tier tier)
+{
+    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return NULL;
+    return &fogvol__tiers[tier];
+}
+
+/* Whether feature f (FOGVOL__F_*) exists on the tier with variants v. */
+static int fogvol__tier_has(fogvol_tier tier, unsigned v, int f)
+{
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t && !(t->off[f] & (v | FOGVOL__NEVER)) && (t->need[f] & v) == t->need[f];
+}
 
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 {
-    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
-    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
-    return names[tier];
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t ? t->name : "invalid";
 }
 
-/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
-static int fogvol__density_ok(fogvol_tier tier, unsigned v)
+/* GLSL 330, 300 es and Vulkan's 450 guarantee highp integers and bit operations (PS13's integer ALU
+   encode) */
+static int fogvol__dialect_integers(fogvol_dialect dialect)
 {
-    if (tier == FOGVOL_TIER_FLOAT) return 1;
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
-}
-
-static int fogvol__light_ok(fogvol_tier tier, unsigned v)
-{
-    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-                                         !(v & FOGVOL_VARIANT_WIDE));
+    return dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES || dialect == FOGVOL_GLSL_VULKAN;
 }
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     const fogvol__dialect_info *di = fogvol__dialect(dialect);
-    int modern; /* float targets, multiple outputs */
-    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = !di->legacy;
-    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
-                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
-        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
-    switch (tier) {
-    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
-                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
-        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    size_t i;
+    if (!di || !t || tier == FOGVOL_TIER_AUTO || (v & ~t->variants)) return FOGVOL_ERROR_UNSUPPORTED;
+    for (i = 0; i < sizeof fogvol__variant_conflicts / sizeof fogvol__variant_conflicts[0]; ++i)
+        if ((v & fogvol__variant_conflicts[i][0]) && (v & fogvol__variant_conflicts[i][1]))
             return FOGVOL_ERROR_UNSUPPORTED;
-        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
-                   ? FOGVOL_ERROR_UNSUPPORTED
-                   : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
-        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return FOGVOL_SUCCESS;
-    case FOGVOL_TIER_MRT:
-        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
-    case FOGVOL_TIER_FLOAT:
-        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
-    default: return FOGVOL_ERROR_UNSUPPORTED;
-    }
+    if (di->legacy && (t->modern || (v & t->modern_variants))) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & t->int_variants) && !fogvol__dialect_integers(dialect)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL__TWO_OUTPUTS) && di->outputs < 2) return FOGVOL_ERROR_UNSUPPORTED; /* GLES2: one output */
+    return FOGVOL_SUCCESS;
 }
 
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
-        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
-    return tier == FOGVOL_TIER_FLOAT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13
-               ? FOGVOL_SUCCESS
-               : FOGVOL_ERROR_UNSUPPORTED; /* (ENGINE_DEPTH: the engine's depth per sample) */
+    return fogvol__tier_has(tier, v, FOGVOL__F_MSAA) ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
 }
 
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
 {
-    switch (program) {
-    case FOGVOL_PROGRAM_ENCODE:
-        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-    case FOGVOL_PROGRAM_FACE:
-    case FOGVOL_PROGRAM_COMPOSITE:
-    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
-    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
-    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
-    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
-    case FOGVOL_PROGRAM_COLOR_FACE:
-    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
-    default: return 0;
-    }
+    /* the feature each program belongs to; -1: every tier's */
+    static const signed char feature[FOGVOL_PROGRAM_COUNT] = {
+        FOGVOL__F_ENCODE, -1, -1, -1, FOGVOL__F_RESOLVE, FOGVOL__F_CHECK, FOGVOL__F_LIGHT, FOGVOL__F_COLORS,
+        FOGVOL__F_COLORS};
+    if ((int)program < 0 || (int)program >= FOGVOL_PROGRAM_COUNT || !fogvol__tier(tier) || tier == FOGVOL_TIER_AUTO)
+        return 0;
+    return feature[program] < 0 || fogvol__tier_has(tier, v, feature[program]);
 }
 
 FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
 {
-    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    /* a tier that draws O itself, in a variant that does not (FLOAT + ENGINE_DEPTH): no O pass, no O */
+    int no_o = t && t->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER && !fogvol__tier_has(tier, v, FOGVOL__F_ENCODE);
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     out->name = fogvol_tier_name(tier);
-    switch (tier) {
-    case FOGVOL_TIER_PS13:
-        out->paper_passes = 6;
-        out->library_passes = 5;
-        out->targets = single ? 3 : 4; /* O, B, F, T */
-        break;
-    case FOGVOL_TIER_PS20:
-        out->paper_passes = 5;
-        out->library_passes = 4;
-        out->targets = single ? 2 : 3;
-        break;
-    case FOGVOL_TIER_MRT:
-        out->paper_passes = 4;
-        out->library_passes = 3;
-        out->targets = single ? 2 : 3; /* O is written by the engine */
-        break;
-    case FOGVOL_TIER_FLOAT:
-        out->paper_passes = 3;
-        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
-        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
-        break;
-    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
+    if (!t || tier == FOGVOL_TIER_AUTO) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    out->paper_passes = t->paper_passes;
+    out->library_passes = t->passes - no_o;
+    out->targets = t->targets - no_o - ((v & FOGVOL_VARIANT_SINGLE_TARGET) ? 1 : 0); /* (S: no F) */
     return FOGVOL_SUCCESS;
-}
-
-/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
-   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
-   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
-   comparing with an R32F O than counting with its RGBA8 O) */
-static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
-}
-
-/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
-   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
-/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
-   FLOAT's engine depth texture, nor COLORS' faces) */
-static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
-{
-    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-}
-
-/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
-static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
-{
-    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
-}
-
-static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
-                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
 }
 
 /* >>shaders =============================================================== */
@@ -5510,9 +5810,6 @@ static const char fogvol__fs_msaa[] =
     "#undef FV_TEXTURE\n"
     "#define FV_TEXTURE fv_tex\n";
 
-static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
-                                                                   "#define FV_FLOAT\n"};
-
 static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
                                                       "#define FV_ENGINE_DEPTH\n", "#define FV_WIDE\n",
@@ -5528,15 +5825,15 @@ typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
    NEAR_CLAMP snaps vertices behind the near plane onto it instead (Baker). */
 static const char fogvol__vs_mesh[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform vec4 fv_depth;\n"
-    "uniform vec4 fv_misc;\n"
-    "FV_VARYING_OUT float fv_d;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(vec4, fv_depth)\n"
+    "FV_UNIFORM(vec4, fv_misc)\n"
+    "FV_LOCATION(0) FV_VARYING_OUT float fv_d;\n"
     "#ifdef FV_DENSITY\n"                        /* density texture coordinates from the model-space position */
-    "uniform vec4 fv_dens_u;\n"
-    "uniform vec4 fv_dens_v;\n"
-    "FV_VARYING_OUT vec2 fv_dtc;\n"
+    "FV_UNIFORM(vec4, fv_dens_u)\n"
+    "FV_UNIFORM(vec4, fv_dens_v)\n"
+    "FV_LOCATION(1) FV_VARYING_OUT vec2 fv_dtc;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5554,11 +5851,14 @@ static const char fogvol__vs_mesh[] =
     "#endif\n"
     "    fv_d = d;\n"
     "    c.z = mix(c.z, d * fv_misc.x - c.w, fv_misc.y);\n"
+    "#ifdef FV_VULKAN\n"                          /* clip z in [0, w]: the same window depth */
+    "    c.z = 0.5 * (c.z + c.w);\n"
+    "#endif\n"
     "    gl_Position = c;\n"
     "}\n";
 
 static const char fogvol__vs_fullscreen[] =
-    "FV_ATTRIB vec3 fv_position;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
     "void main() {\n"
     "    gl_Position = vec4(fv_position.xy, 0.0, 1.0);\n"
     "}\n";
@@ -5567,10 +5867,10 @@ static const char fogvol__vs_fullscreen[] =
    the borrow fold (normalised digits, alpha free), screen coordinates. */
 static const char fogvol__fs_common[] =
     "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
-    "uniform vec4 fv_enc;\n"    /* (N, N^2, depth offset, depth max) */
-    "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_dec;\n"
+    "FV_UNIFORM(vec4, fv_enc)\n"    /* (N, N^2, depth offset, depth max) */
+    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, 0) */
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_dec)\n"
     /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
        texture (fv_nf.zw: the viewport's origin, declared by the programs that read it); FV_ORIGIN
        (SPECIALIZE_ORIGIN, the viewport at the window origin): both offsets 0, left out */
@@ -5589,8 +5889,8 @@ static const char fogvol__fs_common[] =
     /* view depth (distance along the view axis) of an engine depth-buffer sample: st in [0,1]
        across the engine viewport, z its window depth; fv_lin / fv_lin2 hold the inverse
        view-projection rows with the window -> NDC mapping (depth range, clip control) folded in */
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
     "float fv_engine_view_depth(vec2 st, float z) {\n"
     "#ifdef FV_DEPTH_FROM_Z\n"                 /* fv_lin.xy = fv_lin2.xy = 0 (no oblique near plane) */
     "    return (fv_lin.z * z + fv_lin.w) / (fv_lin2.z * z + fv_lin2.w);\n"
@@ -5634,10 +5934,10 @@ static const char fogvol__fs_encode_common[] =
        context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
     "#ifdef FV_ENC_LN\n#define FV_N FV_ENC_N\n#define FV_DD FV_ENC_D\n#define FV_RDD (1.0 / FV_ENC_D)\n"
     "#else\n#define FV_N fv_enc.x\n#define FV_DD fv_dith.z\n#define FV_RDD fv_dith.y\n#endif\n"
-    "uniform sampler2D fv_dither;\n"
+    "FV_BINDING(2) uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
-    "uniform sampler2D fv_rg;\n"
-    "uniform sampler2D fv_blue;\n"
+    "FV_BINDING(0) uniform sampler2D fv_rg;\n"
+    "FV_BINDING(1) uniform sampler2D fv_blue;\n"
     "#endif\n"
     /* FV_IALU: the ALU encode in integers (FOGVOL__IALU_TEXT) */
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
@@ -5718,14 +6018,14 @@ static const char fogvol__fs_encode_common[] =
 
 static const char fogvol__fs_encode[] =
     "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
     "    float depth = FV_ENGINE_Z(fv_opaque);\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
-    "FV_VARYING_IN float fv_d;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
     "#if defined(FV_WIDE)\n"
     "    vec4 hi, lo;\n"
@@ -5747,8 +6047,8 @@ static const char fogvol__fs_encode[] =
    with COUNT rely on the depth test and count faces in alpha. FLOAT: signed
    depth of every face in one pass, the sign from gl_FrontFacing. */
 static const char fogvol__fs_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_FETCH_O\n" /* O from the framebuffer (FOGVOL_SPECIALIZE_FETCH_O) */
     "#define FV_OREAD(s) fv_ofb\n"
     "#undef FV_O_DIGITS\n"
@@ -5757,17 +6057,17 @@ static const char fogvol__fs_face[] =
     "#define FV_OREAD(s) FV_SCREEN(s)\n"
     "#endif\n"
     "#ifdef FV_DENSITY\n"                        /* v = c + rho (min(d, o) - c), c = min(o, fv_dens.x) */
-    "uniform sampler2D fv_density;\n"
-    "uniform vec4 fv_dens;\n"
-    "FV_VARYING_IN vec2 fv_dtc;\n"
+    "FV_BINDING(6) uniform sampler2D fv_density;\n"
+    "FV_UNIFORM(vec4, fv_dens)\n"
+    "FV_LOCATION(1) FV_VARYING_IN vec2 fv_dtc;\n"
     "float fv_density_apply(float d, float o) {\n"
     "    return mix(min(o, fv_dens.x), d, FV_TEXTURE(fv_density, fv_dtc).r);\n"
     "}\n"
     "#endif\n"
     "#ifdef FV_FLOAT\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_speed;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = FV_ENGINE_Z(fv_opaque);\n"
@@ -5787,7 +6087,7 @@ static const char fogvol__fs_face[] =
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
     "}\n"
     "#elif defined(FV_WIDE)\n"
-    "uniform sampler2D fv_opaque2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_opaque2;\n"
     "void main() {\n"
     "    vec4 hi, lo, ohi = FV_SCREEN(fv_opaque), olo = FV_SCREEN(fv_opaque2);\n"
     "    fv_encode_wide(fv_d, hi, lo);\n"
@@ -5800,7 +6100,7 @@ static const char fogvol__fs_face[] =
 /* (the face program's second string: C99 compilers need take no string over 4095 characters) */
 static const char fogvol__fs_face_rgba8[] =
     "#elif defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: the pixel as a 32-bit integer, +- d 2^24 */
-    "uniform float fv_sign;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
     "void main() {\n"
     "    float d = clamp(fv_d, 0.0, 1.0);\n"
     "#ifndef FV_NO_OPAQUE\n"
@@ -5871,9 +6171,9 @@ static const char fogvol__fs_resolve_fn[] =
 
 /* PS13 resolve into T: the digits (0 where B - F < 0), alpha marks covered pixels (2: saturated). */
 static const char fogvol__fs_resolve[] =
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "void main() {\n"
     "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
     "    vec3 d = fv_resolve(b, f, FV_RESOLVE_O(fv_opaque));\n"
@@ -5889,7 +6189,7 @@ static const char fogvol__fs_resolve[] =
    where a check pass marked the channels that hit 255 before the subtraction
    brought them down. FV_CHECK (the check pass) keeps only saturated pixels. */
 static const char fogvol__fs_composite[] =
-    "uniform vec4 fv_rampmap;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
     /* exp(-x), x >= 0; FV_FAST_EXP (FOGVOL_SPEEDUP_FAST_EXP): 2^y = 2^n (1 + g (a + (1 - a) g)),
        n = floor(y), g = y - n, the minimax a with p(0) = 1, p(1) = 2 (relative error 0.0027) */
     "float fv_transmit(float x) {\n"
@@ -5901,17 +6201,17 @@ static const char fogvol__fs_composite[] =
     "    return exp(-x);\n"
     "#endif\n"
     "}\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform sampler2D fv_colors;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
-    "uniform vec4 fv_speed;\n"
-    "uniform vec4 fv_ctex_u;\n"
-    "uniform vec4 fv_ctex_v;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(6) uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
+    "FV_UNIFORM(vec4, fv_speed)\n"
+    "FV_UNIFORM(vec4, fv_ctex_u)\n"
+    "FV_UNIFORM(vec4, fv_ctex_v)\n"
     "#ifdef FV_WIDE\n"
-    "uniform sampler2D fv_back2;\n"
-    "uniform sampler2D fv_front2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_back2;\n"
+    "FV_BINDING(5) uniform sampler2D fv_front2;\n"
     "#endif\n"
     /* FV_DOWNSAMPLE (FLOAT, GLSL 130+): the sum at half resolution, bilinear between the four
        nearest low-resolution texel centres, clamped at the edges. The tw texels span the w pixels of
@@ -6026,11 +6326,11 @@ static const char fogvol__fs_composite_main[] =
    (FLOAT: d; RGBA8: encoded). 1: its back faces light the pixels whose opaque depth o lies
    between L's front depth and their own depth, in the engine framebuffer. */
 static const char fogvol__fs_light[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform FV_TARGET_SAMPLER fv_lfront;\n"
-    "uniform vec4 fv_light;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(7) uniform FV_TARGET_SAMPLER fv_lfront;\n"
+    "FV_UNIFORM(vec4, fv_light)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "float fv_light_depth(vec4 v) {\n"
     "#ifdef FV_FLOAT\n"
     "    return v.r;\n"
@@ -6067,12 +6367,12 @@ static const char fogvol__fs_light[] =
    program) times the volume's per-channel extinction (target 0: optical depth tau) and times its
    extinction * colour (target 1: emission sum E). */
 static const char fogvol__fs_color_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_ext;\n"
-    "uniform vec4 fv_emit;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_ext)\n"
+    "FV_UNIFORM(vec4, fv_emit)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = FV_ENGINE_Z(fv_opaque);\n"
@@ -6091,9 +6391,9 @@ static const char fogvol__fs_color_face[] =
    scene * T + c * (1 - T). fv_rampmap.z picks the step: 0 one FOG-blended draw (every extinction
    grey: T the same in each channel), 1 the multiply draw (scene * T), 2 the emission draw. */
 static const char fogvol__fs_color_composite[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
     "    vec3 tau = max(FV_TEXTURE(fv_back, st).rgb, vec3(0.0));\n"
@@ -6253,18 +6553,18 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
-        if (!fogvol__count_spec_ok(d->tier, v) ||
+        if (!fogvol__tier_has(d->tier, v, FOGVOL__F_DEPTH_TEST) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
             (d->program == FOGVOL_PROGRAM_FACE && !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))
             return FOGVOL_ERROR_UNSUPPORTED; /* (COUNT has no density texture) */
         v |= FOGVOL_VARIANT_COUNT;
     }
-    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__float_o_ok(d->tier, v)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__tier_has(d->tier, v, FOGVOL__F_FLOAT_O)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
-    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__fetch_o_ok(d->tier, v) || d->samples > 1))
+    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__tier_has(d->tier, v, FOGVOL__F_FETCH_O) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) &&
-        (!fogvol__exact_sum_ok(d->tier, v) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
+        (!fogvol__tier_has(d->tier, v, FOGVOL__F_EXACT_SUM) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
          (d->program == FOGVOL_PROGRAM_FACE && (d->samples > 1 || !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))))
         return FOGVOL_ERROR_UNSUPPORTED;
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
@@ -6281,11 +6581,12 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
     } else
         strings[n++] = di->fs;
-    if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
+    strings[n++] = di->decl;
+    if (fogvol__tiers[d->tier].define[0]) strings[n++] = fogvol__tiers[d->tier].define;
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (per_sample) strings[n++] = fogvol__fs_msaa;
-    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, v) &&
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__tier_has(d->tier, v, FOGVOL__F_DENSITY) &&
         !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
     n = fogvol__specialize_defines(d, strings, n);
@@ -6313,7 +6614,9 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
    (the same 8x8 ordered pattern as fogvol_make_dither_index); in integers where the dialect has
    floatBitsToInt and bit operations (GLSL 330+, 300 es), by FV_IALU's FOGVOL__IALU_TEXT. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
+    "#ifndef FOGVOL_MRT_IN_BLOCK\n" /* Vulkan: vec4 fogvol_mrt[2] is a member of the engine's own block */ \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "#endif\n" \
     "vec4 fogvol_view_depth_r32f(float view_depth) {\n" /* N = 0: an R32F target */ \
     "    return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n" \
     "}\n" \
@@ -6458,10 +6761,10 @@ static void fogvol__null_draw_fullscreen(void *u)
 
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
 
-static uintptr_t fogvol__null_native(void *u, fogvol_handle h)
+static fogvol_native fogvol__null_native(void *u, fogvol_handle h)
 {
     (void)u;
-    return (uintptr_t)h;
+    return (fogvol_native)h;
 }
 
 static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
@@ -6580,6 +6883,8 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    int64_t textured;  /* the frame (fogvol__frame_state.serial) in which a volume of it has a density or
+                          colour texture: it leaves the one-pass colour group for that frame */
 };
 
 struct fogvol_volume_texture {
@@ -6666,6 +6971,7 @@ typedef struct fogvol__gpu {
 /* The frame between fogvol_begin_frame and fogvol_end_frame / fogvol_cancel_frame: its desc, camera,
    volumes, occluders and lights. */
 typedef struct fogvol__frame_state {
+    int64_t serial; /* fogvol_begin_frame calls (ramps mark the frame their volumes are textured in) */
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -6689,6 +6995,7 @@ typedef struct fogvol__frame_state {
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
 typedef struct fogvol__overflow_state {
     int counting, overflow_late, overflow_warned, qcur;
+    int coarse;        /* the last ended frame's digit step was coarse (fogvol_frame_stats.depth_lsb) */
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
@@ -6712,7 +7019,7 @@ typedef struct fogvol__run {
     fogvol_frame_stats st;
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
-    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
     int w, h, single, count, rgba8;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
@@ -6817,6 +7124,15 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
 
+/* After the backend calls of a public call (outside a backend frame, or after its end_frame): the
+   backend's own failure since the last take (fogvol_backend.take_error, logged by the backend) is the
+   call's result when the call had none of its own. */
+static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
+{
+    fogvol_result e = ctx->be.take_error ? ctx->be.take_error(ctx->be.user_data) : FOGVOL_SUCCESS;
+    return r == FOGVOL_SUCCESS ? e : r;
+}
+
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
@@ -6867,7 +7183,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
         td.format = FOGVOL_FORMAT_RGBA8;
         td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
             td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
         td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
@@ -7038,43 +7354,57 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH))
         pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
     pd.label = labels[p];
+    (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout); /* (GL dialects: all -1) */
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
 
-/* AUTO: FLOAT with float blending, MRT when the engine writes O and can,
-   PS20 with highp fragment shaders, else PS13; an explicit tier must exist in
-   the backend's dialect and caps. */
+/* Whether the backend can run tier t with variants v: the combination exists in its dialect, and it
+   has the caps the tier needs (automatic: to be chosen by FOGVOL_TIER_AUTO) and those of the
+   variants (two attachments for WIDE and COLORS, a depth texture for ENGINE_DEPTH). */
+static int fogvol__backend_runs(const fogvol_context *ctx, fogvol_tier t, unsigned v, int automatic)
+{
+    const fogvol__tier_row *row = fogvol__tier(t);
+    unsigned caps = ctx->be.caps, need = row->caps | (automatic ? row->auto_caps : 0u);
+    if (fogvol_combination_supported(t, v, ctx->be.dialect) != FOGVOL_SUCCESS || (caps & need) != need) return 0;
+    if ((v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+        (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment))
+        return 0;
+    return !(v & FOGVOL_VARIANT_ENGINE_DEPTH) || (caps & FOGVOL_CAP_DEPTH_TEXTURE);
+}
+
+/* The tier: AUTO takes the first of FLOAT, MRT (when the engine writes O: desc->engine_mrt), PS20 and
+   PS13 that the backend runs with the required variants; an explicit tier must run with them. Then
+   each preferred variant joins where the tier, dialect and backend take it, and is left out (logged)
+   where not. */
 static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_context_desc *desc)
 {
-    unsigned caps = ctx->be.caps;
+    static const fogvol_tier order[4] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_MRT, FOGVOL_TIER_PS20, FOGVOL_TIER_PS13};
     fogvol_tier t = desc->tier;
-    if (t == FOGVOL_TIER_AUTO) {
-        if ((caps & FOGVOL_CAP_FLOAT_BLEND) &&
-            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_FLOAT;
-        else if (desc->engine_mrt && (caps & FOGVOL_CAP_MRT) &&
-                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_MRT;
-        else if (caps & FOGVOL_CAP_HIGHP_FRAGMENT)
-            t = FOGVOL_TIER_PS20;
+    unsigned v = desc->variants, bit;
+    int i;
+    for (i = 0; t == FOGVOL_TIER_AUTO && i < 4; ++i)
+        if ((order[i] != FOGVOL_TIER_MRT || desc->engine_mrt) && fogvol__backend_runs(ctx, order[i], v, 1))
+            t = order[i];
+    if (t == FOGVOL_TIER_AUTO || !fogvol__backend_runs(ctx, t, v, 0)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: %s%s with variants 0x%x does not run on this backend (GLSL %s, caps 0x%x); "
+                    "variants the engine only prefers go in fogvol_context_desc.preferred_variants",
+                    desc->tier == FOGVOL_TIER_AUTO ? "no tier" : "tier ",
+                    desc->tier == FOGVOL_TIER_AUTO ? "" : fogvol_tier_name(t), v,
+                    fogvol_dialect_name(ctx->be.dialect), ctx->be.caps);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    for (bit = 1u; bit & FOGVOL_VARIANT_ALL; bit <<= 1) {
+        if (!(desc->preferred_variants & bit) || (v & bit)) continue;
+        if (fogvol__backend_runs(ctx, t, v | bit, 0))
+            v |= bit;
         else
-            t = FOGVOL_TIER_PS13;
-    }
-    if (fogvol_combination_supported(t, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: tier %s with variants 0x%x does not exist in GLSL %s",
-                    fogvol_tier_name(t), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect));
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
-        (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
-        ((ctx->cfg.variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-         (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
-        ((ctx->cfg.variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
-                    fogvol_tier_name(t), caps);
-        return FOGVOL_ERROR_UNSUPPORTED;
+            fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                        "fogvol: preferred variant 0x%x left out: tier %s with variants 0x%x does not take it here",
+                        bit, fogvol_tier_name(t), v);
     }
     ctx->cfg.tier = t;
+    ctx->cfg.variants = v;
     return FOGVOL_SUCCESS;
 }
 
@@ -7198,44 +7528,35 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     return r;
 }
 
-/* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13 resolves B - F in its composite where fragment shaders have fp32. */
-static void fogvol__default_inline_resolve(fogvol_context *ctx)
+/* Whether the context runs speed-up sp (FOGVOL_SPEEDUP_*), whose feature f is in the tier's row:
+   not turned off (disable_speedups) and on the tier with the context's variants. */
+static int fogvol__speedup(const fogvol_context *ctx, unsigned sp, int f)
 {
-    ctx->cfg.inline_resolve = ctx->cfg.tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-                          !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
+    return !(ctx->cfg.speedups_off & sp) && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, f);
 }
 
-/* FOGVOL_SPEEDUP_EXACT_SUM: what it needs besides the R32F O */
-static int fogvol__exact_sum_can(const fogvol_context *ctx)
+/* The speed-ups the context runs (after the tier): their rows in the tier table, the backend's caps
+   and the programs they need (SPECIALIZE for those that are specialised programs). ALU: the variant
+   joins where the dialect takes it. INLINE_RESOLVE: with fp32 fragment maths. FLOAT_O: where the
+   backend renders R32F targets and the faces can read its float (MRT; PS20 with fp32; PS13 only where
+   it sums in integers: its digits measured slower with it). EXACT_SUM: framebuffer fetch and fp32. */
+static void fogvol__choose_speedups(fogvol_context *ctx)
 {
-    return (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-           !(ctx->cfg.speedups_off &
-             (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-           fogvol__exact_sum_ok(ctx->cfg.tier, ctx->cfg.variants);
-}
-
-/* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
-   fragment shaders have fp32 (the faces encode O's float), and PS13's where it sums in integers
-   (FOGVOL_SPEEDUP_EXACT_SUM; its digits measured slower with it); not WIDE, ENGINE_DEPTH or COUNT
-   (fogvol__float_o_ok). */
-static void fogvol__default_float_o(fogvol_context *ctx)
-{
-    ctx->cfg.float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
-                   fogvol__float_o_ok(ctx->cfg.tier, ctx->cfg.variants) &&
-                   (ctx->cfg.tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
-                   (ctx->cfg.tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
-}
-
-/* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
-   no lookup texture reads) unless the variant set or dialect cannot take it. */
-static void fogvol__default_alu(fogvol_context *ctx)
-{
-    unsigned v = ctx->cfg.variants | FOGVOL_VARIANT_ALU;
-    if ((ctx->cfg.tier == FOGVOL_TIER_PS20 || ctx->cfg.tier == FOGVOL_TIER_MRT || ctx->cfg.tier == FOGVOL_TIER_PS13) &&
-        !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_ALU) &&
-        !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
-        fogvol_combination_supported(ctx->cfg.tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
-        ctx->cfg.variants = v;
+    unsigned caps = ctx->be.caps, unspecialised = ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE;
+    int highp = (caps & FOGVOL_CAP_HIGHP_FRAGMENT) != 0, fetch = (caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) != 0;
+    int exact;
+    if (fogvol__speedup(ctx, FOGVOL_SPEEDUP_ALU, FOGVOL__F_ALU) &&
+        fogvol_combination_supported(ctx->cfg.tier, ctx->cfg.variants | FOGVOL_VARIANT_ALU, ctx->be.dialect) ==
+            FOGVOL_SUCCESS)
+        ctx->cfg.variants |= FOGVOL_VARIANT_ALU;
+    ctx->cfg.inline_resolve = highp && fogvol__speedup(ctx, FOGVOL_SPEEDUP_INLINE_RESOLVE, FOGVOL__F_INLINE_RESOLVE);
+    exact = fetch && highp && !unspecialised && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) &&
+            fogvol__speedup(ctx, FOGVOL_SPEEDUP_EXACT_SUM, FOGVOL__F_EXACT_SUM);
+    ctx->cfg.float_o = (caps & FOGVOL_CAP_FLOAT_TARGET) &&
+                       fogvol__speedup(ctx, FOGVOL_SPEEDUP_FLOAT_O, FOGVOL__F_FLOAT_O) &&
+                       (ctx->cfg.tier == FOGVOL_TIER_MRT || highp) && (ctx->cfg.tier != FOGVOL_TIER_PS13 || exact);
+    ctx->cfg.fetch_o = fetch && !unspecialised && fogvol__speedup(ctx, FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, FOGVOL__F_FETCH_O);
+    ctx->cfg.exact_sum = ctx->cfg.float_o && exact;
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -7258,7 +7579,6 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
     ctx->cfg.speedups_off = desc->disable_speedups;
-    ctx->cfg.variants = desc->variants;
     ctx->cfg.msaa = desc->msaa;
     fogvol_encoding_init(bits, &ctx->cfg.enc);
     r = fogvol__attach_backend(ctx, desc);
@@ -7267,16 +7587,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return r;
     }
     r = fogvol__choose_tier(ctx, desc);
-    if (r == FOGVOL_SUCCESS) {
-        fogvol__default_alu(ctx);
-        fogvol__default_inline_resolve(ctx);
-        fogvol__default_float_o(ctx);
-        ctx->cfg.fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
-                       !(ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-                       fogvol__fetch_o_ok(ctx->cfg.tier, ctx->cfg.variants);
-        ctx->cfg.exact_sum = ctx->cfg.float_o && fogvol__exact_sum_can(ctx);
-    }
+    if (r == FOGVOL_SUCCESS) fogvol__choose_speedups(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
+    r = fogvol__be_result(ctx, r);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
@@ -7557,10 +7870,12 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc);
-    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
+        if (m->handle) ctx->be.destroy_mesh(ctx->be.user_data, m->handle);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, m);
         return r;
     }
@@ -7600,6 +7915,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget(ctx, mesh, NULL);
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
     ctx->live_meshes--;
     fogvol__free(&ctx->alloc, mesh);
 }
@@ -7654,9 +7970,11 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     td.filter = FOGVOL_FILTER_LINEAR;
     td.wrap = FOGVOL_WRAP_CLAMP;
     td.label = "fogvol colour ramp";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture));
     fogvol__free(&ctx->alloc, px);
     if (r != FOGVOL_SUCCESS) {
+        if (rp->texture) ctx->be.destroy_texture(ctx->be.user_data, rp->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, rp);
         return r;
     }
@@ -7681,6 +7999,7 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     if (!ctx || !ramp) return;
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     ctx->live_ramps--;
     fogvol__free(&ctx->alloc, ramp);
 }
@@ -7702,9 +8021,11 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        if (t->texture) ctx->be.destroy_texture(ctx->be.user_data, t->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, t);
         return r;
     }
@@ -7724,19 +8045,57 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
         ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     fogvol__free(&ctx->alloc, texture);
 }
 
 /* >>frame input =========================================================== */
 /* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
 
+/* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
+   next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->cur.in_frame = 0;
-    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.nvol = ctx->cur.nocc = ctx->cur.nlight = 0;
     ctx->cur.engine_occluders = 0;
+    ctx->cur.mrt_ready = 0;
     return FOGVOL_SUCCESS;
+}
+
+/* Matrices as fogvol reads them (column-major: m[column * 4 + row]). */
+static void fogvol__transpose(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* An affine transform: bottom row (m[3], m[7], m[11], m[15]) = (0, 0, 0, 1) within 1e-6 (of the
+   largest coefficient of the 3x3 part for the first three). A row-major matrix copied as it is has
+   its translation there. */
+static int fogvol__affine(const float m[16])
+{
+    double big = 0.0, tol;
+    int c, k;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 3; ++k)
+            if (FOGVOL_FABS(m[c * 4 + k]) > big) big = FOGVOL_FABS(m[c * 4 + k]);
+    tol = 1e-6 * big;
+    return FOGVOL_FABS(m[3]) <= tol && FOGVOL_FABS(m[7]) <= tol && FOGVOL_FABS(m[11]) <= tol &&
+           FOGVOL_FABS(m[15] - 1.0) <= 1e-6;
+}
+
+/* A perspective projection transposed: the w row (0, 0, -1, 0) (or +1, w = z) stands in column 3, so
+   m[14] is exactly +-1 and m[11] (the near/far term) is not, m[12] = m[13] = m[15] = 0 and the w row
+   read where it belongs, (m[3], m[7], m[11], m[15]), has the same (0, 0, c, 0) form. A projection as
+   written by glFrustum, gluPerspective, glm or D3D has m[11] = +-1 (reversed and infinite ones too),
+   so it is never taken for this. */
+static int fogvol__w_at_14(const float p[16])
+{
+    return FOGVOL_FABS(p[14]) == 1.0f && FOGVOL_FABS(p[11]) != 1.0f && p[11] != 0.0f && p[12] == 0.0f &&
+           p[13] == 0.0f && p[15] == 0.0f && p[3] == 0.0f && p[7] == 0.0f;
 }
 
 /* Camera axes in world space from the frame's input: eye, right X, up Y, forward F (view
@@ -7772,6 +8131,9 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
     if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
     if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16))
         return "non-finite view or projection matrix";
+    if (!fogvol__affine(d->view)) return "the view matrix's bottom row (m[3], m[7], m[11], m[15]) is not (0, 0, 0, 1)";
+    if (fogvol__w_at_14(d->projection))
+        return "the projection's clip w takes the view depth from m[14] (the z row), not m[11] (the w row)";
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
     fogvol__mul4(ctx->cur.viewproj, p, v);
@@ -7790,8 +8152,8 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
 /* The frame's camera: how clip w relates to view depth (perspective: w = s e, s > 0;
    orthographic: w constant > 0), whether the projection mirrors the screen (orientation
    of a camera-facing triangle, counter-clockwise as seen from the eye, after projection),
-   and the inverse view-projection. Logs and refuses what it cannot interpret. */
-static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+   and the inverse view-projection. Returns why it cannot interpret the camera, or NULL. */
+static const char *fogvol__camera_why(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
     const char *why = fogvol__camera_axes(ctx, d, ax);
@@ -7827,11 +8189,33 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
         if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
         else ctx->cur.mirrored = det < 0.0;
     }
-    if (why) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    return why;
+}
+
+/* The camera (fogvol__camera_why); a refusal is logged, and says which matrices transposed would be
+   accepted: row-major engine matrices (raylib's Matrix, DirectXMath) copied as they are. */
+static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    static const char *const which[4] = {"", "the view matrix", "the projection", "the view and projection matrices"};
+    const char *why = fogvol__camera_why(ctx, d);
+    fogvol_frame_desc t;
+    int k, hint = 0;
+    if (!why) return FOGVOL_SUCCESS;
+    for (k = d->camera == FOGVOL_CAMERA_VIEW_PROJECTION ? 3 : 1; k <= 3 && !hint; ++k) {
+        t = *d;
+        if (d->camera == FOGVOL_CAMERA_VIEW_PROJECTION) fogvol__transpose(t.view_projection, d->view_projection);
+        if (k & 1) fogvol__transpose(t.view, d->view);
+        if (k & 2) fogvol__transpose(t.projection, d->projection);
+        if (!fogvol__camera_why(ctx, &t)) hint = k;
     }
-    return FOGVOL_SUCCESS;
+    if (hint && d->camera == FOGVOL_CAMERA_VIEW_PROJECTION)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? view_projection "
+                    "transposed would be accepted: a row-major matrix copied as it is)", why);
+    else if (hint)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? %s transposed would be "
+                    "accepted: a row-major matrix copied as it is)", why, which[hint]);
+    else fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
 }
 
 FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
@@ -7918,7 +8302,9 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.frame = *d;
     ctx->cur.nvol = ctx->cur.nocc = 0;
     ctx->cur.in_frame = 1;
+    ctx->cur.serial++;
     ctx->cur.nlight = 0;
+    ctx->cur.mrt_ready = ctx->cur.engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -7941,8 +8327,35 @@ static fogvol_result fogvol__grow(fogvol_context *ctx, void **arr, int *cap, int
     return FOGVOL_SUCCESS;
 }
 
+/* What makes a model matrix unusable, or NULL: non-finite, all zero, not affine (a row-major matrix
+   copied as it is: transposed, told apart by its transpose being affine), and for a volume or a
+   light, singular (|det| of the 3x3 part at most 1e-7 of the product of its column lengths: a zero
+   scale, or two axes along each other, flattens the mesh to no volume). */
+static const char *fogvol__model_problem(const float m[16], int volume)
+{
+    double d[16], c[3];
+    float t[16];
+    int i, k, zero = 1;
+    if (!fogvol__finite_n(m, 16)) return "is not finite";
+    for (i = 0; i < 16; ++i) zero &= m[i] == 0.0f;
+    if (zero) return "is all zero";
+    if (!fogvol__affine(m)) {
+        fogvol__transpose(t, m);
+        return fogvol__affine(t) ? "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1) but its "
+                                   "right column is (transposed? a row-major matrix copied as it is)"
+                                 : "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1)";
+    }
+    if (!volume) return NULL;
+    fogvol__tod(d, m);
+    for (k = 0; k < 3; ++k) c[k] = FOGVOL_SQRT(d[4 * k] * d[4 * k] + d[4 * k + 1] * d[4 * k + 1] + d[4 * k + 2] * d[4 * k + 2]);
+    if (FOGVOL_FABS(fogvol__det3(d)) <= 1e-7 * c[0] * c[1] * c[2])
+        return "is singular (a zero scale or two axes along each other flatten the mesh: no volume)";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16])
 {
+    const char *why;
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
@@ -7953,8 +8366,8 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (!fogvol__finite_n(model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the occluder's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.occ;
@@ -8015,7 +8428,7 @@ static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_vo
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite density_map or color_map");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->density && !fogvol__density_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (desc->density && !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DENSITY)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: density textures need tier FLOAT, PS20 or MRT without the "
                     "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -8044,6 +8457,7 @@ static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *de
 
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
+    const char *why;
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
@@ -8053,8 +8467,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volume's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     r = fogvol__check_textures(ctx, desc);
@@ -8069,6 +8483,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     memcpy(v->model, desc->model, sizeof v->model);
     v->negative = desc->negative != 0;
     fogvol__set_textures(v, desc);
+    if (desc->density || desc->color) /* (a ramp of this context: its own object) */
+        ((fogvol_ramp *)(uintptr_t)desc->ramp)->textured = ctx->cur.serial;
     return FOGVOL_SUCCESS;
 }
 
@@ -8095,10 +8511,14 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
+    const char *why;
     fogvol_draw dr;
     if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_transform: the model matrix %s", why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
     return FOGVOL_SUCCESS;
@@ -8147,23 +8567,27 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
     memset(info, 0, sizeof *info);
     info->draw_buffer = ctx->cur.frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
-    if (r != FOGVOL_SUCCESS)
+    if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    }
     return r;
 }
 
 /* For the *_prepare calls: fogvol's targets sized to the frame (touches the
    GPU, state restored), the frame's constants and O's API object. */
-static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
+static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, fogvol_native *texture)
 {
     fogvol_frame_info fi;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
     if (r != FOGVOL_SUCCESS) return r;
     r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
     *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
+    ctx->gpu.o_far = 0; /* the engine writes O from here, whether or not this frame is ended */
     return FOGVOL_SUCCESS;
 }
 
@@ -8665,6 +9089,15 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
 static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
 {
     return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
+}
+
+/* After the groups: a debug read-back that no group made (the frame draws no volume of debug_ramp,
+   or no volume at all) is the thickness the frame draws for it, 0. */
+static void fogvol__debug_empty(fogvol_context *ctx, const fogvol__run *run)
+{
+    size_t n = (size_t)ctx->cur.frame.viewport[2] * (size_t)ctx->cur.frame.viewport[3], i;
+    if (!ctx->cur.frame.debug_thickness || run->captured) return;
+    for (i = 0; i < n; ++i) ctx->cur.frame.debug_thickness[i] = 0.0f;
 }
 
 /* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
@@ -9314,13 +9747,14 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
 
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
 {
+    const char *why;
     fogvol__light *l;
     void *arr;
     fogvol_result r;
     float k;
     if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__light_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_LIGHT)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -9332,9 +9766,12 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
                                               : "the mesh is too large for the convexity check");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour or intensity");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the light's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.lights;
@@ -9427,9 +9864,12 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 /* >>colour groups ========================================================= */
 /* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
 
+/* A ramp in the colour group this frame: a colour ramp none of whose volumes has a density or colour
+   texture this frame (the colour group's programs draw neither: such a ramp is a group of its own,
+   drawn as without COLORS). */
 static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
-    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
+    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
 }
 
 /* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
@@ -9513,6 +9953,24 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     }
 }
 
+/* The debug read-back of a colour group (its sums are optical depths of all its ramps): one more
+   pass sums the faces of the debug ramp's volumes (debug_ramp NULL: the ramp of the group's first
+   volume, g) into B as the FLOAT tier's groups do, and reads that back. */
+static void fogvol__color_debug(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    const fogvol_ramp *ramp = ctx->cur.frame.debug_ramp ? ctx->cur.frame.debug_ramp : ctx->cur.vols[g].ramp;
+    int i, has_pos = 0, has_neg = 0;
+    if (!fogvol__want_debug(ctx, ramp, run->captured) || !fogvol__color_member(ctx, ramp)) return;
+    for (i = g; i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].ramp == ramp) {
+            has_neg |= ctx->cur.vols[i].negative;
+            has_pos |= !ctx->cur.vols[i].negative;
+        }
+    if (!has_pos) return; /* (no thickness: the frame's end writes 0) */
+    run->xsum = 0;
+    fogvol__sum_passes(ctx, run, ramp, has_neg);
+}
+
 /* The colour group, drawn where its first member volume g comes in the frame's order (once), if it
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
@@ -9524,6 +9982,7 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
     if (!has_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
+    fogvol__color_debug(ctx, run, g);
 }
 
 /* >>end frame ============================================================= */
@@ -9537,7 +9996,7 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
     int i;
     if ((ctx->cfg.speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->cfg.count_broken || ctx->cfg.float_o || ctx->cur.nocc == 0 ||
-        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
         return 0;
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
@@ -9626,11 +10085,38 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
+/* fogvol_frame_stats.depth_lsb, and its warning: the step of the digit sums against the view-depth
+   extent (within znear..zfar) of the bounds of the frame's smallest positive volume. */
+static void fogvol__frame_precision(fogvol_context *ctx, fogvol__run *run)
+{
+    int bits = ctx->gpu.tgt_b2 ? 2 * ctx->cfg.enc.precision_bits : ctx->cfg.enc.precision_bits, i, coarse;
+    double n = ctx->cur.frame.znear, f = ctx->cur.frame.zfar, lsb = (f - n) / (double)(1L << bits), small = 0.0;
+    if (!run->rgba8 || run->st.exact_sum >= run->st.groups) return;
+    run->st.depth_lsb = (float)lsb;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        double lo = 0.0, hi = 0.0;
+        if (ctx->cur.vols[i].negative) continue;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &lo, &hi);
+        lo = lo < n ? n : lo > f ? f : lo;
+        hi = hi < n ? n : hi > f ? f : hi;
+        if (hi > lo && (small == 0.0 || hi - lo < small)) small = hi - lo;
+    }
+    coarse = small > 0.0 && lsb > small / 16.0;
+    if (coarse && !ctx->ovf.coarse)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the %d-bit depth sums step by %g (one LSB: (zfar - znear) / 2^%d), more than 1/16 of "
+                    "the smallest volume's depth extent %g: its thickness is quantised that coarsely (move znear "
+                    "out or zfar in, or use fewer faces per target, or the FLOAT tier)",
+                    bits, lsb, bits, small);
+    ctx->ovf.coarse = coarse;
+}
+
 /* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
 static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run, fogvol_result r,
                                          fogvol_frame_stats *stats)
 {
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     run->st.frame = ctx->ovf.frame_no;
     run->st.overflow_pixels_late = ctx->ovf.overflow_late;
     run->st.overflow_frame = ctx->ovf.overflow_frame;
@@ -9675,6 +10161,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol__opaque_pass(ctx, &run);
         fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
+        fogvol__debug_empty(ctx, &run);
+        fogvol__frame_precision(ctx, &run);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
@@ -9688,13 +10176,13 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
    pixels, clamped to the viewport), from the depth texture's window depth
    through fv_lin / fv_lin2 as in the ENGINE_DEPTH variant. */
 static const char fogvol__fs_post_common[] =
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
-    "uniform vec4 fv_ptexel;\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
-    "uniform vec4 fv_prect;\n"  /* first and last pixel centres of the viewport */
-    "uniform vec4 fv_pparams;\n"
-    "uniform sampler2D fv_pdepth;\n"
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
+    "FV_UNIFORM(vec4, fv_ptexel)\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
+    "FV_UNIFORM(vec4, fv_prect)\n"  /* first and last pixel centres of the viewport */
+    "FV_UNIFORM(vec4, fv_pparams)\n"
+    "FV_BINDING(1) uniform sampler2D fv_pdepth;\n"
     "vec2 fv_ppix(vec2 o) { return clamp(gl_FragCoord.xy + o, fv_prect.xy, fv_prect.zw); }\n"
     "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
     "float fv_view_depth(vec2 o) {\n"
@@ -9705,7 +10193,7 @@ static const char fogvol__fs_post_common[] =
 
 /* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
 static const char fogvol__fs_post_dof[] =
-    "uniform sampler2D fv_pscene;\n"
+    "FV_BINDING(0) uniform sampler2D fv_pscene;\n"
     "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
     "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
     "    vec2 o = floor(dir * r + 0.5);\n"
@@ -9736,7 +10224,7 @@ static const char fogvol__fs_post_dof[] =
 
 /* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
 static const char fogvol__fs_post_outlines[] =
-    "uniform vec4 fv_pcolor;\n"
+    "FV_UNIFORM(vec4, fv_pcolor)\n"
     "float fv_pg(vec2 o) { float e = fv_view_depth(o); return fv_ptexel.z > 0.5 ? 1.0 / e : e; }\n"
     "float fv_pline(vec2 o, float g0) {\n" /* second difference along a line of three, both ends inside */
     "    vec2 a = gl_FragCoord.xy + o, b = gl_FragCoord.xy - o;\n"
@@ -9744,7 +10232,7 @@ static const char fogvol__fs_post_outlines[] =
     "    return abs(fv_pg(o) + fv_pg(-o) - 2.0 * g0);\n"
     "}\n"
     "#ifdef FV_NORMALS\n"
-    "uniform sampler2D fv_pnormal;\n"
+    "FV_BINDING(2) uniform sampler2D fv_pnormal;\n"
     "vec3 fv_pn(vec2 o) { return normalize(fv_ptex(fv_pnormal, o).rgb * 2.0 - 1.0); }\n"
     "#endif\n"
     "void main() {\n"
@@ -9765,8 +10253,8 @@ static const char fogvol__fs_post_outlines[] =
 
 /* Distance fog: fv_pparams.x = start, fv_rampmap as in the volume composite. */
 static const char fogvol__fs_post_fog[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform sampler2D fv_colors;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
     "void main() {\n"
     "    float t = max(fv_view_depth(vec2(0.0)) - fv_pparams.x, 0.0);\n"
     "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
@@ -9790,9 +10278,11 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
     strings[n++] = di->version;
     if (stage == FOGVOL_STAGE_VERTEX) {
         n = fogvol__prelude(strings, n, di->vs);
+        strings[n++] = di->decl;
         strings[n++] = fogvol__vs_fullscreen;
     } else {
         strings[n++] = di->fs;
+        strings[n++] = di->decl;
         strings[n++] = fogvol__fs_post_common;
         if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
@@ -9827,8 +10317,10 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
                          : effect == FOGVOL_POST_OUTLINES && variant ? "fv_pnormal"
                                                                      : NULL;
         pd.label = labels[effect];
+        (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout);
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
+            (void)fogvol__be_result(ctx, r);
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
                         labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
             ctx->gpu.post_prog[slot] = 0;
@@ -9892,6 +10384,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     info.draw_buffer = fd->draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, &info);
     if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
         return r;
     }
@@ -9915,7 +10408,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    return FOGVOL_SUCCESS;
+    return fogvol__be_result(ctx, FOGVOL_SUCCESS);
 }
 
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc)
@@ -10099,7 +10592,7 @@ enum {
     FOGVOL__GL_COLOR_ATTACHMENT0 = 0x8CE0, FOGVOL__GL_DEPTH_ATTACHMENT = 0x8D00,
     FOGVOL__GL_STENCIL_ATTACHMENT = 0x8D20, FOGVOL__GL_FRAMEBUFFER = 0x8D40, FOGVOL__GL_RENDERBUFFER = 0x8D41,
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
-    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
+    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126, FOGVOL__GL_DEBUG_OUTPUT = 0x92E0,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
@@ -10141,6 +10634,7 @@ enum {
     X(void, Enable, (fogvol__GLenum)) \
     X(void, Disable, (fogvol__GLenum)) \
     X(fogvol__GLboolean, IsEnabled, (fogvol__GLenum)) \
+    X(fogvol__GLboolean, IsTexture, (fogvol__GLuint)) \
     X(void, Viewport, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, Scissor, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, ClearColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
@@ -10202,6 +10696,7 @@ enum {
 /* Framebuffer objects: GL 3.0, ARB_framebuffer_object, GLES 2.0; EXT_framebuffer_object names as fallback. */
 #define FOGVOL__GL_FBO(X) \
     X(void, GenFramebuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsFramebuffer, (fogvol__GLuint)) \
     X(void, DeleteFramebuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindFramebuffer, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, FramebufferTexture2D, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint, fogvol__GLint)) \
@@ -10216,6 +10711,7 @@ enum {
 /* Vertex array objects: GL 3.0, GLES 3.0 (required in core profiles). */
 #define FOGVOL__GL_VAO(X) \
     X(void, GenVertexArrays, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsVertexArray, (fogvol__GLuint)) \
     X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindVertexArray, (fogvol__GLuint))
 
@@ -10457,7 +10953,13 @@ typedef struct fogvol__gl {
     int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
     int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
     fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
-    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error */
+    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error (err_fbo:
+                                                           made at creation without VAOs, the context's mark) */
+    int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
+    int skip_draws;                                     /* this pass has an engine texture that is none */
+    fogvol_result own;                                  /* fogvol's own first error since take_error */
+    void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
+    void *user_data, *context_id;                       /* and what it returned at creation */
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -10687,6 +11189,8 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
     gl->MinSampleShading(s->min_sample_shading);
 }
 
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex); /* (with the pass's program) */
+
 /* A pass on multisampled targets: their textures on the multisample binding
    points, multisampling on and every sample shaded (per_sample); other passes
    shade once per pixel. An engine texture of a per-sample pass (its depth) is
@@ -10698,7 +11202,8 @@ static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         const fogvol__gl_texture *t = (const fogvol__gl_texture *)p->textures[i];
         fogvol__GLuint tex = t && t->samples > 1 ? t->tex : 0;
-        if (p->native_textures[i]) tex = p->per_sample ? (fogvol__GLuint)p->native_textures[i] : 0;
+        if (p->native_textures[i])
+            tex = p->per_sample ? fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]) : 0;
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
     }
@@ -10801,6 +11306,7 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
         gl->GetProgramiv(gl->err_shader, FOGVOL__GL_LINK_STATUS, &v);
         break;
     case FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION: /* clearing nothing through an FBO with no attachment */
+        if (!gl->BindFramebuffer) break; /* (a context creation that failed before loading them) */
         gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &v);
         if (!gl->err_fbo) gl->GenFramebuffers(1, &gl->err_fbo);
         gl->BindFramebuffer(fb, gl->err_fbo);
@@ -10814,14 +11320,62 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
     }
 }
 
+/* fogvol's own GL errors, read while the engine's are held: the first becomes the public call's result
+   (FOGVOL_ERROR_BACKEND, through the backend's take_error), logged. */
+static void fogvol__gl_drain(fogvol__gl *gl)
+{
+    fogvol__GLenum first = gl->GetError();
+    int more = 0;
+    if (first == FOGVOL__GL_NO_ERROR) return;
+    while (more < 8 && gl->GetError() != FOGVOL__GL_NO_ERROR) ++more; /* (a lost context repeats its code) */
+    if (gl->own != FOGVOL_SUCCESS) return;
+    gl->own = FOGVOL_ERROR_BACKEND;
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL error 0x%04x raised by fogvol's own GL calls (%d more after it)",
+                first, more);
+}
+
+/* The last exit: fogvol's errors read, then the engine's raised again with GL_DEBUG_OUTPUT off where
+   KHR_debug lets it be switched (the raising calls then reach no debug callback nor the message log;
+   the enable is put back). */
 static void fogvol__gl_host_leave(fogvol__gl *gl)
 {
-    int i;
+    int i, dbg;
     if (gl->host_depth <= 0 || --gl->host_depth > 0) return;
     if (gl->tf_paused) gl->ResumeTransformFeedback();
     gl->tf_paused = 0;
+    fogvol__gl_drain(gl);
+    dbg = gl->host_n > 0 && gl->has_debug_output && gl->IsEnabled(FOGVOL__GL_DEBUG_OUTPUT);
+    if (dbg) gl->Disable(FOGVOL__GL_DEBUG_OUTPUT);
     for (i = 0; i < gl->host_n; ++i) fogvol__gl_raise(gl, gl->host_errors[i]);
+    if (dbg) gl->Enable(FOGVOL__GL_DEBUG_OUTPUT);
     gl->host_n = 0;
+}
+
+/* Another GL context current than fogvol's: fogvol_gl_desc.current_context says so, or fogvol's own
+   per-context object is not there (its full-screen vertex array object; without VAOs a framebuffer
+   object made at creation; neither is shared between contexts). The first refusal of a call is
+   logged and is its result (INVALID_STATE, through take_error); the entry then touches nothing. */
+static int fogvol__gl_foreign(fogvol__gl *gl)
+{
+    int other = gl->current_context && gl->current_context(gl->user_data) != gl->context_id;
+    if (!other && gl->has_vao) other = gl->fullscreen.vao && !gl->IsVertexArray(gl->fullscreen.vao);
+    else if (!other) other = gl->err_fbo && !gl->IsFramebuffer(gl->err_fbo);
+    if (other && gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_STATE;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: another GL context is current than the one fogvol was "
+                                                "created in (its objects are not in it): nothing done; make "
+                                                "fogvol's context current");
+    }
+    return other;
+}
+
+/* fogvol_backend.take_error */
+static fogvol_result fogvol__gl_take_error(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol_result r = gl->own;
+    gl->own = FOGVOL_SUCCESS;
+    return r;
 }
 
 /* Vertex attribute 0 where there is no vertex array object to keep it. */
@@ -11000,6 +11554,7 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     fogvol__gl_host_enter(gl);
     fogvol__gl_save(gl, &gl->saved);
     r = fogvol__gl_check_draw_buffer(gl, info->draw_buffer);
@@ -11091,10 +11646,11 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
     fogvol__gl_texture *t;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     t = (fogvol__gl_texture *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, filt, wrap, d->pixels);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
@@ -11116,7 +11672,7 @@ static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_texture *t = (fogvol__gl_texture *)h;
     if (!t) return;
-    gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11124,9 +11680,11 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
 {
     if (!t) return;
     if (t->second) fogvol__gl_free_target(gl, t->second);
-    gl->DeleteFramebuffers(1, &t->fbo);
-    gl->DeleteTextures(1, &t->base.tex);
-    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    if (!fogvol__gl_foreign(gl)) {
+        gl->DeleteFramebuffers(1, &t->fbo);
+        gl->DeleteTextures(1, &t->base.tex);
+        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    }
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11199,7 +11757,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     t->height = d->height;
     t->format = d->format;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     if (d->samples > 1)
         t->base.tex = fogvol__gl_new_texture_ms(gl, d);
@@ -11251,10 +11809,10 @@ static fogvol_handle fogvol__gl_target_attachment(void *u, fogvol_handle h, int 
     return index == 0 ? h : index == 1 ? (fogvol_handle)t->second : 0;
 }
 
-static uintptr_t fogvol__gl_native_texture(void *u, fogvol_handle h)
+static fogvol_native fogvol__gl_native_texture(void *u, fogvol_handle h)
 {
     (void)u;
-    return h ? (uintptr_t)((const fogvol__gl_texture *)h)->tex : 0;
+    return h ? (fogvol_native)((const fogvol__gl_texture *)h)->tex : 0;
 }
 
 static fogvol__GLuint fogvol__gl_shader(fogvol__gl *gl, fogvol__GLenum type, const char *const *src, int n,
@@ -11292,10 +11850,12 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
     const char *label = d->label ? d->label : "program";
     int i;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     p = (fogvol__gl_program *)fogvol__alloc(&gl->alloc, sizeof *p);
     if (!p) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(p, 0, sizeof *p);
     fogvol__gl_enter(gl, &s);
+    fogvol__gl_drain(gl); /* (earlier calls' errors are theirs, not this program's) */
     vs = fogvol__gl_shader(gl, FOGVOL__GL_VERTEX_SHADER, d->vs, d->vs_count, label, &r);
     fs = r == FOGVOL_SUCCESS ? fogvol__gl_shader(gl, FOGVOL__GL_FRAGMENT_SHADER, d->fs, d->fs_count, label, &r) : 0;
     if (r == FOGVOL_SUCCESS) {
@@ -11347,7 +11907,7 @@ static void fogvol__gl_destroy_program(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_program *p = (fogvol__gl_program *)h;
     if (!p) return;
-    gl->DeleteProgram(p->id); /* deferred by GL while the engine's program is current: no state change */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteProgram(p->id); /* deferred while current: no state change */
     if (gl->program == p) gl->program = NULL;
     fogvol__free(&gl->alloc, p);
 }
@@ -11398,7 +11958,7 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     if (gl->has_vao) {
         gl->GenVertexArrays(1, &m->vao);
         gl->BindVertexArray(m->vao);
@@ -11445,6 +12005,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     fogvol__gl_mesh *m;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
     r = fogvol__gl_upload(gl, m, d);
@@ -11461,7 +12022,7 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_mesh *m = (fogvol__gl_mesh *)h;
     if (!m) return;
-    fogvol__gl_free_mesh(gl, m);
+    if (!fogvol__gl_foreign(gl)) fogvol__gl_free_mesh(gl, m);
     fogvol__free(&gl->alloc, m);
 }
 
@@ -11503,6 +12064,21 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
 }
 
 /* The program of a pass with its uniforms, and its textures on fogvol's units. */
+/* An engine texture of a pass (engine depth, post effect inputs): a name that is no texture of the
+   current context is not bound (in a compatibility profile binding it would make an empty one) and
+   the pass draws nothing; the call's result is INVALID_ARGUMENT, logged. */
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex)
+{
+    if (gl->IsTexture(tex)) return tex;
+    gl->skip_draws = 1;
+    if (gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: texture %u handed to fogvol (an engine depth, colour or "
+                    "normal texture) is not a texture of the current GL context: its passes draw nothing", tex);
+    }
+    return 0;
+}
+
 static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
@@ -11515,7 +12091,8 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
         if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = p->per_sample ? 0 : (fogvol__GLuint)p->native_textures[i]; /* (below) */
+        if (p->native_textures[i]) /* (per-sample passes: on the multisample binding, below) */
+            tex = p->per_sample ? 0 : fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
@@ -11538,6 +12115,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_target *t = (fogvol__gl_target *)p->target;
+    gl->skip_draws = 0;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
@@ -11597,7 +12175,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_mesh *m = (const fogvol__gl_mesh *)h;
-    if (!m) return;
+    if (!m || gl->skip_draws) return;
     fogvol__gl_set_draw(u, d);
     fogvol__gl_bind_mesh(gl, m);
     gl->DrawElements(FOGVOL__GL_TRIANGLES, m->count, m->index_type, NULL);
@@ -11606,6 +12184,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 static void fogvol__gl_draw_fullscreen(void *u)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
+    if (gl->skip_draws) return;
     fogvol__gl_bind_mesh(gl, &gl->fullscreen);
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
@@ -11708,8 +12287,6 @@ static int fogvol__gl_fb_samples(fogvol__gl *gl, fogvol__GLuint fb)
 /* Why the depth of a framebuffer of src samples cannot be copied with samples samples, or NULL. */
 static const char *fogvol__gl_copy_refusal(const fogvol__gl *gl, int src, int samples)
 {
-    if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers)
-        return "copying a depth buffer needs glBlitFramebuffer (GL 3.0, GLES 3.0 or ARB_framebuffer_object)";
     if (samples && !gl->has_msaa) return "a per-sample copy needs multisample textures (GL 3.2)";
     if (samples && src > 1 && src != samples)
         return "its sample count differs from the engine framebuffer's drawn per sample (GL cannot blit it)";
@@ -11718,8 +12295,8 @@ static const char *fogvol__gl_copy_refusal(const fogvol__gl *gl, int src, int sa
     return NULL;
 }
 
-static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int bound, const int rect[4], int samples,
-                                           uintptr_t *texture)
+static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
+                                           fogvol_native *texture)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
@@ -11728,13 +12305,23 @@ static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int b
     const char *why;
     int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3], src_samples;
     *texture = 0;
+    if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copying a depth buffer needs glBlitFramebuffer "
+                                                "(GL 3.0, GLES 3.0 or ARB_framebuffer_object)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
     if (rect[0] < 0 || rect[1] < 0) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth: viewport origin (%d, %d) is negative", rect[0],
                     rect[1]);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    gl->GetError();
-    src_samples = gl->in_frame && gl->has_split_fbo ? fogvol__gl_fb_samples(gl, src) : 0;
+    if (src && !gl->IsFramebuffer(src)) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_framebuffer %u is not a framebuffer of the "
+                                                "current GL context", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_drain(gl);
+    src_samples = fogvol__gl_fb_samples(gl, src);
     if ((why = fogvol__gl_copy_refusal(gl, src_samples, samples > 1 ? samples : 0)) != NULL) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth of framebuffer %u (%d samples): %s", src,
                     src_samples, why);
@@ -11771,7 +12358,7 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     if (t->format == FOGVOL_FORMAT_R32F)
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
@@ -11789,6 +12376,7 @@ static fogvol_result fogvol__gl_create_query(void *u, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     gl->GenQueries(1, &id); /* names only: no state */
     *out = (fogvol_handle)id;
     return id ? FOGVOL_SUCCESS : FOGVOL_ERROR_BACKEND;
@@ -11798,7 +12386,7 @@ static void fogvol__gl_destroy_query(void *u, fogvol_handle q)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = (fogvol__GLuint)q;
-    gl->DeleteQueries(1, &id);
+    if (!fogvol__gl_foreign(gl)) gl->DeleteQueries(1, &id);
 }
 
 /* Not while the engine has an occlusion query running: BeginQuery would fail (and add its error to
@@ -11844,12 +12432,14 @@ static void fogvol__gl_destroy(void *u)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_allocator a;
     if (!gl) return;
-    fogvol__gl_free_mesh(gl, &gl->fullscreen);
-    if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-    if (gl->err_shader) gl->DeleteShader(gl->err_shader);
-    if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
-    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    if (!fogvol__gl_foreign(gl)) {
+        fogvol__gl_free_mesh(gl, &gl->fullscreen);
+        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader);
+        if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
+        if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+        if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    }
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -11974,7 +12564,13 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
         gl->major = desc->version_major;
         gl->minor = desc->version_minor;
         gl->gles = desc->gles != 0;
-        if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
+        if (gl->core && gl->major < 3) { /* (GL 3.x stays the core profile it is; GLES 3 has VAOs too) */
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: a core-profile context cannot be treated as %s %d.%d "
+                        "(drawn without vertex array objects, one GL_EXTENSIONS string): use a compatibility "
+                        "profile for that override", gl->gles ? "OpenGL ES" : "GL", gl->major, gl->minor);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+        if (gl->gles) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
@@ -12158,6 +12754,19 @@ static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *d
 }
 
 /* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+/* Without VAOs, the context's mark (fogvol__gl_foreign): a framebuffer object, which exists once bound
+   (also the one fogvol__gl_raise clears through); the bindings are put back. */
+static void fogvol__gl_mark(fogvol__gl *gl)
+{
+    fogvol__GLint draw = 0, read = 0;
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &read);
+    gl->GenFramebuffers(1, &gl->err_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->err_fbo);
+    gl->BindFramebuffer(gl->has_split_fbo ? FOGVOL__GL_DRAW_FRAMEBUFFER : FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)draw);
+    if (gl->has_split_fbo) gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)read);
+}
+
 static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
@@ -12183,10 +12792,15 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
+    gl->has_debug_output = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2)
+                                    : gl->major > 4 || (gl->major == 4 && gl->minor >= 3);
+    if (!gl->has_debug_output)
+        gl->has_debug_output = gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_KHR_debug") : fogvol__has_ext(ext, "GL_KHR_debug");
     memset(&tri_data, 0, sizeof tri_data);
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
+    if (r == FOGVOL_SUCCESS && !gl->has_vao) fogvol__gl_mark(gl);
     if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     return r;
 }
@@ -12215,6 +12829,7 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->draw_fullscreen = fogvol__gl_draw_fullscreen;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
+    out->take_error = fogvol__gl_take_error;
     if (gl->has_query) {
         out->create_query = fogvol__gl_create_query;
         out->destroy_query = fogvol__gl_destroy_query;
@@ -12224,32 +12839,67 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     }
 }
 
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+/* fogvol_gl_desc's plain loaders behind the get_proc_address interface (user: the desc) */
+static fogvol_gl_proc fogvol__gl_plain_proc(const char *name, void *user)
+{
+    const fogvol_gl_desc *d = (const fogvol_gl_desc *)user;
+    fogvol_gl_proc f = NULL;
+    void *p;
+    if (d->get_proc) return d->get_proc(name);
+    p = d->get_proc_pointer(name); /* (a data pointer to a function pointer: bit for bit, as POSIX dlsym) */
+    if (p && sizeof p == sizeof f) memcpy(&f, &p, sizeof f);
+    return f;
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, const fogvol_allocator *alloc,
                                                   const fogvol_logger *logger, fogvol_backend *out)
 {
     fogvol__gl *gl;
     fogvol_logger silent;
+    fogvol_gl_desc plain; /* in with a plain loader: get_proc_address calls it */
+    const fogvol_gl_desc *desc = in;
     const char *ver = NULL, *ext = NULL;
     fogvol_result r;
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     memset(&silent, 0, sizeof silent);
     if (!logger) logger = &silent;
+    if (in && !in->get_proc_address && (in->get_proc || in->get_proc_pointer)) {
+        plain = *in;
+        plain.get_proc_address = fogvol__gl_plain_proc;
+        plain.user_data = (void *)in;
+        desc = &plain;
+    }
     if (!desc || !desc->get_proc_address) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        fogvol__log(logger, FOGVOL_LOG_ERROR,
+                    "fogvol: the GL backend needs a loader (get_proc_address, get_proc or get_proc_pointer)");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (desc->dialect == FOGVOL_GLSL_VULKAN) return FOGVOL_ERROR_UNSUPPORTED; /* SPIR-V, not GL */
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(gl, 0, sizeof *gl);
     if (alloc) gl->alloc = *alloc;
     gl->log = *logger;
+    gl->current_context = in->current_context;
+    gl->user_data = in->user_data; /* (the caller's, also with a plain loader) */
+    if (gl->current_context) gl->context_id = gl->current_context(gl->user_data);
     r = fogvol__gl_version(gl, desc, &ver);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) { /* (the engine's pending errors held: fogvol's own are this call's) */
+        fogvol__gl_host_enter(gl);
+        r = fogvol__gl_features(gl, desc, &ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+        fogvol__gl_host_leave(gl);
+        if (r == FOGVOL_SUCCESS && fogvol__gl_take_error(gl) != FOGVOL_SUCCESS) {
+            fogvol__gl_destroy(gl);
+            return FOGVOL_ERROR_BACKEND;
+        }
+    }
     if (r != FOGVOL_SUCCESS) {
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader); /* (made to raise the engine's error) */
+        if (gl->err_fbo && gl->DeleteFramebuffers) gl->DeleteFramebuffers(1, &gl->err_fbo);
         fogvol__free(alloc, gl);
         return r;
     }
@@ -12270,14 +12920,15 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
 /*
    REVISION HISTORY
-     unreleased        density and colour textures on volumes, volume light by compare,
+     0.2.0  (2026-11)  density and colour textures on volumes, volume light by compare,
                        image-space effects (depth of field, outlines, distance fog), GLES and
                        WebGL tested, float SIMD analytic kernels, engine conventions (clip
                        control, reversed-Z, G-buffers, MSAA, engine depth and occluders),
                        overflow counted every frame; outputs last everywhere; programs
                        specialised per configuration, PS20/MRT encode by arithmetic by default,
-                       resolve and check passes scissored; declarations in reading order (see
-                       CHANGELOG.md)
+                       resolve and check passes scissored; declarations in reading order; one
+                       tier table, sections by what they hold, preferred variants, plain GL
+                       loaders (see CHANGELOG.md)
      0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
                        colour-ramp textures, mesh validation, PS20 renderer, GL backend,
                        recording null backend.

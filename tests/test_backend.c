@@ -330,6 +330,9 @@ static fogvol_result rec_create_program(void *u, const fogvol_program_desc *d, f
 {
     rec *r = (rec *)u;
     fogvol_result res = r->inner.create_program(r->inner.user_data, d, out);
+    fogvol_uniform_layout want;
+    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
+    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
     if (res == FOGVOL_SUCCESS && r->nprog < REC_MAX_RES) {
         r->prog[r->nprog].h = *out;
         r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
@@ -1036,6 +1039,55 @@ static void test_a1_depth_test_frames(void **state)
         }
 }
 
+/* A backend of the Vulkan dialect (the recording backend says FOGVOL_GLSL_VULKAN): every tier builds its
+   programs from Vulkan strings and hands each one the dialect's layout (fogvol_program_desc.layout),
+   and a frame with an occluder, a volume and the overflow check runs through the same passes. */
+static void test_a1_vulkan_dialect(void **state)
+{
+    static const fogvol_tier tiers[4] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_MRT, FOGVOL_TIER_FLOAT};
+    int t;
+    (void)state;
+    for (t = 0; t < 4; ++t) {
+        static box_scene b;
+        fogvol_frame_desc fd;
+        fogvol_frame_stats st;
+        fogvol_context_desc cd;
+        fogvol_uniform_layout want;
+        rec_init(&b.r);
+        b.r.table.dialect = FOGVOL_GLSL_VULKAN;
+        b.r.table.caps |= FOGVOL_CAP_FLOAT_BLEND;
+        memset(&cd, 0, sizeof cd);
+        cd.backend = b.r.table;
+        cd.tier = tiers[t];
+        assert_int_equal(fogvol_create_context(&cd, &b.fv), FOGVOL_SUCCESS);
+        b.bm = box_mesh();
+        b.pm = shp_grid_plane(1, 1, 2);
+        assert_int_equal(make_mesh(b.fv, &b.bm, 0, 0, &b.box), FOGVOL_SUCCESS);
+        assert_int_equal(make_mesh(b.fv, &b.pm, 1, 0, &b.plane), FOGVOL_SUCCESS);
+        assert_int_equal(make_ramp(b.fv, FOGVOL_BLEND_FOG, &b.ramp), FOGVOL_SUCCESS);
+        memset(&b.vd, 0, sizeof b.vd);
+        b.vd.mesh = b.box;
+        b.vd.ramp = b.ramp;
+        mat_ts(b.vd.model, 0, 0, 0, 1, 1, 1);
+        mat_ts(b.om, 0, 0, -2, 1, 1, 1);
+        a_frame_desc(&fd);
+        assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+        if (tiers[t] == FOGVOL_TIER_MRT) {
+            fogvol_mrt_info mi;
+            assert_int_equal(fogvol_mrt_prepare(b.fv, &mi), FOGVOL_SUCCESS);
+        } else {
+            assert_int_equal(fogvol_add_occluder(b.fv, b.plane, b.om), FOGVOL_SUCCESS);
+        }
+        assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(b.fv, &st), FOGVOL_SUCCESS);
+        assert_true(st.passes >= 2);
+        assert_true(b.r.nprog >= 2);
+        assert_int_equal(b.r.protocol_errors, 0); /* every program got the Vulkan layout */
+        assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, &want), FOGVOL_SUCCESS);
+        box_scene_close(&b);
+    }
+}
+
 /* The same frame drawn with the min compare (FOGVOL_SPEEDUP_DEPTH_TEST off): the faces read O. */
 static void test_a1_pass_structure_min_compare(void **state)
 {
@@ -1432,6 +1484,71 @@ static void test_a4_encoding_combinations(void **state)
     assert_int_equal(r.nb.creates, r.nb.destroys);
 }
 
+/* FOGVOL_TIER_AUTO takes the best tier that runs the required variants (fogvol_context_desc.variants)
+   and adds the preferred ones (preferred_variants) where that tier, the dialect and the backend take
+   them; a required variant no tier runs is refused with a log that names preferred_variants. The
+   expected tiers are the white paper's order (float blending, MRT, ps.2.0, ps.1.3) by hand. */
+static int log_has(const logcap *c, fogvol_log_level level, const char *needle)
+{
+    int i;
+    for (i = 0; i < c->count && i < LOG_MAX; ++i)
+        if (c->level[i] == level && strstr(c->msg[i], needle)) return 1;
+    return 0;
+}
+
+static void tier_choice(rec *r, fogvol_dialect dialect, unsigned caps, unsigned required, unsigned preferred,
+                        fogvol_result want, fogvol_tier tier, unsigned want_on, unsigned want_off, logcap *lc)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    unsigned v = 0;
+    rec_init(r);
+    r->table.dialect = dialect;
+    r->table.caps = caps;
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r->table;
+    cd.logger = cap_logger(lc);
+    cd.variants = required;
+    cd.preferred_variants = preferred;
+    log_reset(lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), want);
+    if (want != FOGVOL_SUCCESS) {
+        assert_null(fv);
+        assert_true(log_error_has(lc, "preferred_variants"));
+        return;
+    }
+    assert_int_equal(fogvol_context_tier(fv, &v), tier);
+    assert_int_equal(v & want_on, want_on);
+    assert_int_equal(v & want_off, 0);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r->nb.creates, r->nb.destroys);
+}
+
+static void test_a4_tier_choice(void **state)
+{
+    const unsigned ed = FOGVOL_VARIANT_ENGINE_DEPTH, st = FOGVOL_VARIANT_SINGLE_TARGET;
+    const unsigned hp = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_DEPTH_TEXTURE, fl = hp | FOGVOL_CAP_FLOAT_BLEND;
+    rec r;
+    logcap lc;
+    (void)state;
+    /* GL 2.1 (GLSL 120): no tier reads the engine's depth (it needs texelFetch) */
+    tier_choice(&r, FOGVOL_GLSL_120, hp, ed, 0, FOGVOL_ERROR_UNSUPPORTED, FOGVOL_TIER_AUTO, 0, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_120, hp, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, 0, ed, &lc);
+    assert_true(log_has(&lc, FOGVOL_LOG_INFO, "preferred variant 0x10 left out"));
+    assert_int_equal(lc.errors + lc.warnings, 0);
+    /* GLSL 330 without float blending: PS20 takes it; with float blending FLOAT does */
+    tier_choice(&r, FOGVOL_GLSL_330, hp, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, ed, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, ed, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, ed, 0, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, ed, 0, &lc);
+    /* FLOAT has no single target: required, the next tier that has one (PS20); preferred, FLOAT without it */
+    tier_choice(&r, FOGVOL_GLSL_330, fl, st, 0, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, st, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, 0, st, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, 0, st, &lc);
+    /* without highp fragment shaders AUTO ends at PS13, which has no engine depth */
+    tier_choice(&r, FOGVOL_GLSL_100, FOGVOL_CAP_DEPTH_TEXTURE, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS13, 0, ed, &lc);
+    tier_choice(&r, FOGVOL_GLSL_100, FOGVOL_CAP_DEPTH_TEXTURE, ed, 0, FOGVOL_ERROR_UNSUPPORTED, FOGVOL_TIER_AUTO, 0,
+                0, &lc);
+}
+
 static void test_a4_bad_input(void **state)
 {
     rec r;
@@ -1692,6 +1809,209 @@ static void test_a4_bad_input(void **state)
     assert_int_equal(r.protocol_errors, 0);
     shp_free(&box);
     shp_free(&plane);
+}
+
+static void transposed(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* Issue 31 3e and 3f: row-major engine matrices copied as they are (raylib's Matrix, DirectXMath)
+   and degenerate model matrices were accepted and drew nothing (or the wrong thing). What can be
+   told is refused with INVALID_ARGUMENT and a log that says "transposed?": a view or model matrix
+   whose bottom row is not (0, 0, 0, 1) (its translation went there), a projection whose w row is
+   in the wrong place (the -1 that makes clip w from view depth at m[14], not m[11]), a
+   view-projection whose transpose is the camera that was meant. A volume or light model matrix
+   that is singular (all zero, a zero scale) has no volume: refused; an occluder flattened to a
+   plane still hides, an all-zero one does not. */
+static void test_a4_transposed_and_degenerate(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd, t;
+    fogvol_volume_desc vd;
+    fogvol_light_desc ld;
+    fogvol_mesh *closed, *open_mesh;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh box = box_mesh(), plane = shp_grid_plane(1, 1, 2);
+    float m[16], zero[16], tr[16];
+    (void)state;
+    log_reset(&lc);
+    rec_init(&r);
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r.table;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.logger = cap_logger(&lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &box, 0, 0, &closed), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &plane, 1, 0, &open_mesh), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+    memset(zero, 0, sizeof zero);
+
+    /* ---- camera ---- */
+    a_frame_desc(&fd);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    t = fd; /* the view transposed: its translation (0, 0, -5) in the bottom row */
+    transposed(t.view, fd.view);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    assert_true(log_error_has(&lc, "bottom row"));
+    t = fd; /* the projection transposed */
+    transposed(t.projection, fd.projection);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    transposed(t.view, fd.view); /* both (a raylib Matrix copied with memcpy) */
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    t = fd; /* a view whose bottom row is (0, 0, 0, 2): view depth would be off by 2 */
+    t.view[15] = 2.0f;
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "bottom row"));
+    /* the view-projection camera: P V with the eye and forward of a_frame_desc's view (the camera at
+       (5, 0, 0) looking down -x), then transposed */
+    t = fd;
+    t.camera = FOGVOL_CAMERA_VIEW_PROJECTION;
+    shp_mat_mul(t.view_projection, fd.projection, fd.view);
+    t.eye[0] = 5.0f;
+    t.forward[0] = -1.0f;
+    assert_int_equal(fogvol_begin_frame(fv, &t), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    memcpy(m, t.view_projection, sizeof m);
+    transposed(t.view_projection, m);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+
+    /* ---- model matrices ---- */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = closed;
+    vd.ramp = ramp;
+    memcpy(vd.model, zero, sizeof zero);
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "all zero"));
+    mat_ts(m, 0.5f, 0.25f, -0.5f, 1.0f, 1.0f, 1.0f); /* a translation, transposed */
+    transposed(vd.model, m);
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f); /* y scaled to 0: flat, no volume */
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "singular"));
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f); /* y along x: rank 2 */
+    vd.model[4] = 1.0f;
+    vd.model[5] = 0.0f;
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    /* occluders: all zero and transposed refused, flattened to a plane accepted */
+    EXPECT_LOGGED(fogvol_add_occluder(fv, closed, zero), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "all zero"));
+    mat_ts(m, 0.5f, 0.25f, -0.5f, 1.0f, 1.0f, 1.0f);
+    transposed(tr, m);
+    EXPECT_LOGGED(fogvol_add_occluder(fv, closed, tr), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    mat_ts(m, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f);
+    assert_int_equal(fogvol_add_occluder(fv, closed, m), FOGVOL_SUCCESS);
+    /* lights: a singular model refused */
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = closed;
+    ld.color[0] = 1.0f;
+    memcpy(ld.model, zero, sizeof zero);
+    EXPECT_LOGGED(fogvol_add_light(fv, &ld), FOGVOL_ERROR_INVALID_ARGUMENT);
+    mat_ts(ld.model, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f);
+    EXPECT_LOGGED(fogvol_add_light(fv, &ld), FOGVOL_ERROR_INVALID_ARGUMENT);
+    /* what is fine: a small uniform scale, a mirror, a translation */
+    mat_ts(vd.model, 0.5f, 0.25f, -0.5f, 1e-3f, 1e-3f, 1e-3f);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, -1.0f, 1.0f, 1.0f);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.volumes, 2);
+    assert_int_equal(st.occluders, 1);
+    assert_int_equal(st.lights, 0);
+    fogvol_destroy_mesh(fv, closed);
+    fogvol_destroy_mesh(fv, open_mesh);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r.nb.creates, r.nb.destroys);
+    shp_free(&box);
+    shp_free(&plane);
+}
+
+/* a warning-level message containing needle */
+static int log_warning_has(const logcap *c, const char *needle)
+{
+    int i;
+    for (i = 0; i < c->count && i < LOG_MAX; ++i)
+        if (c->level[i] == FOGVOL_LOG_WARNING && strstr(c->msg[i], needle)) return 1;
+    return 0;
+}
+
+/* Issue 31 3h: RGBA8 digits over near 1e-4 / far 1e5 quantise the thickness in steps of
+   1e5 / 2^12 = 24.4 units, ten times a 2-unit box (PS20 + COUNT drew fog in 30 of its 484
+   pixels), and nothing said so. Now: fogvol_frame_stats.depth_lsb is the step (hand-computed:
+   (far - near) / 2^(3L)) and a warning is logged when it is coarser than 1/16 of the depth extent
+   of the frame's smallest volume, once until a frame is fine again. */
+static void test_a4_coarse_lsb(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_mesh *box;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh b = shp_box(1.0f, 1.0f, 1.0f); /* 2 units across */
+    int frame, tier;
+    (void)state;
+    for (tier = 0; tier < 2; ++tier) {
+        log_reset(&lc);
+        rec_init(&r);
+        memset(&cd, 0, sizeof cd);
+        cd.backend = r.table;
+        if (tier) cd.backend.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_FLOAT_TARGET;
+        cd.tier = tier ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_PS20;
+        cd.variants = tier ? 0u : (unsigned)FOGVOL_VARIANT_COUNT;
+        cd.logger = cap_logger(&lc);
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        assert_int_equal(make_mesh(fv, &b, 0, 0, &box), FOGVOL_SUCCESS);
+        assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+        for (frame = 0; frame < 4; ++frame) {
+            int coarse = frame != 2; /* frame 2: near 0.5, far 10.5: a step of 10 / 4096 */
+            a_frame_desc(&fd);
+            if (coarse) {
+                glu_perspective(fd.projection, 60.0, (double)A_W / A_H, 1e-4, 1e5);
+                fd.znear = 1e-4f;
+                fd.zfar = 1e5f;
+            }
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = box;
+            vd.ramp = ramp;
+            mat_identity(vd.model); /* 5 units in front of the camera */
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            lc.count = lc.warnings = 0;
+            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            if (tier) { /* float sums: no step, no warning */
+                assert_true(st.depth_lsb == 0.0f);
+                assert_false(log_warning_has(&lc, "LSB"));
+                continue;
+            }
+            assert_close(st.depth_lsb, ((double)fd.zfar - fd.znear) / 4096.0, 1e-6, "depth_lsb");
+            /* warned on frames 0 and 3 (the first coarse frame, and again after a fine one) */
+            if (frame == 0 || frame == 3) assert_true(log_warning_has(&lc, "LSB"));
+            else assert_false(log_warning_has(&lc, "LSB"));
+        }
+        fogvol_destroy_mesh(fv, box);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+    }
+    shp_free(&b);
 }
 
 /* ---- A5: fault injection ---- */
@@ -2330,6 +2650,53 @@ static void test_b6_loader_finds_nothing(void **state)
     assert_int_equal(cnt.live, 0);
 }
 
+/* The plain loaders of fogvol_gl_desc, as GLFW, EGL and SDL hand them out, with no wrapper:
+   get_proc (a function pointer back) and get_proc_pointer (void * back). Each must be the one asked
+   (it counts the names) and give a context that draws as with get_proc_address. */
+static int g_plain_calls;
+static fogvol_gl_proc plain_proc(const char *name)
+{
+    g_plain_calls++;
+    return (fogvol_gl_proc)OSMesaGetProcAddress(name);
+}
+static void *plain_pointer(const char *name)
+{
+    fogvol_gl_proc f = plain_proc(name);
+    void *p = NULL;
+    memcpy(&p, &f, sizeof p); /* (as SDL2's loader hands a function over) */
+    return p;
+}
+
+static void test_b6_plain_loaders(void **state)
+{
+    int k;
+    (void)state;
+    for (k = 0; k < 2; ++k) {
+        logcap lc;
+        counting cnt;
+        fogvol_context_desc cd;
+        fogvol_context *fv = NULL;
+        fogvol_frame_stats st;
+        fogvol_frame_desc fd;
+        memset(&cnt, 0, sizeof cnt);
+        log_reset(&lc);
+        memset(&cd, 0, sizeof cd);
+        cd.logger = cap_logger(&lc);
+        cd.allocator = cnt_allocator(&cnt);
+        if (k == 0) cd.gl.get_proc = plain_proc;
+        else cd.gl.get_proc_pointer = plain_pointer;
+        g_plain_calls = 0;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        assert_true(g_plain_calls > 20); /* every entry point came through it */
+        a_frame_desc(&fd);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        assert_int_equal(lc.errors + lc.warnings, 0);
+        fogvol_destroy_context(fv);
+        assert_int_equal(cnt.live, 0);
+    }
+}
+
 /* ---- B7: dialects ---- */
 static void expect_dialect(const fogvol_gl_desc *in, fogvol_dialect want, const char *what)
 {
@@ -2381,6 +2748,16 @@ static void test_b7_dialects_core(void **state)
     d.version_minor = 0;
     d.dialect = FOGVOL_GLSL_100;
     expect_dialect(&d, FOGVOL_GLSL_100, "dialect override 100");
+    { /* SPIR-V is no GL dialect: refused, and no GL context picks it */
+        fogvol_backend be;
+        fogvol_allocator a;
+        counting cnt;
+        memset(&cnt, 0, sizeof cnt);
+        a = cnt_allocator(&cnt);
+        d.dialect = FOGVOL_GLSL_VULKAN;
+        assert_int_equal(fogvol_gl_backend_create(&d, &a, NULL, &be), FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(cnt.live, 0);
+    }
 }
 
 static void test_b7_dialects_compat(void **state)
@@ -2907,13 +3284,17 @@ int main(void)
         cmocka_unit_test(test_a1_pass_structure_fullscreen),
         cmocka_unit_test(test_a1_pass_structure_min_compare),
         cmocka_unit_test(test_a1_depth_test_frames),
+        cmocka_unit_test(test_a1_vulkan_dialect),
         cmocka_unit_test(test_a1_pass_structure_geometry),
         cmocka_unit_test(test_a1_geometry_without_stencil),
         cmocka_unit_test(test_a2_negative_only_group),
         cmocka_unit_test(test_a3_frame_protocol),
         cmocka_unit_test(test_a3_destroy_inside_frame),
         cmocka_unit_test(test_a4_encoding_combinations),
+        cmocka_unit_test(test_a4_tier_choice),
         cmocka_unit_test(test_a4_bad_input),
+        cmocka_unit_test(test_a4_transposed_and_degenerate),
+        cmocka_unit_test(test_a4_coarse_lsb),
         cmocka_unit_test(test_a5_backend_create_faults),
         cmocka_unit_test(test_a5_alloc_faults_context),
         cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),
@@ -2925,6 +3306,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_b6_missing_core33, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b6_missing_gl21, setup_compat, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b6_loader_finds_nothing, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_b6_plain_loaders, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_dialects_core, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_dialects_compat, setup_compat, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_glsl100_renders_in_core, setup_core, teardown_gl),

@@ -1612,6 +1612,144 @@ static void test_mesh_winding(void **state)
     shp_free(&good);
 }
 
+/* A box [lo, hi] whose faces are grids of n[axis] quads along each axis (per-face vertices, so
+   the caller welds them with weld_distance), outward, or inward with inward = 1. */
+static shp_mesh grid_box(const double lo[3], const double hi[3], const int n[3], int inward)
+{
+    int a, s, i, j, nv = 0, ni = 0;
+    shp_mesh m;
+    for (a = 0; a < 3; ++a) {
+        int u = (a + 1) % 3, v = (a + 2) % 3;
+        nv += 2 * (n[u] + 1) * (n[v] + 1);
+        ni += 2 * 6 * n[u] * n[v];
+    }
+    m = shp__alloc(nv, ni);
+    if (!m.pos) return m;
+    nv = ni = 0;
+    for (a = 0; a < 3; ++a)
+        for (s = 0; s < 2; ++s) {
+            int u = (a + 1) % 3, v = (a + 2) % 3, base = nv;
+            for (j = 0; j <= n[v]; ++j)
+                for (i = 0; i <= n[u]; ++i, ++nv) {
+                    double c[3];
+                    c[a] = s ? hi[a] : lo[a];
+                    c[u] = lo[u] + (hi[u] - lo[u]) * i / n[u];
+                    c[v] = lo[v] + (hi[v] - lo[v]) * j / n[v];
+                    shp__setv(&m, nv, c[0], c[1], c[2]);
+                }
+            for (j = 0; j < n[v]; ++j)
+                for (i = 0; i < n[u]; ++i) {
+                    unsigned q[4], *p = m.idx + ni;
+                    q[0] = (unsigned)(base + j * (n[u] + 1) + i); /* u x v = +axis: counter-clockwise */
+                    q[1] = q[0] + 1;                              /* seen from +axis */
+                    q[2] = q[1] + (unsigned)(n[u] + 1);
+                    q[3] = q[0] + (unsigned)(n[u] + 1);
+                    if (s == inward) shp__quad(&p, (int)q[0], (int)q[3], (int)q[2], (int)q[1]);
+                    else shp__quad(&p, (int)q[0], (int)q[1], (int)q[2], (int)q[3]);
+                    ni += 6;
+                }
+        }
+    return m;
+}
+
+static fogvol_result validate_welded(const shp_mesh *m, fogvol_mesh_report *rep)
+{
+    fogvol_mesh_desc d = mesh_desc(m->pos, m->vcount, (const uint32_t *)m->idx, m->icount);
+    d.weld_distance = 1e-6f;
+    return fogvol_validate_mesh(&d, NULL, rep);
+}
+
+/* Issue 31 3a: parts built from quads exactly one probe-grid step wide. The probe grid divides
+   the mesh's bounds in FOGVOL__WIND_GRID (32) steps per axis; with an outward box [-1,1]^3
+   beside it, the inward box [2,3]x[-.5,.5]^2 of 8x16x16 quads has quads one step wide, so every
+   probe ray that lands at the same offset in both of a quad's axes lies on its diagonal. */
+static void test_mesh_winding_grid(void **state)
+{
+    static const double olo[3] = {-1, -1, -1}, ohi[3] = {1, 1, 1}, ilo[3] = {2, -.5, -.5}, ihi[3] = {3, .5, .5};
+    static const int on[3] = {16, 32, 32}, in[3] = {8, 16, 16}, cube_n[3] = {32, 32, 32}, one[3] = {1, 1, 1};
+    fogvol_mesh_report rep;
+    shp_mesh outer = grid_box(olo, ohi, on, 0), inner = grid_box(ilo, ihi, in, 1), both = shp__zero();
+    shp_mesh cube = grid_box(olo, ohi, cube_n, 0), plain = grid_box(ilo, ihi, one, 1), both1 = shp__zero();
+    (void)state;
+    assert_non_null(outer.pos);
+    assert_non_null(inner.pos);
+    assert_true(shp_append(&both, &outer));
+    assert_true(shp_append(&both, &inner));
+    assert_true(shp_append(&both1, &outer));
+    assert_true(shp_append(&both1, &plain));
+    /* each box alone: the outward one is valid, the inward one exposed (winding -1 inside) */
+    assert_int_equal(validate_welded(&outer, &rep), FOGVOL_SUCCESS);
+    CHECK_NEAR(rep.volume, 8.0, 1e-9);
+    assert_int_equal(validate_welded(&inner, &rep), FOGVOL_ERROR_INVALID_MESH);
+    /* the inward box as 12 triangles beside the grid box: refused (the probes are not all on diagonals) */
+    assert_int_equal(validate_welded(&both1, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_int_equal(rep.inward_components, 1);
+    /* the grid-aligned inward box beside the outward one: refused too, the bad triangle named */
+    assert_int_equal(validate_welded(&both, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_true(rep.closed && rep.consistent);
+    assert_int_equal(rep.components, 2);
+    assert_int_equal(rep.inward_components, 1);
+    CHECK_NEAR(rep.volume, 8.0 - 1.0, 1e-9);
+    assert_true(rep.negative_winding > 0);
+    assert_true(rep.negative_triangle >= outer.icount / 3);
+    assert_false(rep.valid);
+    /* a welded cube of 32x32 quads per face: valid (its probe rays all lie on quad diagonals) */
+    assert_int_equal(validate_welded(&cube, &rep), FOGVOL_SUCCESS);
+    assert_int_equal(rep.vertices, 6 * 32 * 32 + 2);
+    CHECK_NEAR(rep.volume, 8.0, 1e-9);
+    assert_int_equal(rep.negative_winding, 0);
+    /* the same cube inward: refused */
+    shp_flip(&cube);
+    assert_int_equal(validate_welded(&cube, &rep), FOGVOL_ERROR_INVALID_MESH);
+    /* an inward box [.5,3]x[-.5,.5]^2 of 20x16x16 quads (one probe-grid step each: the bounds are
+       [-1,3]x[-1,1]^2) half inside the outward box [-1,1]^3: winding 0 where they overlap, -1 in
+       [1,3]x[-.5,.5]^2; the probe just inside the inward part lands where they overlap, so the
+       probe rays must see it */
+    {
+        static const double plo[3] = {.5, -.5, -.5}, phi[3] = {3, .5, .5};
+        static const int pn[3] = {20, 16, 16};
+        shp_mesh part = grid_box(plo, phi, pn, 1), box = grid_box(olo, ohi, one, 0);
+        assert_true(shp_append(&box, &part));
+        assert_int_equal(validate_welded(&box, &rep), FOGVOL_ERROR_INVALID_MESH);
+        assert_int_equal(rep.inward_components, 1);
+        assert_true(rep.negative_winding > 0);
+        assert_true(rep.negative_triangle >= 0); /* the outward box's face x = 1 bounds the region too */
+        shp_free(&part);
+        shp_free(&box);
+    }
+    /* outward boxes [-1,1]^3 and [2,4]x[-1,1]^2 (bounds: steps 5/32 in x, 2/32 in y and z) and between
+       them an inward box from 0.05 to 0.15 of a probe-grid cell in each axis: no probe ray (at 0.47
+       to 0.52 of a cell) meets it, the probe just inside the inward part alone must see it */
+    {
+        static const double blo[3] = {2, -1, -1}, bhi[3] = {4, 1, 1};
+        double tlo[3], thi[3];
+        shp_mesh two = grid_box(olo, ohi, one, 0), b = grid_box(blo, bhi, one, 0), tiny;
+        int c;
+        for (c = 0; c < 3; ++c) {
+            double lo = -1.0, step = c ? 2.0 / 32 : 5.0 / 32, i = c ? 10 : 16;
+            tlo[c] = lo + (i + 0.05) * step;
+            thi[c] = lo + (i + 0.15) * step;
+        }
+        tiny = grid_box(tlo, thi, one, 1);
+        assert_true(shp_append(&two, &b));
+        assert_int_equal(validate_welded(&two, &rep), FOGVOL_SUCCESS);
+        assert_true(shp_append(&two, &tiny));
+        assert_int_equal(validate_welded(&two, &rep), FOGVOL_ERROR_INVALID_MESH);
+        assert_int_equal(rep.inward_components, 1);
+        assert_int_equal(rep.negative_winding, 1);
+        assert_true(rep.negative_triangle >= 24);
+        shp_free(&two);
+        shp_free(&b);
+        shp_free(&tiny);
+    }
+    shp_free(&outer);
+    shp_free(&inner);
+    shp_free(&both);
+    shp_free(&cube);
+    shp_free(&plain);
+    shp_free(&both1);
+}
+
 static void test_mesh_alloc_and_stride(void **state)
 {
     fogvol_mesh_report rep;
@@ -1703,6 +1841,180 @@ static void test_result_strings(void **state)
     assert_non_null(strstr(fogvol_result_string(FOGVOL_ERROR_BUFFER_TOO_SMALL), "small"));
 }
 
+
+/* ---- the Vulkan dialect (FOGVOL_GLSL_VULKAN) ------------------------------------------------
+   The layout a backend fills without reflection (fogvol_dialect_layout, fogvol_program_desc.layout)
+   against what the Vulkan strings declare (the std140 pass block and the push constants, read from
+   the text: std140 puts the n-th vec4 member at 16 n), against fogvol_pass.uniforms as the struct
+   lays it out, and against the sampler units the backend table's documentation lists (written out
+   here); and which programs exist: every one of GLSL 330 core but the framebuffer fetch's
+   (FETCH_O, EXACT_SUM) and the per-sample ones, which the caps leave out on Vulkan. */
+static const char *const g_unit_names[][2] = {
+    {"fv_rg", "0"}, {"fv_blue", "1"}, {"fv_dither", "2"}, {"fv_opaque", "3"}, {"fv_opaque2", "4"},
+    {"fv_density", "6"}, {"fv_lfront", "7"}, {"fv_back", "0"}, {"fv_front", "1"}, {"fv_colors", "2"},
+    {"fv_back2", "4"}, {"fv_front2", "5"}, {"fv_ctex", "6"}, {"fv_pscene", "0"}, {"fv_pdepth", "1"},
+    {"fv_pnormal", "2"}};
+
+static void join_strings(const char *const *s, int n, char *buf, size_t cap)
+{
+    int i;
+    buf[0] = 0;
+    for (i = 0; i < n; ++i) {
+        assert_true(strlen(buf) + strlen(s[i]) < cap);
+        strcat(buf, s[i]);
+    }
+}
+
+/* every "FV_BINDING(n) uniform TYPE NAME;" of a text: n is NAME's documented unit; returns the count */
+static int check_bindings(const char *text)
+{
+    const char *p = text;
+    int found = 0;
+    while ((p = strstr(p, "FV_BINDING(")) != NULL) {
+        char type[64], name[64], unit[8];
+        size_t k;
+        int matched = 0;
+        if (sscanf(p, "FV_BINDING(%7[0-9]) uniform %63s %63[a-z0-9_];", unit, type, name) == 3) {
+            for (k = 0; k < sizeof g_unit_names / sizeof g_unit_names[0]; ++k)
+                if (strcmp(name, g_unit_names[k][0]) == 0) {
+                    if (strcmp(unit, g_unit_names[k][1]) != 0) fail_msg("%s at unit %s, documented %s", name, unit,
+                                                                         g_unit_names[k][1]);
+                    matched = 1;
+                }
+            if (!matched) fail_msg("sampler %s has no documented unit", name);
+            found++;
+        } else if (strncmp(p, "FV_BINDING(unit)", 16) != 0) { /* (the macro's own definition) */
+            fail_msg("unexpected FV_BINDING use: %.60s", p);
+        }
+        p += 11;
+    }
+    return found;
+}
+
+static void test_vulkan_layout(void **state)
+{
+    static const char *const draw_decl[FOGVOL_DRAW_VALUE_COUNT] = {"mat4 fv_mvp;", "vec4 fv_depth;", "vec4 fv_ext;",
+                                                                  "vec4 fv_emit;", "float fv_sign;"};
+    static const int draw_bytes[FOGVOL_DRAW_VALUE_COUNT] = {64, 16, 16, 16, 4};
+    fogvol_uniform_layout l;
+    fogvol_pass pass;
+    fogvol_shader_desc sd;
+    const char *s[FOGVOL_MAX_SHADER_STRINGS];
+    static char text[65536];
+    const char *block, *p;
+    char want[128];
+    int n, i, d, end = 0;
+    (void)state;
+    assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    for (d = FOGVOL_GLSL_AUTO; d < FOGVOL_GLSL_COUNT; ++d) { /* GL dialects: by name, every field -1 */
+        if (d == FOGVOL_GLSL_VULKAN) continue;
+        assert_int_equal(fogvol_dialect_layout((fogvol_dialect)d, &l), FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(l.pass_binding, -1);
+        assert_int_equal(l.pass_offsets[FOGVOL_U_SPEEDUP], -1);
+        assert_int_equal(l.draw_offsets[FOGVOL_DRAW_SIGN], -1);
+        assert_int_equal(l.sampler_bindings[7], -1);
+    }
+    assert_string_equal(fogvol_dialect_name(FOGVOL_GLSL_VULKAN), "vulkan");
+    assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, &l), FOGVOL_SUCCESS);
+    /* the pass block is fogvol_pass.uniforms as the struct holds it */
+    assert_int_equal(l.pass_size, (int)sizeof pass.uniforms);
+    for (i = 0; i < FOGVOL_U_COUNT; ++i)
+        assert_int_equal(l.pass_offsets[i], (int)((const char *)pass.uniforms[i] - (const char *)pass.uniforms[0]));
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) assert_int_equal(l.sampler_bindings[i], i);
+    assert_true(l.draw_size <= 128); /* the push-constant size every Vulkan device has */
+    /* ... and as the strings declare it */
+    memset(&sd, 0, sizeof sd);
+    sd.tier = FOGVOL_TIER_PS20;
+    sd.program = FOGVOL_PROGRAM_FACE;
+    sd.dialect = FOGVOL_GLSL_VULKAN;
+    sd.stage = FOGVOL_STAGE_FRAGMENT;
+    assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_SUCCESS);
+    join_strings(s, n, text, sizeof text);
+    snprintf(want, sizeof want, "layout(std140, set = 0, binding = %d) uniform fv_pass_block {\n", l.pass_binding);
+    block = strstr(text, want);
+    assert_non_null(block);
+    p = block + strlen(want);
+    for (i = 0; i < FOGVOL_U_COUNT; ++i) { /* std140: the i-th vec4 member at 16 i */
+        snprintf(want, sizeof want, "    vec4 %s;\n", fogvol_uniform_name((fogvol_uniform)i));
+        assert_true(strncmp(p, want, strlen(want)) == 0);
+        assert_int_equal(l.pass_offsets[i], 16 * i);
+        p += strlen(want);
+    }
+    assert_true(strncmp(p, "};", 2) == 0);
+    assert_non_null(strstr(text, "layout(push_constant) uniform fv_draw_block {\n"));
+    for (i = 0; i < FOGVOL_DRAW_VALUE_COUNT; ++i) {
+        snprintf(want, sizeof want, "layout(offset = %d) %s", l.draw_offsets[i], draw_decl[i]);
+        assert_non_null(strstr(text, want));
+        if (l.draw_offsets[i] + draw_bytes[i] > end) end = l.draw_offsets[i] + draw_bytes[i];
+    }
+    assert_int_equal(l.draw_size, end);
+    /* no loose uniforms: every uniform of a Vulkan text is a sampler with its binding, or a block */
+    assert_true(check_bindings(text) >= 3);
+}
+
+static void test_vulkan_programs(void **state)
+{
+    static const unsigned specs[] = {0,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN,
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED};
+    static char text[65536];
+    int t, p, st, k, exist = 0, samplers = 0;
+    unsigned v;
+    (void)state;
+    for (t = 1; t < FOGVOL_TIER_COUNT; ++t)
+        for (v = 0; v <= FOGVOL_VARIANT_ALL; ++v)
+            for (p = 0; p < FOGVOL_PROGRAM_COUNT; ++p)
+                for (st = 0; st < 2; ++st)
+                    for (k = 0; k < (int)(sizeof specs / sizeof specs[0]); ++k) {
+                        fogvol_shader_desc sd;
+                        const char *s[FOGVOL_MAX_SHADER_STRINGS];
+                        int n = -1, in330;
+                        memset(&sd, 0, sizeof sd);
+                        sd.tier = (fogvol_tier)t;
+                        sd.variants = v;
+                        sd.program = (fogvol_program)p;
+                        sd.stage = (fogvol_stage)st;
+                        sd.specialize = specs[k];
+                        sd.dialect = FOGVOL_GLSL_330;
+                        in330 = fogvol_shader_strings(&sd, s, &n) == FOGVOL_SUCCESS;
+                        sd.dialect = FOGVOL_GLSL_VULKAN;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n),
+                                         in330 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED);
+                        if (!in330) continue;
+                        join_strings(s, n, text, sizeof text);
+                        assert_true(strncmp(text, "#version 450\n", 13) == 0);
+                        samplers += check_bindings(text);
+                        ++exist;
+                        /* the framebuffer fetch and per-sample shading: not in Vulkan's dialect */
+                        sd.specialize = specs[k] | FOGVOL_SPECIALIZE_FETCH_O;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                        sd.specialize = specs[k] | FOGVOL_SPECIALIZE_EXACT_SUM;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                        sd.specialize = specs[k];
+                        sd.samples = 4;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                    }
+    print_message("# %d Vulkan shaders exist where GLSL 330 core has them; %d sampler bindings checked\n", exist,
+                  samplers);
+    assert_true(exist > 1000);
+    {
+        const char *s[FOGVOL_MAX_SHADER_STRINGS];
+        int n = 0;
+        assert_int_equal(fogvol_post_shader_strings(FOGVOL_POST_OUTLINES, 1, FOGVOL_GLSL_VULKAN, FOGVOL_STAGE_FRAGMENT,
+                                                    s, &n),
+                         FOGVOL_SUCCESS);
+        join_strings(s, n, text, sizeof text);
+        assert_int_equal(check_bindings(text), 2); /* fv_pdepth, fv_pnormal */
+        assert_int_equal(fogvol_analytic_shader_strings(FOGVOL_GLSL_VULKAN, FOGVOL_STAGE_VERTEX, 0, s, &n),
+                         FOGVOL_SUCCESS);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1718,8 +2030,11 @@ int main(void)
         cmocka_unit_test(test_mesh_nonmanifold),
         cmocka_unit_test(test_mesh_torus),
         cmocka_unit_test(test_mesh_winding),
+        cmocka_unit_test(test_mesh_winding_grid),
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
+        cmocka_unit_test(test_vulkan_layout),
+        cmocka_unit_test(test_vulkan_programs),
     };
     /* CPU_TEST_FILTER: a cmocka pattern (* and ?), e.g. for the quick runs under valgrind */
     if (getenv("CPU_TEST_FILTER")) cmocka_set_test_filter(getenv("CPU_TEST_FILTER"));
