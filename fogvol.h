@@ -466,9 +466,10 @@ enum {
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* FOGVOL_SUCCESS if the tier with these variants can render into a
    multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
-   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
-   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
-   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
+   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT,
+   PS20 or PS13 (with ENGINE_DEPTH: the engine's depth read per sample), not WIDE
+   or COLORS. GLSL 110/120/130 and ES 100/300 es have no multisample textures
+   with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 
 typedef struct fogvol_tier_info {
@@ -535,7 +536,9 @@ typedef struct fogvol_gl_desc {
    fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
    3.9-4.6x the time of the same scene on a single-sample framebuffer, one
    run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
-   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample; with
+   ENGINE_DEPTH (its depth copied or read per sample) mean 0.8, max 2, where
+   the single-sample fallback's resolved depth gives mean 35.6, max 100. */
 typedef enum fogvol_msaa {
     FOGVOL_MSAA_AUTO = 0,
     FOGVOL_MSAA_SINGLE_SAMPLE = 1,
@@ -839,7 +842,10 @@ typedef struct fogvol_frame_desc {
        object, GL: texture name), sampled with its .r; its window depth is mapped back
        to view depth through the inverse of projection * view (any projection above) and
        the depth conventions the backend reports (fogvol_frame_info) unless overridden by
-       the two fields below */
+       the two fields below. In a frame drawn per sample (a multisampled engine
+       framebuffer, FOGVOL_MSAA_AUTO) it is a multisample texture of the framebuffer's
+       sample count (GL: GL_TEXTURE_2D_MULTISAMPLE), read at each sample. It is read as
+       it is at each end_frame. */
     fogvol_native engine_depth_texture;
     int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
     float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
@@ -851,12 +857,17 @@ typedef struct fogvol_frame_desc {
     float eye[3], forward[3];
     /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
        The other sources are depth buffers that cannot be sampled (the default
-       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
-       copies the viewport's depth into a single-sample depth texture of its own
+       framebuffer's, renderbuffers, multisampled ones): at every end_frame fogvol
+       copies the viewport's depth as it is then into a depth texture of its own
        (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
-       format, which resolves a multisampled source to one sample per pixel;
-       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
-       FOGVOL_ERROR_UNSUPPORTED). */
+       format; needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED), so every frame and every view of a frame (split
+       screen: one begin/end_frame per viewport) reads its own depth. Single-sample
+       frames: a multisampled source is resolved to one sample per pixel. Frames drawn
+       per sample: every sample is copied, from a source of the engine framebuffer's
+       sample count (the bound framebuffer, or that framebuffer by name); a single-sample
+       source gives each pixel's depth to all its samples (desktop GL; OpenGL ES:
+       FOGVOL_ERROR_UNSUPPORTED); another sample count: FOGVOL_ERROR_INVALID_ARGUMENT. */
     fogvol_depth_source engine_depth_source;
     fogvol_native engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
@@ -1412,12 +1423,15 @@ typedef struct fogvol_backend {
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
-    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
-       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
-       bound at begin_frame; else framebuffer, an API object) into a
-       single-sample depth texture the backend owns, with the same texel
-       coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4],
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside every frame that reads it, before
+       the first pass: copies the depth of rect (x, y, w, h) of the engine framebuffer as it is now
+       (bound: the one bound at begin_frame; else framebuffer, an API object) into a depth texture
+       the backend owns, with the same texel coordinates, and returns that texture's API object in
+       *texture. samples 0: a single-sample texture (a multisampled source resolved to one sample
+       per pixel); samples > 1 (a frame drawn per sample): a multisample texture of that many
+       samples, each sample copied (GL: GL_TEXTURE_2D_MULTISAMPLE). The texture may be reused
+       from frame to frame, its contents never: each call copies again. */
+    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                 fogvol_native *texture);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
        the samples passing between begin_query and end_query, which fogvol calls around the draws of
@@ -5677,7 +5691,7 @@ static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
     /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
     {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
      FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
-     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X,
       FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
      {0, 0, 0, 0, 0, FOGVOL__K}}};
 #undef FOGVOL__S
@@ -5783,10 +5797,12 @@ FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_
 
 /* FV_MSAA: fogvol's targets are sampler2DMS (FV_TARGET_SAMPLER); FV_TEXTURE
    overloads on the sampler type, so a target read fetches this fragment's
-   own sample and the ramps keep their filtered lookups. */
+   own sample and the ramps keep their filtered lookups. The engine's depth
+   (ENGINE_DEPTH) is a multisample texture too, read at this sample. */
 static const char fogvol__fs_msaa[] =
     "#define FV_MSAA\n"
     "#define FV_TARGET_SAMPLER sampler2DMS\n"
+    "#define FV_ENGINE_Z(s) texelFetch(s, FV_ENGINE_TEXEL, gl_SampleID).r\n"
     "vec4 fv_tex(sampler2D s, vec2 st) { return texture(s, st); }\n"
     "vec4 fv_tex(sampler2DMS s, vec2 st) {\n"
     "    return texelFetch(s, ivec2(floor(st * vec2(textureSize(s)))), gl_SampleID);\n"
@@ -5861,6 +5877,8 @@ static const char fogvol__fs_common[] =
     "#ifdef FV_ORIGIN\n#define FV_PIXEL gl_FragCoord.xy\n#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy)\n#else\n"
     "#define FV_PIXEL (gl_FragCoord.xy + fv_screen.zw)\n"
     "#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy + fv_nf.zw)\n#endif\n"
+    /* FV_ENGINE_Z(s): the engine's window depth at this pixel (FV_MSAA: at this sample) */
+    "#ifndef FV_ENGINE_Z\n#define FV_ENGINE_Z(s) texelFetch(s, FV_ENGINE_TEXEL, 0).r\n#endif\n"
     "vec2 fv_st() { return FV_PIXEL * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
@@ -6000,10 +6018,10 @@ static const char fogvol__fs_encode_common[] =
 
 static const char fogvol__fs_encode[] =
     "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
-    "FV_BINDING(3) uniform sampler2D fv_opaque;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
-    "    float depth = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float depth = FV_ENGINE_Z(fv_opaque);\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
@@ -6052,7 +6070,7 @@ static const char fogvol__fs_face[] =
     "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
@@ -6322,7 +6340,7 @@ static const char fogvol__fs_light[] =
     "}\n"
     "float fv_light_opaque() {\n"
     "#if defined(FV_FLOAT) && defined(FV_ENGINE_DEPTH)\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    return fv_light_depth(FV_O_DIGITS(fv_opaque));\n"
@@ -6357,7 +6375,7 @@ static const char fogvol__fs_color_face[] =
     "FV_UNIFORM(vec4, fv_emit)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
@@ -8527,7 +8545,7 @@ static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_fra
             why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
         else if (fogvol_msaa_supported(ctx->cfg.tier, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS)
             why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
-                  "or ENGINE_DEPTH)";
+                  "or COLORS)";
         else if (ctx->cur.frame.debug_thickness)
             why = "debug_thickness cannot read multisampled targets";
         if (why) {
@@ -10009,7 +10027,7 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
         r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
                                fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
-                               &run->engine_depth);
+                               ctx->cur.samples > 1 ? ctx->cur.samples : 0, &run->engine_depth);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
                         fogvol_result_string(r));
@@ -10950,7 +10968,7 @@ typedef struct fogvol__gl {
     fogvol__gl_mesh fullscreen;
     fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
     fogvol__GLuint depth_tex, depth_fbo; /* the engine's depth copied by copy_depth */
-    int depth_w, depth_h;
+    int depth_w, depth_h, depth_samples; /* depth_samples > 1: a multisample texture */
     fogvol__GLenum depth_format;
     int has_query; /* occlusion queries loaded (GL 1.5+, GLES 3.0+) */
     int webgl;     /* a WebGL context behind GLES (GL_VERSION names WebGL, as emscripten reports it) */
@@ -11171,18 +11189,23 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
     gl->MinSampleShading(s->min_sample_shading);
 }
 
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex); /* (with the pass's program) */
+
 /* A pass on multisampled targets: their textures on the multisample binding
    points, multisampling on and every sample shaded (per_sample); other passes
-   shade once per pixel. */
+   shade once per pixel. An engine texture of a per-sample pass (its depth) is
+   a multisample texture as well. */
 static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
     if (!gl->has_msaa) return;
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         const fogvol__gl_texture *t = (const fogvol__gl_texture *)p->textures[i];
+        fogvol__GLuint tex = t && t->samples > 1 ? t->tex : 0;
+        if (p->native_textures[i])
+            tex = p->per_sample ? fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]) : 0;
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE,
-                        t && !p->native_textures[i] && t->samples > 1 ? t->tex : 0);
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
     }
     fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, p->per_sample);
     if (p->per_sample) {
@@ -12068,7 +12091,8 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
         if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
+        if (p->native_textures[i]) /* (per-sample passes: on the multisample binding, below) */
+            tex = p->per_sample ? 0 : fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
@@ -12201,46 +12225,85 @@ static fogvol__GLenum fogvol__gl_depth_format(fogvol__gl *gl, int default_fb)
     return bits == 32 && !gl->gles ? FOGVOL__GL_DEPTH_COMPONENT32 : 0;
 }
 
-/* (Re)creates the copy texture and its framebuffer for a format and size. */
-static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h)
+/* The copy texture and its framebuffer for a format, size and sample count (0: single-sample),
+   recreated only when the format or samples differ or it is too small (it keeps the engine's
+   texel coordinates, so the views of a split screen share one); leaves the draw framebuffer alone. */
+static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h, int samples)
 {
     static const fogvol__GLenum none = FOGVOL__GL_NONE;
     int packed = format == FOGVOL__GL_DEPTH24_STENCIL8 || format == FOGVOL__GL_DEPTH32F_STENCIL8;
+    fogvol__GLenum target = samples ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
+                                    : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D;
     fogvol__GLenum type = format == FOGVOL__GL_DEPTH_COMPONENT16 ? FOGVOL__GL_UNSIGNED_SHORT
                           : format == FOGVOL__GL_DEPTH24_STENCIL8 ? FOGVOL__GL_UNSIGNED_INT_24_8
                           : format == FOGVOL__GL_DEPTH32F_STENCIL8 ? FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV
                           : format == FOGVOL__GL_DEPTH_COMPONENT32F ? FOGVOL__GL_FLOAT
                                                                     : FOGVOL__GL_UNSIGNED_INT;
-    if (gl->depth_tex && gl->depth_format == format && gl->depth_w == w && gl->depth_h == h) return;
+    fogvol__GLuint fbo = 0;
+    if (gl->depth_tex && gl->depth_format == format && gl->depth_samples == samples) {
+        if (gl->depth_w >= w && gl->depth_h >= h) return;
+        w = w > gl->depth_w ? w : gl->depth_w; /* grow only: views of other sizes keep fitting */
+        h = h > gl->depth_h ? h : gl->depth_h;
+    }
     if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
     if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, (fogvol__GLint *)&fbo);
     gl->GenTextures(1, &gl->depth_tex);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, gl->depth_tex);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, (fogvol__GLint)format, w, h, 0,
-                   packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    gl->BindTexture(target, gl->depth_tex);
+    if (samples) {
+        gl->TexImage2DMultisample(target, samples, format, w, h, 1);
+    } else {
+        gl->TexParameteri(target, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+        gl->TexParameteri(target, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+        gl->TexImage2D(target, 0, (fogvol__GLint)format, w, h, 0,
+                       packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
+    }
+    gl->BindTexture(target, 0);
     gl->GenFramebuffers(1, &gl->depth_fbo);
     gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo);
     gl->FramebufferTexture2D(FOGVOL__GL_DRAW_FRAMEBUFFER,
-                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT,
-                             FOGVOL__GL_TEXTURE_2D, gl->depth_tex, 0);
+                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT, target,
+                             gl->depth_tex, 0);
     gl->DrawBuffers(1, &none); /* depth only (framebuffer state of our own FBO) */
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, fbo);
     gl->depth_format = format;
+    gl->depth_samples = samples;
     gl->depth_w = w;
     gl->depth_h = h;
 }
 
-static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+/* The samples per pixel of framebuffer fb (0: single-sample); leaves fb bound for drawing. */
+static int fogvol__gl_fb_samples(fogvol__gl *gl, fogvol__GLuint fb)
+{
+    fogvol__GLint buffers = 0, samples = 0;
+    if (!gl->has_msaa) return 0;
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, fb);
+    gl->GetIntegerv(FOGVOL__GL_SAMPLE_BUFFERS, &buffers);
+    gl->GetIntegerv(FOGVOL__GL_SAMPLES, &samples);
+    return buffers ? samples : 0;
+}
+
+/* Why the depth of a framebuffer of src samples cannot be copied with samples samples, or NULL. */
+static const char *fogvol__gl_copy_refusal(const fogvol__gl *gl, int src, int samples)
+{
+    if (samples && !gl->has_msaa) return "a per-sample copy needs multisample textures (GL 3.2)";
+    if (samples && src > 1 && src != samples)
+        return "its sample count differs from the engine framebuffer's drawn per sample (GL cannot blit it)";
+    if (samples && src <= 1 && gl->gles)
+        return "OpenGL ES cannot blit a single-sample depth buffer into a multisampled one";
+    return NULL;
+}
+
+static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                            fogvol_native *texture)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
     fogvol__GLenum format;
     fogvol_result r;
-    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3];
+    const char *why;
+    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3], src_samples;
     *texture = 0;
     if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copying a depth buffer needs glBlitFramebuffer "
@@ -12258,6 +12321,12 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     fogvol__gl_drain(gl);
+    src_samples = fogvol__gl_fb_samples(gl, src);
+    if ((why = fogvol__gl_copy_refusal(gl, src_samples, samples > 1 ? samples : 0)) != NULL) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth of framebuffer %u (%d samples): %s", src,
+                    src_samples, why);
+        return src_samples > 1 && samples > 1 ? FOGVOL_ERROR_INVALID_ARGUMENT : FOGVOL_ERROR_UNSUPPORTED;
+    }
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
     format = fogvol__gl_depth_format(gl, src == 0);
     if (!format) {
@@ -12265,13 +12334,15 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
                     "fogvol: framebuffer %u has no depth buffer, or one whose format no depth texture matches", src);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    fogvol__gl_depth_target(gl, format, x1, y1);
+    fogvol__gl_depth_target(gl, format, x1, y1, samples > 1 ? samples : 0);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo); /* every copy names its destination */
     gl->Disable(FOGVOL__GL_SCISSOR_TEST);
     if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
     /* the same rectangle on both sides: required to resolve a multisampled source */
     gl->BlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, FOGVOL__GL_DEPTH_BUFFER_BIT,
                         FOGVOL__GL_NEAREST);
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)gl->saved.read_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)gl->saved.draw_fbo);
     r = fogvol__gl_check(gl, "copy_depth (glBlitFramebuffer of the engine's depth)");
     if (r == FOGVOL_SUCCESS) *texture = gl->depth_tex;
     return r;

@@ -1168,15 +1168,15 @@ static void fogvk__end_pass(void *u)
 
 /* ---- the engine's depth, read-back, queries ---- */
 
-static fogvol_result fogvk__copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+static fogvol_result fogvk__copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                        fogvol_native *texture)
 {
     fogvk *vk = (fogvk *)u;
     VkCommandBuffer cmd = vk->frame.cmd;
     VkImageCopy c;
     (void)framebuffer;
-    if (!bound || !vk->engine_depth.image) {
-        fogvk__log(vk, "fogvk: copy_depth copies the depth image of fogvk_frame only");
+    if (!bound || !vk->engine_depth.image || samples > 1) { /* (no FOGVOL_CAP_MULTISAMPLE: samples is 0) */
+        fogvk__log(vk, "fogvk: copy_depth copies the single-sample depth image of fogvk_frame only");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvk__end_rendering(vk);

@@ -767,6 +767,156 @@ static void test_geometry_21(void **st)
     geometry_scenes(PROF_21);
 }
 
+/* ---- sequences (tests/sequence.h) -------------------------------------------------------------
+   The engine framebuffer over the default script: a 4-attachment FBO with a stencil pattern, the
+   draw buffer fogvol composites into changing every frame (frame % 4), the camera walking into the
+   big sphere and out, the second ramp's sphere coming and going (the "occluders" of this scene),
+   the viewport shrinking and splitting, a cancelled frame in between; full-screen and geometry
+   composites. Each view: thickness against its own ray cast (1 LSB per pair of faces, interior
+   pixels), the other attachments and the named one outside the viewport byte-identical, the
+   stencil untouched, the engine state snapshot unchanged. */
+typedef struct fbseq {
+    eng e;
+    efbo f;
+    fogvol_composite composite;
+    unsigned char *pre[4], *post, st0[NPIX], st1[NPIX];
+    float *thick;
+    double *gt;
+    unsigned char *in;
+} fbseq;
+
+static void fbseq_camera(eng *e, double walk, const int vp[4])
+{
+    e->cam.eye[0] = 0.5 * walk;
+    e->cam.eye[1] = 0.3 * walk;
+    e->cam.eye[2] = 6.0 - 5.5 * walk; /* 0.5 at the end: inside the radius-2 sphere */
+    e->cam.target[0] = e->cam.eye[0] - 0.2;
+    e->cam.target[1] = e->cam.eye[1] - 0.1;
+    e->cam.target[2] = e->cam.eye[2] - 6.0;
+    e->cam.aspect = (double)vp[2] / vp[3];
+    e->cam.width = vp[2];
+    e->cam.height = vp[3];
+}
+
+/* begin a frame of the view's objects (the second sphere with occluders) into viewport vp */
+static void fbseq_begin(fbseq *q, const sq_view *v, double walk, float *thick)
+{
+    fogvol_frame_desc fd;
+    int i;
+    fbseq_camera(&q->e, walk, v->viewport);
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&q->e.cam, fd.view, fd.projection);
+    fd.znear = (float)ZN;
+    fd.zfar = (float)ZF;
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    fd.draw_buffer = v->frame % 4;
+    fd.composite = q->composite;
+    fd.debug_thickness = thick;
+    fd.debug_ramp = q->e.ramp[0];
+    assert_int_equal(fogvol_begin_frame(q->e.fv, &fd), FOGVOL_SUCCESS);
+    for (i = 0; i < q->e.n - !v->occluders; ++i) {
+        fogvol_volume_desc vd;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = q->e.o[i].m;
+        vd.ramp = q->e.ramp[q->e.o[i].ramp];
+        memcpy(vd.model, q->e.o[i].model, sizeof vd.model);
+        assert_int_equal(fogvol_add_volume(q->e.fv, &vd), FOGVOL_SUCCESS);
+    }
+}
+
+static void fbseq_cancel(void *user, const sq_view *v)
+{
+    fbseq *q = (fbseq *)user;
+    fbseq_begin(q, v, 1.0 - v->walk, NULL);
+    assert_int_equal(fogvol_cancel_frame(q->e.fv), FOGVOL_SUCCESS);
+}
+
+static void fbseq_view(void *user, const sq_view *v, sq_check *out)
+{
+    fbseq *q = (fbseq *)user;
+    const int *vp = v->viewport;
+    snap before, after;
+    rc_object ro[MAXOBJ];
+    rc_scene rs;
+    int i, x, y, named = v->frame % 4;
+    glBindFramebuffer(GL_FRAMEBUFFER, q->f.fbo);
+    for (i = 0; i < 4; ++i) {
+        tex_fill(q->f.tex[i], 11u * (unsigned)v->frame + (unsigned)i);
+        tex_read(q->f.tex[i], q->pre[i]);
+    }
+    stencil_pattern();
+    read_stencil(q->st0);
+    take_snap(&q->e, &before);
+    fbseq_begin(q, v, v->walk, q->thick);
+    assert_int_equal(fogvol_end_frame(q->e.fv, NULL), FOGVOL_SUCCESS);
+    take_snap(&q->e, &after);
+    out->wrong += memcmp(&before, &after, sizeof before) != 0;
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    read_stencil(q->st1);
+    for (i = 0; i < NPIX; ++i) out->wrong += q->st0[i] != q->st1[i];
+    for (i = 0; i < 4; ++i) { /* only the named attachment, only inside the viewport */
+        tex_read(q->f.tex[i], q->post);
+        for (y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                int inside = i == named && x >= vp[0] && x < vp[0] + vp[2] && y >= vp[1] && y < vp[1] + vp[3];
+                out->wrong += !inside && memcmp(q->pre[i] + 4 * (y * W + x), q->post + 4 * (y * W + x), 4) != 0;
+            }
+    }
+    for (i = 0; i < q->e.n - !v->occluders; ++i) { /* ramp 0's volumes (the read-back's group) */
+        ro[i].pos = q->e.o[i].mesh.pos;
+        ro[i].vcount = q->e.o[i].mesh.vcount;
+        ro[i].idx = q->e.o[i].mesh.idx;
+        ro[i].icount = q->e.o[i].mesh.icount;
+        memcpy(ro[i].model, q->e.o[i].model, sizeof ro[i].model);
+        ro[i].sign = q->e.o[i].ramp == 0 ? q->e.o[i].sign : 0; /* (the other ramp occludes nothing: sign 0 */
+        if (q->e.o[i].ramp != 0) ro[i].icount = 0;            /*  and no triangles) */
+    }
+    assert_true(rc_scene_init(&rs, ro, q->e.n - !v->occluders));
+    out->bound = LSB;
+    for (y = 0; y < vp[3]; ++y)
+        for (x = 0; x < vp[2]; ++x) {
+            rc_result r;
+            double err;
+            int pairs;
+            if (!rc_interior(&rs, &q->e.cam, x, y)) continue;
+            r = rc_trace(&rs, &q->e.cam, x + 0.5, y + 0.5);
+            pairs = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            err = fabs(q->thick[y * vp[2] + x] - r.thickness) / (pairs > 1 ? pairs : 1);
+            out->pixels++;
+            out->wrong += err > LSB;
+            if (err > out->max_err) out->max_err = err;
+        }
+    rc_scene_free(&rs);
+}
+
+static void test_fb_sequence(void **st)
+{
+    int c;
+    (void)st;
+    for (c = 0; c < 2; ++c) {
+        fbseq q;
+        int i;
+        memset(&q, 0, sizeof q);
+        q.composite = c ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN;
+        eng_open(&q.e, PROF_CORE, FOGVOL_TIER_PS20);
+        add_obj(&q.e, shp_sphere(2.0f, 48, 24), 0, 0, 0, 1, 1, 0);
+        add_obj(&q.e, shp_sphere(1.0f, 32, 16), 1.5f, 1.0f, -2.0f, 1, 1, 1); /* the one that comes and goes */
+        efbo_make(&q.f, 4, GL_RGBA8);
+        glDrawBuffers(4, g_list4);
+        engine_blend_state();
+        for (i = 0; i < 4; ++i) q.pre[i] = (unsigned char *)malloc(NPIX * 4);
+        q.post = (unsigned char *)malloc(NPIX * 4);
+        q.thick = (float *)calloc(NPIX, sizeof(float));
+        sq_run(c ? "engine FBO, 4 draw buffers, geometry composite" : "engine FBO, 4 draw buffers", W, H,
+               sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, fbseq_view, fbseq_cancel, &q);
+        for (i = 0; i < 4; ++i) free(q.pre[i]);
+        free(q.post);
+        free(q.thick);
+        efbo_free(&q.f);
+        eng_close(&q.e);
+    }
+}
+
 /* ---- 3. engine state left set --------------------------------------------- */
 typedef struct state_item {
     const char *name;
@@ -1418,7 +1568,8 @@ int main(void)
         cmocka_unit_test(test_drawbuffers_21),    cmocka_unit_test(test_drawbuffers_es30),
         cmocka_unit_test(test_drawbuffers_swizzled),
         cmocka_unit_test(test_drawbuffers_refused), cmocka_unit_test(test_geometry_core),
-        cmocka_unit_test(test_geometry_21),       cmocka_unit_test(test_state_core),
+        cmocka_unit_test(test_geometry_21),       cmocka_unit_test(test_fb_sequence),
+        cmocka_unit_test(test_state_core),
         cmocka_unit_test(test_state_compat),      cmocka_unit_test(test_transform_feedback),
         cmocka_unit_test(test_errors_core),       cmocka_unit_test(test_errors_21),
         cmocka_unit_test(test_errors_unraisable),
@@ -1427,5 +1578,6 @@ int main(void)
         cmocka_unit_test(test_alpha),             cmocka_unit_test(test_srgb),
         cmocka_unit_test(test_srgb_own_targets),
     };
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
