@@ -6562,6 +6562,10 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    /* its colour-ramp group in the frame being ended (fogvol__link_groups): valid while stamp is the
+       frame's group_stamp; head and tail: its first and last volume in the frame's order */
+    int64_t stamp;
+    int head, tail;
 };
 
 struct fogvol_volume_texture {
@@ -6575,6 +6579,7 @@ typedef struct fogvol__volume {
     int negative;
     const fogvol_volume_texture *density, *color; /* NULL: none */
     float density_map[8], color_map[6];
+    int next; /* the next volume of the same ramp in the frame's order, -1: none (fogvol__link_groups) */
 } fogvol__volume;
 
 typedef struct fogvol__light {
@@ -6666,6 +6671,9 @@ typedef struct fogvol__frame_state {
     int nlight, caplight;
     int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
+    int64_t group_stamp;    /* fogvol__link_groups: which end_frame the ramps' group lists belong to */
+    int color_first;        /* the first volume of the one-pass colour group, -1: none (FOGVOL_VARIANT_COLORS) */
+    int color_pos;          /* the colour group holds a positive volume */
 } fogvol__frame_state;
 
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
@@ -8374,15 +8382,51 @@ static void fogvol__end_pass(fogvol_context *ctx)
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
 }
 
+static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp);
+
+/* The frame's colour-ramp groups as lists, once per end_frame, so that each group's passes visit its
+   own volumes only: each ramp's first and last volume (stamped with this end_frame), each volume's
+   next of the same ramp, in the frame's order; the one-pass colour group's first volume. (The ramps
+   belong to the context; the const of the volume desc is the caller's promise, not theirs.) */
+static void fogvol__link_groups(fogvol_context *ctx)
+{
+    int i;
+    ctx->cur.group_stamp++;
+    ctx->cur.color_first = -1;
+    ctx->cur.color_pos = 0;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        fogvol__volume *v = &ctx->cur.vols[i];
+        fogvol_ramp *rp = (fogvol_ramp *)(uintptr_t)v->ramp;
+        v->next = -1;
+        if (rp->stamp != ctx->cur.group_stamp) {
+            rp->stamp = ctx->cur.group_stamp;
+            rp->head = i;
+        } else {
+            ctx->cur.vols[rp->tail].next = i;
+        }
+        rp->tail = i;
+        if (fogvol__color_member(ctx, rp)) {
+            if (ctx->cur.color_first < 0) ctx->cur.color_first = i;
+            ctx->cur.color_pos |= !v->negative;
+        }
+    }
+}
+
+/* The first volume of a ramp's group in this frame (then vols[i].next), -1: none. */
+static int fogvol__first(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    return ramp->stamp == ctx->cur.group_stamp ? ramp->head : -1;
+}
+
 /* Draw the volumes of one ramp group into the current pass: negative = 0
    positives, 1 negatives, -1 both (FLOAT: the sign goes to the shader). */
 static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
     fogvol_draw dr;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || v->density) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
@@ -8444,11 +8488,11 @@ static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
         fogvol_pass ps;
         fogvol_draw dr;
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
         if (ps.read_target) { /* (the general program samples O) */
@@ -8476,9 +8520,9 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
 static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
     int i;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || !v->color) continue;
+        if (!v->color) continue;
         ps->textures[FOGVOL__UNIT_CTEX] = v->color->texture;
         memcpy(ps->uniforms[FOGVOL_U_COLOR_U], v->color_map, 3 * sizeof(float));
         memcpy(ps->uniforms[FOGVOL_U_COLOR_V], v->color_map + 3, 3 * sizeof(float));
@@ -8649,41 +8693,46 @@ static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp
     return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
 }
 
-/* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
-   ramp group can cover: the 8 corners of each mesh's box projected, rounded
-   out by a pixel, within the viewport. A corner nearer than the near plane
-   (perspective; NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole
-   viewport. An empty rectangle is 1x1 in the corner (nothing is drawn). */
-static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+/* Window rectangles (x, y, w, h) that hold every pixel some volumes can cover:
+   the 8 corners of each mesh's box projected (fogvol__rect_add, into the window
+   extent lo, hi), rounded out by a pixel, within the viewport
+   (fogvol__rect_finish). A corner nearer than the near plane (perspective;
+   NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole viewport
+   (rect_add returns 0). An empty rectangle is 1x1 in the corner (nothing is
+   drawn). */
+static int fogvol__rect_add(const fogvol_context *ctx, const fogvol__volume *v, double lo[2], double hi[2])
 {
     const int *vp = ctx->cur.frame.viewport;
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, wmin;
-    int i, k, c;
+    double m[16], mvp[16], wmin;
+    int k, c;
     wmin = ctx->cur.frame.projection[15] == 0.0f ? (double)ctx->cur.frame.znear * (1.0 - 1e-6) : 1e-12;
-    memcpy(rect, vp, 4 * sizeof(int));
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        const fogvol__volume *v = &ctx->cur.vols[i];
-        double m[16], mvp[16];
-        if (v->ramp != ramp) continue;
-        fogvol__tod(m, v->model);
-        fogvol__mul4(mvp, ctx->cur.viewproj, m);
-        for (k = 0; k < 8; ++k) {
-            double p[3], clip[4];
-            for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
-            for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
-            if (!(clip[3] >= wmin)) return; /* behind the near plane (or NaN): whole viewport */
-            for (c = 0; c < 2; ++c) {
-                double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
-                if (win < lo[c]) lo[c] = win;
-                if (win > hi[c]) hi[c] = win;
-            }
+    fogvol__tod(m, v->model);
+    fogvol__mul4(mvp, ctx->cur.viewproj, m);
+    for (k = 0; k < 8; ++k) {
+        double p[3], clip[4];
+        for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
+        for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
+        if (!(clip[3] >= wmin)) return 0; /* behind the near plane (or NaN): whole viewport */
+        for (c = 0; c < 2; ++c) {
+            double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
+            if (win < lo[c]) lo[c] = win;
+            if (win > hi[c]) hi[c] = win;
         }
     }
+    return 1;
+}
+
+/* The extent rounded out and clamped to the viewport in floating point before it becomes integers (a
+   volume far off screen projects to any double: 1e9 pixels and more, or infinite). */
+static void fogvol__rect_finish(const fogvol_context *ctx, const double lo[2], const double hi[2], int rect[4])
+{
+    const int *vp = ctx->cur.frame.viewport;
+    int c;
     for (c = 0; c < 2; ++c) { /* downsample 2: the bilinear read spreads a texel over 2 more pixels */
-        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0;
+        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0, v0 = vp[c], v1 = (double)vp[c] + vp[c + 2];
         double a = FOGVOL_FLOOR(lo[c]) - 1.0 - m, b = FOGVOL_FLOOR(hi[c]) + 2.0 + m;
-        if (a < vp[c]) a = vp[c];
-        if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
+        a = !(a >= v0) ? v0 : a > v1 ? v1 : a;
+        b = !(b >= v0) ? v0 : b > v1 ? v1 : b;
         rect[c] = (int)a;
         rect[c + 2] = b > a ? (int)(b - a) : 0;
     }
@@ -8692,6 +8741,17 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
         rect[1] = vp[1];
         rect[2] = rect[3] = 1;
     }
+}
+
+/* The rectangle of the volumes of a ramp group. */
+static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+{
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next)
+        if (!fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi)) return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
@@ -9448,24 +9508,16 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
     return grey;
 }
 
-/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY): the union of their
-   ramps' rectangles. */
+/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY), each projected once. */
 static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
 {
-    int i, k, r[4], lo[2] = {0, 0}, hi[2] = {0, 0}, any = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        if (!fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) continue;
-        fogvol__group_rect(ctx, ctx->cur.vols[i].ramp, r);
-        for (k = 0; k < 2; ++k) {
-            if (!any || r[k] < lo[k]) lo[k] = r[k];
-            if (!any || r[k] + r[k + 2] > hi[k]) hi[k] = r[k] + r[k + 2];
-        }
-        any = 1;
-    }
-    rect[0] = lo[0];
-    rect[1] = lo[1];
-    rect[2] = hi[0] - lo[0];
-    rect[3] = hi[1] - lo[1];
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = ctx->cur.color_first; i >= 0 && i < ctx->cur.nvol; ++i)
+        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi))
+            return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 /* The composite of the colour group into the engine framebuffer: one FOG-blended draw when every
@@ -9499,11 +9551,7 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 {
-    int i, has_pos = 0;
-    for (i = 0; i < g; ++i)
-        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) return;
-    for (i = g; i < ctx->cur.nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !ctx->cur.vols[i].negative;
-    if (!has_pos) return;
+    if (g != ctx->cur.color_first || !ctx->cur.color_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
 }
@@ -9582,16 +9630,14 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
         fogvol__color_group(ctx, run, g);
         return;
     }
-    for (i = 0; i < g; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) return;
-    for (i = g; i < ctx->cur.nvol; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) {
-            if (ctx->cur.vols[i].negative) has_neg = 1;
-            else has_pos = 1;
-            convex &= ctx->cur.vols[i].mesh->convex == 1;
-            density |= ctx->cur.vols[i].density != NULL;
-            ++n;
-        }
+    if (fogvol__first(ctx, ramp) != g) return;
+    for (i = g; i >= 0; i = ctx->cur.vols[i].next) {
+        if (ctx->cur.vols[i].negative) has_neg = 1;
+        else has_pos = 1;
+        convex &= ctx->cur.vols[i].mesh->convex == 1;
+        density |= ctx->cur.vols[i].density != NULL;
+        ++n;
+    }
     if (!has_pos) return;
     /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
     run->xsum = ctx->cfg.exact_sum && !run->count && ctx->cur.samples <= 1 && !density && n < 128;
@@ -9651,6 +9697,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.depth_tested = run.count;
     run.st.inline_resolved = ctx->cfg.inline_resolve;
     run.rgba8 = ctx->cfg.tier != FOGVOL_TIER_FLOAT;
+    fogvol__link_groups(ctx);
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {
         fogvol__frame_uniforms(ctx, &run);
