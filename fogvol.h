@@ -593,6 +593,10 @@ enum {
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+/* Frees everything the context owns, host memory and backend objects: its targets, programs and
+   lookup textures, and the meshes, ramps and volume textures made with it that are still alive
+   (destroyed with it; a warning in the log counts them: destroy them first). An open frame is
+   dropped. */
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
 FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
@@ -2502,14 +2506,66 @@ static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
     }
 }
 
-/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on
-   every axis (i itself when none). A sweep along the axis of largest extent
-   (sorted keys) limits the candidates. Non-finite vertices stay alone. Returns
-   how many vertices were merged. */
-static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, uint32_t *rep, fogvol__wkey *keys)
+/* The weld's sweep: the kept vertices in a hash of their cells on the two axes across the sweep
+   (cells dist wide: floor(coordinate / dist) as a double; the quotient of two floats is exact
+   enough in double that coordinates within dist of each other lie in the same or neighbouring
+   cells, for any floats), chained newest first (heads: mask + 1 buckets, next: per vertex). */
+typedef struct fogvol__weld_grid {
+    const unsigned char *base;
+    int stride, axis; /* axis: the sweep's */
+    float dist;
+    uint32_t *heads, *next, mask;
+} fogvol__weld_grid;
+
+#define FOGVOL__NONE 0xffffffffu
+
+/* The bucket of v's cell moved by (du, dv) cells across the sweep (-0 made +0; cells beyond 32-bit
+   integers hashed by their bits). */
+static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const float v[3], int du, int dv)
 {
-    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3], w[3];
-    int i, a, b, k, axis = 0, merged = 0, any = 0;
+    uint32_t h[2], w[2];
+    int k;
+    for (k = 0; k < 2; ++k) {
+        double c = FOGVOL_FLOOR((double)v[(g->axis + 1 + k) % 3] / g->dist) + (k ? dv : du) + 0.0;
+        if (c > -2147483648.0 && c < 2147483648.0) {
+            h[k] = (uint32_t)(int32_t)c;
+        } else {
+            memcpy(w, &c, sizeof w);
+            h[k] = (w[0] ^ w[1]) * 0x9e3779b1u;
+        }
+    }
+    return (h[0] * 0x9e3779b1u + h[1]) & g->mask;
+}
+
+/* The lowest-numbered kept vertex within dist of v on every axis among those the sweep has met, from
+   the 9 cells around v across the sweep, FOGVOL__NONE: none. A vertex more than dist behind v along
+   the sweep is behind every vertex to come as well: the chain is cut there (it and every older
+   entry), so the chains hold the last dist of the sweep only. */
+static uint32_t fogvol__weld_find(fogvol__weld_grid *g, const float v[3])
+{
+    uint32_t best = FOGVOL__NONE, j, *link;
+    float w[3];
+    int d;
+    for (d = 0; d < 9; ++d)
+        for (link = &g->heads[fogvol__weld_bucket(g, v, d % 3 - 1, d / 3 - 1)]; (j = *link) != FOGVOL__NONE;
+             link = &g->next[j]) {
+            memcpy(w, g->base + (size_t)j * g->stride, sizeof w);
+            if ((double)v[g->axis] - w[g->axis] > g->dist) {
+                *link = FOGVOL__NONE;
+                break;
+            }
+            if (j < best && FOGVOL_FABS((double)w[0] - v[0]) <= g->dist &&
+                FOGVOL_FABS((double)w[1] - v[1]) <= g->dist && FOGVOL_FABS((double)w[2] - v[2]) <= g->dist)
+                best = j;
+        }
+    return best;
+}
+
+/* The axis of largest extent of the finite vertices (rep[i] = i on the way). */
+static int fogvol__weld_axis(const unsigned char *base, int stride, int nv, uint32_t *rep)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3];
+    int i, k, axis = 0, any = 0;
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
         rep[i] = (uint32_t)i;
@@ -2522,28 +2578,61 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     }
     for (k = 1; k < 3; ++k)
         if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    return axis;
+}
+
+/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on every axis among those
+   before it in the sweep (i itself when none): the sweep takes the vertices in order of their
+   coordinate on the axis of largest extent (then of their number) and keeps a vertex that finds
+   none. Non-finite vertices stay alone. The candidates come from fogvol__weld_find, so vertices
+   sharing the sweep's coordinate (a face of a subdivided cube) cost no more than others: O(n log n).
+   Scratch memory from alloc: 12 bytes per vertex and 4 per hash bucket (2 to 4 buckets per vertex).
+   Returns how many vertices were merged, -1: out of memory. */
+static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, const fogvol_allocator *alloc,
+                        uint32_t *rep)
+{
+    fogvol__weld_grid g;
+    fogvol__wkey *keys;
+    size_t buckets = 2;
+    float v[3];
+    int i, merged = 0;
+    while (buckets < 2u * (size_t)nv && buckets < ((size_t)1 << 31)) buckets <<= 1;
+    keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)nv);
+    g.heads = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (buckets + (size_t)nv));
+    if (!keys || !g.heads) {
+        fogvol__free(alloc, keys);
+        fogvol__free(alloc, g.heads);
+        return -1;
+    }
+    g.base = base;
+    g.stride = stride;
+    g.dist = dist;
+    g.next = g.heads + buckets;
+    g.mask = (uint32_t)(buckets - 1u);
+    memset(g.heads, 0xff, sizeof(uint32_t) * buckets);
+    g.axis = fogvol__weld_axis(base, stride, nv, rep);
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
-        keys[i].key = fogvol__finite_n(v, 3) ? v[axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].key = fogvol__finite_n(v, 3) ? v[g.axis] : 3.0e38f; /* non-finite: sorted last, skipped */
         keys[i].i = (uint32_t)i;
     }
     fogvol__sort_wkeys(keys, nv);
-    for (a = 0; a < nv; ++a) {
-        uint32_t self = keys[a].i, best = 0xffffffffu;
+    for (i = 0; i < nv; ++i) {
+        uint32_t self = keys[i].i, best, h;
         memcpy(v, base + (size_t)self * stride, sizeof v);
         if (!fogvol__finite_n(v, 3)) continue;
-        for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
-            uint32_t j = keys[b].i;
-            if (rep[j] != j || j > best) continue;
-            memcpy(w, base + (size_t)j * stride, sizeof w);
-            if (FOGVOL_FABS((double)w[0] - v[0]) <= dist && FOGVOL_FABS((double)w[1] - v[1]) <= dist &&
-                FOGVOL_FABS((double)w[2] - v[2]) <= dist)
-                best = j;
+        best = fogvol__weld_find(&g, v);
+        if (best != FOGVOL__NONE) {
+            rep[self] = best;
+            merged++;
+            continue;
         }
-        if (best == 0xffffffffu) continue; /* kept */
-        rep[self] = best;
-        merged++;
+        h = fogvol__weld_bucket(&g, v, 0, 0); /* kept: a candidate for the vertices after it */
+        g.next[self] = g.heads[h];
+        g.heads[h] = self;
     }
+    fogvol__free(alloc, keys);
+    fogvol__free(alloc, g.heads);
     return merged;
 }
 
@@ -2555,30 +2644,23 @@ static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvo
     const unsigned char *base = (const unsigned char *)d->positions + d->offset;
     int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0;
     uint32_t *idx, *rep = NULL;
-    fogvol__wkey *keys = NULL;
     *out = NULL;
     *welded = 0;
     if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
     idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
-    if (weld) {
-        rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
-        keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)d->vertex_count);
-    }
-    if (!idx || (weld && (!rep || !keys))) {
+    if (weld) rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
+    if (weld && rep && idx) *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, alloc, rep);
+    if (!idx || (weld && (!rep || *welded < 0))) {
         fogvol__free(alloc, idx);
         fogvol__free(alloc, rep);
-        fogvol__free(alloc, keys);
+        *welded = 0;
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     for (i = 0; i < d->index_count; ++i)
         idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
-    if (weld) {
-        *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, rep, keys);
-        for (i = 0; i < d->index_count; ++i)
-            if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
-    }
+    for (i = 0; weld && i < d->index_count; ++i)
+        if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
     fogvol__free(alloc, rep);
-    fogvol__free(alloc, keys);
     *out = idx;
     return FOGVOL_SUCCESS;
 }
@@ -6532,7 +6614,15 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
 /* >>context =============================================================== */
 /* The renderer's objects and the context: resolved configuration, targets, programs. */
 
+/* The objects a context hands out (meshes, ramps, volume textures) are on a list of its own per kind
+   (circular, the context's node the head), each object's node its first member, so that
+   fogvol_destroy_context destroys those the caller did not. */
+typedef struct fogvol__live {
+    struct fogvol__live *prev, *next;
+} fogvol__live;
+
 struct fogvol_mesh {
+    fogvol__live live;
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
@@ -6553,6 +6643,7 @@ typedef struct fogvol__spec_program {
 } fogvol__spec_program;
 
 struct fogvol_ramp {
+    fogvol__live live;
     fogvol_handle texture;
     int width;
     float max_thickness;
@@ -6569,6 +6660,7 @@ struct fogvol_ramp {
 };
 
 struct fogvol_volume_texture {
+    fogvol__live live;
     fogvol_handle texture;
 };
 
@@ -6689,7 +6781,8 @@ struct fogvol_context {
     fogvol_logger log;
     fogvol_backend be;
     int owns_backend;
-    int live_meshes, live_ramps;
+    fogvol__live meshes, ramps, textures; /* the objects alive (fogvol__live), counted: */
+    int live_meshes, live_ramps, live_textures;
     int msaa_warned;
     fogvol__config cfg;       /* resolved configuration */
     fogvol__gpu gpu;          /* GPU resources */
@@ -6806,6 +6899,24 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 }
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
+
+/* An object joins (count +1) or leaves (count -1) its kind's list. */
+static void fogvol__live_add(fogvol__live *head, fogvol__live *n, int *count)
+{
+    n->prev = head;
+    n->next = head->next;
+    head->next->prev = n;
+    head->next = n;
+    (*count)++;
+}
+
+static void fogvol__live_remove(fogvol__live *n, int *count)
+{
+    n->prev->next = n->next;
+    n->next->prev = n->prev;
+    n->prev = n->next = n;
+    (*count)--;
+}
 
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
@@ -7244,6 +7355,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(ctx, 0, sizeof *ctx);
+    ctx->meshes.prev = ctx->meshes.next = &ctx->meshes;
+    ctx->ramps.prev = ctx->ramps.next = &ctx->ramps;
+    ctx->textures.prev = ctx->textures.next = &ctx->textures;
     ctx->alloc = desc->allocator;
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
@@ -7287,10 +7401,16 @@ FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx)
 {
     fogvol_allocator a;
     if (!ctx) return;
-    if (ctx->live_meshes || ctx->live_ramps)
+    if (ctx->live_meshes || ctx->live_ramps || ctx->live_textures)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: context destroyed with %d meshes and %d ramps alive (their GPU objects leak)",
-                    ctx->live_meshes, ctx->live_ramps);
+                    "fogvol: context destroyed with %d meshes, %d ramps and %d volume textures alive: destroyed with "
+                    "it (destroy them before the context)",
+                    ctx->live_meshes, ctx->live_ramps, ctx->live_textures);
+    ctx->cur.in_frame = 0; /* (nothing to drop from an open frame: it goes too) */
+    while (ctx->meshes.next != &ctx->meshes) fogvol_destroy_mesh(ctx, (fogvol_mesh *)(void *)ctx->meshes.next);
+    while (ctx->ramps.next != &ctx->ramps) fogvol_destroy_ramp(ctx, (fogvol_ramp *)(void *)ctx->ramps.next);
+    while (ctx->textures.next != &ctx->textures)
+        fogvol_destroy_volume_texture(ctx, (fogvol_volume_texture *)(void *)ctx->textures.next);
     a = ctx->alloc;
     fogvol__release(ctx);
     fogvol__free(&a, ctx);
@@ -7559,7 +7679,7 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     m->volume = rep.valid;
     m->convex = rep.valid ? fogvol__convexity(desc) : -1;
     if (report) report->convex = m->convex;
-    ctx->live_meshes++;
+    fogvol__live_add(&ctx->meshes, &m->live, &ctx->live_meshes);
     *out = m;
     return FOGVOL_SUCCESS;
 }
@@ -7590,7 +7710,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget(ctx, mesh, NULL);
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
-    ctx->live_meshes--;
+    fogvol__live_remove(&mesh->live, &ctx->live_meshes);
     fogvol__free(&ctx->alloc, mesh);
 }
 
@@ -7661,7 +7781,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
         rp->exp_rgba[2] = fogvol__unorm8(desc->color[2]) / 255.0f;
         rp->exp_rgba[3] = desc->density;
     }
-    ctx->live_ramps++;
+    fogvol__live_add(&ctx->ramps, &rp->live, &ctx->live_ramps);
     *out = rp;
     return FOGVOL_SUCCESS;
 }
@@ -7671,7 +7791,7 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     if (!ctx || !ramp) return;
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
-    ctx->live_ramps--;
+    fogvol__live_remove(&ramp->live, &ctx->live_ramps);
     fogvol__free(&ctx->alloc, ramp);
 }
 
@@ -7698,6 +7818,7 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
         fogvol__free(&ctx->alloc, t);
         return r;
     }
+    fogvol__live_add(&ctx->textures, &t->live, &ctx->live_textures);
     *out = t;
     return FOGVOL_SUCCESS;
 }
@@ -7714,6 +7835,7 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
         ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    fogvol__live_remove(&texture->live, &ctx->live_textures);
     fogvol__free(&ctx->alloc, texture);
 }
 

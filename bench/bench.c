@@ -1384,7 +1384,8 @@ static void scale_frames(scale_figs *s, int quick)
     shp_free(&box);
 }
 
-/* the weld of a per-face subdivided cube (6 x 257^2 vertices at 1e-5): alone, and inside
+/* the weld of a per-face subdivided cube (6 x 257^2 vertices at 1e-5): alone (fogvol__weld, the
+   implementation is in this file), and inside
    fogvol_validate_mesh (weld + the checks of the welded mesh) */
 static void scale_weld(scale_figs *s, int quick)
 {
@@ -1392,16 +1393,14 @@ static void scale_weld(scale_figs *s, int quick)
     fogvol_mesh_desc md;
     fogvol_mesh_report rep;
     uint32_t *rep_idx;
-    fogvol__wkey *keys;
     double t0;
     s->weld_n = quick ? 64 : 256;
     m = shp_cube_faces(1.0f, s->weld_n);
     s->weld_v = m.vcount;
     rep_idx = (uint32_t *)malloc(sizeof *rep_idx * (size_t)m.vcount);
-    keys = (fogvol__wkey *)malloc(sizeof *keys * (size_t)m.vcount);
-    if (!m.pos || !rep_idx || !keys) die("out of memory");
+    if (!m.pos || !rep_idx) die("out of memory");
     t0 = now_ms();
-    s->weld_kept = m.vcount - fogvol__weld((const unsigned char *)m.pos, 12, m.vcount, 1e-5f, rep_idx, keys);
+    s->weld_kept = m.vcount - fogvol__weld((const unsigned char *)m.pos, 12, m.vcount, 1e-5f, NULL, rep_idx);
     s->weld_ms = now_ms() - t0;
     memset(&md, 0, sizeof md);
     md.positions = m.pos;
@@ -1414,7 +1413,6 @@ static void scale_weld(scale_figs *s, int quick)
     s->weld_total_ms = now_ms() - t0;
     if (rep.vertices != s->weld_kept) die("weld: the validation welded another count");
     free(rep_idx);
-    free(keys);
     shp_free(&m);
 }
 
