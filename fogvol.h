@@ -615,7 +615,10 @@ typedef struct fogvol_mesh_desc {
     const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
     int vertex_count;
     int stride;                /* bytes between vertices, 0 = 12; at least 12 */
-    const uint32_t *indices;   /* 3 per triangle */
+    const uint32_t *indices;   /* 3 per triangle. No index array (indices and indices16 NULL, index_count
+                                  0): the triangles are the vertices in order, (0, 1, 2), (3, 4, 5), ...
+                                  (vertex_count a multiple of 3: glDrawArrays order, raylib's Mesh
+                                  without indices); usually with weld_distance, as its corners repeat */
     int index_count;
     int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
     /* Engine vertex buffers as they are: offset is the byte offset of x inside
@@ -658,17 +661,20 @@ typedef struct fogvol_mesh_report {
     int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
                                   vertices counts the rest */
     /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
-       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
-       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
-       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
-       2^26 triangle x vertex pairs). */
+       every vertex the triangles use lies on the inner side of the plane of every non-degenerate
+       triangle (both after the weld: triangles it collapses have no plane; vertices of a shared
+       buffer that no triangle uses do not count), within 1e-5 of the used vertices' bounding box
+       diagonal (a convex hull: usable by fogvol_add_light); 0 when some vertex lies outside some face
+       plane (concave); -1 not checked (not a valid hull, or more than 2^26 triangle x vertex
+       pairs). */
     int convex;
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
-   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   (about 40 bytes per triangle, + 4 per index with 16-bit indices, without an
+   index array or when welding, + 24 to 32 per vertex when welding; the weld takes
+   O(n log n) time) comes from alloc (NULL = default). Never reads outside
    the vertex_count vertices (stride, offset) or indices[0 .. index_count).
    FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
    stride, unknown index_type, missing arrays, bad weld_distance). */
@@ -2453,18 +2459,32 @@ static int fogvol__mesh_stride(const fogvol_mesh_desc *d)
     return d->stride ? d->stride : 12;
 }
 
+/* No index array (fogvol_mesh_desc): the triangles are the vertices 0, 1, 2, then 3, 4, 5, ... */
+static int fogvol__non_indexed(const fogvol_mesh_desc *d)
+{
+    return !d->indices && !d->indices16 && d->index_count == 0;
+}
+
+/* Indices the mesh's triangles have (vertex_count without an index array). */
+static int fogvol__index_count(const fogvol_mesh_desc *d)
+{
+    return fogvol__non_indexed(d) ? d->vertex_count : d->index_count;
+}
+
 /* NULL for a usable layout, else what is wrong with it. */
 static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
 {
     int stride;
     if (!d || !d->positions) return "no positions";
-    if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
-        return "vertex_count must be > 0 and index_count a positive multiple of 3";
+    if (d->vertex_count <= 0 || fogvol__index_count(d) <= 0 || fogvol__index_count(d) % 3 != 0)
+        return fogvol__non_indexed(d) ? "no index array: vertex_count must be a positive multiple of 3"
+                                      : "vertex_count must be > 0 and index_count a positive multiple of 3";
     if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
     stride = fogvol__mesh_stride(d);
     if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
     if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
-    if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
+    if (!fogvol__non_indexed(d) && (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16))
+        return "no index array of index_type (leave both arrays NULL and index_count 0 for none)";
     if (!fogvol__finite(d->weld_distance) || d->weld_distance < 0) return "weld_distance negative or not finite";
     return NULL;
 }
@@ -2636,18 +2656,18 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     return merged;
 }
 
-/* The desc's indices as 32 bits, welded when asked: *out is NULL when the
-   desc's own 32-bit array serves as it is, else an array from alloc. */
+/* The desc's indices as 32 bits (0, 1, 2, ... without an index array), welded when asked: *out is NULL
+   when the desc's own 32-bit array serves as it is, else an array from alloc. */
 static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvol_allocator *alloc, uint32_t **out,
                                           int *welded)
 {
     const unsigned char *base = (const unsigned char *)d->positions + d->offset;
-    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0;
+    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0, n = fogvol__index_count(d);
     uint32_t *idx, *rep = NULL;
     *out = NULL;
     *welded = 0;
-    if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
-    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
+    if (!weld && d->index_type == FOGVOL_INDEX_UINT32 && !fogvol__non_indexed(d)) return FOGVOL_SUCCESS;
+    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)n);
     if (weld) rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
     if (weld && rep && idx) *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, alloc, rep);
     if (!idx || (weld && (!rep || *welded < 0))) {
@@ -2656,9 +2676,11 @@ static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvo
         *welded = 0;
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < d->index_count; ++i)
-        idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
-    for (i = 0; weld && i < d->index_count; ++i)
+    for (i = 0; i < n; ++i)
+        idx[i] = fogvol__non_indexed(d)                 ? (uint32_t)i
+                 : d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i]
+                                                        : d->indices[i];
+    for (i = 0; weld && i < n; ++i)
         if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
     fogvol__free(alloc, rep);
     *out = idx;
@@ -3104,7 +3126,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     w.stride = fogvol__mesh_stride(desc);
     w.base = (const unsigned char *)desc->positions + desc->offset;
     w.indices = indices;
-    w.ntri = desc->index_count / 3;
+    w.ntri = fogvol__index_count(desc) / 3;
     w.nvert = desc->vertex_count;
     rep->vertices = desc->vertex_count;
     rep->triangles = w.ntri;
@@ -6900,6 +6922,14 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
 
+/* A refusal of a public call: logged (error level) with why, the result returned, so that no refusal
+   goes unexplained. */
+static fogvol_result fogvol__refuse(const fogvol_context *ctx, fogvol_result r, const char *why)
+{
+    fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s (%s)", why, fogvol_result_string(r));
+    return r;
+}
+
 /* An object joins (count +1) or leaves (count -1) its kind's list. */
 static void fogvol__live_add(fogvol__live *head, fogvol__live *n, int *count)
 {
@@ -7247,6 +7277,11 @@ static fogvol_result fogvol__attach_backend(fogvol_context *ctx, const fogvol_co
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend table lacks a required entry");
             return FOGVOL_ERROR_INVALID_ARGUMENT;
         }
+        if ((int)b->dialect < 0 || (int)b->dialect >= FOGVOL_GLSL_COUNT) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in the backend table "
+                        "(FOGVOL_GLSL_*)", (int)b->dialect);
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
         ctx->be = *b;
         return FOGVOL_SUCCESS;
     }
@@ -7513,22 +7548,39 @@ static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
     ctx->cur.nlight = n;
 }
 
-/* The bounding box of the positions (finite: validated before). */
-static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
+/* The vertices the triangles use, each once (idx: the validated indices, all in range), in a list
+   from ctx's allocator of *count entries; NULL: out of memory. A shared vertex buffer's other
+   vertices are no part of the mesh: not in its bounds, not in its convexity. */
+static uint32_t *fogvol__referenced(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx, int *count)
+{
+    int i, n = 0, ni = fogvol__index_count(desc), nv = desc->vertex_count;
+    uint32_t *list = (uint32_t *)fogvol__alloc(&ctx->alloc, (sizeof(uint32_t) + 1u) * (size_t)nv);
+    unsigned char *seen;
+    *count = 0;
+    if (!list) return NULL;
+    seen = (unsigned char *)(list + nv);
+    memset(seen, 0, (size_t)nv);
+    for (i = 0; i < ni; ++i)
+        if (!seen[idx[i]]) {
+            seen[idx[i]] = 1;
+            list[n++] = idx[i];
+        }
+    *count = n;
+    return list;
+}
+
+/* The bounding box of the used vertices (finite: validated before). */
+static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc, const uint32_t *used, int nused)
 {
     size_t stride = (size_t)fogvol__mesh_stride(desc);
     const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
     int i, c;
-    for (c = 0; c < 3; ++c) {
-        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
-        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
-    }
-    for (i = 0; i < desc->vertex_count; ++i) {
+    for (i = 0; i < nused; ++i) {
         float p[3];
-        memcpy(p, base + (size_t)i * stride, sizeof p);
+        memcpy(p, base + (size_t)used[i] * stride, sizeof p);
         for (c = 0; c < 3; ++c) {
-            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
-            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
+            if (i == 0 || p[c] < m->bmin[c]) m->bmin[c] = p[c];
+            if (i == 0 || p[c] > m->bmax[c]) m->bmax[c] = p[c];
         }
     }
 }
@@ -7547,11 +7599,11 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     md.positions = desc->positions;
     md.vertex_count = desc->vertex_count;
     md.indices = idx ? idx : desc->indices;
-    md.index_count = desc->index_count;
+    md.index_count = fogvol__index_count(desc);
     if (ctx->be.caps & FOGVOL_CAP_MESH_LAYOUT) {
         md.stride = stride;
         md.offset = desc->offset;
-        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->weld_distance <= 0) { /* 16-bit as given */
+        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->indices16 && desc->weld_distance <= 0) { /* as given */
             md.index_type = FOGVOL_INDEX_UINT16;
             md.indices16 = desc->indices16;
             md.indices = NULL;
@@ -7578,16 +7630,18 @@ static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3]
     p[2] = f[2];
 }
 
-/* fogvol_mesh_report.convex of a valid hull: every vertex on the inner side of every face plane
-   (outward normals: counter-clockwise seen from outside), within 1e-5 of the box diagonal. */
-static int fogvol__convexity(const fogvol_mesh_desc *desc)
+/* fogvol_mesh_report.convex of a valid hull: every used vertex on the inner side of every face plane
+   (outward normals: counter-clockwise seen from outside), within 1e-5 of the used vertices' box
+   diagonal; decided on the triangles as validated (idx: welded), where the slivers that a weld closes
+   (repeated corners) have no plane. */
+static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused)
 {
-    int t, v, k, tris = desc->index_count / 3;
+    int t, v, k, tris = fogvol__index_count(desc) / 3;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0.0, tol;
-    if ((double)tris * (double)desc->vertex_count > 67108864.0) return -1;
-    for (v = 0; v < desc->vertex_count; ++v) {
+    if ((double)tris * (double)nused > 67108864.0) return -1;
+    for (v = 0; v < nused; ++v) {
         double p[3];
-        fogvol__vertex(desc, (uint32_t)v, p);
+        fogvol__vertex(desc, used[v], p);
         for (k = 0; k < 3; ++k) {
             if (p[k] < lo[k]) lo[k] = p[k];
             if (p[k] > hi[k]) hi[k] = p[k];
@@ -7598,12 +7652,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
     tol = 1e-5 * diag;
     for (t = 0; t < tris; ++t) {
         double a[3], b[3], c[3], n[3], len;
-        uint32_t ix[3];
-        for (k = 0; k < 3; ++k)
-            ix[k] = desc->index_type == FOGVOL_INDEX_UINT16 ? desc->indices16[3 * t + k] : desc->indices[3 * t + k];
-        fogvol__vertex(desc, ix[0], a);
-        fogvol__vertex(desc, ix[1], b);
-        fogvol__vertex(desc, ix[2], c);
+        fogvol__vertex(desc, idx[3 * t], a);
+        fogvol__vertex(desc, idx[3 * t + 1], b);
+        fogvol__vertex(desc, idx[3 * t + 2], c);
         for (k = 0; k < 3; ++k) {
             b[k] -= a[k];
             c[k] -= a[k];
@@ -7613,9 +7664,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
         n[2] = b[0] * c[1] - b[1] * c[0];
         len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
-        for (v = 0; v < desc->vertex_count; ++v) {
+        for (v = 0; v < nused; ++v) {
             double p[3];
-            fogvol__vertex(desc, (uint32_t)v, p);
+            fogvol__vertex(desc, used[v], p);
             if ((n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]) + n[2] * (p[2] - a[2])) / len > tol) return 0;
         }
     }
@@ -7627,11 +7678,13 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
 {
     fogvol_mesh_report rep;
     fogvol_mesh *m;
-    uint32_t *idx = NULL;
+    uint32_t *idx = NULL, *used;
     fogvol_result r;
     const char *problem;
+    int nused;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_mesh: desc or out is NULL");
     problem = fogvol__mesh_problem(desc);
     r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
     if (report) *report = rep;
@@ -7661,12 +7714,17 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
                     desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    if (!m) {
+    used = m ? fogvol__referenced(ctx, desc, idx ? idx : desc->indices, &nused) : NULL;
+    if (!m || !used) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: out of memory");
+        fogvol__free(&ctx->alloc, m);
         fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(m, 0, sizeof *m);
-    fogvol__mesh_box(m, desc);
+    fogvol__mesh_box(m, desc, used, nused);
+    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused) : -1;
+    fogvol__free(&ctx->alloc, used);
     r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
@@ -7675,9 +7733,8 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         return r;
     }
     m->vertex_count = desc->vertex_count;
-    m->index_count = desc->index_count;
+    m->index_count = fogvol__index_count(desc);
     m->volume = rep.valid;
-    m->convex = rep.valid ? fogvol__convexity(desc) : -1;
     if (report) report->convex = m->convex;
     fogvol__live_add(&ctx->meshes, &m->live, &ctx->live_meshes);
     *out = m;
@@ -7742,7 +7799,8 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     float tmax;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_ramp: desc or out is NULL");
     r = fogvol_make_color_ramp(desc, NULL, 0, &info, &tmax);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: invalid ramp description");
@@ -7753,7 +7811,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     if (!px || !rp) {
         fogvol__free(&ctx->alloc, px);
         fogvol__free(&ctx->alloc, rp);
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_ramp: out of memory");
     }
     memset(rp, 0, sizeof *rp);
     fogvol_make_color_ramp(desc, px, info.size, &info, &tmax);
@@ -7768,7 +7826,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     fogvol__free(&ctx->alloc, px);
     if (r != FOGVOL_SUCCESS) {
         fogvol__free(&ctx->alloc, rp);
-        return r;
+        return fogvol__refuse(ctx, r, "create_ramp: the backend could not make its texture");
     }
     rp->width = info.width;
     rp->max_thickness = tmax;
@@ -7802,14 +7860,22 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     fogvol_texture_desc td;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_volume_texture: desc or out is NULL");
     if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
                     "(got %dx%d)", desc->width, desc->height);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    if ((desc->filter != FOGVOL_FILTER_NEAREST && desc->filter != FOGVOL_FILTER_LINEAR) ||
+        (desc->wrap != FOGVOL_WRAP_REPEAT && desc->wrap != FOGVOL_WRAP_CLAMP)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture filter %d or wrap %d unknown (FOGVOL_FILTER_*, "
+                    "FOGVOL_WRAP_*)", (int)desc->filter, (int)desc->wrap);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
-    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    if (!t) return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_volume_texture: out of memory");
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
     r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
@@ -7983,6 +8049,16 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
     return FOGVOL_SUCCESS;
 }
 
+/* A viewport fogvol takes: its origin within -32768..32767 (the least viewport bounds range GL 4.1 /
+   ARB_viewport_array reports) and its size 1..16384, so that every sum of them is an int; else a
+   reason. */
+static const char *fogvol__viewport_problem(const int vp[4])
+{
+    if (vp[2] <= 0 || vp[3] <= 0 || vp[2] > 16384 || vp[3] > 16384) return "size outside 1..16384";
+    if (vp[0] < -32768 || vp[0] > 32767 || vp[1] < -32768 || vp[1] > 32767) return "origin outside -32768..32767";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     fogvol_result r;
@@ -7992,19 +8068,19 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
                     "fogvol: begin_frame without end_frame: the open frame is discarded");
         fogvol_cancel_frame(ctx);
     }
-    if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!d) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: desc is NULL");
     if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: need 0 < znear < zfar (got %g, %g)", (double)d->znear,
                     (double)d->zfar);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (d->viewport[2] <= 0 || d->viewport[3] <= 0 || d->viewport[2] > 16384 || d->viewport[3] > 16384) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport %dx%d outside 1..16384", d->viewport[2],
-                    d->viewport[3]);
+    if (fogvol__viewport_problem(d->viewport)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport (%d, %d) %dx%d: %s", d->viewport[0], d->viewport[1],
+                    d->viewport[2], d->viewport[3], fogvol__viewport_problem(d->viewport));
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: unknown composite");
     if (d->downsample < 0 || d->downsample > 2) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample %d is not 0, 1 or 2", d->downsample);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -8058,8 +8134,10 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!mesh || !model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder: mesh or model is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_occluder outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
@@ -8085,8 +8163,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fn) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder_callback: fn is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "add_occluder_callback outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
@@ -8159,8 +8240,11 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
-    if (!ctx || !desc || !desc->mesh || !desc->ramp) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh || !desc->ramp)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_volume: desc, its mesh or its ramp is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_volume outside a frame (after begin_frame only)");
     if (!desc->mesh->volume) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
@@ -8208,9 +8292,13 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
     fogvol_draw dr;
-    if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: model is NULL");
+    if (!ctx->cur.in_occluder_pass)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "occluder_transform outside an occluder callback (fogvol_add_occluder_callback)");
+    if (!fogvol__finite_n(model, 16))
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: non-finite model matrix");
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
     return FOGVOL_SUCCESS;
@@ -8283,7 +8371,8 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
 {
     fogvol_constants k;
     fogvol_result r;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "mrt_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     if (ctx->cfg.tier != FOGVOL_TIER_MRT || !ctx->cur.in_frame || !ctx->be.native_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
@@ -8384,7 +8473,8 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     fogvol_constants k;
     fogvol_result r;
     int fl;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     fl = ctx->cfg.tier == FOGVOL_TIER_FLOAT;
     if (!ctx->cur.in_frame || ctx->cur.nocc > 0 || !ctx->be.native_texture) {
@@ -9482,8 +9572,10 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     void *arr;
     fogvol_result r;
     float k;
-    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_light: desc or its mesh is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_light outside a frame (after begin_frame only)");
     if (!fogvol__light_ok(ctx->cfg.tier, ctx->cfg.variants)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
@@ -9804,7 +9896,9 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.overflow_frame = -1;
     if (stats) *stats = run.st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "end_frame without begin_frame (or after the frame was ended or cancelled)");
     r = fogvol__frame_refusal(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__begin_backend_frame(ctx, &run.info);
     if (r != FOGVOL_SUCCESS) {
@@ -10012,9 +10106,8 @@ static fogvol_result fogvol__post_check(fogvol_context *ctx, const fogvol_frame_
         why = "no depth texture (frame->engine_depth_texture)";
     else if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear))
         why = "need 0 < znear < zfar";
-    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || d->viewport[2] <= 0 || d->viewport[3] <= 0 ||
-             d->viewport[2] > 16384 || d->viewport[3] > 16384)
-        why = "viewport outside the framebuffer's 0..16384";
+    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || fogvol__viewport_problem(d->viewport))
+        why = "viewport origin outside 0..32767 or size outside 1..16384";
     else if (size[0] < 0 || size[1] < 0 || (size[0] && size[0] < d->viewport[0] + d->viewport[2]) ||
              (size[1] && size[1] < d->viewport[1] + d->viewport[3]))
         why = "texture_size smaller than the viewport's extent";
@@ -12344,7 +12437,11 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
         fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in fogvol_gl_desc (FOGVOL_GLSL_*)",
+                    (int)desc->dialect);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(gl, 0, sizeof *gl);
