@@ -153,8 +153,8 @@
        fogvol_occluder_info oi; fogvol_occluder_prepare(fv, &oi); // O texture, size, clear colour, uniforms
        // engine FBO: colour oi.texture + its own depth; shader: fogvol_occluder_snippet(),
        // fogvol_mrt[2] = oi.uniforms, colour = fogvol_occluder_color(-view_space_z)
-       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
-       //         weld_distance > 0 for seams and per-face vertices
+       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16 or no
+       //         index array (triangles in vertex order), weld_distance > 0 for seams and per-face vertices
 
    ANALYTIC FOG VOLUMES (no render passes; FOGVOL_NO_ANALYTIC leaves them out)
    ====================
@@ -832,7 +832,8 @@ typedef struct fogvol_frame_desc {
     float projection[16];
     float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
                                depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
-    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer: x and y within -32768..32767,
+                               width and height 1..16384 (else FOGVOL_ERROR_INVALID_ARGUMENT) */
     fogvol_composite composite;
     /* The engine's draw buffer the composite writes (index into its
        glDrawBuffers list; 0 = the first, the only one for most engines); the
