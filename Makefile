@@ -131,6 +131,7 @@ SCRIPT_RUNS = \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
   "gl_compile=$(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
+  "doc_index=tests/doc_index.sh" \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \
@@ -158,7 +159,7 @@ TEST_RUNS = $(foreach t,$(TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)"
 check: deps-test
 	@$(MAKE) --no-print-directory -j$(JOBS) $(BUILD)/test_cpu $(BUILD)/test_backend
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(TAP) $(BUILD)/test_backend" \
-	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh"
+	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" "doc_index=tests/doc_index.sh"
 
 # everything; the README's test command and CI
 test: deps-test deps-run

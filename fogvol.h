@@ -1,4 +1,4 @@
-/* fogvol.h - v0.1.0 - mesh-shaped fog and light volumes for real-time engines
+/* fogvol.h - v0.2.0 - mesh-shaped fog and light volumes for real-time engines
    MIT or public domain (see the end of this file).
 
    fogvol.h renders ordinary closed polygon meshes (convex or concave, animated,
@@ -30,8 +30,77 @@
        encoding             the RGB encoding of depths, fogvol_context_encoding
        textures             the lookup textures and colour ramps on the CPU
        shaders              the GLSL strings of each tier, variant and dialect
+       tuning               the speed-ups (on by default) and disable_speedups
        analytic fog         the analytic volumes (left out by FOGVOL_NO_ANALYTIC)
        CPU reference        the GPU arithmetic on the CPU, for tests and tools
+
+   API INDEX (every public function, one line each, by task)
+   =========
+   context      fogvol_create_context        make a context: backend, tier, variants, encoding
+                fogvol_destroy_context       free it and everything it owns
+                fogvol_context_tier          the tier and variants it chose
+                fogvol_context_encoding      its encoding (bits, faces it sums)
+                fogvol_set_dither            dithering on or off
+   meshes       fogvol_create_mesh           upload a closed mesh (validated, optionally welded)
+                fogvol_destroy_mesh          free it
+                fogvol_validate_mesh         check a mesh without a context (the report)
+   ramps        fogvol_create_ramp           thickness -> colour and alpha (extinction or table)
+                fogvol_destroy_ramp          free it
+   frames       fogvol_begin_frame           start a frame: camera, viewport, planes, debug read-back
+                fogvol_add_volume            a volume: mesh, model matrix, ramp, sign, textures
+                fogvol_add_occluder          an opaque mesh that cuts the volumes
+                fogvol_add_occluder_callback the engine draws an occluder itself
+                fogvol_occluder_transform    inside that callback: the model matrix to draw with
+                fogvol_add_light             a volume light by compare
+                fogvol_end_frame             draw and composite; the engine's state restored
+                fogvol_cancel_frame          drop the frame
+                fogvol_projection_planes     near and far planes from a projection matrix
+   textures     fogvol_create_volume_texture a density or colour texture for volumes
+                fogvol_destroy_volume_texture  free it
+   engine       fogvol_mrt_prepare           MRT: the O texture and uniforms for the engine's pass
+                fogvol_mrt_snippet           MRT: the GLSL to paste into the engine's opaque shader
+                fogvol_occluder_prepare      occluders drawn by the engine's own shaders into O
+                fogvol_occluder_snippet      the GLSL for those shaders
+   effects      fogvol_post_dof              depth of field (edge-preserving)
+                fogvol_post_outlines         outlines from depth (and normals)
+                fogvol_post_distance_fog     distance fog from depth
+   questions    fogvol_result_string         a result code's name
+                fogvol_tier_name             a tier's name
+                fogvol_dialect_name          a GLSL dialect's name
+                fogvol_combination_supported does a tier with these variants exist in a dialect
+                fogvol_msaa_supported        ... per sample on multisampled framebuffers
+                fogvol_tier_costs            passes and targets of a tier
+                fogvol_tier_uses_program     which programs a tier draws with
+   backends     fogvol_gl_backend_create     the GL backend on its own
+                fogvol_null_backend_init     a recording backend without a GPU (tests)
+                fogvol_uniform_name          the GLSL name of a uniform slot
+   shaders      fogvol_shader_strings        the GLSL of a program (tier, variants, dialect, stage)
+                fogvol_shader_source         the same with no variant
+                fogvol_post_shader_strings   the GLSL of an image-space effect
+   encoding     fogvol_encoding_init         the encoding with L bits per digit
+                fogvol_encoding_from_faces   ... that sums at least n faces
+                fogvol_encoding_from_precision ... with at least n bits
+                fogvol_encoding_table        every encoding (bits, faces, precision)
+                fogvol_compute_constants     the shaders' constants for near/far planes
+                fogvol_encode_depth          a depth as RGBA8 digits (CPU reference)
+                fogvol_sum_rgba8             saturating 8-bit sums (CPU reference)
+                fogvol_sum_encoded           sums of encoded depths (CPU reference)
+                fogvol_decode                digits -> depth (CPU reference)
+                fogvol_decode_difference     decode(a) - decode(b) (CPU reference)
+                fogvol_make_rg_ramp          the red+green lookup texture
+                fogvol_make_blue_ramp        the dithered blue lookup texture
+                fogvol_make_dither_index     the 8x8 dither pattern texture
+                fogvol_dither_threshold      a dither row's rounding threshold
+                fogvol_make_color_ramp       a colour ramp texture on the CPU
+   analytic     fogvol_analytic_prepare      analytic volumes (JCAB): prepare a set
+                fogvol_analytic_segment      one volume's entry and exit on a ray
+                fogvol_analytic_eval         fog of one eye-to-point ray
+                fogvol_analytic_batch        fog of many vertices (SIMD kernels)
+                fogvol_analytic_kernel_resolve  which kernel a batch runs
+                fogvol_fold_fog              fold fog into diffuse and specular
+                fogvol_analytic_pack_uniforms  the uniforms of the analytic GLSL
+                fogvol_analytic_shader_strings the analytic fog's GLSL
+                fogvol_analytic_snippet      its function for the engine's shaders
 
    BUILDING
    ========
@@ -63,7 +132,7 @@
    QUICK START (default GL backend, any GL 2.1+ / 3.x core / GLES2+ context)
    ===========
        fogvol_context_desc cd;  memset(&cd, 0, sizeof cd);   // 0 = default
-       cd.gl.get_proc_address = my_get_proc;                  // e.g. glfwGetProcAddress wrapper
+       cd.gl.get_proc = glfwGetProcAddress;                   // or SDL/EGL/GLX/your own loader
        fogvol_context *fv;
        if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) ...;
 
@@ -193,9 +262,9 @@
 #define FOGVOL_H
 
 #define FOGVOL_VERSION_MAJOR 0
-#define FOGVOL_VERSION_MINOR 1
+#define FOGVOL_VERSION_MINOR 2
 #define FOGVOL_VERSION_PATCH 0
-#define FOGVOL_VERSION_STRING "0.1.0"
+#define FOGVOL_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -405,9 +474,14 @@ FOGVOL_API const char *fogvol_dialect_name(fogvol_dialect dialect);
 typedef void (*fogvol_gl_proc)(void);
 typedef fogvol_gl_proc (*fogvol_gl_get_proc_fn)(const char *name, void *user_data);
 
+/* The GL backend's loader: one of the three (get_proc_address first where several are set). */
 typedef struct fogvol_gl_desc {
-    fogvol_gl_get_proc_fn get_proc_address; /* required for the GL backend */
+    fogvol_gl_get_proc_fn get_proc_address; /* a loader that takes user_data */
     void *user_data;
+    fogvol_gl_proc (*get_proc)(const char *name); /* a plain loader returning a function pointer, as it
+                                 is: glfwGetProcAddress, eglGetProcAddress, SDL3's SDL_GL_GetProcAddress */
+    void *(*get_proc_pointer)(const char *name); /* a plain loader returning void *, as it is: SDL2's
+                                 SDL_GL_GetProcAddress, glad-style loaders (GLADloadproc) */
     fogvol_dialect dialect;   /* 0 = from the context */
     int version_major;        /* 0 = from the context; else treat the context as this GL version */
     int version_minor;
@@ -467,130 +541,6 @@ typedef enum fogvol_overflow_policy {
    table (search "---- context desc"). */
 typedef struct fogvol_context_desc fogvol_context_desc;
 
-/* Speed-ups on by default; fogvol_context_desc.disable_speedups turns them off one by one.
-   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
-                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
-                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
-                 O pass (same pixels).
-   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
-                 instead of a filtered lookup at computed coordinates (same pixels).
-   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
-                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
-                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
-                 interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
-                 overflow check passes likewise.
-   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
-                 no O read without occluders (and no test for it with them), no density texture
-                 outside textured volumes, exp or
-                 ramp composite, no colour texture, no overflow test without show_overflow,
-                 target and engine-depth reads without the viewport offset where the viewport
-                 starts at the window origin) instead of one program that switches on uniforms;
-                 built on first use (same pixels).
-   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
-                 the depth is encoded and the dither row computed by arithmetic instead of three
-                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
-                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
-                 (FOGVOL_SPECIALIZE_ENCODING).
-   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
-                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
-                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
-                 newest count of each band: the whole picture over 8 frames, the same count while
-                 the picture holds still. Not with show_overflow (same pixels).
-   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
-                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
-                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
-                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
-   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
-                 FLOAT_O, below) in frames with
-                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
-                 and every volume's box either wholly between the near and far planes or wholly
-                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
-                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
-                 fragment behind an occluder is not shaded, and the composite adds the opaque
-                 depth once per missing back face. Other frames (a camera inside or near a volume)
-                 take the min compare as before. The same sums: B - F equals the min compare's
-                 bytes up to the faces that lie within depth-buffer precision of an occluder.
-                 FLOAT keeps the min compare: there the count needs a second float channel, and
-                 both ways tried measured slower on llvmpipe than the O read per face fragment
-                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
-                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
-                 against 16.1 ms).
-   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
-                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
-                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
-                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
-                 its resolve pass, which is exact in mediump.
-   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
-                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
-                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
-                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
-                 through the fragment shader (the same blend equation; the same pixels where the
-                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
-                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
-                 texture holding the normalised view depth d = (view depth - near) / (far - near),
-                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
-                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
-                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
-                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
-                 O's digits: one encode per fragment and no compare in the faces, and no encode where
-                 O is written. PS20 then draws frames with occluders with that compare, not
-                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
-                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
-                 PS13 keeps its RGBA8 O and the count). The
-                 same bytes: the faces encode O as the snippet or the O pass did (the same
-                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
-                 is the encoding of the lesser depth.
-   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
-                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
-                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
-                 at most one back and one front face on a ray, so no sum can saturate (the half is
-                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
-                 their box's diagonal, which a ray grazing them could cross more than once), and the
-                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
-                 out).
-   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
-                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
-                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
-                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
-                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
-                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
-                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
-                 about half a texture read, on tile-based GPUs it comes from tile memory
-                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
-   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
-                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
-                 without density-textured volumes sums its faces by programmable blending: one pass
-                 over every face reads B's RGBA8 pixel as a 32-bit
-                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
-                 of it and O) for a back face and subtracts it for a front face (sign flipped for
-                 negative volumes), and writes the integer back; the composite reads that one target.
-                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
-                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
-                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
-                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
-                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
-                 Not the digits' bytes: closer to the true thickness. */
-enum {
-    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
-    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
-    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
-    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
-    FOGVOL_SPEEDUP_ALU = 1u << 5,
-    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
-    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
-    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
-    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
-    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
-    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
-    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
-    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
-    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
-};
-#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
 /* Frees everything the context owns, host memory and backend objects: its targets, programs and
@@ -1425,22 +1375,27 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
    Here, after the backend table, because it holds a fogvol_backend by value (C99 needs
    the struct complete); fogvol_create_context is in the context section. */
 struct fogvol_context_desc {
-    fogvol_allocator allocator;
-    fogvol_logger logger;
+    /* what most engines set (all 0 = the GL backend, the best tier it runs, default encoding) */
+    fogvol_gl_desc gl;     /* the GL backend: its loader (gl.get_proc = glfwGetProcAddress, ...) */
+    fogvol_logger logger;  /* where errors, warnings and shader info logs go (0 = nowhere) */
+    fogvol_tier tier;      /* 0 = the first of FLOAT, MRT (with engine_mrt), PS20, PS13 that the
+                              backend runs with the required variants */
+    unsigned variants;     /* FOGVOL_VARIANT_* the engine requires: refused where the tier (AUTO: every
+                              tier the backend runs) does not take them */
+    unsigned preferred_variants; /* FOGVOL_VARIANT_* used where the chosen tier, dialect and backend take
+                              them, left out (logged at INFO) where not; fogvol_context_tier says which */
     int encoding_bits;     /* 0 = FOGVOL_DEFAULT_BITS (4: 12 bits, 16 faces); WIDE: 0 = 3, > 3 refused;
                               SINGLE_TARGET: 8 refused (no face fits beside the bias) */
-    fogvol_tier tier;      /* 0 = chosen from the backend's caps and dialect:
-                              FLOAT if float blending, else MRT if engine_mrt and MRT,
-                              else PS20 if highp fragment shaders, else PS13 */
-    unsigned variants;     /* FOGVOL_VARIANT_* */
+    /* less often */
+    fogvol_allocator allocator; /* 0 = FOGVOL_MALLOC / FOGVOL_FREE */
     int engine_mrt;        /* 1: the engine will write O in its opaque pass (lets AUTO pick MRT) */
     int disable_dither;    /* dithering is on by default */
     fogvol_msaa msaa;      /* multisampled engine framebuffers: 0 = AUTO (per sample, or refused) */
-    fogvol_backend backend;/* a custom table; if create_texture is NULL the GL backend is used */
-    fogvol_gl_desc gl;     /* for the GL backend */
     fogvol_overflow_policy overflow_policy; /* 0 = FOGVOL_OVERFLOW_WARN_ONCE */
-    unsigned disable_speedups; /* FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on); for
-                                  measuring what each one gives (bench/bench.c) */
+    fogvol_backend backend;/* a custom table (backend authors); if create_texture is NULL the GL backend
+                              is used */
+    unsigned disable_speedups; /* tuning: FOGVOL_SPEEDUP_* bits to turn off (0 = every speed-up on),
+                                  to measure what each gives (see "---- tuning") */
 };
 
 /* ---- encoding ------------------------------------------------------------
@@ -1653,6 +1608,137 @@ FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned variants, fog
    fv_pscene (unit 0), fv_pdepth (1), fv_pnormal or fv_colors (2). */
 FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
                                                     fogvol_stage stage, const char **strings, int *count);
+
+/* ---- tuning: the speed-ups (for measuring them, and for backend authors) ---------
+   Every speed-up is on by default wherever the tier, variants, dialect and backend take it (the
+   tier table in the >>tiers section says where) and gives the same pixels, or closer ones where
+   said; fogvol_context_desc.disable_speedups turns them off one by one, to measure what each gives
+   (bench/bench.c) or to rule one out on a driver. The FOGVOL_SPECIALIZE_* bits above are the
+   programs some of them draw with. */
+/* The speed-ups (bits of fogvol_context_desc.disable_speedups):
+   SKIP_OPAQUE   no occluder, no engine depth (no MRT, ENGINE_DEPTH, COUNT or
+                 fogvol_occluder_prepare): the opaque depth O is the far plane. FLOAT faces skip
+                 their O read; the other tiers keep the O cleared by an earlier frame and draw no
+                 O pass (same pixels).
+   TEXEL_FETCH   GLSL 130+ and 300 es: fogvol's targets are read with texelFetch at the pixel
+                 instead of a filtered lookup at computed coordinates (same pixels).
+   EXP_COMPOSITE EXTINCTION ramps whose range reaches 7 / density: the composite computes
+                 alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
+                 the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
+                 interpolation error, rgb is the same).
+   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
+                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
+                 overflow check passes likewise.
+   SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
+                 no O read without occluders (and no test for it with them), no density texture
+                 outside textured volumes, exp or
+                 ramp composite, no colour texture, no overflow test without show_overflow,
+                 target and engine-depth reads without the viewport offset where the viewport
+                 starts at the window origin) instead of one program that switches on uniforms;
+                 built on first use (same pixels).
+   ALU           PS20 and MRT (not WIDE), and PS13 in GLSL 330 and 300 es, take FOGVOL_VARIANT_ALU:
+                 the depth is encoded and the dither row computed by arithmetic instead of three
+                 lookup texture reads per face fragment (same bytes; fogvol_context_tier reports the
+                 variant). With SPECIALIZE the encoding's constants are compiled into the programs
+                 (FOGVOL_SPECIALIZE_ENCODING).
+   OVERFLOW_BANDS the overflow check passes of a frame cover one of FOGVOL_OVERFLOW_BANDS (8)
+                 horizontal bands of the group's rectangle, in turn, instead of all of it (an
+                 eighth of their cost); fogvol_frame_stats.overflow_pixels_late then sums the
+                 newest count of each band: the whole picture over 8 frames, the same count while
+                 the picture holds still. Not with show_overflow (same pixels).
+   FAST_EXP      the EXP_COMPOSITE alpha from a degree-2 polynomial of 2^x with the exponent added in
+                 integer bits, where the dialect has floatBitsToInt (GLSL 330, 300 es), instead of
+                 exp() (FOGVOL_SPECIALIZE_FAST_EXP; with SPECIALIZE): the transmittance
+                 1 - alpha is within 0.27% of exp(-density t), alpha exactly 0 at t = 0.
+   DEPTH_TEST    PS20 and PS13 (not SINGLE_TARGET, WIDE or ENGINE_DEPTH) whose O is RGBA8 (not
+                 FLOAT_O, below) in frames with
+                 fogvol_add_occluder* calls, no density-textured volume, no fogvol_add_light,
+                 and every volume's box either wholly between the near and far planes or wholly
+                 outside that range: the frame is drawn as the COUNT variant (Baker's face count,
+                 FOGVOL_SPECIALIZE_COUNT): the faces are depth-tested against the occluders, so a
+                 fragment behind an occluder is not shaded, and the composite adds the opaque
+                 depth once per missing back face. Other frames (a camera inside or near a volume)
+                 take the min compare as before. The same sums: B - F equals the min compare's
+                 bytes up to the faces that lie within depth-buffer precision of an occluder.
+                 FLOAT keeps the min compare: there the count needs a second float channel, and
+                 both ways tried measured slower on llvmpipe than the O read per face fragment
+                 they save (cut by floor+pillars: an RG32F sum and count with O read by the
+                 composite, 19.7 against 18.2 ms; an RGBA32F target holding O in alpha, 17.1
+                 against 16.1 ms).
+   INLINE_RESOLVE PS13 where the backend has FOGVOL_CAP_HIGHP_FRAGMENT: the composite and the overflow
+                 check passes resolve B - F themselves (the RESOLVE program's digit arithmetic, exact
+                 in fp32; FOGVOL_SPECIALIZE_INLINE_RESOLVE) instead of reading the resolved target T:
+                 one full-screen pass and one target fewer (same bytes). Without highp the tier keeps
+                 its resolve pass, which is exact in mediump.
+   BLEND_COLOR   composites of one colour (the EXP composite without a colour texture, outside
+                 show_overflow) on a backend with FOGVOL_CAP_BLEND_CONSTANT: the blend unit supplies
+                 the fog colour (fogvol_pass.blend_constant; GL: CONSTANT_COLOR) and the program
+                 writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
+                 through the fragment shader (the same blend equation; the same pixels where the
+                 blender rounds the constant colour as it rounds a shader's output, as Mesa does).
+   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
+                 on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
+                 texture holding the normalised view depth d = (view depth - near) / (far - near),
+                 written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
+                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
+                 (fogvol_occluder_info.format), and the faces encode min(own depth, O)
+                 (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
+                 O's digits: one encode per fragment and no compare in the faces, and no encode where
+                 O is written. PS20 then draws frames with occluders with that compare, not
+                 DEPTH_TEST's face count, whose composite would read O's digits (on llvmpipe the
+                 compare with the R32F O costs less; PS13's, which normalises its encoding, more:
+                 PS13 keeps its RGBA8 O and the count). The
+                 same bytes: the faces encode O as the snippet or the O pass did (the same
+                 arithmetic on the same float), and the encode is monotonic, so the lesser encoding
+                 is the encoding of the lesser depth.
+   SKIP_CHECK    RGBA8 tiers (not SINGLE_TARGET or NEAR_CLAMP): a ramp group whose volumes are all
+                 convex (fogvol_mesh_report.convex), at most half as many as a target sums
+                 (fogvol_encoding.max_faces / 2), draws no overflow check pass: a convex volume puts
+                 at most one back and one front face on a ray, so no sum can saturate (the half is
+                 a margin for meshes convex only within the convexity test's tolerance, 1e-5 of
+                 their box's diagonal, which a ray grazing them could cross more than once), and the
+                 frame counts 0 for the group at once (fogvol_frame_stats.overflow_passes leaves it
+                 out).
+   FRAMEBUFFER_FETCH  on a backend with FOGVOL_CAP_FRAMEBUFFER_FETCH (GL: EXT_shader_framebuffer_fetch
+                 with GLSL 330 or 300 es and per-buffer colour masks), the face passes that read fogvol's
+                 O (FLOAT, PS20, MRT and PS13 comparing with the occluders' depth; not the face count,
+                 WIDE, FLOAT + ENGINE_DEPTH or multisampled targets) read it from the framebuffer: O is
+                 bound beside the sum as a write-masked colour attachment (fogvol_pass.read_target)
+                 and the program reads its value there (FOGVOL_SPECIALIZE_FETCH_O) instead of a
+                 texelFetch. The same value, so the same bytes; on llvmpipe a framebuffer read costs
+                 about half a texture read, on tile-based GPUs it comes from tile memory
+                 (fogvol_frame_stats.fetched_o). A program that does not build turns it off.
+   EXACT_SUM     PS20, MRT and PS13 with FRAMEBUFFER_FETCH and fp32 fragment shaders, and FLOAT_O
+                 (PS13 then keeps O as R32F too; not SINGLE_TARGET; single-sample): a ramp group
+                 without density-textured volumes sums its faces by programmable blending: one pass
+                 over every face reads B's RGBA8 pixel as a 32-bit
+                 integer (FOGVOL_SPECIALIZE_EXACT_SUM), adds its depth quantised to 24 bits (the lesser
+                 of it and O) for a back face and subtracts it for a front face (sign flipped for
+                 negative volumes), and writes the integer back; the composite reads that one target.
+                 Modular arithmetic, so the order of the faces does not matter, and the result is exact
+                 to 2^-24 of the depth range: no F target, no dither, no digits that saturate, so no
+                 overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
+                 to 127 times the depth range, 127 layers each as deep as the whole range (groups of
+                 128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
+                 Not the digits' bytes: closer to the true thickness. */
+enum {
+    FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
+    FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
+    FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
+    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
+    FOGVOL_SPEEDUP_ALU = 1u << 5,
+    FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
+    FOGVOL_SPEEDUP_FAST_EXP = 1u << 7,
+    FOGVOL_SPEEDUP_DEPTH_TEST = 1u << 8,
+    FOGVOL_SPEEDUP_INLINE_RESOLVE = 1u << 9,
+    FOGVOL_SPEEDUP_BLEND_COLOR = 1u << 10,
+    FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
+    FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
+    FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
+    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
+};
+#define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
 #ifndef FOGVOL_NO_ANALYTIC /* the analytic fog shares nothing with the renderer: define it to leave it out */
 /* ---- analytic fog volumes (JCAB, GDC 2001) -------------------------------
@@ -5425,155 +5511,180 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
 #endif /* FOGVOL_NO_ANALYTIC */
 
 /* >>tiers ================================================================= */
-/* What each tier can do: the variants, speed-ups and features it supports and what it costs. */
+/* What each tier can do: one row of fogvol__tiers per fogvol_tier, read by every question the library
+   asks about a tier (fogvol_combination_supported, fogvol_msaa_supported, fogvol_tier_uses_program,
+   fogvol_tier_costs, fogvol_shader_strings, the context's choice of tier and speed-ups, the frame's
+   plan). A feature exists on a tier with a set of variants unless the set holds one of its bits in the
+   row's off[] (FOGVOL__NEVER there: not on this tier) and it holds all of need[].
+   To add a tier: its value in fogvol_tier, its row here, and the passes that differ in the >>passes
+   section. To add a speed-up or feature: its FOGVOL__F_ value, its off[] entry in each row, the
+   context's switch for it (>>context) and the one pass function that uses it. */
+
+enum {
+    FOGVOL__F_ENCODE,         /* fogvol draws O itself with the ENCODE program (occluders, or the engine's depth) */
+    FOGVOL__F_RESOLVE,        /* B - F is resolved into an encoded thickness T before the composite (PS13) */
+    FOGVOL__F_CHECK,          /* the sums can saturate: overflow check passes (FOGVOL_PROGRAM_CHECK) */
+    FOGVOL__F_DENSITY,        /* faces weighted by a volume's density texture */
+    FOGVOL__F_LIGHT,          /* volume lights by compare (FOGVOL_PROGRAM_LIGHT) */
+    FOGVOL__F_COLORS,         /* the one-pass colour group (FOGVOL_PROGRAM_COLOR_FACE, _COMPOSITE) */
+    FOGVOL__F_MSAA,           /* per-sample rendering into a multisampled engine framebuffer */
+    FOGVOL__F_ALU,            /* FOGVOL_SPEEDUP_ALU: FOGVOL_VARIANT_ALU added where the dialect takes it */
+    FOGVOL__F_INLINE_RESOLVE, /* FOGVOL_SPEEDUP_INLINE_RESOLVE: the composite resolves B - F itself */
+    FOGVOL__F_FLOAT_O,        /* FOGVOL_SPEEDUP_FLOAT_O: O is R32F (FOGVOL_SPECIALIZE_FLOAT_O) */
+    FOGVOL__F_FETCH_O,        /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O there (FOGVOL_SPECIALIZE_FETCH_O) */
+    FOGVOL__F_EXACT_SUM,      /* FOGVOL_SPEEDUP_EXACT_SUM: 32-bit integer sums (FOGVOL_SPECIALIZE_EXACT_SUM) */
+    FOGVOL__F_DEPTH_TEST,     /* FOGVOL_SPEEDUP_DEPTH_TEST: frames drawn as COUNT (FOGVOL_SPECIALIZE_COUNT) */
+    FOGVOL__F_COUNT
+};
+#define FOGVOL__NEVER 0x80000000u /* in off[]: the tier has no such feature (no variant uses this bit) */
+
+typedef struct fogvol__tier_row {
+    const char *name;           /* fogvol_tier_name */
+    const char *define;         /* its line in every program (fogvol_shader_strings) */
+    unsigned char paper_passes; /* fogvol_tier_costs: as the white paper counts them */
+    unsigned char passes;       /* passes fogvol issues for one group, no variant */
+    unsigned char targets;      /* targets fogvol allocates, no variant */
+    unsigned char modern;       /* needs a dialect with float targets, two outputs and texelFetch */
+    fogvol_format sum_format;   /* the format of the face sums (RGBA8: encoded digits) */
+    unsigned caps;              /* backend caps (FOGVOL_CAP_*) it needs */
+    unsigned auto_caps;         /* ... for FOGVOL_TIER_AUTO to choose it */
+    unsigned variants;          /* the variants it takes */
+    unsigned modern_variants;   /* ... those of them that need a modern dialect */
+    unsigned int_variants;      /* ... and those that need highp integers (GLSL 330, 300 es) */
+    unsigned off[FOGVOL__F_COUNT], need[FOGVOL__F_COUNT];
+} fogvol__tier_row;
+
+/* (S single target, C count, A ALU, N near clamp, E engine depth, W wide, K colours) */
+#define FOGVOL__S FOGVOL_VARIANT_SINGLE_TARGET
+#define FOGVOL__C FOGVOL_VARIANT_COUNT
+#define FOGVOL__A FOGVOL_VARIANT_ALU
+#define FOGVOL__N FOGVOL_VARIANT_NEAR_CLAMP
+#define FOGVOL__E FOGVOL_VARIANT_ENGINE_DEPTH
+#define FOGVOL__W FOGVOL_VARIANT_WIDE
+#define FOGVOL__K FOGVOL_VARIANT_COLORS
+#define FOGVOL__X FOGVOL__NEVER
+static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
+    {"auto", "", 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
+     {FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
+     {0}},
+    /* PS13: O, B, F, T resolved, composite; lowp/mediump (texture ramps, per-channel compare) */
+    {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
+     FOGVOL__A,
+     /*       ENCODE RESOLVE CHECK DENSITY LIGHT COLORS MSAA                 ALU */
+     {0, 0, 0, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W,
+      /* INLINE_RESOLVE FLOAT_O                          FETCH_O */
+      0, FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      /* EXACT_SUM                                                     DEPTH_TEST */
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* PS20: O, B, F, composite */
+    {"PS20", "", 5, 4, 3, 0, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
+     FOGVOL__S | FOGVOL__C | FOGVOL__A | FOGVOL__N | FOGVOL__E | FOGVOL__W, FOGVOL__E, 0,
+     {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+     {0}},
+    /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
+    {"MRT", "", 4, 3, 3, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
+     {FOGVOL__X, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__X, FOGVOL__W, FOGVOL__X,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X},
+     {0}},
+    /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
+    {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
+     FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
+     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
+     {0, 0, 0, 0, 0, FOGVOL__K}}};
+#undef FOGVOL__S
+#undef FOGVOL__C
+#undef FOGVOL__A
+#undef FOGVOL__N
+#undef FOGVOL__E
+#undef FOGVOL__W
+#undef FOGVOL__K
+#undef FOGVOL__X
+
+/* Variants that cannot go together on any tier, and what a variant needs of every tier's backend. */
+static const unsigned fogvol__variant_conflicts[][2] = {
+    {FOGVOL_VARIANT_SINGLE_TARGET, FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_WIDE, FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT},
+    {FOGVOL_VARIANT_ENGINE_DEPTH, FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE}};
+#define FOGVOL__TWO_OUTPUTS FOGVOL_VARIANT_WIDE /* variants whose programs write two colour outputs */
+
+/* The row of a tier; NULL for values out of range. */
+static const fogvol__tier_row *fogvol__tier(fogvol_tier tier)
+{
+    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return NULL;
+    return &fogvol__tiers[tier];
+}
+
+/* Whether feature f (FOGVOL__F_*) exists on the tier with variants v. */
+static int fogvol__tier_has(fogvol_tier tier, unsigned v, int f)
+{
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t && !(t->off[f] & (v | FOGVOL__NEVER)) && (t->need[f] & v) == t->need[f];
+}
 
 FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
 {
-    static const char *const names[FOGVOL_TIER_COUNT] = {"auto", "PS13", "PS20", "MRT", "FLOAT"};
-    if ((int)tier < 0 || (int)tier >= FOGVOL_TIER_COUNT) return "invalid";
-    return names[tier];
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    return t ? t->name : "invalid";
 }
 
-/* Tiers and variants that can weight faces by a density texture and draw volume lights. */
-static int fogvol__density_ok(fogvol_tier tier, unsigned v)
+/* GLSL 330 and 300 es guarantee highp integers and bit operations (PS13's integer ALU encode) */
+static int fogvol__dialect_integers(fogvol_dialect dialect)
 {
-    if (tier == FOGVOL_TIER_FLOAT) return 1;
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE));
-}
-
-static int fogvol__light_ok(fogvol_tier tier, unsigned v)
-{
-    return tier == FOGVOL_TIER_FLOAT || ((tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_MRT) &&
-                                         !(v & FOGVOL_VARIANT_WIDE));
+    return dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES;
 }
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     const fogvol__dialect_info *di = fogvol__dialect(dialect);
-    int modern; /* float targets, multiple outputs */
-    if (!di) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & ~(unsigned)FOGVOL_VARIANT_ALL) return FOGVOL_ERROR_UNSUPPORTED;
-    modern = !di->legacy;
-    if ((v & FOGVOL_VARIANT_SINGLE_TARGET) && (v & FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_COLORS) && tier != FOGVOL_TIER_FLOAT) return FOGVOL_ERROR_UNSUPPORTED;
-    if ((v & FOGVOL_VARIANT_WIDE) && (tier != FOGVOL_TIER_PS20 || di->outputs < 2 ||
-                                      (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT))))
-        return FOGVOL_ERROR_UNSUPPORTED; /* GLES2 has one colour output */
-    switch (tier) {
-    case FOGVOL_TIER_PS13: /* texture ramps for GPUs without fp32 fragment maths; the integer ALU encode
-                              where the dialect guarantees highp integers (GLSL 330, 300 es) */
-        if ((v & FOGVOL_VARIANT_ALU) && dialect != FOGVOL_GLSL_330 && dialect != FOGVOL_GLSL_300ES)
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    size_t i;
+    if (!di || !t || tier == FOGVOL_TIER_AUTO || (v & ~t->variants)) return FOGVOL_ERROR_UNSUPPORTED;
+    for (i = 0; i < sizeof fogvol__variant_conflicts / sizeof fogvol__variant_conflicts[0]; ++i)
+        if ((v & fogvol__variant_conflicts[i][0]) && (v & fogvol__variant_conflicts[i][1]))
             return FOGVOL_ERROR_UNSUPPORTED;
-        return (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE))
-                   ? FOGVOL_ERROR_UNSUPPORTED
-                   : FOGVOL_SUCCESS;
-    case FOGVOL_TIER_PS20: /* the engine's depth: a full-screen encode pass reading it by texelFetch */
-        if ((v & FOGVOL_VARIANT_ENGINE_DEPTH) && (!modern || (v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE))))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return FOGVOL_SUCCESS;
-    case FOGVOL_TIER_MRT:
-        if (v & (FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* the engine's shader needs 2 outputs */
-    case FOGVOL_TIER_FLOAT:
-        if (v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_ALU))
-            return FOGVOL_ERROR_UNSUPPORTED;
-        return modern ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED; /* float targets and blending */
-    default: return FOGVOL_ERROR_UNSUPPORTED;
-    }
+    if (di->legacy && (t->modern || (v & t->modern_variants))) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & t->int_variants) && !fogvol__dialect_integers(dialect)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((v & FOGVOL__TWO_OUTPUTS) && di->outputs < 2) return FOGVOL_ERROR_UNSUPPORTED; /* GLES2: one output */
+    return FOGVOL_SUCCESS;
 }
 
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
 {
     if (!fogvol__dialect(dialect) || !fogvol__dialect(dialect)->version_msaa) return FOGVOL_ERROR_UNSUPPORTED;
     if (fogvol_combination_supported(tier, v, dialect) != FOGVOL_SUCCESS) return FOGVOL_ERROR_UNSUPPORTED;
-    if (v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS))
-        return FOGVOL_ERROR_UNSUPPORTED; /* second attachments stay single-sample */
-    if (tier == FOGVOL_TIER_FLOAT) /* the engine's depth texture holds one depth per pixel */
-        return (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? FOGVOL_ERROR_UNSUPPORTED : FOGVOL_SUCCESS;
-    return tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
+    return fogvol__tier_has(tier, v, FOGVOL__F_MSAA) ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED;
 }
 
 FOGVOL_API int fogvol_tier_uses_program(fogvol_tier tier, unsigned v, fogvol_program program)
 {
-    switch (program) {
-    case FOGVOL_PROGRAM_ENCODE:
-        return tier != FOGVOL_TIER_MRT && !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-    case FOGVOL_PROGRAM_FACE:
-    case FOGVOL_PROGRAM_COMPOSITE:
-    case FOGVOL_PROGRAM_COMPOSITE_MESH: return 1;
-    case FOGVOL_PROGRAM_RESOLVE: return tier == FOGVOL_TIER_PS13;
-    case FOGVOL_PROGRAM_CHECK: return tier != FOGVOL_TIER_FLOAT; /* float sums cannot saturate */
-    case FOGVOL_PROGRAM_LIGHT: return fogvol__light_ok(tier, v);
-    case FOGVOL_PROGRAM_COLOR_FACE:
-    case FOGVOL_PROGRAM_COLOR_COMPOSITE: return tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_COLORS);
-    default: return 0;
-    }
+    /* the feature each program belongs to; -1: every tier's */
+    static const signed char feature[FOGVOL_PROGRAM_COUNT] = {
+        FOGVOL__F_ENCODE, -1, -1, -1, FOGVOL__F_RESOLVE, FOGVOL__F_CHECK, FOGVOL__F_LIGHT, FOGVOL__F_COLORS,
+        FOGVOL__F_COLORS};
+    if ((int)program < 0 || (int)program >= FOGVOL_PROGRAM_COUNT || !fogvol__tier(tier) || tier == FOGVOL_TIER_AUTO)
+        return 0;
+    return feature[program] < 0 || fogvol__tier_has(tier, v, feature[program]);
 }
 
 FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_tier_info *out)
 {
-    int single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    const fogvol__tier_row *t = fogvol__tier(tier);
+    /* a tier that draws O itself, in a variant that does not (FLOAT + ENGINE_DEPTH): no O pass, no O */
+    int no_o = t && t->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER && !fogvol__tier_has(tier, v, FOGVOL__F_ENCODE);
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     out->name = fogvol_tier_name(tier);
-    switch (tier) {
-    case FOGVOL_TIER_PS13:
-        out->paper_passes = 6;
-        out->library_passes = 5;
-        out->targets = single ? 3 : 4; /* O, B, F, T */
-        break;
-    case FOGVOL_TIER_PS20:
-        out->paper_passes = 5;
-        out->library_passes = 4;
-        out->targets = single ? 2 : 3;
-        break;
-    case FOGVOL_TIER_MRT:
-        out->paper_passes = 4;
-        out->library_passes = 3;
-        out->targets = single ? 2 : 3; /* O is written by the engine */
-        break;
-    case FOGVOL_TIER_FLOAT:
-        out->paper_passes = 3;
-        out->library_passes = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 2 : 3;
-        out->targets = (v & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 2;
-        break;
-    default: return FOGVOL_ERROR_INVALID_ARGUMENT;
-    }
+    if (!t || tier == FOGVOL_TIER_AUTO) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    out->paper_passes = t->paper_passes;
+    out->library_passes = t->passes - no_o;
+    out->targets = t->targets - no_o - ((v & FOGVOL_VARIANT_SINGLE_TARGET) ? 1 : 0); /* (S: no F) */
     return FOGVOL_SUCCESS;
-}
-
-/* FOGVOL_SPECIALIZE_FLOAT_O: a tier and variants whose O can be R32F (MRT, PS20; not WIDE, which
-   keeps O in two RGBA8 targets, ENGINE_DEPTH, whose O pass encodes the engine's depth, nor COUNT,
-   whose composite adds O's digits; PS13, whose faces normalise their encoding, measured slower
-   comparing with an R32F O than counting with its RGBA8 O) */
-static int fogvol__float_o_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_MRT || tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT));
-}
-
-/* FOGVOL_SPECIALIZE_COUNT: a tier and variants that the COUNT variant extends (PS20 and PS13, not
-   with SINGLE_TARGET, WIDE or ENGINE_DEPTH, nor COUNT itself) */
-/* FOGVOL_SPECIALIZE_FETCH_O: face programs that read fogvol's O (not the face count, WIDE's two targets,
-   FLOAT's engine depth texture, nor COLORS' faces) */
-static int fogvol__fetch_o_ok(fogvol_tier tier, unsigned v)
-{
-    return !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-           !(tier == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH));
-}
-
-/* FOGVOL_SPECIALIZE_EXACT_SUM: PS20, MRT and PS13 whose O can be R32F (fogvol__float_o_ok), not SINGLE_TARGET */
-static int fogvol__exact_sum_ok(fogvol_tier tier, unsigned v)
-{
-    return fogvol__float_o_ok(tier, v) && !(v & (FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_COLORS));
-}
-
-static int fogvol__count_spec_ok(fogvol_tier tier, unsigned v)
-{
-    return (tier == FOGVOL_TIER_PS20 || tier == FOGVOL_TIER_PS13) &&
-           !(v & (FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET | FOGVOL_VARIANT_WIDE |
-                  FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS));
 }
 
 /* >>shaders =============================================================== */
@@ -5598,9 +5709,6 @@ static const char fogvol__fs_msaa[] =
     "}\n"
     "#undef FV_TEXTURE\n"
     "#define FV_TEXTURE fv_tex\n";
-
-static const char *const fogvol__tier_define[FOGVOL_TIER_COUNT] = {"", "#define FV_PS13\n", "", "",
-                                                                   "#define FV_FLOAT\n"};
 
 static const char *const fogvol__variant_define[] = {"#define FV_SINGLE\n", "#define FV_COUNT\n",
                                                       "#define FV_ALU\n", "#define FV_NEAR_CLAMP\n",
@@ -6340,18 +6448,18 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
-        if (!fogvol__count_spec_ok(d->tier, v) ||
+        if (!fogvol__tier_has(d->tier, v, FOGVOL__F_DEPTH_TEST) ||
             fogvol_combination_supported(d->tier, v | FOGVOL_VARIANT_COUNT, d->dialect) != FOGVOL_SUCCESS ||
             (d->program == FOGVOL_PROGRAM_FACE && !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))
             return FOGVOL_ERROR_UNSUPPORTED; /* (COUNT has no density texture) */
         v |= FOGVOL_VARIANT_COUNT;
     }
-    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__float_o_ok(d->tier, v)) return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) && !fogvol__tier_has(d->tier, v, FOGVOL__F_FLOAT_O)) return FOGVOL_ERROR_UNSUPPORTED;
     di = fogvol__dialect(d->dialect);
-    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__fetch_o_ok(d->tier, v) || d->samples > 1))
+    if ((d->specialize & FOGVOL_SPECIALIZE_FETCH_O) && (!di->fs_fetch || !fogvol__tier_has(d->tier, v, FOGVOL__F_FETCH_O) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) &&
-        (!fogvol__exact_sum_ok(d->tier, v) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
+        (!fogvol__tier_has(d->tier, v, FOGVOL__F_EXACT_SUM) || !di->fs_fetch || /* (uint: the framebuffer fetch's dialects) */
          (d->program == FOGVOL_PROGRAM_FACE && (d->samples > 1 || !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY)))))
         return FOGVOL_ERROR_UNSUPPORTED;
     per_sample = d->samples > 1 && d->stage == FOGVOL_STAGE_FRAGMENT;
@@ -6368,11 +6476,11 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
     } else
         strings[n++] = di->fs;
-    if (fogvol__tier_define[d->tier][0]) strings[n++] = fogvol__tier_define[d->tier];
+    if (fogvol__tiers[d->tier].define[0]) strings[n++] = fogvol__tiers[d->tier].define;
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
     if (per_sample) strings[n++] = fogvol__fs_msaa;
-    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__density_ok(d->tier, v) &&
+    if (d->program == FOGVOL_PROGRAM_FACE && fogvol__tier_has(d->tier, v, FOGVOL__F_DENSITY) &&
         !(d->specialize & FOGVOL_SPECIALIZE_NO_DENSITY))
         strings[n++] = "#define FV_DENSITY\n";
     n = fogvol__specialize_defines(d, strings, n);
@@ -6999,7 +7107,7 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
         td.format = FOGVOL_FORMAT_RGBA8;
         td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
             td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
         td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
@@ -7173,40 +7281,53 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
 
-/* AUTO: FLOAT with float blending, MRT when the engine writes O and can,
-   PS20 with highp fragment shaders, else PS13; an explicit tier must exist in
-   the backend's dialect and caps. */
+/* Whether the backend can run tier t with variants v: the combination exists in its dialect, and it
+   has the caps the tier needs (automatic: to be chosen by FOGVOL_TIER_AUTO) and those of the
+   variants (two attachments for WIDE and COLORS, a depth texture for ENGINE_DEPTH). */
+static int fogvol__backend_runs(const fogvol_context *ctx, fogvol_tier t, unsigned v, int automatic)
+{
+    const fogvol__tier_row *row = fogvol__tier(t);
+    unsigned caps = ctx->be.caps, need = row->caps | (automatic ? row->auto_caps : 0u);
+    if (fogvol_combination_supported(t, v, ctx->be.dialect) != FOGVOL_SUCCESS || (caps & need) != need) return 0;
+    if ((v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
+        (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment))
+        return 0;
+    return !(v & FOGVOL_VARIANT_ENGINE_DEPTH) || (caps & FOGVOL_CAP_DEPTH_TEXTURE);
+}
+
+/* The tier: AUTO takes the first of FLOAT, MRT (when the engine writes O: desc->engine_mrt), PS20 and
+   PS13 that the backend runs with the required variants; an explicit tier must run with them. Then
+   each preferred variant joins where the tier, dialect and backend take it, and is left out (logged)
+   where not. */
 static fogvol_result fogvol__choose_tier(fogvol_context *ctx, const fogvol_context_desc *desc)
 {
-    unsigned caps = ctx->be.caps;
+    static const fogvol_tier order[4] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_MRT, FOGVOL_TIER_PS20, FOGVOL_TIER_PS13};
     fogvol_tier t = desc->tier;
-    if (t == FOGVOL_TIER_AUTO) {
-        if ((caps & FOGVOL_CAP_FLOAT_BLEND) &&
-            fogvol_combination_supported(FOGVOL_TIER_FLOAT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_FLOAT;
-        else if (desc->engine_mrt && (caps & FOGVOL_CAP_MRT) &&
-                 fogvol_combination_supported(FOGVOL_TIER_MRT, ctx->cfg.variants, ctx->be.dialect) == FOGVOL_SUCCESS)
-            t = FOGVOL_TIER_MRT;
-        else if (caps & FOGVOL_CAP_HIGHP_FRAGMENT)
-            t = FOGVOL_TIER_PS20;
+    unsigned v = desc->variants, bit;
+    int i;
+    for (i = 0; t == FOGVOL_TIER_AUTO && i < 4; ++i)
+        if ((order[i] != FOGVOL_TIER_MRT || desc->engine_mrt) && fogvol__backend_runs(ctx, order[i], v, 1))
+            t = order[i];
+    if (t == FOGVOL_TIER_AUTO || !fogvol__backend_runs(ctx, t, v, 0)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: %s%s with variants 0x%x does not run on this backend (GLSL %s, caps 0x%x); "
+                    "variants the engine only prefers go in fogvol_context_desc.preferred_variants",
+                    desc->tier == FOGVOL_TIER_AUTO ? "no tier" : "tier ",
+                    desc->tier == FOGVOL_TIER_AUTO ? "" : fogvol_tier_name(t), v,
+                    fogvol_dialect_name(ctx->be.dialect), ctx->be.caps);
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
+    for (bit = 1u; bit & FOGVOL_VARIANT_ALL; bit <<= 1) {
+        if (!(desc->preferred_variants & bit) || (v & bit)) continue;
+        if (fogvol__backend_runs(ctx, t, v | bit, 0))
+            v |= bit;
         else
-            t = FOGVOL_TIER_PS13;
-    }
-    if (fogvol_combination_supported(t, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: tier %s with variants 0x%x does not exist in GLSL %s",
-                    fogvol_tier_name(t), ctx->cfg.variants, fogvol_dialect_name(ctx->be.dialect));
-        return FOGVOL_ERROR_UNSUPPORTED;
-    }
-    if ((t == FOGVOL_TIER_FLOAT && !(caps & FOGVOL_CAP_FLOAT_BLEND)) ||
-        (t == FOGVOL_TIER_MRT && !(caps & FOGVOL_CAP_MRT)) ||
-        ((ctx->cfg.variants & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COLORS)) &&
-         (!(caps & FOGVOL_CAP_MRT) || !ctx->be.target_attachment)) ||
-        ((ctx->cfg.variants & FOGVOL_VARIANT_ENGINE_DEPTH) && !(caps & FOGVOL_CAP_DEPTH_TEXTURE))) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend cannot run tier %s (caps 0x%x)",
-                    fogvol_tier_name(t), caps);
-        return FOGVOL_ERROR_UNSUPPORTED;
+            fogvol__log(&ctx->log, FOGVOL_LOG_INFO,
+                        "fogvol: preferred variant 0x%x left out: tier %s with variants 0x%x does not take it here",
+                        bit, fogvol_tier_name(t), v);
     }
     ctx->cfg.tier = t;
+    ctx->cfg.variants = v;
     return FOGVOL_SUCCESS;
 }
 
@@ -7335,44 +7456,35 @@ static fogvol_result fogvol__context_resources(fogvol_context *ctx)
     return r;
 }
 
-/* FOGVOL_SPEEDUP_INLINE_RESOLVE: PS13 resolves B - F in its composite where fragment shaders have fp32. */
-static void fogvol__default_inline_resolve(fogvol_context *ctx)
+/* Whether the context runs speed-up sp (FOGVOL_SPEEDUP_*), whose feature f is in the tier's row:
+   not turned off (disable_speedups) and on the tier with the context's variants. */
+static int fogvol__speedup(const fogvol_context *ctx, unsigned sp, int f)
 {
-    ctx->cfg.inline_resolve = ctx->cfg.tier == FOGVOL_TIER_PS13 && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-                          !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_INLINE_RESOLVE);
+    return !(ctx->cfg.speedups_off & sp) && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, f);
 }
 
-/* FOGVOL_SPEEDUP_EXACT_SUM: what it needs besides the R32F O */
-static int fogvol__exact_sum_can(const fogvol_context *ctx)
+/* The speed-ups the context runs (after the tier): their rows in the tier table, the backend's caps
+   and the programs they need (SPECIALIZE for those that are specialised programs). ALU: the variant
+   joins where the dialect takes it. INLINE_RESOLVE: with fp32 fragment maths. FLOAT_O: where the
+   backend renders R32F targets and the faces can read its float (MRT; PS20 with fp32; PS13 only where
+   it sums in integers: its digits measured slower with it). EXACT_SUM: framebuffer fetch and fp32. */
+static void fogvol__choose_speedups(fogvol_context *ctx)
 {
-    return (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) && (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT) &&
-           !(ctx->cfg.speedups_off &
-             (FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-           fogvol__exact_sum_ok(ctx->cfg.tier, ctx->cfg.variants);
-}
-
-/* FOGVOL_SPEEDUP_FLOAT_O: O is R32F where the backend renders float targets: MRT's, and PS20's where
-   fragment shaders have fp32 (the faces encode O's float), and PS13's where it sums in integers
-   (FOGVOL_SPEEDUP_EXACT_SUM; its digits measured slower with it); not WIDE, ENGINE_DEPTH or COUNT
-   (fogvol__float_o_ok). */
-static void fogvol__default_float_o(fogvol_context *ctx)
-{
-    ctx->cfg.float_o = (ctx->be.caps & FOGVOL_CAP_FLOAT_TARGET) && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FLOAT_O) &&
-                   fogvol__float_o_ok(ctx->cfg.tier, ctx->cfg.variants) &&
-                   (ctx->cfg.tier == FOGVOL_TIER_MRT || (ctx->be.caps & FOGVOL_CAP_HIGHP_FRAGMENT)) &&
-                   (ctx->cfg.tier != FOGVOL_TIER_PS13 || fogvol__exact_sum_can(ctx)); /* (PS13: its integer sums) */
-}
-
-/* FOGVOL_SPEEDUP_ALU: PS20, MRT and PS13 encode by arithmetic (FOGVOL_VARIANT_ALU: the same bytes,
-   no lookup texture reads) unless the variant set or dialect cannot take it. */
-static void fogvol__default_alu(fogvol_context *ctx)
-{
-    unsigned v = ctx->cfg.variants | FOGVOL_VARIANT_ALU;
-    if ((ctx->cfg.tier == FOGVOL_TIER_PS20 || ctx->cfg.tier == FOGVOL_TIER_MRT || ctx->cfg.tier == FOGVOL_TIER_PS13) &&
-        !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_ALU) &&
-        !fogvol__has(ctx, FOGVOL_VARIANT_WIDE) &&
-        fogvol_combination_supported(ctx->cfg.tier, v, ctx->be.dialect) == FOGVOL_SUCCESS)
-        ctx->cfg.variants = v;
+    unsigned caps = ctx->be.caps, unspecialised = ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE;
+    int highp = (caps & FOGVOL_CAP_HIGHP_FRAGMENT) != 0, fetch = (caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) != 0;
+    int exact;
+    if (fogvol__speedup(ctx, FOGVOL_SPEEDUP_ALU, FOGVOL__F_ALU) &&
+        fogvol_combination_supported(ctx->cfg.tier, ctx->cfg.variants | FOGVOL_VARIANT_ALU, ctx->be.dialect) ==
+            FOGVOL_SUCCESS)
+        ctx->cfg.variants |= FOGVOL_VARIANT_ALU;
+    ctx->cfg.inline_resolve = highp && fogvol__speedup(ctx, FOGVOL_SPEEDUP_INLINE_RESOLVE, FOGVOL__F_INLINE_RESOLVE);
+    exact = fetch && highp && !unspecialised && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) &&
+            fogvol__speedup(ctx, FOGVOL_SPEEDUP_EXACT_SUM, FOGVOL__F_EXACT_SUM);
+    ctx->cfg.float_o = (caps & FOGVOL_CAP_FLOAT_TARGET) &&
+                       fogvol__speedup(ctx, FOGVOL_SPEEDUP_FLOAT_O, FOGVOL__F_FLOAT_O) &&
+                       (ctx->cfg.tier == FOGVOL_TIER_MRT || highp) && (ctx->cfg.tier != FOGVOL_TIER_PS13 || exact);
+    ctx->cfg.fetch_o = fetch && !unspecialised && fogvol__speedup(ctx, FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, FOGVOL__F_FETCH_O);
+    ctx->cfg.exact_sum = ctx->cfg.float_o && exact;
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -7398,7 +7510,6 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
     ctx->cfg.speedups_off = desc->disable_speedups;
-    ctx->cfg.variants = desc->variants;
     ctx->cfg.msaa = desc->msaa;
     fogvol_encoding_init(bits, &ctx->cfg.enc);
     r = fogvol__attach_backend(ctx, desc);
@@ -7407,15 +7518,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return r;
     }
     r = fogvol__choose_tier(ctx, desc);
-    if (r == FOGVOL_SUCCESS) {
-        fogvol__default_alu(ctx);
-        fogvol__default_inline_resolve(ctx);
-        fogvol__default_float_o(ctx);
-        ctx->cfg.fetch_o = (ctx->be.caps & FOGVOL_CAP_FRAMEBUFFER_FETCH) &&
-                       !(ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_SPECIALIZE)) &&
-                       fogvol__fetch_o_ok(ctx->cfg.tier, ctx->cfg.variants);
-        ctx->cfg.exact_sum = ctx->cfg.float_o && fogvol__exact_sum_can(ctx);
-    }
+    if (r == FOGVOL_SUCCESS) fogvol__choose_speedups(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
@@ -8209,7 +8312,7 @@ static fogvol_result fogvol__check_textures(fogvol_context *ctx, const fogvol_vo
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite density_map or color_map");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->density && !fogvol__density_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (desc->density && !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DENSITY)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: density textures need tier FLOAT, PS20 or MRT without the "
                     "COUNT and WIDE variants (tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -9577,7 +9680,7 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     if (!desc || !desc->mesh) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_light: desc or its mesh is NULL");
     if (!ctx->cur.in_frame)
         return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_light outside a frame (after begin_frame only)");
-    if (!fogvol__light_ok(ctx->cfg.tier, ctx->cfg.variants)) {
+    if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_LIGHT)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -9782,7 +9885,7 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
 {
     int i;
     if ((ctx->cfg.speedups_off & FOGVOL_SPEEDUP_DEPTH_TEST) || ctx->cfg.count_broken || ctx->cfg.float_o || ctx->cur.nocc == 0 ||
-        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__count_spec_ok(ctx->cfg.tier, ctx->cfg.variants))
+        ctx->cur.engine_occluders || ctx->cur.nlight > 0 || !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
         return 0;
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
@@ -12423,19 +12526,40 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     }
 }
 
-FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, const fogvol_allocator *alloc,
+/* fogvol_gl_desc's plain loaders behind the get_proc_address interface (user: the desc) */
+static fogvol_gl_proc fogvol__gl_plain_proc(const char *name, void *user)
+{
+    const fogvol_gl_desc *d = (const fogvol_gl_desc *)user;
+    fogvol_gl_proc f = NULL;
+    void *p;
+    if (d->get_proc) return d->get_proc(name);
+    p = d->get_proc_pointer(name); /* (a data pointer to a function pointer: bit for bit, as POSIX dlsym) */
+    if (p && sizeof p == sizeof f) memcpy(&f, &p, sizeof f);
+    return f;
+}
+
+FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, const fogvol_allocator *alloc,
                                                   const fogvol_logger *logger, fogvol_backend *out)
 {
     fogvol__gl *gl;
     fogvol_logger silent;
+    fogvol_gl_desc plain; /* in with a plain loader: get_proc_address calls it */
+    const fogvol_gl_desc *desc = in;
     const char *ver = NULL, *ext = NULL;
     fogvol_result r;
     if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     memset(&silent, 0, sizeof silent);
     if (!logger) logger = &silent;
+    if (in && !in->get_proc_address && (in->get_proc || in->get_proc_pointer)) {
+        plain = *in;
+        plain.get_proc_address = fogvol__gl_plain_proc;
+        plain.user_data = (void *)in;
+        desc = &plain;
+    }
     if (!desc || !desc->get_proc_address) {
-        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend needs get_proc_address");
+        fogvol__log(logger, FOGVOL_LOG_ERROR,
+                    "fogvol: the GL backend needs a loader (get_proc_address, get_proc or get_proc_pointer)");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) {
@@ -12473,14 +12597,15 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *desc, co
 
 /*
    REVISION HISTORY
-     unreleased        density and colour textures on volumes, volume light by compare,
+     0.2.0  (2026-11)  density and colour textures on volumes, volume light by compare,
                        image-space effects (depth of field, outlines, distance fog), GLES and
                        WebGL tested, float SIMD analytic kernels, engine conventions (clip
                        control, reversed-Z, G-buffers, MSAA, engine depth and occluders),
                        overflow counted every frame; outputs last everywhere; programs
                        specialised per configuration, PS20/MRT encode by arithmetic by default,
-                       resolve and check passes scissored; declarations in reading order (see
-                       CHANGELOG.md)
+                       resolve and check passes scissored; declarations in reading order; one
+                       tier table, sections by what they hold, preferred variants, plain GL
+                       loaders (see CHANGELOG.md)
      0.1.0  (2026-11)  first release: RGB encoding with dithered blue ramp, ramp and
                        colour-ramp textures, mesh validation, PS20 renderer, GL backend,
                        recording null backend.

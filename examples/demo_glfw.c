@@ -75,12 +75,6 @@ static void log_cb(void *u, fogvol_log_level level, const char *msg)
     if (level <= FOGVOL_LOG_WARNING) fprintf(stderr, "%s\n", msg);
 }
 
-static fogvol_gl_proc get_proc(const char *name, void *user)
-{
-    (void)user;
-    return glfwGetProcAddress(name); /* GLFWglproc and fogvol_gl_proc are both void (*)(void) */
-}
-
 /* The main group's colour ramp: the model R cycles, the blend L toggles. */
 static void make_main_ramp(app *a)
 {
@@ -120,7 +114,7 @@ static int build_fog(app *a, fogvol_tier tier, int bits)
     fogvol_ramp_desc rd;
     int i;
     memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = get_proc;
+    cd.gl.get_proc = glfwGetProcAddress; /* GLFWglproc and fogvol_gl_proc are both void (*)(void) */
     cd.logger.func = log_cb;
     cd.tier = tier;
     cd.encoding_bits = bits;

@@ -9,9 +9,10 @@
    carved by a negative sphere, a sunbeam and the lamp's cone of light. The
    opaque objects cut the volumes. It writes PNGs:
      scene_overview.png, scene_low.png, scene_inside_fog_bank.png  three viewpoints
-     tiers.png        the same frame per tier: PS13 | PS20 | FLOAT
+     tiers.png        the same frame per tier: PS13 | PS20 | FLOAT (the RGBA8 tiers on their
+                      classic digit path: FOGVOL_SPEEDUP_EXACT_SUM off)
      dither.png       L = 2 bits per channel (6-bit depth precision), close to the fog sphere,
-                      dithering off | on (the banding and its cure)
+                      dithering off | on (the banding and its cure; the digit path too)
      ramps.png        colour ramps: extinction | linear | artist gradient
      thickness.png    the raw thickness of the fog group as false colour
      dof.png, outlines.png, distance_fog.png  the overview with the image-space effects
@@ -68,6 +69,7 @@ typedef struct settings {
     int bits, dither, ramp; /* ramp: 0 extinction, 1 linear, 2 gradient */
     int w, h, view;
     float fog_scale;         /* density multiplier of the fog group */
+    unsigned speedups_off;   /* fogvol_context_desc.disable_speedups */
 } settings;
 
 typedef struct shot {
@@ -150,6 +152,7 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
     cd.tier = s->tier;
     cd.encoding_bits = s->bits;
     cd.disable_dither = !s->dither;
+    cd.disable_speedups = s->speedups_off;
     if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
         ds_gl_free(&d->gl);
         glu_destroy(&d->g);
@@ -244,11 +247,13 @@ static void false_colour(const float *t, unsigned char *out, int n, float tmax)
 
 /* n renders with these settings side by side; a setting whose context cannot
    be created (tier not available) is left out; report: print each one's tier */
-static void row(demo *d, const char *dir, const char *name, const settings *v, int n, int report_each)
+/* Renders n settings side by side into one PNG; returns the fewest pixels in which an earlier panel
+   differs from the last (0 when a panel is missing). */
+static int row(demo *d, const char *dir, const char *name, const settings *v, int n, int report_each)
 {
     shot sh[3];
     unsigned char *imgs[3];
-    int k, got = 0;
+    int k, i, got = 0, fewest = -1;
     for (k = 0; k < n; ++k) {
         sh[got] = new_shot(v[k].w, v[k].h);
         if (render(d, &v[k], 1, &sh[got])) {
@@ -259,10 +264,16 @@ static void row(demo *d, const char *dir, const char *name, const settings *v, i
         }
     }
     save_row(dir, name, imgs, got, v[0].w, v[0].h);
+    for (k = 0; k + 1 < got; ++k) {
+        int differ = 0;
+        for (i = 0; i < v[0].w * v[0].h; ++i) differ += memcmp(imgs[got - 1] + 4 * i, imgs[k] + 4 * i, 3) != 0;
+        if (fewest < 0 || differ < fewest) fewest = differ;
+    }
     for (k = 0; k < got; ++k) {
         if (report_each) report(fogvol_tier_name(sh[k].tier), &sh[k]);
         free_shot(&sh[k]);
     }
+    return got == n && fewest > 0 ? fewest : 0;
 }
 
 /* ---- image-space effects on the overview: the scene (opaque + fog volumes) goes into a framebuffer
@@ -638,29 +649,39 @@ int main(int argc, char **argv)
     }
     for (k = 0; k < 3; ++k) free_shot(&sh[k]);
 
-    /* side by side at half size: the tiers, dithering at L = 2 (6-bit depth), the colour ramps */
+    /* side by side at half size: the tiers, dithering at L = 2 (6-bit depth), the colour ramps. The
+       tiers and the dithering on the classic RGBA8 digit path, as GPUs without framebuffer fetch run
+       it: where the GL has it (Mesa), PS20 and PS13 sum 32-bit integers instead
+       (FOGVOL_SPEEDUP_EXACT_SUM), which have no digits to dither and look like FLOAT */
     {
         settings v[3];
+        int differ;
         for (k = 0; k < 3; ++k) {
             v[k] = s;
             v[k].w = DW / 2;
             v[k].h = DH / 2;
             v[k].view = 1;
+            v[k].speedups_off = FOGVOL_SPEEDUP_EXACT_SUM;
         }
         v[0].tier = FOGVOL_TIER_PS13;
         v[1].tier = FOGVOL_TIER_PS20;
         v[2].tier = FOGVOL_TIER_FLOAT;
-        row(&d, dir, "tiers.png", v, 3, 1);
+        differ = row(&d, dir, "tiers.png", v, 3, 1);
+        printf("# tiers.png: the RGBA8 tiers' digits differ from FLOAT in at least %d pixels\n", differ);
+        if (do_check) failures += !check(differ > 100, "tiers.png: the RGBA8 panels show their digits (differ from FLOAT)");
         for (k = 0; k < 2; ++k) { /* banding at low precision (close to the fog sphere) and its cure */
             v[k].tier = FOGVOL_TIER_PS20;
             v[k].bits = 2;
             v[k].view = 3;
             v[k].dither = k;
         }
-        row(&d, dir, "dither.png", v, 2, 0);
+        differ = row(&d, dir, "dither.png", v, 2, 0);
+        printf("# dither.png: %d pixels differ between dithering off and on\n", differ);
+        if (do_check) failures += !check(differ > 100, "dither.png: dithering changes the picture");
         for (k = 0; k < 3; ++k) {
             v[k] = v[2];
             v[k].tier = FOGVOL_TIER_AUTO;
+            v[k].speedups_off = 0;
             v[k].ramp = k;
         }
         row(&d, dir, "ramps.png", v, 3, 0);

@@ -154,28 +154,37 @@ add_executable(consumer main.c)
 target_link_libraries(consumer PRIVATE fogvol::fogvol)
 EOF
   prefix=$cm/prefix
-  run "cmake: configure, build and install fogvol" bash -c "cmake -S '$root' -B '$cm/fogvol' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=OFF \
+  run "cmake: configure, build and install fogvol (the defaults)" bash -c "cmake -S '$root' -B '$cm/fogvol' \
     -DCMAKE_INSTALL_PREFIX='$prefix' && cmake --build '$cm/fogvol' && cmake --install '$cm/fogvol'"
+  # installing the header builds nothing: no example, no test program
+  if [ -z "$(find "$cm/fogvol" -type f -perm -u+x -newer "$root/fogvol.h" ! -path '*/CMakeFiles/*' 2> /dev/null)" ]; then
+    ok "cmake: installing builds no program (examples and tests are off by default)"
+  else
+    not_ok "cmake: installing builds no program (examples and tests are off by default)"
+  fi
   if [ -f "$prefix/include/fogvol.h" ] && [ -f "$prefix/share/cmake/fogvol/fogvolConfig.cmake" ] &&
      [ -f "$prefix/share/cmake/fogvol/fogvolConfigVersion.cmake" ] && [ -f "$prefix/share/pkgconfig/fogvol.pc" ]; then
     ok "cmake: installed fogvol.h, fogvolConfig.cmake, fogvolConfigVersion.cmake, fogvol.pc"
   else
     not_ok "cmake: installed fogvol.h, fogvolConfig.cmake, fogvolConfigVersion.cmake, fogvol.pc"
   fi
-  run "cmake: find_package(fogvol 0.1) consumer builds and runs" bash -c "cmake -S '$cm/consumer' -B '$cm/find' \
-    -DCMAKE_PREFIX_PATH='$prefix' -DFOGVOL_WANT=0.1 && cmake --build '$cm/find' && '$cm/find/consumer'"
+  run "cmake: find_package(fogvol 0.2) consumer builds and runs" bash -c "cmake -S '$cm/consumer' -B '$cm/find' \
+    -DCMAKE_PREFIX_PATH='$prefix' -DFOGVOL_WANT=0.2 && cmake --build '$cm/find' && '$cm/find/consumer'"
   note '^fogvol [0-9]'
-  if cmake -S "$cm/consumer" -B "$cm/find_wrong" -DCMAKE_PREFIX_PATH="$prefix" -DFOGVOL_WANT=1.0 > "$log" 2>&1; then
-    not_ok "cmake: find_package(fogvol 1.0) is refused (0.x is only compatible within its minor version)"
-  else
-    ok "cmake: find_package(fogvol 1.0) is refused (0.x is only compatible within its minor version)"
-  fi
+  for want in 1.0 0.1; do # 0.1: the API before 0.2's breaking changes
+    if cmake -S "$cm/consumer" -B "$cm/find_wrong" -DCMAKE_PREFIX_PATH="$prefix" -DFOGVOL_WANT=$want > "$log" 2>&1; then
+      not_ok "cmake: find_package(fogvol $want) is refused (0.x is only compatible within its minor version)"
+    else
+      ok "cmake: find_package(fogvol $want) is refused (0.x is only compatible within its minor version)"
+    fi
+    rm -rf "$cm/find_wrong"
+  done
   run "cmake: add_subdirectory consumer builds and runs (examples off)" bash -c "cmake -S '$cm/consumer' \
     -B '$cm/subdir' -DFOGVOL_SOURCE_DIR='$root' && cmake --build '$cm/subdir' && '$cm/subdir/consumer'"
   # the tests through CMake: configure, build and ctest (one cmocka program, the ray-cast self-test and
   # the shader script here; `make test` runs the whole list)
   RUN_TIMEOUT=900 run "cmake -B b && cmake --build b && ctest --test-dir b (tests: $CTEST_PROGRAMS)" bash -c "cmake -S '$root' \
-    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
+    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=ON -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
     cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|shaders)\$' \
     --output-on-failure"
   expect "ctest: every test passed" '100% tests passed, 0 tests failed out of [3-9]'
@@ -198,7 +207,7 @@ EOF
       test \"\$(PKG_CONFIG_PATH='$moved/share/pkgconfig' pkg-config --variable=includedir fogvol | xargs realpath)\" \
         = \"\$(realpath '$moved/include')\" && '$cm/pc_moved'"
     run "cmake: find_package from the moved install" bash -c "cmake -S '$cm/consumer' -B '$cm/find_moved' \
-      -DCMAKE_PREFIX_PATH='$moved' -DFOGVOL_WANT=0.1 && cmake --build '$cm/find_moved' && '$cm/find_moved/consumer'"
+      -DCMAKE_PREFIX_PATH='$moved' -DFOGVOL_WANT=0.2 && cmake --build '$cm/find_moved' && '$cm/find_moved/consumer'"
     run "pkg-config consumer builds and runs" bash -c "$cc -std=c99 '$cm/consumer/main.c' -o '$cm/pc_consumer' \
       \$(PKG_CONFIG_PATH='$prefix/share/pkgconfig' pkg-config --cflags --libs fogvol) && '$cm/pc_consumer'"
   else

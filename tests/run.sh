@@ -23,7 +23,7 @@ pass=0; fail=0; shown=0
 report() {
   local name=${names[$1]} log="$logdir/${names[$1]}.log" rc p f
   rc=$(cat "$logdir/$name.rc")
-  echo "=== $name"
+  echo "=== $name ($(cat "$logdir/$name.time" 2> /dev/null || echo ?) s)"
   cat "$log"
   p=$(grep -cE '^ok [0-9]+' "$log" || true)
   f=$(grep -E '^not ok [0-9]+' "$log" | grep -vc '# SKIP' || true) # cmocka writes a skipped test as "not ok N # SKIP"
@@ -35,7 +35,7 @@ report() {
     f=1
   fi
   pass=$((pass + p)); fail=$((fail + f))
-  rm -f "$logdir/$name.rc"
+  rm -f "$logdir/$name.rc" "$logdir/$name.time"
 }
 # print every finished job at the head of the list
 flush() {
@@ -47,8 +47,11 @@ for ((i = 0; i < total; ++i)); do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do
     wait -n; flush
   done
-  ( bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1
-    echo $? > "$logdir/${names[i]}.rc.tmp" && mv "$logdir/${names[i]}.rc.tmp" "$logdir/${names[i]}.rc" ) &
+  ( t0=$(date +%s%N)
+    bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1
+    rc=$?
+    echo $(( ($(date +%s%N) - t0) / 100000000 )) | sed 's/.$/.&/; s/^\./0./' > "$logdir/${names[i]}.time"
+    echo $rc > "$logdir/${names[i]}.rc.tmp" && mv "$logdir/${names[i]}.rc.tmp" "$logdir/${names[i]}.rc" ) &
 done
 wait
 flush

@@ -1432,6 +1432,71 @@ static void test_a4_encoding_combinations(void **state)
     assert_int_equal(r.nb.creates, r.nb.destroys);
 }
 
+/* FOGVOL_TIER_AUTO takes the best tier that runs the required variants (fogvol_context_desc.variants)
+   and adds the preferred ones (preferred_variants) where that tier, the dialect and the backend take
+   them; a required variant no tier runs is refused with a log that names preferred_variants. The
+   expected tiers are the white paper's order (float blending, MRT, ps.2.0, ps.1.3) by hand. */
+static int log_has(const logcap *c, fogvol_log_level level, const char *needle)
+{
+    int i;
+    for (i = 0; i < c->count && i < LOG_MAX; ++i)
+        if (c->level[i] == level && strstr(c->msg[i], needle)) return 1;
+    return 0;
+}
+
+static void tier_choice(rec *r, fogvol_dialect dialect, unsigned caps, unsigned required, unsigned preferred,
+                        fogvol_result want, fogvol_tier tier, unsigned want_on, unsigned want_off, logcap *lc)
+{
+    fogvol_context_desc cd;
+    fogvol_context *fv = NULL;
+    unsigned v = 0;
+    rec_init(r);
+    r->table.dialect = dialect;
+    r->table.caps = caps;
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r->table;
+    cd.logger = cap_logger(lc);
+    cd.variants = required;
+    cd.preferred_variants = preferred;
+    log_reset(lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), want);
+    if (want != FOGVOL_SUCCESS) {
+        assert_null(fv);
+        assert_true(log_error_has(lc, "preferred_variants"));
+        return;
+    }
+    assert_int_equal(fogvol_context_tier(fv, &v), tier);
+    assert_int_equal(v & want_on, want_on);
+    assert_int_equal(v & want_off, 0);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r->nb.creates, r->nb.destroys);
+}
+
+static void test_a4_tier_choice(void **state)
+{
+    const unsigned ed = FOGVOL_VARIANT_ENGINE_DEPTH, st = FOGVOL_VARIANT_SINGLE_TARGET;
+    const unsigned hp = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_DEPTH_TEXTURE, fl = hp | FOGVOL_CAP_FLOAT_BLEND;
+    rec r;
+    logcap lc;
+    (void)state;
+    /* GL 2.1 (GLSL 120): no tier reads the engine's depth (it needs texelFetch) */
+    tier_choice(&r, FOGVOL_GLSL_120, hp, ed, 0, FOGVOL_ERROR_UNSUPPORTED, FOGVOL_TIER_AUTO, 0, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_120, hp, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, 0, ed, &lc);
+    assert_true(log_has(&lc, FOGVOL_LOG_INFO, "preferred variant 0x10 left out"));
+    assert_int_equal(lc.errors + lc.warnings, 0);
+    /* GLSL 330 without float blending: PS20 takes it; with float blending FLOAT does */
+    tier_choice(&r, FOGVOL_GLSL_330, hp, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, ed, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, ed, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, ed, 0, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, ed, 0, &lc);
+    /* FLOAT has no single target: required, the next tier that has one (PS20); preferred, FLOAT without it */
+    tier_choice(&r, FOGVOL_GLSL_330, fl, st, 0, FOGVOL_SUCCESS, FOGVOL_TIER_PS20, st, 0, &lc);
+    tier_choice(&r, FOGVOL_GLSL_330, fl, 0, st, FOGVOL_SUCCESS, FOGVOL_TIER_FLOAT, 0, st, &lc);
+    /* without highp fragment shaders AUTO ends at PS13, which has no engine depth */
+    tier_choice(&r, FOGVOL_GLSL_100, FOGVOL_CAP_DEPTH_TEXTURE, 0, ed, FOGVOL_SUCCESS, FOGVOL_TIER_PS13, 0, ed, &lc);
+    tier_choice(&r, FOGVOL_GLSL_100, FOGVOL_CAP_DEPTH_TEXTURE, ed, 0, FOGVOL_ERROR_UNSUPPORTED, FOGVOL_TIER_AUTO, 0,
+                0, &lc);
+}
+
 static void test_a4_bad_input(void **state)
 {
     rec r;
@@ -2330,6 +2395,53 @@ static void test_b6_loader_finds_nothing(void **state)
     assert_int_equal(cnt.live, 0);
 }
 
+/* The plain loaders of fogvol_gl_desc, as GLFW, EGL and SDL hand them out, with no wrapper:
+   get_proc (a function pointer back) and get_proc_pointer (void * back). Each must be the one asked
+   (it counts the names) and give a context that draws as with get_proc_address. */
+static int g_plain_calls;
+static fogvol_gl_proc plain_proc(const char *name)
+{
+    g_plain_calls++;
+    return (fogvol_gl_proc)OSMesaGetProcAddress(name);
+}
+static void *plain_pointer(const char *name)
+{
+    fogvol_gl_proc f = plain_proc(name);
+    void *p = NULL;
+    memcpy(&p, &f, sizeof p); /* (as SDL2's loader hands a function over) */
+    return p;
+}
+
+static void test_b6_plain_loaders(void **state)
+{
+    int k;
+    (void)state;
+    for (k = 0; k < 2; ++k) {
+        logcap lc;
+        counting cnt;
+        fogvol_context_desc cd;
+        fogvol_context *fv = NULL;
+        fogvol_frame_stats st;
+        fogvol_frame_desc fd;
+        memset(&cnt, 0, sizeof cnt);
+        log_reset(&lc);
+        memset(&cd, 0, sizeof cd);
+        cd.logger = cap_logger(&lc);
+        cd.allocator = cnt_allocator(&cnt);
+        if (k == 0) cd.gl.get_proc = plain_proc;
+        else cd.gl.get_proc_pointer = plain_pointer;
+        g_plain_calls = 0;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        assert_true(g_plain_calls > 20); /* every entry point came through it */
+        a_frame_desc(&fd);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        assert_int_equal(lc.errors + lc.warnings, 0);
+        fogvol_destroy_context(fv);
+        assert_int_equal(cnt.live, 0);
+    }
+}
+
 /* ---- B7: dialects ---- */
 static void expect_dialect(const fogvol_gl_desc *in, fogvol_dialect want, const char *what)
 {
@@ -2913,6 +3025,7 @@ int main(void)
         cmocka_unit_test(test_a3_frame_protocol),
         cmocka_unit_test(test_a3_destroy_inside_frame),
         cmocka_unit_test(test_a4_encoding_combinations),
+        cmocka_unit_test(test_a4_tier_choice),
         cmocka_unit_test(test_a4_bad_input),
         cmocka_unit_test(test_a5_backend_create_faults),
         cmocka_unit_test(test_a5_alloc_faults_context),
@@ -2925,6 +3038,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_b6_missing_core33, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b6_missing_gl21, setup_compat, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b6_loader_finds_nothing, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_b6_plain_loaders, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_dialects_core, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_dialects_compat, setup_compat, teardown_gl),
         cmocka_unit_test_setup_teardown(test_b7_glsl100_renders_in_core, setup_core, teardown_gl),

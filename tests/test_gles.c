@@ -37,6 +37,7 @@
 #include "tests/shapes.h"
 #include "tests/scenes.h"
 #include "tests/fixtures.h"
+#include "tests/scene_gt.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -56,15 +57,6 @@ static const es_ctx g_ctx[] = {
 #define NCTX 3
 
 
-typedef struct gt_cache {
-    double *gt, *slope;
-    int *pairs;
-    unsigned char *interior, *covered;
-    int max_faces;
-    double tmax;
-} gt_cache;
-
-static gt_cache g_gt[NSCENE];
 /* measured: max error per context, combo, scene (LSB per pair of faces, or units of 3e-5 range on FLOAT) */
 static double g_err[NCTX][NTIER_COMBO][NSCENE], g_mean[NCTX][NTIER_COMBO], g_comp[NCTX][NTIER_COMBO];
 static int g_ran[NCTX][NTIER_COMBO];
@@ -948,19 +940,8 @@ static void test_partial_extension(void **state)
 
 static int setup_all(void **state)
 {
-    int i;
     (void)state;
-    build_scenes();
-    for (i = 0; i < NSCENE; ++i) {
-        gt_cache *t = &g_gt[i];
-        t->gt = (double *)calloc((size_t)W * H, sizeof(double));
-        t->slope = (double *)calloc((size_t)W * H, sizeof(double));
-        t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
-        t->interior = (unsigned char *)calloc((size_t)W * H, 1);
-        t->covered = (unsigned char *)calloc((size_t)W * H, 1);
-        ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
-                     &t->max_faces, &t->tmax, t->slope);
-    }
+    gt_setup();
     return 0;
 }
 
@@ -988,13 +969,7 @@ static int print_table(void **state)
     print_message("(max |error| over interior pixels, bound 1 (+ 1e-6 range for fp32 vertex maths); mean per pair "
                   "over covered pixels, bound 0.5; composite bound 2/255; "
                   "PS13/PS20+count on camera_inside_sphere: refused, 0)\n\n");
-    for (sc = 0; sc < NSCENE; ++sc) {
-        free(g_gt[sc].gt);
-        free(g_gt[sc].pairs);
-        free(g_gt[sc].interior);
-        free(g_gt[sc].covered);
-    }
-    free_scenes();
+    gt_teardown();
     return 0;
 }
 

@@ -26,6 +26,7 @@
 #include "tests/shapes.h"
 #include "tests/scenes.h"
 #include "tests/fixtures.h"
+#include "tests/scene_gt.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -37,15 +38,6 @@ static const fogvol_dialect g_dialects[] = {FOGVOL_GLSL_110, FOGVOL_GLSL_120,   
                                             FOGVOL_GLSL_330, FOGVOL_GLSL_100, FOGVOL_GLSL_300ES};
 #define NDIALECT ((int)(sizeof g_dialects / sizeof g_dialects[0]))
 
-typedef struct gt_cache {
-    double *gt, *slope;
-    int *pairs;
-    unsigned char *interior, *covered;
-    int max_faces;
-    double tmax;
-} gt_cache;
-
-static gt_cache g_gt[NSCENE];
 static double g_max[NTIER_COMBO][NDIALECT], g_mean[NTIER_COMBO][NDIALECT], g_comp[NTIER_COMBO][NDIALECT];
 static int g_ran[NTIER_COMBO][NDIALECT];
 
@@ -742,31 +734,14 @@ static int print_table(void **state)
     }
     print_message("(max error / mean error per pair of faces over interior pixels of %d scenes / max composite "
                   "colour error in 1/255; n/a: the combination does not exist in that dialect)\n\n", NSCENE);
-    for (ci = 0; ci < NSCENE; ++ci) {
-        free(g_gt[ci].gt);
-        free(g_gt[ci].pairs);
-        free(g_gt[ci].interior);
-        free(g_gt[ci].covered);
-    }
-    free_scenes();
+    gt_teardown();
     return 0;
 }
 
 static int setup_all(void **state)
 {
-    int i;
     (void)state;
-    build_scenes();
-    for (i = 0; i < NSCENE; ++i) {
-        gt_cache *t = &g_gt[i];
-        t->gt = (double *)calloc((size_t)W * H, sizeof(double));
-        t->slope = (double *)calloc((size_t)W * H, sizeof(double));
-        t->pairs = (int *)calloc((size_t)W * H, sizeof(int));
-        t->interior = (unsigned char *)calloc((size_t)W * H, 1);
-        t->covered = (unsigned char *)calloc((size_t)W * H, 1);
-        ground_truth(&g_scenes[scene_index(g_scene_names[i])], t->gt, t->pairs, t->interior, t->covered,
-                     &t->max_faces, &t->tmax, t->slope);
-    }
+    gt_setup();
     return 0;
 }
 
