@@ -623,8 +623,8 @@ typedef struct fogvol_mesh_report {
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
    (about 40 bytes per triangle, + 4 per index with 16-bit indices, without an
-   index array or when welding, + 24 to 32 per vertex when welding; the weld takes
-   O(n log n) time) comes from alloc (NULL = default). Never reads outside
+   index array or when welding, + about 26 per vertex when welding; the weld takes
+   O(n) time) comes from alloc (NULL = default). Never reads outside
    the vertex_count vertices (stride, offset) or indices[0 .. index_count).
    FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
    stride, unknown index_type, missing arrays, bad weld_distance). */
@@ -2576,40 +2576,41 @@ static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
     return NULL;
 }
 
+/* The weld's sweep order: each vertex's coordinate on the sweep axis as an unsigned key in the order
+   of the floats (-0 as +0), with its number. */
 typedef struct fogvol__wkey {
-    float key;
+    uint32_t key;
     uint32_t i;
 } fogvol__wkey;
 
-static int fogvol__wkey_less(const fogvol__wkey *x, const fogvol__wkey *y)
+static uint32_t fogvol__sweep_key(float f)
 {
-    return x->key < y->key || (x->key == y->key && x->i < y->i);
+    uint32_t b;
+    f += 0.0f; /* -0 -> +0 */
+    memcpy(&b, &f, sizeof b);
+    return (b & 0x80000000u) ? ~b : b | 0x80000000u;
 }
 
-static void fogvol__sift_wkeys(fogvol__wkey *k, int root, int n)
+/* Stable LSD radix sort of k by key, 8 bits a pass (tmp: n entries), so that equal keys keep their
+   vertices' order: O(n). */
+static void fogvol__sort_wkeys(fogvol__wkey *k, fogvol__wkey *tmp, int n)
 {
-    int child;
-    fogvol__wkey t;
-    for (; (child = 2 * root + 1) < n; root = child) {
-        if (child + 1 < n && fogvol__wkey_less(&k[child], &k[child + 1])) ++child;
-        if (!fogvol__wkey_less(&k[root], &k[child])) return;
-        t = k[root];
-        k[root] = k[child];
-        k[child] = t;
-    }
-}
-
-/* In-place heap sort (no allocation, O(n log n)). */
-static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
-{
-    int i;
-    fogvol__wkey t;
-    for (i = n / 2 - 1; i >= 0; --i) fogvol__sift_wkeys(k, i, n);
-    for (i = n - 1; i > 0; --i) {
-        t = k[0];
-        k[0] = k[i];
-        k[i] = t;
-        fogvol__sift_wkeys(k, 0, i);
+    size_t cnt[256], sum, c;
+    fogvol__wkey *src = k, *dst = tmp, *t;
+    int pass, i;
+    for (pass = 0; pass < 4; ++pass) { /* (an even count: the result ends in k) */
+        unsigned sh = 8u * (unsigned)pass;
+        memset(cnt, 0, sizeof cnt);
+        for (i = 0; i < n; ++i) cnt[(src[i].key >> sh) & 255u]++;
+        for (i = 0, sum = 0; i < 256; ++i) {
+            c = cnt[i];
+            cnt[i] = sum;
+            sum += c;
+        }
+        for (i = 0; i < n; ++i) dst[cnt[(src[i].key >> sh) & 255u]++] = src[i];
+        t = src;
+        src = dst;
+        dst = t;
     }
 }
 
@@ -2626,18 +2627,25 @@ typedef struct fogvol__weld_grid {
 
 #define FOGVOL__NONE 0xffffffffu
 
-/* The bucket of v's cell moved by (du, dv) cells across the sweep (-0 made +0; cells beyond 32-bit
-   integers hashed by their bits). */
-static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const float v[3], int du, int dv)
+/* v's cell across the sweep: floor(coordinate / dist) on the two other axes. */
+static void fogvol__weld_cell(const fogvol__weld_grid *g, const float v[3], double c[2])
+{
+    c[0] = FOGVOL_FLOOR((double)v[(g->axis + 1) % 3] / g->dist);
+    c[1] = FOGVOL_FLOOR((double)v[(g->axis + 2) % 3] / g->dist);
+}
+
+/* The bucket of cell c moved by (du, dv) (-0 made +0; cells beyond 32-bit integers hashed by their
+   bits). Neighbours along the second axis land in neighbouring buckets. */
+static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const double c[2], int du, int dv)
 {
     uint32_t h[2], w[2];
     int k;
     for (k = 0; k < 2; ++k) {
-        double c = FOGVOL_FLOOR((double)v[(g->axis + 1 + k) % 3] / g->dist) + (k ? dv : du) + 0.0;
-        if (c > -2147483648.0 && c < 2147483648.0) {
-            h[k] = (uint32_t)(int32_t)c;
+        double x = c[k] + (k ? dv : du) + 0.0;
+        if (x > -2147483648.0 && x < 2147483648.0) {
+            h[k] = (uint32_t)(int32_t)x;
         } else {
-            memcpy(w, &c, sizeof w);
+            memcpy(w, &x, sizeof w);
             h[k] = (w[0] ^ w[1]) * 0x9e3779b1u;
         }
     }
@@ -2645,16 +2653,16 @@ static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const float v[3]
 }
 
 /* The lowest-numbered kept vertex within dist of v on every axis among those the sweep has met, from
-   the 9 cells around v across the sweep, FOGVOL__NONE: none. A vertex more than dist behind v along
-   the sweep is behind every vertex to come as well: the chain is cut there (it and every older
+   the 9 cells around v's cell c across the sweep, FOGVOL__NONE: none. A vertex more than dist behind v
+   along the sweep is behind every vertex to come as well: the chain is cut there (it and every older
    entry), so the chains hold the last dist of the sweep only. */
-static uint32_t fogvol__weld_find(fogvol__weld_grid *g, const float v[3])
+static uint32_t fogvol__weld_find(fogvol__weld_grid *g, const float v[3], const double c[2])
 {
     uint32_t best = FOGVOL__NONE, j, *link;
     float w[3];
     int d;
     for (d = 0; d < 9; ++d)
-        for (link = &g->heads[fogvol__weld_bucket(g, v, d % 3 - 1, d / 3 - 1)]; (j = *link) != FOGVOL__NONE;
+        for (link = &g->heads[fogvol__weld_bucket(g, c, d % 3 - 1, d / 3 - 1)]; (j = *link) != FOGVOL__NONE;
              link = &g->next[j]) {
             memcpy(w, g->base + (size_t)j * g->stride, sizeof w);
             if ((double)v[g->axis] - w[g->axis] > g->dist) {
@@ -2692,8 +2700,9 @@ static int fogvol__weld_axis(const unsigned char *base, int stride, int nv, uint
    before it in the sweep (i itself when none): the sweep takes the vertices in order of their
    coordinate on the axis of largest extent (then of their number) and keeps a vertex that finds
    none. Non-finite vertices stay alone. The candidates come from fogvol__weld_find, so vertices
-   sharing the sweep's coordinate (a face of a subdivided cube) cost no more than others: O(n log n).
-   Scratch memory from alloc: 12 bytes per vertex and 4 per hash bucket (2 to 4 buckets per vertex).
+   sharing the sweep's coordinate (a face of a subdivided cube) cost no more than others: O(n) but for
+   hash collisions. Scratch memory from alloc: 20 bytes per vertex and 4 per hash bucket (one bucket
+   per 2 to 4 vertices).
    Returns how many vertices were merged, -1: out of memory. */
 static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, const fogvol_allocator *alloc,
                         uint32_t *rep)
@@ -2703,8 +2712,9 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     size_t buckets = 2;
     float v[3];
     int i, merged = 0;
-    while (buckets < 2u * (size_t)nv && buckets < ((size_t)1 << 31)) buckets <<= 1;
-    keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)nv);
+    while (buckets < (size_t)nv / 4u && buckets < ((size_t)1 << 30)) buckets <<= 1; /* (the chains hold the
+                                                       sweep's last dist only: small, cached buckets) */
+    keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * 2u * (size_t)nv); /* (+ the sort's) */
     g.heads = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (buckets + (size_t)nv));
     if (!keys || !g.heads) {
         fogvol__free(alloc, keys);
@@ -2720,21 +2730,23 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     g.axis = fogvol__weld_axis(base, stride, nv, rep);
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
-        keys[i].key = fogvol__finite_n(v, 3) ? v[g.axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].key = fogvol__sweep_key(fogvol__finite_n(v, 3) ? v[g.axis] : 3.0e38f); /* non-finite: skipped */
         keys[i].i = (uint32_t)i;
     }
-    fogvol__sort_wkeys(keys, nv);
+    fogvol__sort_wkeys(keys, keys + nv, nv);
     for (i = 0; i < nv; ++i) {
         uint32_t self = keys[i].i, best, h;
+        double c[2];
         memcpy(v, base + (size_t)self * stride, sizeof v);
         if (!fogvol__finite_n(v, 3)) continue;
-        best = fogvol__weld_find(&g, v);
+        fogvol__weld_cell(&g, v, c);
+        best = fogvol__weld_find(&g, v, c);
         if (best != FOGVOL__NONE) {
             rep[self] = best;
             merged++;
             continue;
         }
-        h = fogvol__weld_bucket(&g, v, 0, 0); /* kept: a candidate for the vertices after it */
+        h = fogvol__weld_bucket(&g, c, 0, 0); /* kept: a candidate for the vertices after it */
         g.next[self] = g.heads[h];
         g.heads[h] = self;
     }

@@ -137,6 +137,16 @@ static int gl_ready(void)
 }
 
 /* ---- the context ---- */
+static fogvol_gl_proc plain_proc(const char *name) { return glu_proc(name, NULL); }
+
+static void *plain_pointer(const char *name)
+{
+    fogvol_gl_proc f = glu_proc(name, NULL);
+    void *p = NULL;
+    memcpy(&p, &f, sizeof p < sizeof f ? sizeof p : sizeof f); /* (POSIX: the same size) */
+    return p;
+}
+
 static void make_context(run *R)
 {
     static const unsigned caps[8] = {
@@ -161,7 +171,9 @@ static void make_context(run *R)
     cd.logger.user_data = R;
     cd.tier = (fogvol_tier)(u8(in) % 6);
     cd.variants = u8(in);
-    if (u8(in) & 1) cd.variants &= FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_ENGINE_DEPTH;
+    e = (int)u8(in);
+    if (e & 1) cd.variants &= FOGVOL_VARIANT_ALU | FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_ENGINE_DEPTH;
+    if (e & 2) cd.preferred_variants = u8(in);
     cd.overflow_policy = (fogvol_overflow_policy)(u8(in) % 5);
     cd.msaa = (fogvol_msaa)(u8(in) % 3);
     cd.encoding_bits = (int)(u8(in) % 11) - 1;
@@ -169,9 +181,12 @@ static void make_context(run *R)
     cd.disable_dither = (int)(u8(in) & 1);
     cd.engine_mrt = (int)(u8(in) & 1);
     if (R->gl) {
-        cd.gl.get_proc_address = glu_proc;
         cd.gl.dialect = (fogvol_dialect)(u8(in) % 10 == 9 ? 0 : u8(in) % 9);
-        cd.gl.mrt_highp = (int)(u8(in) & 1);
+        e = (int)u8(in);
+        cd.gl.mrt_highp = e & 1;
+        if ((e >> 1) % 3 == 0) cd.gl.get_proc_address = glu_proc; /* the three kinds of loader */
+        else if ((e >> 1) % 3 == 1) cd.gl.get_proc = plain_proc;
+        else cd.gl.get_proc_pointer = plain_pointer;
     } else {
         fogvol_null_backend_init(&R->nb, &cd.backend);
         cd.backend.caps = caps[u8(in) & 7];

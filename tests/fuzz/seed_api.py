@@ -10,11 +10,13 @@ import os
 import sys
 
 
-def context(gl=False, tier=2, variants=0, caps=1, dialect=5, queries=0, samples=0, overflow=0, msaa=0, leave=0):
+def context(gl=False, tier=2, variants=0, caps=1, dialect=5, queries=0, samples=0, overflow=0, msaa=0, leave=0,
+            preferred=None, loader=0):
     b = [(3 if gl else 0) | (4 if leave else 0)]
-    b += [tier, variants, 0, overflow, msaa, 1, 0, 0, 0]  # encoding_bits byte 1 -> 0 (default)
+    b += [tier, variants] + ([2, preferred] if preferred is not None else [0])
+    b += [overflow, msaa, 1, 0, 0, 0]  # encoding_bits byte 1 -> 0 (default)
     if gl:
-        b += [0, 0, 0]  # dialect: not 9 -> next byte % 9 = 0 (from the context); mrt_highp 0
+        b += [0, 0, loader << 1]  # dialect: not 9 -> next byte % 9 = 0 (from the context); the loader
     else:
         b += [caps, dialect, queries, 0, 5, samples, 0]
     return b
@@ -109,6 +111,9 @@ SEEDS = [
     + volume(0) + volume(1, 1) + end() + begin(camkind=1) + volume(0) + end() + begin(camkind=5) + volume(1) + end(),
     context(leave=1) + mesh() + mesh(1, kind=2, weld=0) + ramp() + ramp(1) + texture() + frame_seq(),
     context(gl=True, tier=2, leave=1) + mesh() + ramp() + texture() + begin() + volume(0, density_tex=True) + end(),
+    context(tier=0, preferred=0x52, caps=2) + mesh() + ramp() + frame_seq(),
+    context(gl=True, tier=0, preferred=0x10, loader=1) + mesh() + ramp() + frame_seq(depth_tex=1),
+    context(gl=True, tier=2, loader=2) + mesh() + ramp() + frame_seq(),
 ]
 
 
