@@ -11,10 +11,12 @@ import sys
 
 
 def context(gl=False, tier=2, variants=0, caps=1, dialect=5, queries=0, samples=0, overflow=0, msaa=0, leave=0,
-            preferred=None, loader=0):
+            preferred=None, loader=0, speedups_off=0):
     b = [(3 if gl else 0) | (4 if leave else 0)]
     b += [tier, variants] + ([2, preferred] if preferred is not None else [0])
-    b += [overflow, msaa, 1, 0, 0, 0]  # encoding_bits byte 1 -> 0 (default)
+    b += [overflow, msaa, 1]  # encoding_bits byte 1 -> 0 (default)
+    b += [1] + [(speedups_off >> k) & 255 for k in (0, 8, 16, 24)] if speedups_off else [0]
+    b += [0, 0]  # dither on, engine_mrt 0
     if gl:
         b += [0, 0, loader << 1]  # dialect: not 9 -> next byte % 9 = 0 (from the context); the loader
     else:
@@ -45,7 +47,8 @@ def texture(slot=0, w=2, h=2):
 
 def begin(w=63, h=63, composite=1, show=1, downsample=1, depth_tex=0, source=0, camkind=9, debug=1):
     cam = [4, 50, camkind, 4, 4, 8, 1, 40, 1] + ([1] if camkind == 5 else [])  # (5: the forward kept)
-    return [8, 0] + cam + [w, h, 4, 4, composite, 1, 1, 1, show, downsample, 1, depth_tex, 1, 1, source, 1, debug]
+    b = [8, 0] + cam + [w, h, 4, 4, composite, 1, 1, 1, show, downsample, 1, depth_tex, 1, 1, source, 1, debug]
+    return b + ([0] if debug == 0 else [])  # the read-back on: for the first group
 
 
 def volume(mesh_slot=0, ramp_slot=0, matrix=(7,), negative=1, density_tex=False, color_tex=False):
@@ -67,6 +70,14 @@ def end():
     return [15, 1]
 
 
+def occluder_callback():  # its model matrix comes from the byte after the end_frame that calls it
+    return [13, 0, 1]
+
+
+def validate(kind=0):
+    return [21] + mesh(kind=kind)[2:]
+
+
 def prepare(which):
     return [18, which, 1]
 
@@ -77,6 +88,10 @@ def post(which):
     if which == 1:
         return [19, 1, 1, 0, 0, 1, 1]
     return [19, 2, 1, 0, 1]
+
+
+def frames(k, n=3, **kw):
+    return sum((frame_seq(n, **kw) for _ in range(k)), [])
 
 
 def frame_seq(n=3, **kw):
@@ -114,6 +129,25 @@ SEEDS = [
     context(tier=0, preferred=0x52, caps=2) + mesh() + ramp() + frame_seq(),
     context(gl=True, tier=0, preferred=0x10, loader=1) + mesh() + ramp() + frame_seq(depth_tex=1),
     context(gl=True, tier=2, loader=2) + mesh() + ramp() + frame_seq(),
+    # the paths the first corpus did not reach (gcov of its replay)
+    context(tier=4, variants=0x40, caps=2) + mesh() + ramp() + ramp(1, density=9) + frame_seq(4, composite=0),
+    context(gl=True, tier=4) + mesh() + ramp() + frame_seq(debug=0) + frame_seq(debug=0, composite=0),
+    context(gl=True, tier=2) + mesh(kind=3) + ramp() + frames(3, debug=0, show=0),
+    context(tier=2, variants=0x01) + mesh(kind=3) + ramp() + frame_seq(debug=0) + frame_seq(show=0),
+    context(tier=4, caps=3) + mesh() + ramp() + frame_seq(downsample=2, debug=0),
+    context(tier=2, queries=1, overflow=2) + mesh(kind=3) + ramp() + frames(4),
+    context(tier=1, queries=1, caps=1) + mesh(kind=3) + ramp() + frames(3, debug=0),
+    context(gl=True, tier=1) + mesh(kind=3) + ramp() + frames(2, debug=0),
+    context(gl=True, tier=3) + mesh() + ramp() + begin(debug=0) + prepare(1) + volume() + end(),
+    context(gl=True, tier=2, variants=0x10) + mesh() + ramp() + frame_seq(depth_tex=1, debug=0),
+    context(gl=True, tier=4) + mesh() + mesh(1, kind=3) + ramp() + begin() + light() + occluder(1) + volume()
+    + end() + begin() + prepare(0) + volume() + end(),
+    context(gl=True, tier=2) + mesh() + mesh(1) + ramp() + begin() + occluder(1) + light() + volume() + end(),
+    context(gl=True, tier=2, speedups_off=(1 << 13) | (1 << 14)) + mesh(kind=3) + ramp() + frames(3, debug=0),
+    context(tier=2, variants=0x20) + mesh() + ramp() + frame_seq(debug=0),
+    context(tier=2) + mesh() + ramp() + begin() + occluder_callback() + volume() + end() + [7] + [20, 1]
+    + validate(3) + validate(7),
+    context(gl=True, tier=4) + mesh() + ramp() + begin() + occluder_callback() + volume() + end() + [7],
 ]
 
 
