@@ -104,7 +104,8 @@ $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
 # API sequences on the null and the GL backend (OSMesa): libFuzzer under ASan+UBSan with
 # float-cast-overflow, and its corpus replayed by the sanitizer build of the tests (GL under
-# valgrind would take minutes)
+# valgrind would take minutes). make test's short run starts from the seeds (tests/fuzz/seed_api.py
+# writes them; loading the whole corpus into libFuzzer takes a minute), make fuzz from the corpus.
 FUZZ_API_DEPS = tests/fuzz/fuzz_api.c fogvol.h tests/gl_util.h tests/shapes.h
 $(BUILD)/fuzz_api: $(FUZZ_API_DEPS) | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined,float-cast-overflow -fno-sanitize-recover=all $(INC) $< -o $@ \
@@ -141,7 +142,7 @@ SCRIPT_RUNS = \
   "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
   "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
   "fuzz_api_corpus_asan_ubsan=$(LSAN_ENV) $(BUILD)/replay_api_san tests/fuzz/corpus_api" \
-  "fuzz_api_5s=mkdir -p $(BUILD)/fuzz/api && $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api tests/fuzz/corpus_api"
+  "fuzz_api_5s=rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
