@@ -13,7 +13,8 @@
    on Mesa's EGL device (llvmpipe); on a GPU machine: make gl-compile. Programs
    that read O by framebuffer fetch (FOGVOL_SPECIALIZE_FETCH_O) are skipped, as a
    TAP SKIP, by a context without EXT_shader_framebuffer_fetch (fogvol's GL
-   backend does not ask for them there). */
+   backend does not ask for them there). A program whose two texts (and context) another one
+   already had is not linked again: it gets that one's result (many files are the same text). */
 #define _POSIX_C_SOURCE 200809L
 #define GLU_EGL
 #include "tests/gl_util.h" /* glu_egl_display */
@@ -167,6 +168,62 @@ static int glc_program(const glc_gl *gl, const char *vs, const char *fs, char *l
     return ok != 0;
 }
 
+/* Programs already linked: their texts (vertex, fragment) and context, with the result. */
+typedef struct glc_seen {
+    char *vs, *fs;
+    int es, ok, logged;
+    char *log;
+} glc_seen;
+static glc_seen *g_seen;
+static size_t g_nseen, g_capseen;
+static size_t *g_hash; /* open addressing over g_seen, 0 = empty, else index + 1; size 2 * g_capseen */
+
+static size_t glc_text_hash(const char *vs, const char *fs, int es)
+{
+    size_t h = 1469598103u + (size_t)es;
+    for (; *vs; ++vs) h = (h ^ (unsigned char)*vs) * 16777619u;
+    for (; *fs; ++fs) h = (h ^ (unsigned char)*fs) * 16777619u;
+    return h;
+}
+
+/* the earlier program with these texts, or NULL */
+static glc_seen *glc_find(const char *vs, const char *fs, int es, size_t *slot)
+{
+    size_t n = 2 * g_capseen, i;
+    if (!n) return NULL;
+    for (i = glc_text_hash(vs, fs, es) % n; g_hash[i]; i = (i + 1) % n) {
+        glc_seen *e = &g_seen[g_hash[i] - 1];
+        if (e->es == es && strcmp(e->vs, vs) == 0 && strcmp(e->fs, fs) == 0) return e;
+    }
+    *slot = i;
+    return NULL;
+}
+
+/* keeps the texts (taken over) and the result; grows the table at half load */
+static void glc_remember(char *vs, char *fs, int es, int ok, int logged, const char *log)
+{
+    size_t slot = 0, i;
+    if (2 * (g_nseen + 1) > g_capseen) {
+        size_t cap = g_capseen ? 2 * g_capseen : 1024;
+        g_seen = (glc_seen *)realloc(g_seen, cap * sizeof *g_seen);
+        free(g_hash);
+        g_hash = (size_t *)calloc(2 * cap, sizeof *g_hash);
+        g_capseen = cap;
+        for (i = 0; i < g_nseen; ++i) {
+            glc_find(g_seen[i].vs, g_seen[i].fs, g_seen[i].es, &slot);
+            g_hash[slot] = i + 1;
+        }
+    }
+    glc_find(vs, fs, es, &slot);
+    g_seen[g_nseen].vs = vs;
+    g_seen[g_nseen].fs = fs;
+    g_seen[g_nseen].es = es;
+    g_seen[g_nseen].ok = ok;
+    g_seen[g_nseen].logged = logged;
+    g_seen[g_nseen].log = strdup(log);
+    g_hash[slot] = ++g_nseen;
+}
+
 static int glc_is_es(const char *name)
 {
     return strstr(name, "_100.") || strstr(name, "_100_") || strstr(name, "_300es");
@@ -200,7 +257,7 @@ int main(int argc, char **argv)
     EGLint n = 0;
     DIR *d;
     struct dirent *e;
-    int passed = 0, failed = 0, skipped = 0, logs = 0, cur = -1;
+    int passed = 0, failed = 0, skipped = 0, logs = 0, cur = -1, reused = 0;
     if (argc != 2) {
         fprintf(stderr, "usage: %s DIR (the shaders dump_shaders wrote)\n", argv[0]);
         return 2;
@@ -236,8 +293,25 @@ int main(int argc, char **argv)
             continue;
         }
         vs = glc_vertex(argv[1], e->d_name);
-        ok = fs && vs && glc_program(&ctx[es].gl, vs, fs, log, (int)sizeof log, &logged);
-        if (!fs || !vs) snprintf(log, sizeof log, "missing %s shader file", fs ? "vertex" : "fragment");
+        if (fs && vs) {
+            size_t slot;
+            const glc_seen *seen = glc_find(vs, fs, es, &slot);
+            if (seen) { /* the same program as an earlier file: its result */
+                ok = seen->ok;
+                logged = seen->logged;
+                snprintf(log, sizeof log, "%s", seen->log);
+                ++reused;
+                free(vs);
+                free(fs);
+            } else {
+                ok = glc_program(&ctx[es].gl, vs, fs, log, (int)sizeof log, &logged);
+                glc_remember(vs, fs, es, ok, logged, log);
+            }
+            vs = fs = NULL; /* (kept by the table, or freed) */
+        } else {
+            ok = 0;
+            snprintf(log, sizeof log, "missing %s shader file", fs ? "vertex" : "fragment");
+        }
         if (ok) {
             printf("ok %d - %s\n", passed + failed + skipped + 1, e->d_name);
             ++passed;
@@ -250,7 +324,16 @@ int main(int argc, char **argv)
         free(vs);
     }
     closedir(d);
-    printf("%d of the programs that linked had a non-empty driver log; %d skipped\n", logs, skipped);
+    printf("%d of the programs that linked had a non-empty driver log; %d skipped; %d linked, %d the same texts "
+           "as an earlier file\n", logs, skipped, (int)g_nseen, reused);
+    while (g_nseen > 0) {
+        --g_nseen;
+        free(g_seen[g_nseen].vs);
+        free(g_seen[g_nseen].fs);
+        free(g_seen[g_nseen].log);
+    }
+    free(g_seen);
+    free(g_hash);
     printf("%d passed, %d failed\n", passed, failed);
     eglMakeCurrent(g_dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglTerminate(g_dpy);

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Every shader string of every program and dialect passes glslangValidator.
+# Every shader string of every program and dialect passes glslangValidator (each different text
+# compiled once; every file gets a TAP line).
 # The files go to glslangValidator in batches (one process compiles many files, each on
 # its own, no linking), JOBS batches at a time; a file passes when its part of the
 # output holds no ERROR line. One TAP line a file, in file-name order.
@@ -14,7 +15,12 @@ rm -f "$b/shaders"/*.vert "$b/shaders"/*.frag "$b/shaders"/batch_*
 # inputs as plain outputs, which it reads; gl_compile compiles them as written with a driver that has it
 grep -l "^#extension GL_EXT_shader_framebuffer_fetch" "$b/shaders"/*.frag |
   xargs -r sed -i -e '/^#extension GL_EXT_shader_framebuffer_fetch/d' -e 's/^layout(location = \([01]\)) inout /layout(location = \1) out /'
-ls "$b/shaders"/*.vert "$b/shaders"/*.frag | LC_ALL=C sort > "$b/shaders/batch_list"
+ls "$b/shaders"/*.vert "$b/shaders"/*.frag | LC_ALL=C sort > "$b/shaders/all_list"
+# many files hold the same text: each text is compiled once, from its first file (in name order), and
+# every file gets its text's result (file -> first file of the same contents, same stage)
+xargs md5sum < "$b/shaders/all_list" |
+  awk '{ stage = $2; sub(/.*\./, "", stage); key = $1 stage; if (!(key in first)) { first[key] = $2; print $2 > "/dev/stderr" }
+         print $2, first[key] }' > "$b/shaders/same_as" 2> "$b/shaders/batch_list"
 # batches of 100 files; each writes its output and exit status to its own files
 split -l 100 -d -a 4 "$b/shaders/batch_list" "$b/shaders/batch_in_"
 ls "$b/shaders"/batch_in_* | xargs -P "$jobs" -I{} sh -c \
@@ -35,7 +41,15 @@ for f in "$b/shaders"/batch_in_*[0-9]; do
       }
       if (rc != 0 && errs == 0) print "not ok - " list ": glslangValidator exited with " rc " without an ERROR line"
     }' "$f.out"
-done > "$b/shaders.tap"
-rm -f "$b/shaders"/batch_*
+done > "$b/shaders.unique.tap"
+# every file: the line of the first file with its text
+awk 'FNR == NR { line = $0; name = $0; sub(/^(not )?ok - /, "", name); sub(/ .*/, "", name); res[name] = line
+                 if ($0 ~ /^#/) { msg[last] = msg[last] "\n" $0 } else last = name; next }
+     { f = $1; g = $2; sub(/.*\//, "", f); sub(/.*\//, "", g)
+       if (!(g in res)) { print "not ok - " f " (its text was not compiled)"; next }
+       r = res[g]; sub(/ - [^ ]*/, " - " f, r); print r msg[g] }' \
+  "$b/shaders.unique.tap" "$b/shaders/same_as" > "$b/shaders.tap"
+echo "# $(wc -l < "$b/shaders/all_list") shader files, $(wc -l < "$b/shaders/batch_list") different texts compiled"
+rm -f "$b/shaders"/batch_* "$b/shaders/all_list" "$b/shaders/same_as" "$b/shaders.unique.tap"
 awk '/^(ok|not ok) - /{ n++; sub(/ - /, " " n " - "); } { print } END { print "1.." n }' "$b/shaders.tap"
 ! grep -q "^not ok" "$b/shaders.tap"
