@@ -7,6 +7,7 @@
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
 #   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
 #   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
+#   make vulkan the Vulkan example (examples/vulkan_backend.c, lavapipe) into build/vulkan/*.png
 # Adding a test program: one name in TESTS (see "test programs" below). JOBS=n sets how many
 # compilers and tests run at once (default: the number of cores).
 CC      ?= cc
@@ -25,7 +26,7 @@ EMCC     ?= emcc
 CHROMIUM ?= chromium
 
 .PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
-        web test-web deps-web
+        web test-web deps-web vulkan vulkan-bench
 
 all: test
 
@@ -98,6 +99,8 @@ $(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)
 
 $(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
+$(BUILD)/test_raycast_san: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
+	$(CC) -std=c99 -DRC_SANITIZE $(SAN) $(WARN) $(INC) -Itests $< -o $@ -lm
 $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
 $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
@@ -115,10 +118,11 @@ $(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) | $(BUILD)
 
 TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
-            $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
+            $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/replay_api_san $(BUILD)/fuzz_api \
-            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless \
+            $(BUILD)/vulkan_backend
 
 # every shader dump_shaders writes, compiled and linked by an EGL driver (Mesa's llvmpipe here;
 # make gl-compile on a machine with a GPU driver)
@@ -127,6 +131,8 @@ GL_COMPILE = mkdir -p $(BUILD)/shaders_gl && rm -f $(BUILD)/shaders_gl/*.vert $(
 
 # name=command lines for tests/run.sh, besides the cmocka programs
 SCRIPT_RUNS = \
+  "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
+  "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
   "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
   "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
@@ -136,6 +142,7 @@ SCRIPT_RUNS = \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \
+  "raycast_selftest_asan_ubsan=$(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
   "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
   "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
@@ -166,6 +173,32 @@ check: deps-test
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_BINS)
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
+
+# --- Vulkan ------------------------------------------------------------------------
+# examples/vulkan_backend.c: an engine on Vulkan with fogvol's backend examples/fogvol_vulkan.h (GLSL of
+# FOGVOL_GLSL_VULKAN compiled at run time by shaderc: Debian's static libraries, glslang and SPIRV-Tools
+# with them) and, for its --check, the GL backend on OSMesa beside it. Mesa's lavapipe runs it
+# (VK_ENV: the lavapipe ICD where it is installed, so the check's figures are the same on every machine).
+VK_LIBS = -lvulkan -Wl,--start-group -l:libshaderc_combined.a -lglslang -lSPIRV -lMachineIndependent -lOSDependent \
+          -lOGLCompiler -lGenericCodeGen -lglslang-default-resource-limits -l:libSPIRV-Tools-opt.a -l:libSPIRV-Tools.a \
+          -Wl,--end-group -lstdc++ -lpthread
+LVP_ICD := $(firstword $(wildcard /usr/share/vulkan/icd.d/lvp_icd.*.json))
+VK_ENV   = $(if $(LVP_ICD),VK_ICD_FILENAMES=$(LVP_ICD) VK_DRIVER_FILES=$(LVP_ICD))
+$(BUILD)/vulkan_backend: examples/vulkan_backend.c examples/fogvol_vulkan.h examples/vulkan_scene.h $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(CFLAGS) $(WARN) $(INC) $< -o $@ $(VK_LIBS) $(GL_LIBS)
+
+# the Vulkan pictures (FLOAT with the engine's depth, PS20, MRT), validation layers on
+vulkan: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/vulkan_backend
+	@mkdir -p $(BUILD)/vulkan
+	$(VK_ENV) $(BUILD)/vulkan_backend $(BUILD)/vulkan/vulkan_float.png
+	$(VK_ENV) $(BUILD)/vulkan_backend --tier ps20 $(BUILD)/vulkan/vulkan_ps20.png
+	$(VK_ENV) $(BUILD)/vulkan_backend --tier mrt $(BUILD)/vulkan/vulkan_mrt.png
+
+# milliseconds per frame: the Vulkan backend on lavapipe beside the GL backend on llvmpipe, same scene
+vulkan-bench: deps-test
+	@$(MAKE) --no-print-directory $(BUILD)/vulkan_backend
+	$(VK_ENV) $(BUILD)/vulkan_backend --bench
 
 # --- demo --------------------------------------------------------------------------
 $(BUILD)/demo_headless: examples/demo_headless.c examples/demo_scene.h examples/example_gl.h $(TEST_DEPS) | $(BUILD)

@@ -74,6 +74,7 @@
    backends     fogvol_gl_backend_create     the GL backend on its own
                 fogvol_null_backend_init     a recording backend without a GPU (tests)
                 fogvol_uniform_name          the GLSL name of a uniform slot
+                fogvol_dialect_layout        where the Vulkan dialect puts uniforms, per-draw values, samplers
    shaders      fogvol_shader_strings        the GLSL of a program (tier, variants, dialect, stage)
                 fogvol_shader_source         the same with no variant
                 fogvol_post_shader_strings   the GLSL of an image-space effect
@@ -351,6 +352,12 @@ typedef enum fogvol_format {
                                  EXT_color_buffer_float + EXT_float_blend) */
 } fogvol_format;
 
+/* An object of the backend's graphics API that the engine and fogvol hand each other (engine depth
+   textures and framebuffers, fogvol's O texture for the engine's MRT and occluder passes, the post
+   effects' inputs): GL a texture or framebuffer name, Vulkan a non-dispatchable handle such as a
+   VkImageView (64 bits on every platform), D3D12 or Metal a pointer or descriptor handle. */
+typedef uint64_t fogvol_native;
+
 /* ---- context: handles, tiers, variants, dialects, the GL backend's desc ---- */
 typedef struct fogvol_context fogvol_context;
 typedef struct fogvol_mesh fogvol_mesh;
@@ -367,7 +374,13 @@ typedef enum fogvol_dialect {
     FOGVOL_GLSL_330 = 5, /* 330 core */
     FOGVOL_GLSL_100 = 6, /* GLSL ES 1.00 (GLES2, WebGL1) */
     FOGVOL_GLSL_300ES = 7,
-    FOGVOL_GLSL_COUNT = 8,
+    /* GLSL 450 for SPIR-V (glslangValidator -V, shaderc): samplers at layout(set = 0, binding = unit),
+       the pass uniforms in one std140 block at (set 0, binding FOGVOL_MAX_TEXTURE_UNITS), the
+       per-draw values in push constants, explicit locations; gl_FragCoord and rows as stored (row 0
+       first), depth [0, 1]. Where a backend finds each value: fogvol_program_desc.layout. No context
+       picks it: a Vulkan backend names it in fogvol_backend.dialect. */
+    FOGVOL_GLSL_VULKAN = 8,
+    FOGVOL_GLSL_COUNT = 9,
     FOGVOL_GLSL_MAX_ENUM = 0x7fffffff
 } fogvol_dialect;
 
@@ -809,7 +822,7 @@ typedef struct fogvol_frame_desc {
        to view depth through the inverse of projection * view (any projection above) and
        the depth conventions the backend reports (fogvol_frame_info) unless overridden by
        the two fields below */
-    uintptr_t engine_depth_texture;
+    fogvol_native engine_depth_texture;
     int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
     float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
     /* camera input: FOGVOL_CAMERA_VIEW_PROJECTION reads view_projection, eye and forward
@@ -827,7 +840,7 @@ typedef struct fogvol_frame_desc {
        needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
        FOGVOL_ERROR_UNSUPPORTED). */
     fogvol_depth_source engine_depth_source;
-    uintptr_t engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
+    fogvol_native engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
     /* 0 or 1: fogvol's sums at the viewport's resolution. 2: at half its width and height
        (rounded up): the O and face passes shade a quarter of the fragments and the composite
@@ -948,7 +961,7 @@ FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx);
    nothing). The engine's framebuffer must be viewport-sized with origin (0,0),
    and its pass must not blend into the attachment. */
 typedef struct fogvol_mrt_info {
-    uintptr_t texture;
+    fogvol_native texture;
     float clear_color[4];
     float uniforms[8];
     fogvol_format format;
@@ -960,7 +973,9 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
    writes to its second colour output (fogvol_encode_depth's bytes; computed in
    integers where the engine's GLSL has bit operations and floatBitsToInt: 330+,
    300 es; with an R32F O, fogvol_mrt[0].z = 0: the normalised view depth in
-   red). Insert after the #version line and the engine's precision statements. */
+   red). Insert after the #version line and the engine's precision statements.
+   GLSL for Vulkan (no loose uniforms): declare vec4 fogvol_mrt[2] in one of the engine's own
+   uniform blocks or push constants and #define FOGVOL_MRT_IN_BLOCK before the snippet. */
 FOGVOL_API const char *fogvol_mrt_snippet(void);
 
 /* Occluders drawn by the engine with its own programs, pipelines and vertex
@@ -977,7 +992,7 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
    uniforms. end_frame then uses what the engine drew instead of its own O
    pass; fogvol_add_occluder* in the same frame is refused. */
 typedef struct fogvol_occluder_info {
-    uintptr_t texture;        /* backend API object (GL: texture name) */
+    fogvol_native texture;        /* backend API object (GL: texture name) */
     int width, height;
     fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT, and PS20 with
                                  FOGVOL_SPEEDUP_FLOAT_O: d = (view depth - near)/(far - near)) */
@@ -1031,7 +1046,7 @@ typedef enum fogvol_post_effect {
    without blending (in-focus pixels keep their colour exactly). */
 typedef struct fogvol_dof_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t color_texture; /* the scene's colour (GL texture name), required */
+    fogvol_native color_texture; /* the scene's colour (GL texture name), required */
     int texture_size[2];     /* of the colour and depth textures; 0 = from the viewport */
     float focus_distance;    /* view depth in focus (> 0) */
     float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
@@ -1051,7 +1066,7 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
    (rgb = mix(rgb, color.rgb, color.a)); the others are untouched. */
 typedef struct fogvol_outline_desc {
     const fogvol_frame_desc *frame;
-    uintptr_t normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
+    fogvol_native normal_texture; /* 0 = depth only; else rgb = normal * 0.5 + 0.5 (any space) */
     int texture_size[2];      /* of the depth (and normal) texture; 0 = from the viewport */
     float color[4];           /* rgb, a = opacity; all 0 = opaque black */
     float depth_threshold;    /* relative second difference, 0 = 0.05 */
@@ -1080,7 +1095,19 @@ FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fog
    may come inside or outside a frame. A backend must leave the engine's
    state as it found it at begin_frame when end_frame returns, and resource
    entries called outside a frame must not change engine state either.
-   NULL optional entries (marked) are skipped. */
+   NULL optional entries (marked) are skipped.
+   Any graphics API: the table asks for no GL concept. Programs come as GLSL of
+   the backend's dialect (fogvol_backend.dialect: a GL dialect, whose uniforms a
+   backend sets by name, or FOGVOL_GLSL_VULKAN, SPIR-V-ready GLSL whose uniforms,
+   per-draw values and samplers sit where fogvol_program_desc.layout says); the
+   objects the engine and fogvol hand each other are fogvol_native values (GL
+   names, Vulkan handles, pointers); rows of targets and read-backs are in the
+   order the API stores them, row 0 at framebuffer y 0 (GL: the bottom; Vulkan
+   with a positive viewport height: the top row of memory), and fogvol's clip z
+   is GL's [-w, w] (the Vulkan dialect maps it to [0, w]: the same window
+   depth). examples/fogvol_vulkan.h is a complete backend on Vulkan,
+   examples/custom_backend.c wraps the GL one; the README's "Other graphics
+   APIs" says what each entry must do. */
 typedef uintptr_t fogvol_handle;
 
 /* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in
@@ -1154,7 +1181,9 @@ FOGVOL_API const char *fogvol_uniform_name(fogvol_uniform u);
    Per-draw uniforms: "fv_mvp" (mat4), "fv_depth" (vec4: d = dot(fv_depth, vec4(p,1))),
    "fv_sign" (float, FLOAT tier: -1 for negative volumes), "fv_ext" and "fv_emit" (vec4,
    FOGVOL_PROGRAM_COLOR_FACE: fogvol_draw.extinction and .emission).
-   Vertex attribute 0: "fv_position" (vec3). */
+   Vertex attribute 0: "fv_position" (vec3).
+   FOGVOL_GLSL_VULKAN: the same units as bindings of set 0, the uniforms above in one std140 block
+   and push constants, not names: fogvol_program_desc.layout (fogvol_dialect_layout). */
 #define FOGVOL_MAX_TEXTURE_UNITS 8
 
 typedef struct fogvol_target_desc {
@@ -1176,6 +1205,36 @@ typedef struct fogvol_target_desc {
 
 #define FOGVOL_MAX_SHADER_STRINGS 20
 
+/* The per-draw values of fogvol_draw as a program reads them (fogvol_uniform_layout.draw_offsets). */
+typedef enum fogvol_draw_value {
+    FOGVOL_DRAW_MVP = 0,        /* mat4 fv_mvp: fogvol_draw.mvp */
+    FOGVOL_DRAW_DEPTH = 1,      /* vec4 fv_depth: .depth */
+    FOGVOL_DRAW_EXTINCTION = 2, /* vec4 fv_ext: .extinction */
+    FOGVOL_DRAW_EMISSION = 3,   /* vec4 fv_emit: .emission */
+    FOGVOL_DRAW_SIGN = 4,       /* float fv_sign: .sign */
+    FOGVOL_DRAW_VALUE_COUNT = 5
+} fogvol_draw_value;
+
+/* Where a program's inputs live, for backends that bind by number instead of by name (the Vulkan
+   dialect; fogvol_dialect_layout). Pass uniforms: one std140 uniform block of pass_size bytes at
+   (descriptor set 0, binding pass_binding) holding fogvol_pass.uniforms exactly as the struct holds
+   them (uniform u at pass_offsets[u] = 16 u: copy the array as it is). Per-draw values: draw_size
+   bytes of push constants, visible to the vertex and fragment stages, value i at draw_offsets[i]
+   (mvp 16 floats, column-major; depth, extinction, emission 4 floats; sign 1 float). Samplers:
+   texture unit i (fogvol_pass.textures[i]) is the combined image sampler at (set 0,
+   sampler_bindings[i] = i). Vertex input: fv_position at location 0 (3 floats). Fragment outputs
+   from location 0 (two-attachment targets: locations 0 and 1). GL dialects: all -1 (by name). */
+typedef struct fogvol_uniform_layout {
+    int pass_binding, pass_size;
+    int pass_offsets[FOGVOL_U_COUNT];
+    int draw_size;
+    int draw_offsets[FOGVOL_DRAW_VALUE_COUNT];
+    int sampler_bindings[FOGVOL_MAX_TEXTURE_UNITS];
+} fogvol_uniform_layout;
+/* The layout of a dialect's programs: FOGVOL_SUCCESS for FOGVOL_GLSL_VULKAN; the GL dialects
+   (uniforms by name) fill every field with -1 and return FOGVOL_ERROR_UNSUPPORTED. */
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out);
+
 typedef struct fogvol_program_desc {
     const char *vs[FOGVOL_MAX_SHADER_STRINGS];
     int vs_count;
@@ -1183,6 +1242,8 @@ typedef struct fogvol_program_desc {
     int fs_count;
     const char *samplers[FOGVOL_MAX_TEXTURE_UNITS]; /* name bound to unit i, NULL = unused */
     const char *label;
+    fogvol_uniform_layout layout; /* the backend's dialect: where the uniforms, per-draw values and samplers
+                                     are (Vulkan), or all -1 (GL: by name) */
 } fogvol_program_desc;
 
 typedef struct fogvol_mesh_data {
@@ -1238,8 +1299,9 @@ typedef struct fogvol_pass {
     fogvol_handle program;
     fogvol_handle textures[FOGVOL_MAX_TEXTURE_UNITS]; /* texture or target handles (a target is
                                                          sampled as its colour texture) */
-    uintptr_t native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
-                                                            backend's own API (GL: a texture name) */
+    fogvol_native native_textures[FOGVOL_MAX_TEXTURE_UNITS]; /* non-zero: an engine texture in the
+                                                            backend's own API (GL: a texture name;
+                                                            Vulkan: an image view) */
     float uniforms[FOGVOL_U_COUNT][4];
 } fogvol_pass;
 
@@ -1309,12 +1371,13 @@ typedef struct fogvol_backend {
     void (*draw_mesh)(void *user_data, fogvol_handle mesh, const fogvol_draw *draw);
     void (*draw_fullscreen)(void *user_data); /* one triangle covering the viewport */
     void (*end_pass)(void *user_data);        /* optional */
-    /* optional (debug read-back): the whole target, rows bottom to top, as RGBA8
+    /* optional (debug read-back; may wait for the GPU): the whole target, row 0 first (GL: bottom to top), as RGBA8
        bytes or (R32F targets) floats, size >= w*h*4; RGBA32F targets: 4 floats a pixel, size >= w*h*16 */
     fogvol_result (*read_target)(void *user_data, fogvol_handle target, unsigned char *rgba, size_t size);
     void (*destroy)(void *user_data); /* optional: called by fogvol_destroy_context for owned backends */
-    /* optional (MRT tier): the API object behind a texture or target (GL: texture name) */
-    uintptr_t (*native_texture)(void *user_data, fogvol_handle texture);
+    /* optional (MRT tier, fogvol_occluder_prepare): the API object behind a texture or target
+       (GL: texture name; Vulkan: image view) */
+    fogvol_native (*native_texture)(void *user_data, fogvol_handle texture);
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
@@ -1323,8 +1386,8 @@ typedef struct fogvol_backend {
        bound at begin_frame; else framebuffer, an API object) into a
        single-sample depth texture the backend owns, with the same texel
        coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, uintptr_t framebuffer, int bound, const int rect[4],
-                                uintptr_t *texture);
+    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4],
+                                fogvol_native *texture);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
        the samples passing between begin_query and end_query, which fogvol calls around the draws of
        one pass (after begin_pass, before end_pass). create_query may be called inside or outside a
@@ -1811,7 +1874,9 @@ enum {
    their own shaders paste the strings of fogvol_analytic_snippet(): the
    uniform, void fogvol_analytic(vec3 world_pos, out float fog, out vec3 color)
    and fogvol_fold_fog(inout vec4 diffuse, inout vec4 specular, float fog,
-   vec3 color).
+   vec3 color) (GLSL for Vulkan: declare vec4 fv_analytic[42] in a block of your own and #define
+   FOGVOL_ANALYTIC_IN_BLOCK before them). FOGVOL_GLSL_VULKAN's own programs read one std140 block at
+   (set 0, binding 0): fv_mvp at byte 0, fv_model at 64, fv_analytic at 128; fv_position at location 0.
    Fragment shaders need highp and 42 uniform vectors (GLES2 promises 16 only).
 
    Degenerate input never gives NaN: invalid volumes are left out of a set (and
@@ -3316,6 +3381,43 @@ static const char fogvol__an_fs_modern[] =
    GLSL 400 or ARB_sample_shading, declared before any other token. */
 #define FOGVOL__SAMPLE_SHADING "#extension GL_ARB_sample_shading : require\n"
 
+/* Declarations the program bodies write through macros, so that one body serves GL and Vulkan:
+   FV_UNIFORM(type, name) (a GL uniform; in Vulkan a member of the pass block or of the push
+   constants, declared here), FV_BINDING(unit) before a sampler (Vulkan: its binding in set 0),
+   FV_LOCATION(n) before a vertex input or a varying (Vulkan: its location). */
+static const char fogvol__decl_gl[] =
+    "#define FV_UNIFORM(type, name) uniform type name;\n#define FV_BINDING(unit)\n#define FV_LOCATION(n)\n";
+#define FOGVOL__VK_MACROS \
+    "#define FV_VULKAN\n#define FV_UNIFORM(type, name)\n" \
+    "#define FV_BINDING(unit) layout(set = 0, binding = unit)\n#define FV_LOCATION(n) layout(location = n)\n"
+/* the pass block: fogvol_pass.uniforms as it is (FOGVOL_UNIFORMS in order, one vec4 each), at binding
+   FOGVOL_MAX_TEXTURE_UNITS (8) after the samplers; the per-draw values: fogvol__vk_draw_offsets */
+#define FOGVOL__VK_BLOCK_MEMBER(id, name) "    vec4 " #name ";\n"
+static const char fogvol__decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "precision highp float;\nprecision highp int;\n" /* (no effect in GLSL 450: says what highp in the bodies means) */
+    "layout(std140, set = 0, binding = 8) uniform fv_pass_block {\n" FOGVOL_UNIFORMS(FOGVOL__VK_BLOCK_MEMBER) "};\n"
+    "layout(push_constant) uniform fv_draw_block {\n"
+    "    layout(offset = 0) mat4 fv_mvp;\n"
+    "    layout(offset = 64) vec4 fv_depth;\n"
+    "    layout(offset = 80) vec4 fv_ext;\n"
+    "    layout(offset = 96) vec4 fv_emit;\n"
+    "    layout(offset = 112) float fv_sign;\n"
+    "};\n";
+#undef FOGVOL__VK_BLOCK_MEMBER
+/* the analytic fog's block (what the engine fills: fv_mvp at 0, fv_model at 64, then the
+   FOGVOL_ANALYTIC_UNIFORM_VEC4S vec4 of fogvol_analytic_pack_uniforms at 128) */
+static const char fogvol__an_decl_vulkan[] =
+    FOGVOL__VK_MACROS
+    "layout(std140, set = 0, binding = 0) uniform fv_analytic_block {\n"
+    "    mat4 fv_mvp;\n    mat4 fv_model;\n    vec4 fv_analytic[42];\n};\n#define FOGVOL_ANALYTIC_IN_BLOCK\n";
+#undef FOGVOL__VK_MACROS
+static const char fogvol__fs_vulkan[] =
+    "#define FV_VARYING_IN in\n#define FV_TEXTURE texture\nlayout(location = 0) out vec4 fv_fragcolor;\n"
+    "#define FV_FRAGCOLOR fv_fragcolor\n";
+static const char fogvol__fs_vulkan_analytic[] =
+    "#define FV_VARYING_IN in\nlayout(location = 0) out vec4 fv_fragcolor;\n#define FV_FRAGCOLOR fv_fragcolor\n";
+
 typedef struct fogvol__dialect_info {
     const char *name;                 /* fogvol_dialect_name */
     const char *version;              /* the #version line */
@@ -3328,27 +3430,38 @@ typedef struct fogvol__dialect_info {
     const char *fs_two[2];            /* fragment prelude, two outputs (WIDE encode and face) */
     const char *an_vs[2], *an_fs[2];  /* the analytic fog's preludes */
     const char *fs_fetch;             /* fragment prelude of FOGVOL_SPECIALIZE_FETCH_O; NULL: not in this dialect */
+    const char *decl, *an_decl;       /* after the prelude: FV_UNIFORM, FV_BINDING, FV_LOCATION (and the Vulkan
+                                         blocks) for the volume programs and for the analytic fog */
+    unsigned char vulkan;             /* SPIR-V: never chosen for a GL context */
 } fogvol__dialect_info;
 
 static const fogvol__dialect_info fogvol__dialects[] = {
-    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL},
+    {"auto", "", NULL, 0, 0, 0, 0, 0, {NULL, NULL}, NULL, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, NULL, NULL, NULL,
+     0},
     {"110", "#version 110\n", NULL, 0, 1, 2, 2, 0, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"120", "#version 120\n", NULL, 0, 1, 2, 2, 1, {fogvol__vs_legacy, NULL}, fogvol__fs_legacy,
-     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL},
+     {fogvol__fs_two_legacy, NULL}, {NULL, fogvol__vs_legacy}, {NULL, fogvol__an_fs_legacy}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"130", "#version 130\n", NULL, 0, 0, 2, 3, 0, {fogvol__vs_modern, NULL}, fogvol__fs_modern,
-     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL},
+     {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern}, NULL, fogvol__decl_gl,
+     fogvol__decl_gl, 0},
     {"150", "#version 150\n", "#version 150\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 2, {fogvol__vs_modern, NULL},
      fogvol__fs_modern, {fogvol__fs_two_modern, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__an_fs_modern},
-     NULL},
+     NULL, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"330 core", "#version 330 core\n", "#version 330 core\n" FOGVOL__SAMPLE_SHADING, 0, 0, 2, 3, 3,
      {fogvol__vs_modern, NULL}, fogvol__fs_modern, {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern},
-     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330},
+     {NULL, fogvol__an_fs_modern}, fogvol__fs_fetch_330, fogvol__decl_gl, fogvol__decl_gl, 0},
     {"100", "#version 100\n", NULL, 1, 1, 1, 2, 0, {fogvol__vs_legacy, fogvol__highp_float}, fogvol__fs_es100,
-     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL},
+     {NULL, NULL}, {fogvol__highp_float, fogvol__vs_legacy}, {fogvol__an_fs_es100, fogvol__an_fs_legacy}, NULL,
+     fogvol__decl_gl, fogvol__decl_gl, 0},
     {"300 es", "#version 300 es\n", NULL, 1, 0, 2, 3, 0, {fogvol__vs_modern, fogvol__highp_float}, fogvol__fs_es300,
      {fogvol__fs_two_es300, fogvol__fs_two_layout}, {fogvol__highp_float, fogvol__vs_modern},
-     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300}};
+     {fogvol__highp_float, fogvol__an_fs_modern}, fogvol__fs_fetch_es300, fogvol__decl_gl, fogvol__decl_gl, 0},
+    {"vulkan", "#version 450\n", NULL, 0, 0, 2, 4, 5, {fogvol__vs_modern, NULL}, fogvol__fs_vulkan,
+     {fogvol__fs_two_layout, NULL}, {NULL, fogvol__vs_modern}, {NULL, fogvol__fs_vulkan_analytic}, NULL,
+     fogvol__decl_vulkan, fogvol__an_decl_vulkan, 1}};
 #undef FOGVOL__SAMPLE_SHADING
 /* one row per value of fogvol_dialect */
 typedef char
@@ -3369,6 +3482,25 @@ static int fogvol__prelude(const char **strings, int n, const char *const prelud
     return n;
 }
 
+FOGVOL_API fogvol_result fogvol_dialect_layout(fogvol_dialect dialect, fogvol_uniform_layout *out)
+{
+    static const int draw[FOGVOL_DRAW_VALUE_COUNT] = {0, 64, 80, 96, 112}; /* fogvol__decl_vulkan's push constants */
+    const fogvol__dialect_info *di = fogvol__dialect(dialect);
+    int i;
+    if (!out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    memset(out, 0xff, sizeof *out); /* every field -1 */
+    if (!di || !di->vulkan) return FOGVOL_ERROR_UNSUPPORTED;
+    out->pass_binding = FOGVOL_MAX_TEXTURE_UNITS;
+    out->pass_size = (int)(FOGVOL_U_COUNT * 4 * sizeof(float));
+    for (i = 0; i < FOGVOL_U_COUNT; ++i) out->pass_offsets[i] = 16 * i;
+    out->draw_size = 116;
+    for (i = 0; i < FOGVOL_DRAW_VALUE_COUNT; ++i) out->draw_offsets[i] = draw[i];
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) out->sampler_bindings[i] = i;
+    return FOGVOL_SUCCESS;
+}
+/* fogvol__decl_vulkan names binding 8 for the pass block and fogvol_pass.uniforms is that block */
+typedef char fogvol__vk_pass_binding[FOGVOL_MAX_TEXTURE_UNITS == 8 ? 1 : -1];
+
 #ifndef FOGVOL_NO_GL
 /* The newest dialect of a GL (gles = 0) or GLES context of this version. */
 static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
@@ -3376,7 +3508,7 @@ static fogvol_dialect fogvol__dialect_for_gl(int gles, int major, int minor)
     int d, best = FOGVOL_GLSL_AUTO;
     for (d = 1; d < FOGVOL_GLSL_COUNT; ++d) { /* the rows of each family go from old to new */
         const fogvol__dialect_info *di = &fogvol__dialects[d];
-        if ((di->es != 0) != (gles != 0)) continue;
+        if ((di->es != 0) != (gles != 0) || di->vulkan) continue;
         if (best == FOGVOL_GLSL_AUTO || major > di->gl_major || (major == di->gl_major && minor >= di->gl_minor))
             best = d;
     }
@@ -5324,7 +5456,9 @@ FOGVOL_API fogvol_result fogvol_analytic_pack_uniforms(const fogvol_analytic_set
    gives the CPU's (t, event) order. Misses get t = 2 and sort to the end. */
 static const char fogvol__an_glsl_segment[] =
     "#define FV_AN_MAX 8\n"
+    "#ifndef FOGVOL_ANALYTIC_IN_BLOCK\n"       /* (Vulkan: a member of the engine's uniform block) */
     "uniform vec4 fv_analytic[2 + 5 * FV_AN_MAX];\n"
+    "#endif\n"
     "vec2 fv_an_slab(vec2 t, float o, float v) {\n"
     "    if (v != 0.0) {\n"
     "        float a = (-1.0 - o) / v, b = (1.0 - o) / v;\n"
@@ -5448,16 +5582,18 @@ static const char fogvol__an_glsl_main[] =
     "    fog = s.x;\n"
     "    color = law > 1.5 ? num : (s.y > 0.0 ? num / s.y : vec3(0.0));\n"
     "}\n";
+/* fogvol__an_decl_vulkan declares fv_analytic[42] */
+typedef char fogvol__an_vk_block[FOGVOL_ANALYTIC_UNIFORM_VEC4S == 42 ? 1 : -1];
 static const char *const fogvol__an_glsl[3] = {fogvol__an_glsl_segment, fogvol__an_glsl_add, fogvol__an_glsl_main};
 
 static const char fogvol__an_vs_body[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform mat4 fv_model;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(mat4, fv_model)\n"
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_OUT vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_OUT vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_OUT vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5475,9 +5611,9 @@ static const char fogvol__an_vs_body[] =
 
 static const char fogvol__an_fs_body[] =
     "#ifdef FV_PER_PIXEL\n"
-    "FV_VARYING_IN vec3 fv_world;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec3 fv_world;\n"
     "#else\n"
-    "FV_VARYING_IN vec4 fv_fog;\n"
+    "FV_LOCATION(0) FV_VARYING_IN vec4 fv_fog;\n"
     "#endif\n"
     "void main() {\n"
     "#ifdef FV_PER_PIXEL\n"
@@ -5501,6 +5637,7 @@ FOGVOL_API fogvol_result fogvol_analytic_shader_strings(fogvol_dialect dialect, 
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
     strings[n++] = di->version;
     n = fogvol__prelude(strings, n, stage == FOGVOL_STAGE_VERTEX ? di->an_vs : di->an_fs);
+    strings[n++] = di->an_decl;
     if (per_pixel) strings[n++] = "#define FV_PER_PIXEL\n";
     if ((stage == FOGVOL_STAGE_VERTEX) != (per_pixel != 0)) {
         strings[n++] = fogvol__an_glsl[0];
@@ -5645,10 +5782,11 @@ FOGVOL_API const char *fogvol_tier_name(fogvol_tier tier)
     return t ? t->name : "invalid";
 }
 
-/* GLSL 330 and 300 es guarantee highp integers and bit operations (PS13's integer ALU encode) */
+/* GLSL 330, 300 es and Vulkan's 450 guarantee highp integers and bit operations (PS13's integer ALU
+   encode) */
 static int fogvol__dialect_integers(fogvol_dialect dialect)
 {
-    return dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES;
+    return dialect == FOGVOL_GLSL_330 || dialect == FOGVOL_GLSL_300ES || dialect == FOGVOL_GLSL_VULKAN;
 }
 
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned v, fogvol_dialect dialect)
@@ -5737,15 +5875,15 @@ typedef char fogvol__variant_defines_match[FOGVOL_VARIANT_ALL == (1u << FOGVOL__
    plane still clips exactly (d >= 0) and nothing is clipped at the far plane.
    NEAR_CLAMP snaps vertices behind the near plane onto it instead (Baker). */
 static const char fogvol__vs_mesh[] =
-    "FV_ATTRIB vec3 fv_position;\n"
-    "uniform mat4 fv_mvp;\n"
-    "uniform vec4 fv_depth;\n"
-    "uniform vec4 fv_misc;\n"
-    "FV_VARYING_OUT float fv_d;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
+    "FV_UNIFORM(mat4, fv_mvp)\n"
+    "FV_UNIFORM(vec4, fv_depth)\n"
+    "FV_UNIFORM(vec4, fv_misc)\n"
+    "FV_LOCATION(0) FV_VARYING_OUT float fv_d;\n"
     "#ifdef FV_DENSITY\n"                        /* density texture coordinates from the model-space position */
-    "uniform vec4 fv_dens_u;\n"
-    "uniform vec4 fv_dens_v;\n"
-    "FV_VARYING_OUT vec2 fv_dtc;\n"
+    "FV_UNIFORM(vec4, fv_dens_u)\n"
+    "FV_UNIFORM(vec4, fv_dens_v)\n"
+    "FV_LOCATION(1) FV_VARYING_OUT vec2 fv_dtc;\n"
     "#endif\n"
     "void main() {\n"
     "    vec4 p = vec4(fv_position, 1.0);\n"
@@ -5763,11 +5901,14 @@ static const char fogvol__vs_mesh[] =
     "#endif\n"
     "    fv_d = d;\n"
     "    c.z = mix(c.z, d * fv_misc.x - c.w, fv_misc.y);\n"
+    "#ifdef FV_VULKAN\n"                          /* clip z in [0, w]: the same window depth */
+    "    c.z = 0.5 * (c.z + c.w);\n"
+    "#endif\n"
     "    gl_Position = c;\n"
     "}\n";
 
 static const char fogvol__vs_fullscreen[] =
-    "FV_ATTRIB vec3 fv_position;\n"
+    "FV_LOCATION(0) FV_ATTRIB vec3 fv_position;\n"
     "void main() {\n"
     "    gl_Position = vec4(fv_position.xy, 0.0, 1.0);\n"
     "}\n";
@@ -5776,10 +5917,10 @@ static const char fogvol__vs_fullscreen[] =
    the borrow fold (normalised digits, alpha free), screen coordinates. */
 static const char fogvol__fs_common[] =
     "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
-    "uniform vec4 fv_enc;\n"    /* (N, N^2, depth offset, depth max) */
-    "uniform vec4 fv_dith;\n"   /* (255 or 0, 1/D, D, 0) */
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_dec;\n"
+    "FV_UNIFORM(vec4, fv_enc)\n"    /* (N, N^2, depth offset, depth max) */
+    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, 0) */
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_dec)\n"
     /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
        texture (fv_nf.zw: the viewport's origin, declared by the programs that read it); FV_ORIGIN
        (SPECIALIZE_ORIGIN, the viewport at the window origin): both offsets 0, left out */
@@ -5796,8 +5937,8 @@ static const char fogvol__fs_common[] =
     /* view depth (distance along the view axis) of an engine depth-buffer sample: st in [0,1]
        across the engine viewport, z its window depth; fv_lin / fv_lin2 hold the inverse
        view-projection rows with the window -> NDC mapping (depth range, clip control) folded in */
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
     "float fv_engine_view_depth(vec2 st, float z) {\n"
     "#ifdef FV_DEPTH_FROM_Z\n"                 /* fv_lin.xy = fv_lin2.xy = 0 (no oblique near plane) */
     "    return (fv_lin.z * z + fv_lin.w) / (fv_lin2.z * z + fv_lin2.w);\n"
@@ -5841,10 +5982,10 @@ static const char fogvol__fs_encode_common[] =
        context's encoding compiled in, so the encode's arithmetic on them folds at compile time */
     "#ifdef FV_ENC_LN\n#define FV_N FV_ENC_N\n#define FV_DD FV_ENC_D\n#define FV_RDD (1.0 / FV_ENC_D)\n"
     "#else\n#define FV_N fv_enc.x\n#define FV_DD fv_dith.z\n#define FV_RDD fv_dith.y\n#endif\n"
-    "uniform sampler2D fv_dither;\n"
+    "FV_BINDING(2) uniform sampler2D fv_dither;\n"
     "#ifndef FV_ALU\n"
-    "uniform sampler2D fv_rg;\n"
-    "uniform sampler2D fv_blue;\n"
+    "FV_BINDING(0) uniform sampler2D fv_rg;\n"
+    "FV_BINDING(1) uniform sampler2D fv_blue;\n"
     "#endif\n"
     /* FV_IALU: the ALU encode in integers (FOGVOL__IALU_TEXT) */
     "#if defined(FV_ALU) && (__VERSION__ >= 330 || (defined(GL_ES) && __VERSION__ >= 300))\n"
@@ -5925,14 +6066,14 @@ static const char fogvol__fs_encode_common[] =
 
 static const char fogvol__fs_encode[] =
     "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
-    "uniform sampler2D fv_opaque;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_BINDING(3) uniform sampler2D fv_opaque;\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
     "    float depth = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
-    "FV_VARYING_IN float fv_d;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
     "void main() {\n"
     "#if defined(FV_WIDE)\n"
     "    vec4 hi, lo;\n"
@@ -5954,8 +6095,8 @@ static const char fogvol__fs_encode[] =
    with COUNT rely on the depth test and count faces in alpha. FLOAT: signed
    depth of every face in one pass, the sign from gl_FrontFacing. */
 static const char fogvol__fs_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "#ifdef FV_FETCH_O\n" /* O from the framebuffer (FOGVOL_SPECIALIZE_FETCH_O) */
     "#define FV_OREAD(s) fv_ofb\n"
     "#undef FV_O_DIGITS\n"
@@ -5964,17 +6105,17 @@ static const char fogvol__fs_face[] =
     "#define FV_OREAD(s) FV_SCREEN(s)\n"
     "#endif\n"
     "#ifdef FV_DENSITY\n"                        /* v = c + rho (min(d, o) - c), c = min(o, fv_dens.x) */
-    "uniform sampler2D fv_density;\n"
-    "uniform vec4 fv_dens;\n"
-    "FV_VARYING_IN vec2 fv_dtc;\n"
+    "FV_BINDING(6) uniform sampler2D fv_density;\n"
+    "FV_UNIFORM(vec4, fv_dens)\n"
+    "FV_LOCATION(1) FV_VARYING_IN vec2 fv_dtc;\n"
     "float fv_density_apply(float d, float o) {\n"
     "    return mix(min(o, fv_dens.x), d, FV_TEXTURE(fv_density, fv_dtc).r);\n"
     "}\n"
     "#endif\n"
     "#ifdef FV_FLOAT\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_speed;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
@@ -5994,7 +6135,7 @@ static const char fogvol__fs_face[] =
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
     "}\n"
     "#elif defined(FV_WIDE)\n"
-    "uniform sampler2D fv_opaque2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_opaque2;\n"
     "void main() {\n"
     "    vec4 hi, lo, ohi = FV_SCREEN(fv_opaque), olo = FV_SCREEN(fv_opaque2);\n"
     "    fv_encode_wide(fv_d, hi, lo);\n"
@@ -6007,7 +6148,7 @@ static const char fogvol__fs_face[] =
 /* (the face program's second string: C99 compilers need take no string over 4095 characters) */
 static const char fogvol__fs_face_rgba8[] =
     "#elif defined(FV_XSUM)\n" /* FOGVOL_SPECIALIZE_EXACT_SUM: the pixel as a 32-bit integer, +- d 2^24 */
-    "uniform float fv_sign;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
     "void main() {\n"
     "    float d = clamp(fv_d, 0.0, 1.0);\n"
     "#ifndef FV_NO_OPAQUE\n"
@@ -6078,9 +6219,9 @@ static const char fogvol__fs_resolve_fn[] =
 
 /* PS13 resolve into T: the digits (0 where B - F < 0), alpha marks covered pixels (2: saturated). */
 static const char fogvol__fs_resolve[] =
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "void main() {\n"
     "    vec4 b = FV_SCREEN(fv_back), f = FV_SCREEN(fv_front);\n"
     "    vec3 d = fv_resolve(b, f, FV_RESOLVE_O(fv_opaque));\n"
@@ -6096,7 +6237,7 @@ static const char fogvol__fs_resolve[] =
    where a check pass marked the channels that hit 255 before the subtraction
    brought them down. FV_CHECK (the check pass) keeps only saturated pixels. */
 static const char fogvol__fs_composite[] =
-    "uniform vec4 fv_rampmap;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
     /* exp(-x), x >= 0; FV_FAST_EXP (FOGVOL_SPEEDUP_FAST_EXP): 2^y = 2^n (1 + g (a + (1 - a) g)),
        n = floor(y), g = y - n, the minimax a with p(0) = 1, p(1) = 2 (relative error 0.0027) */
     "float fv_transmit(float x) {\n"
@@ -6108,17 +6249,17 @@ static const char fogvol__fs_composite[] =
     "    return exp(-x);\n"
     "#endif\n"
     "}\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
-    "uniform sampler2D fv_colors;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
-    "uniform vec4 fv_speed;\n"
-    "uniform vec4 fv_ctex_u;\n"
-    "uniform vec4 fv_ctex_v;\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(6) uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
+    "FV_UNIFORM(vec4, fv_speed)\n"
+    "FV_UNIFORM(vec4, fv_ctex_u)\n"
+    "FV_UNIFORM(vec4, fv_ctex_v)\n"
     "#ifdef FV_WIDE\n"
-    "uniform sampler2D fv_back2;\n"
-    "uniform sampler2D fv_front2;\n"
+    "FV_BINDING(4) uniform sampler2D fv_back2;\n"
+    "FV_BINDING(5) uniform sampler2D fv_front2;\n"
     "#endif\n"
     /* FV_DOWNSAMPLE (FLOAT, GLSL 130+): the sum at half resolution, bilinear between the four
        nearest low-resolution texel centres, clamped at the edges. The tw texels span the w pixels of
@@ -6233,11 +6374,11 @@ static const char fogvol__fs_composite_main[] =
    (FLOAT: d; RGBA8: encoded). 1: its back faces light the pixels whose opaque depth o lies
    between L's front depth and their own depth, in the engine framebuffer. */
 static const char fogvol__fs_light[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform FV_TARGET_SAMPLER fv_lfront;\n"
-    "uniform vec4 fv_light;\n"
-    "uniform vec4 fv_nf;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_BINDING(7) uniform FV_TARGET_SAMPLER fv_lfront;\n"
+    "FV_UNIFORM(vec4, fv_light)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
     "float fv_light_depth(vec4 v) {\n"
     "#ifdef FV_FLOAT\n"
     "    return v.r;\n"
@@ -6274,12 +6415,12 @@ static const char fogvol__fs_light[] =
    program) times the volume's per-channel extinction (target 0: optical depth tau) and times its
    extinction * colour (target 1: emission sum E). */
 static const char fogvol__fs_color_face[] =
-    "FV_VARYING_IN float fv_d;\n"
-    "uniform FV_TARGET_SAMPLER fv_opaque;\n"
-    "uniform float fv_sign;\n"
-    "uniform vec4 fv_nf;\n"
-    "uniform vec4 fv_ext;\n"
-    "uniform vec4 fv_emit;\n"
+    "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
+    "FV_UNIFORM(float, fv_sign)\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_ext)\n"
+    "FV_UNIFORM(vec4, fv_emit)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
@@ -6298,9 +6439,9 @@ static const char fogvol__fs_color_face[] =
    scene * T + c * (1 - T). fv_rampmap.z picks the step: 0 one FOG-blended draw (every extinction
    grey: T the same in each channel), 1 the multiply draw (scene * T), 2 the emission draw. */
 static const char fogvol__fs_color_composite[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform FV_TARGET_SAMPLER fv_back;\n"
-    "uniform FV_TARGET_SAMPLER fv_front;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(0) uniform FV_TARGET_SAMPLER fv_back;\n"
+    "FV_BINDING(1) uniform FV_TARGET_SAMPLER fv_front;\n"
     "void main() {\n"
     "    vec2 st = fv_st();\n"
     "    vec3 tau = max(FV_TEXTURE(fv_back, st).rgb, vec3(0.0));\n"
@@ -6488,6 +6629,7 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         if (d->specialize & FOGVOL_SPECIALIZE_FETCH_O) strings[n++] = fogvol__fs_fetch_o;
     } else
         strings[n++] = di->fs;
+    strings[n++] = di->decl;
     if (fogvol__tiers[d->tier].define[0]) strings[n++] = fogvol__tiers[d->tier].define;
     for (i = 0; i < FOGVOL__VARIANT_COUNT; ++i)
         if (v & (1u << i)) strings[n++] = fogvol__variant_define[i];
@@ -6520,7 +6662,9 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
    (the same 8x8 ordered pattern as fogvol_make_dither_index); in integers where the dialect has
    floatBitsToInt and bit operations (GLSL 330+, 300 es), by FV_IALU's FOGVOL__IALU_TEXT. */
 #define FOGVOL__MRT_SNIPPET_TEXT \
+    "#ifndef FOGVOL_MRT_IN_BLOCK\n" /* Vulkan: vec4 fogvol_mrt[2] is a member of the engine's own block */ \
     "uniform vec4 fogvol_mrt[2]; /* (1/(far-near), -near/(far-near), N, N^2), (offset, max, D, dither) */\n" \
+    "#endif\n" \
     "vec4 fogvol_view_depth_r32f(float view_depth) {\n" /* N = 0: an R32F target */ \
     "    return vec4(clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, 1.0), 0.0, 0.0, 0.0);\n" \
     "}\n" \
@@ -6665,10 +6809,10 @@ static void fogvol__null_draw_fullscreen(void *u)
 
 static void fogvol__null_end_pass(void *u) { ((fogvol_null_backend *)u)->in_pass = 0; }
 
-static uintptr_t fogvol__null_native(void *u, fogvol_handle h)
+static fogvol_native fogvol__null_native(void *u, fogvol_handle h)
 {
     (void)u;
-    return (uintptr_t)h;
+    return (fogvol_native)h;
 }
 
 static fogvol_handle fogvol__null_attachment(void *u, fogvol_handle t, int index)
@@ -6938,7 +7082,7 @@ typedef struct fogvol__run {
     fogvol_frame_stats st;
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
-    uintptr_t engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
     int w, h, single, count, rgba8;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
@@ -7290,6 +7434,7 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
     if (p == FOGVOL_PROGRAM_ENCODE && !fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH))
         pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
     pd.label = labels[p];
+    (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout); /* (GL dialects: all -1) */
     return ctx->be.create_program(ctx->be.user_data, &pd, out);
 }
 
@@ -8470,7 +8615,7 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
 
 /* For the *_prepare calls: fogvol's targets sized to the frame (touches the
    GPU, state restored), the frame's constants and O's API object. */
-static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, uintptr_t *texture)
+static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, fogvol_native *texture)
 {
     fogvol_frame_info fi;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
@@ -10049,13 +10194,13 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
    pixels, clamped to the viewport), from the depth texture's window depth
    through fv_lin / fv_lin2 as in the ENGINE_DEPTH variant. */
 static const char fogvol__fs_post_common[] =
-    "uniform vec4 fv_screen;\n"
-    "uniform vec4 fv_lin;\n"
-    "uniform vec4 fv_lin2;\n"
-    "uniform vec4 fv_ptexel;\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
-    "uniform vec4 fv_prect;\n"  /* first and last pixel centres of the viewport */
-    "uniform vec4 fv_pparams;\n"
-    "uniform sampler2D fv_pdepth;\n"
+    "FV_UNIFORM(vec4, fv_screen)\n"
+    "FV_UNIFORM(vec4, fv_lin)\n"
+    "FV_UNIFORM(vec4, fv_lin2)\n"
+    "FV_UNIFORM(vec4, fv_ptexel)\n" /* (1/texture width, 1/texture height, 1 = perspective, 0) */
+    "FV_UNIFORM(vec4, fv_prect)\n"  /* first and last pixel centres of the viewport */
+    "FV_UNIFORM(vec4, fv_pparams)\n"
+    "FV_BINDING(1) uniform sampler2D fv_pdepth;\n"
     "vec2 fv_ppix(vec2 o) { return clamp(gl_FragCoord.xy + o, fv_prect.xy, fv_prect.zw); }\n"
     "vec4 fv_ptex(sampler2D s, vec2 o) { return FV_TEXTURE(s, fv_ppix(o) * fv_ptexel.xy); }\n"
     "float fv_view_depth(vec2 o) {\n"
@@ -10066,7 +10211,7 @@ static const char fogvol__fs_post_common[] =
 
 /* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
 static const char fogvol__fs_post_dof[] =
-    "uniform sampler2D fv_pscene;\n"
+    "FV_BINDING(0) uniform sampler2D fv_pscene;\n"
     "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
     "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
     "    vec2 o = floor(dir * r + 0.5);\n"
@@ -10097,7 +10242,7 @@ static const char fogvol__fs_post_dof[] =
 
 /* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
 static const char fogvol__fs_post_outlines[] =
-    "uniform vec4 fv_pcolor;\n"
+    "FV_UNIFORM(vec4, fv_pcolor)\n"
     "float fv_pg(vec2 o) { float e = fv_view_depth(o); return fv_ptexel.z > 0.5 ? 1.0 / e : e; }\n"
     "float fv_pline(vec2 o, float g0) {\n" /* second difference along a line of three, both ends inside */
     "    vec2 a = gl_FragCoord.xy + o, b = gl_FragCoord.xy - o;\n"
@@ -10105,7 +10250,7 @@ static const char fogvol__fs_post_outlines[] =
     "    return abs(fv_pg(o) + fv_pg(-o) - 2.0 * g0);\n"
     "}\n"
     "#ifdef FV_NORMALS\n"
-    "uniform sampler2D fv_pnormal;\n"
+    "FV_BINDING(2) uniform sampler2D fv_pnormal;\n"
     "vec3 fv_pn(vec2 o) { return normalize(fv_ptex(fv_pnormal, o).rgb * 2.0 - 1.0); }\n"
     "#endif\n"
     "void main() {\n"
@@ -10126,8 +10271,8 @@ static const char fogvol__fs_post_outlines[] =
 
 /* Distance fog: fv_pparams.x = start, fv_rampmap as in the volume composite. */
 static const char fogvol__fs_post_fog[] =
-    "uniform vec4 fv_rampmap;\n"
-    "uniform sampler2D fv_colors;\n"
+    "FV_UNIFORM(vec4, fv_rampmap)\n"
+    "FV_BINDING(2) uniform sampler2D fv_colors;\n"
     "void main() {\n"
     "    float t = max(fv_view_depth(vec2(0.0)) - fv_pparams.x, 0.0);\n"
     "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
@@ -10151,9 +10296,11 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
     strings[n++] = di->version;
     if (stage == FOGVOL_STAGE_VERTEX) {
         n = fogvol__prelude(strings, n, di->vs);
+        strings[n++] = di->decl;
         strings[n++] = fogvol__vs_fullscreen;
     } else {
         strings[n++] = di->fs;
+        strings[n++] = di->decl;
         strings[n++] = fogvol__fs_post_common;
         if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
@@ -10188,6 +10335,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
                          : effect == FOGVOL_POST_OUTLINES && variant ? "fv_pnormal"
                                                                      : NULL;
         pd.label = labels[effect];
+        (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout);
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
@@ -11609,10 +11757,10 @@ static fogvol_handle fogvol__gl_target_attachment(void *u, fogvol_handle h, int 
     return index == 0 ? h : index == 1 ? (fogvol_handle)t->second : 0;
 }
 
-static uintptr_t fogvol__gl_native_texture(void *u, fogvol_handle h)
+static fogvol_native fogvol__gl_native_texture(void *u, fogvol_handle h)
 {
     (void)u;
-    return h ? (uintptr_t)((const fogvol__gl_texture *)h)->tex : 0;
+    return h ? (fogvol_native)((const fogvol__gl_texture *)h)->tex : 0;
 }
 
 static fogvol__GLuint fogvol__gl_shader(fogvol__gl *gl, fogvol__GLenum type, const char *const *src, int n,
@@ -12036,8 +12184,8 @@ static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w
     gl->depth_h = h;
 }
 
-static fogvol_result fogvol__gl_copy_depth(void *u, uintptr_t framebuffer, int bound, const int rect[4],
-                                           uintptr_t *texture)
+static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+                                           fogvol_native *texture)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
@@ -12578,6 +12726,11 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
         fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in fogvol_gl_desc (FOGVOL_GLSL_*)",
                     (int)desc->dialect);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->dialect == FOGVOL_GLSL_VULKAN) { /* SPIR-V, not GL */
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend cannot take FOGVOL_GLSL_VULKAN (a dialect for "
+                    "SPIR-V backends)");
+        return FOGVOL_ERROR_UNSUPPORTED;
     }
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;

@@ -953,10 +953,10 @@ static void compare(const rt *r, const float *fv, const float *pt, const int *pc
 }
 
 /* fogvol's own CPU cost per frame: the same frame on the recording null backend */
-static uintptr_t null_native(void *u, fogvol_handle h)
+static fogvol_native null_native(void *u, fogvol_handle h)
 {
     (void)u;
-    return (uintptr_t)h;
+    return (fogvol_native)h;
 }
 
 static double null_frame_us(const scene *s, int t, int w, int h)

@@ -295,7 +295,7 @@ static void rec_destroy(void *u)
 
 /* native_texture (optional, MRT tier). The API object behind a texture or target
    handle (GL: the texture name), for the engine to attach. */
-static uintptr_t rec_native_texture(void *u, fogvol_handle h)
+static fogvol_native rec_native_texture(void *u, fogvol_handle h)
 {
     recorder *r = (recorder *)u;
     r->calls[E_NATIVE_TEXTURE]++;

@@ -14,7 +14,10 @@
    with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH);
    FOGVOL_SPECIALIZE_EXACT_SUM in GLSL 330 and 300 es by PS20's, MRT's and PS13's FACE (with NO_DENSITY,
    single-sample), COMPOSITE and COMPOSITE_MESH where FLOAT_O could be (not WIDE, ENGINE_DEPTH, COUNT,
-   SINGLE_TARGET), not with COUNT. */
+   SINGLE_TARGET), not with COUNT.
+   The Vulkan dialect (FOGVOL_GLSL_VULKAN, SPIR-V) goes apart: `dump_shaders --vulkan DIR` writes only
+   its shaders (tests/vulkan_shaders.sh compiles them with glslangValidator -V), `dump_shaders DIR`
+   only the GL dialects' (tests/shaders.sh, gl_compile). */
 #define FOGVOL_IMPLEMENTATION
 #define FOGVOL_NO_GL
 #include "fogvol.h"
@@ -96,7 +99,8 @@ int main(int argc, char **argv)
 {
     static const char *const prog[FOGVOL_PROGRAM_COUNT] = {"encode", "face", "composite", "composite_mesh",
                                                            "resolve", "check", "light", "color_face", "color_composite"};
-    static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
+    static const char *const dia[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es",
+                                                       "vulkan"};
     static const unsigned specs[] = {0,
                                      FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE,
@@ -192,7 +196,8 @@ int main(int argc, char **argv)
                                      FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
-    const char *dir = argc > 1 ? argv[1] : ".";
+    int vulkan = argc > 1 && strcmp(argv[1], "--vulkan") == 0;
+    const char *dir = argc > 1 + vulkan ? argv[1 + vulkan] : ".";
     int t, p, d, st, n = 0, refused = 0, ms, k;
     unsigned v;
     for (k = 0; k < (int)(sizeof specs / sizeof specs[0]); ++k)
@@ -216,6 +221,7 @@ int main(int argc, char **argv)
                         sd.samples = ms ? 4 : 0;
                         sd.specialize = specs[k];
                         if (ms && st == FOGVOL_STAGE_VERTEX) continue; /* the same as single-sample */
+                        if ((d == FOGVOL_GLSL_VULKAN) != vulkan) continue;
                         r = fogvol_shader_strings(&sd, s, &count);
                         if (fogvol_combination_supported((fogvol_tier)t, v, (fogvol_dialect)d) != FOGVOL_SUCCESS ||
                             !variant_spec_applies(t, v, d, p, specs[k], ms) ||
@@ -253,6 +259,7 @@ int main(int argc, char **argv)
             for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
                 for (st = 0; st < 2; ++st) {
                     const char *s[FOGVOL_MAX_SHADER_STRINGS];
+                    if ((d == FOGVOL_GLSL_VULKAN) != vulkan) continue;
                     int count = -1, i;
                     char path[512];
                     FILE *f;

@@ -49,9 +49,9 @@ CTEST_PROGRAMS=${CTEST_PROGRAMS:-glstate} # the cmocka programs the CMake test b
 flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
 # name, libraries: OSMesa for the headless ones (every GL call must reach OSMesa), GLFW + libGL for the windows
 builds="demo_headless:-lOSMesa custom_backend:-lOSMesa demo_glfw:-lglfw_-lGL engine_integration:-lglfw_-lGL"
-for b in $builds; do # in parallel; each writes its own log
+for b in $builds; do # in parallel; each writes its own log (300 s each: make test runs other jobs beside them)
   name=${b%%:*}; libs=$(echo "${b#*:}" | tr _ ' ')
-  (timeout 120 $cc $flags "examples/$name.c" -o "$out/$name" $libs -lm > "$out/build_$name.log" 2>&1
+  (timeout 300 $cc $flags "examples/$name.c" -o "$out/$name" $libs -lm > "$out/build_$name.log" 2>&1
    echo $? > "$out/build_$name.rc") &
 done
 wait
@@ -68,6 +68,14 @@ for b in $builds; do
   run "$name compiles as C++11 (-Wall -Wextra -pedantic -Werror)" \
     ${CXX:-c++} -x c++ -std=c++11 -Wall -Wextra -pedantic -Werror -fsyntax-only -I. "examples/$name.c"
 done
+# the Vulkan example (make test builds and runs it on its own: vulkan_check) compiles as C++11 too
+if [ -f /usr/include/vulkan/vulkan.h ] && [ -f /usr/include/shaderc/shaderc.h ]; then
+  run "vulkan_backend compiles as C++11 (-Wall -Wextra -pedantic -Werror)" \
+    ${CXX:-c++} -x c++ -std=c++11 -Wall -Wextra -pedantic -Werror -fsyntax-only -D_POSIX_C_SOURCE=200809L -I. \
+    examples/vulkan_backend.c
+else
+  skip "vulkan_backend compiles as C++11" "libvulkan-dev or libshaderc-dev not installed"
+fi
 lines=$(grep -c 'fogvol \*/' examples/engine_integration.c)
 if [ "$lines" -gt 0 ] && [ "$lines" -lt 40 ]; then ok "engine_integration adds fog in $lines marked lines (< 40)"
 else not_ok "engine_integration adds fog in $lines marked lines (want 1..39)"; fi

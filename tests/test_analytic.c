@@ -1594,12 +1594,13 @@ static void test_pack_uniforms(void **state)
 
 /* ==== 10: glslangValidator ========================================================= */
 
-static const char *const dialect_tag[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es"};
+static const char *const dialect_tag[FOGVOL_GLSL_COUNT] = {"auto", "110", "120", "130", "150", "330", "100", "300es",
+                                                           "vulkan"};
 
 static void test_shaders_glslang(void **state)
 {
     const char *b = getenv("BUILD") ? getenv("BUILD") : "build";
-    char dir[512], cmd[2048];
+    char dir[512], cmd[4096];
     int d, st, pp, n = 0, failed = 0;
     (void)state;
     {
@@ -1635,7 +1636,11 @@ static void test_shaders_glslang(void **state)
                 assert_non_null(f);
                 for (i = 0; i < count; ++i) fputs(s[i], f);
                 fclose(f);
-                snprintf(cmd, sizeof cmd, "glslangValidator '%s' > '%s.log' 2>&1", path, path);
+                if (d == FOGVOL_GLSL_VULKAN) /* to SPIR-V, validated (the block, explicit locations) */
+                    snprintf(cmd, sizeof cmd, "glslangValidator -V '%s' -o '%s.spv' > '%s.log' 2>&1 && "
+                             "spirv-val '%s.spv' >> '%s.log' 2>&1", path, path, path, path, path);
+                else
+                    snprintf(cmd, sizeof cmd, "glslangValidator '%s' > '%s.log' 2>&1", path, path);
                 if (system(cmd) != 0) {
                     print_message("# glslangValidator failed on %s (see %s.log)\n", path, path);
                     ++failed;

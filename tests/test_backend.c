@@ -330,6 +330,9 @@ static fogvol_result rec_create_program(void *u, const fogvol_program_desc *d, f
 {
     rec *r = (rec *)u;
     fogvol_result res = r->inner.create_program(r->inner.user_data, d, out);
+    fogvol_uniform_layout want;
+    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
+    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
     if (res == FOGVOL_SUCCESS && r->nprog < REC_MAX_RES) {
         r->prog[r->nprog].h = *out;
         r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
@@ -1034,6 +1037,55 @@ static void test_a1_depth_test_frames(void **state)
             assert_int_equal(face_passes, tiers[t] == FOGVOL_TIER_FLOAT ? 1 : 2);
             box_scene_close(&b);
         }
+}
+
+/* A backend of the Vulkan dialect (the recording backend says FOGVOL_GLSL_VULKAN): every tier builds its
+   programs from Vulkan strings and hands each one the dialect's layout (fogvol_program_desc.layout),
+   and a frame with an occluder, a volume and the overflow check runs through the same passes. */
+static void test_a1_vulkan_dialect(void **state)
+{
+    static const fogvol_tier tiers[4] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_MRT, FOGVOL_TIER_FLOAT};
+    int t;
+    (void)state;
+    for (t = 0; t < 4; ++t) {
+        static box_scene b;
+        fogvol_frame_desc fd;
+        fogvol_frame_stats st;
+        fogvol_context_desc cd;
+        fogvol_uniform_layout want;
+        rec_init(&b.r);
+        b.r.table.dialect = FOGVOL_GLSL_VULKAN;
+        b.r.table.caps |= FOGVOL_CAP_FLOAT_BLEND;
+        memset(&cd, 0, sizeof cd);
+        cd.backend = b.r.table;
+        cd.tier = tiers[t];
+        assert_int_equal(fogvol_create_context(&cd, &b.fv), FOGVOL_SUCCESS);
+        b.bm = box_mesh();
+        b.pm = shp_grid_plane(1, 1, 2);
+        assert_int_equal(make_mesh(b.fv, &b.bm, 0, 0, &b.box), FOGVOL_SUCCESS);
+        assert_int_equal(make_mesh(b.fv, &b.pm, 1, 0, &b.plane), FOGVOL_SUCCESS);
+        assert_int_equal(make_ramp(b.fv, FOGVOL_BLEND_FOG, &b.ramp), FOGVOL_SUCCESS);
+        memset(&b.vd, 0, sizeof b.vd);
+        b.vd.mesh = b.box;
+        b.vd.ramp = b.ramp;
+        mat_ts(b.vd.model, 0, 0, 0, 1, 1, 1);
+        mat_ts(b.om, 0, 0, -2, 1, 1, 1);
+        a_frame_desc(&fd);
+        assert_int_equal(fogvol_begin_frame(b.fv, &fd), FOGVOL_SUCCESS);
+        if (tiers[t] == FOGVOL_TIER_MRT) {
+            fogvol_mrt_info mi;
+            assert_int_equal(fogvol_mrt_prepare(b.fv, &mi), FOGVOL_SUCCESS);
+        } else {
+            assert_int_equal(fogvol_add_occluder(b.fv, b.plane, b.om), FOGVOL_SUCCESS);
+        }
+        assert_int_equal(fogvol_add_volume(b.fv, &b.vd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(b.fv, &st), FOGVOL_SUCCESS);
+        assert_true(st.passes >= 2);
+        assert_true(b.r.nprog >= 2);
+        assert_int_equal(b.r.protocol_errors, 0); /* every program got the Vulkan layout */
+        assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, &want), FOGVOL_SUCCESS);
+        box_scene_close(&b);
+    }
 }
 
 /* The same frame drawn with the min compare (FOGVOL_SPEEDUP_DEPTH_TEST off): the faces read O. */
@@ -2493,6 +2545,16 @@ static void test_b7_dialects_core(void **state)
     d.version_minor = 0;
     d.dialect = FOGVOL_GLSL_100;
     expect_dialect(&d, FOGVOL_GLSL_100, "dialect override 100");
+    { /* SPIR-V is no GL dialect: refused, and no GL context picks it */
+        fogvol_backend be;
+        fogvol_allocator a;
+        counting cnt;
+        memset(&cnt, 0, sizeof cnt);
+        a = cnt_allocator(&cnt);
+        d.dialect = FOGVOL_GLSL_VULKAN;
+        assert_int_equal(fogvol_gl_backend_create(&d, &a, NULL, &be), FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(cnt.live, 0);
+    }
 }
 
 static void test_b7_dialects_compat(void **state)
@@ -3019,6 +3081,7 @@ int main(void)
         cmocka_unit_test(test_a1_pass_structure_fullscreen),
         cmocka_unit_test(test_a1_pass_structure_min_compare),
         cmocka_unit_test(test_a1_depth_test_frames),
+        cmocka_unit_test(test_a1_vulkan_dialect),
         cmocka_unit_test(test_a1_pass_structure_geometry),
         cmocka_unit_test(test_a1_geometry_without_stencil),
         cmocka_unit_test(test_a2_negative_only_group),

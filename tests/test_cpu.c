@@ -1703,6 +1703,180 @@ static void test_result_strings(void **state)
     assert_non_null(strstr(fogvol_result_string(FOGVOL_ERROR_BUFFER_TOO_SMALL), "small"));
 }
 
+
+/* ---- the Vulkan dialect (FOGVOL_GLSL_VULKAN) ------------------------------------------------
+   The layout a backend fills without reflection (fogvol_dialect_layout, fogvol_program_desc.layout)
+   against what the Vulkan strings declare (the std140 pass block and the push constants, read from
+   the text: std140 puts the n-th vec4 member at 16 n), against fogvol_pass.uniforms as the struct
+   lays it out, and against the sampler units the backend table's documentation lists (written out
+   here); and which programs exist: every one of GLSL 330 core but the framebuffer fetch's
+   (FETCH_O, EXACT_SUM) and the per-sample ones, which the caps leave out on Vulkan. */
+static const char *const g_unit_names[][2] = {
+    {"fv_rg", "0"}, {"fv_blue", "1"}, {"fv_dither", "2"}, {"fv_opaque", "3"}, {"fv_opaque2", "4"},
+    {"fv_density", "6"}, {"fv_lfront", "7"}, {"fv_back", "0"}, {"fv_front", "1"}, {"fv_colors", "2"},
+    {"fv_back2", "4"}, {"fv_front2", "5"}, {"fv_ctex", "6"}, {"fv_pscene", "0"}, {"fv_pdepth", "1"},
+    {"fv_pnormal", "2"}};
+
+static void join_strings(const char *const *s, int n, char *buf, size_t cap)
+{
+    int i;
+    buf[0] = 0;
+    for (i = 0; i < n; ++i) {
+        assert_true(strlen(buf) + strlen(s[i]) < cap);
+        strcat(buf, s[i]);
+    }
+}
+
+/* every "FV_BINDING(n) uniform TYPE NAME;" of a text: n is NAME's documented unit; returns the count */
+static int check_bindings(const char *text)
+{
+    const char *p = text;
+    int found = 0;
+    while ((p = strstr(p, "FV_BINDING(")) != NULL) {
+        char type[64], name[64], unit[8];
+        size_t k;
+        int matched = 0;
+        if (sscanf(p, "FV_BINDING(%7[0-9]) uniform %63s %63[a-z0-9_];", unit, type, name) == 3) {
+            for (k = 0; k < sizeof g_unit_names / sizeof g_unit_names[0]; ++k)
+                if (strcmp(name, g_unit_names[k][0]) == 0) {
+                    if (strcmp(unit, g_unit_names[k][1]) != 0) fail_msg("%s at unit %s, documented %s", name, unit,
+                                                                         g_unit_names[k][1]);
+                    matched = 1;
+                }
+            if (!matched) fail_msg("sampler %s has no documented unit", name);
+            found++;
+        } else if (strncmp(p, "FV_BINDING(unit)", 16) != 0) { /* (the macro's own definition) */
+            fail_msg("unexpected FV_BINDING use: %.60s", p);
+        }
+        p += 11;
+    }
+    return found;
+}
+
+static void test_vulkan_layout(void **state)
+{
+    static const char *const draw_decl[FOGVOL_DRAW_VALUE_COUNT] = {"mat4 fv_mvp;", "vec4 fv_depth;", "vec4 fv_ext;",
+                                                                  "vec4 fv_emit;", "float fv_sign;"};
+    static const int draw_bytes[FOGVOL_DRAW_VALUE_COUNT] = {64, 16, 16, 16, 4};
+    fogvol_uniform_layout l;
+    fogvol_pass pass;
+    fogvol_shader_desc sd;
+    const char *s[FOGVOL_MAX_SHADER_STRINGS];
+    static char text[65536];
+    const char *block, *p;
+    char want[128];
+    int n, i, d, end = 0;
+    (void)state;
+    assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    for (d = FOGVOL_GLSL_AUTO; d < FOGVOL_GLSL_COUNT; ++d) { /* GL dialects: by name, every field -1 */
+        if (d == FOGVOL_GLSL_VULKAN) continue;
+        assert_int_equal(fogvol_dialect_layout((fogvol_dialect)d, &l), FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(l.pass_binding, -1);
+        assert_int_equal(l.pass_offsets[FOGVOL_U_SPEEDUP], -1);
+        assert_int_equal(l.draw_offsets[FOGVOL_DRAW_SIGN], -1);
+        assert_int_equal(l.sampler_bindings[7], -1);
+    }
+    assert_string_equal(fogvol_dialect_name(FOGVOL_GLSL_VULKAN), "vulkan");
+    assert_int_equal(fogvol_dialect_layout(FOGVOL_GLSL_VULKAN, &l), FOGVOL_SUCCESS);
+    /* the pass block is fogvol_pass.uniforms as the struct holds it */
+    assert_int_equal(l.pass_size, (int)sizeof pass.uniforms);
+    for (i = 0; i < FOGVOL_U_COUNT; ++i)
+        assert_int_equal(l.pass_offsets[i], (int)((const char *)pass.uniforms[i] - (const char *)pass.uniforms[0]));
+    for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) assert_int_equal(l.sampler_bindings[i], i);
+    assert_true(l.draw_size <= 128); /* the push-constant size every Vulkan device has */
+    /* ... and as the strings declare it */
+    memset(&sd, 0, sizeof sd);
+    sd.tier = FOGVOL_TIER_PS20;
+    sd.program = FOGVOL_PROGRAM_FACE;
+    sd.dialect = FOGVOL_GLSL_VULKAN;
+    sd.stage = FOGVOL_STAGE_FRAGMENT;
+    assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_SUCCESS);
+    join_strings(s, n, text, sizeof text);
+    snprintf(want, sizeof want, "layout(std140, set = 0, binding = %d) uniform fv_pass_block {\n", l.pass_binding);
+    block = strstr(text, want);
+    assert_non_null(block);
+    p = block + strlen(want);
+    for (i = 0; i < FOGVOL_U_COUNT; ++i) { /* std140: the i-th vec4 member at 16 i */
+        snprintf(want, sizeof want, "    vec4 %s;\n", fogvol_uniform_name((fogvol_uniform)i));
+        assert_true(strncmp(p, want, strlen(want)) == 0);
+        assert_int_equal(l.pass_offsets[i], 16 * i);
+        p += strlen(want);
+    }
+    assert_true(strncmp(p, "};", 2) == 0);
+    assert_non_null(strstr(text, "layout(push_constant) uniform fv_draw_block {\n"));
+    for (i = 0; i < FOGVOL_DRAW_VALUE_COUNT; ++i) {
+        snprintf(want, sizeof want, "layout(offset = %d) %s", l.draw_offsets[i], draw_decl[i]);
+        assert_non_null(strstr(text, want));
+        if (l.draw_offsets[i] + draw_bytes[i] > end) end = l.draw_offsets[i] + draw_bytes[i];
+    }
+    assert_int_equal(l.draw_size, end);
+    /* no loose uniforms: every uniform of a Vulkan text is a sampler with its binding, or a block */
+    assert_true(check_bindings(text) >= 3);
+}
+
+static void test_vulkan_programs(void **state)
+{
+    static const unsigned specs[] = {0,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_NO_OPAQUE,
+                                     FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE,
+                                     FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_ORIGIN,
+                                     FOGVOL_SPECIALIZE_FLOAT_O | FOGVOL_SPECIALIZE_DITHER | FOGVOL_SPECIALIZE_ENCODING(4),
+                                     FOGVOL_SPECIALIZE_INLINE_RESOLVE,
+                                     FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED};
+    static char text[65536];
+    int t, p, st, k, exist = 0, samplers = 0;
+    unsigned v;
+    (void)state;
+    for (t = 1; t < FOGVOL_TIER_COUNT; ++t)
+        for (v = 0; v <= FOGVOL_VARIANT_ALL; ++v)
+            for (p = 0; p < FOGVOL_PROGRAM_COUNT; ++p)
+                for (st = 0; st < 2; ++st)
+                    for (k = 0; k < (int)(sizeof specs / sizeof specs[0]); ++k) {
+                        fogvol_shader_desc sd;
+                        const char *s[FOGVOL_MAX_SHADER_STRINGS];
+                        int n = -1, in330;
+                        memset(&sd, 0, sizeof sd);
+                        sd.tier = (fogvol_tier)t;
+                        sd.variants = v;
+                        sd.program = (fogvol_program)p;
+                        sd.stage = (fogvol_stage)st;
+                        sd.specialize = specs[k];
+                        sd.dialect = FOGVOL_GLSL_330;
+                        in330 = fogvol_shader_strings(&sd, s, &n) == FOGVOL_SUCCESS;
+                        sd.dialect = FOGVOL_GLSL_VULKAN;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n),
+                                         in330 ? FOGVOL_SUCCESS : FOGVOL_ERROR_UNSUPPORTED);
+                        if (!in330) continue;
+                        join_strings(s, n, text, sizeof text);
+                        assert_true(strncmp(text, "#version 450\n", 13) == 0);
+                        samplers += check_bindings(text);
+                        ++exist;
+                        /* the framebuffer fetch and per-sample shading: not in Vulkan's dialect */
+                        sd.specialize = specs[k] | FOGVOL_SPECIALIZE_FETCH_O;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                        sd.specialize = specs[k] | FOGVOL_SPECIALIZE_EXACT_SUM;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                        sd.specialize = specs[k];
+                        sd.samples = 4;
+                        assert_int_equal(fogvol_shader_strings(&sd, s, &n), FOGVOL_ERROR_UNSUPPORTED);
+                    }
+    print_message("# %d Vulkan shaders exist where GLSL 330 core has them; %d sampler bindings checked\n", exist,
+                  samplers);
+    assert_true(exist > 1000);
+    {
+        const char *s[FOGVOL_MAX_SHADER_STRINGS];
+        int n = 0;
+        assert_int_equal(fogvol_post_shader_strings(FOGVOL_POST_OUTLINES, 1, FOGVOL_GLSL_VULKAN, FOGVOL_STAGE_FRAGMENT,
+                                                    s, &n),
+                         FOGVOL_SUCCESS);
+        join_strings(s, n, text, sizeof text);
+        assert_int_equal(check_bindings(text), 2); /* fv_pdepth, fv_pnormal */
+        assert_int_equal(fogvol_analytic_shader_strings(FOGVOL_GLSL_VULKAN, FOGVOL_STAGE_VERTEX, 0, s, &n),
+                         FOGVOL_SUCCESS);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1720,6 +1894,8 @@ int main(void)
         cmocka_unit_test(test_mesh_winding),
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
+        cmocka_unit_test(test_vulkan_layout),
+        cmocka_unit_test(test_vulkan_programs),
     };
     /* CPU_TEST_FILTER: a cmocka pattern (* and ?), e.g. for the quick runs under valgrind */
     if (getenv("CPU_TEST_FILTER")) cmocka_set_test_filter(getenv("CPU_TEST_FILTER"));

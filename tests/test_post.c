@@ -323,7 +323,7 @@ static void outline_reference(const double *e, const double (*n)[3], unsigned ch
 }
 
 /* outlines drawn black over white: returns the number of pixels where GPU and CPU disagree */
-static int outline_run(fx *x, const fogvol_frame_desc *fd, uintptr_t normals, const unsigned char *mask)
+static int outline_run(fx *x, const fogvol_frame_desc *fd, fogvol_native normals, const unsigned char *mask)
 {
     fogvol_outline_desc od;
     int i, bad = 0;

@@ -5,7 +5,7 @@
 # FOGVOL_NO_INSTALL=1 turns installing off (provide the packages yourself, e.g. on a non-Debian system).
 set -euo pipefail
 what=${1:-test}
-pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0 libopengl-dev"
+pkgs_test="gcc g++ clang make libosmesa6-dev libstb-dev glslang-tools libcmocka-dev libclang-rt-14-dev valgrind libegl-dev libgles-dev libegl-mesa0 libopengl-dev libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers spirv-tools spirv-cross glslc libshaderc-dev glslang-dev"
 pkgs_demo="gcc make libosmesa6-dev libstb-dev"
 pkgs_run="gcc make libglfw3-dev libgl-dev xvfb xauth cmake pkg-config libosmesa6-dev libstb-dev"
 pkgs_web="make emscripten chromium libstb-dev"
@@ -26,7 +26,9 @@ deps: this is not a Debian-like system (no dpkg-query/apt-get), so nothing is in
 deps: '$what' needs these Debian packages or their equivalents: $pkgs
 deps:   (OSMesa: mesa's libOSMesa + headers; Mesa's EGL with the surfaceless platform + GLES headers; cmocka;
 deps:    stb_image_write.h under <stb/>; glslangValidator; GLFW 3 and Xvfb for the windowed demo; cmake and
-deps:    pkg-config for the packaging tests; emscripten and chromium for the browser build and its test)
+deps:    pkg-config for the packaging tests; emscripten and chromium for the browser build and its test;
+deps:    the Vulkan loader and headers, Mesa's lavapipe, the Khronos validation layers, glslc and shaderc
+deps:    (with glslang's static libraries), spirv-val and spirv-cross for the Vulkan example and shaders)
 deps: install them, then run again with FOGVOL_NO_INSTALL=1.
 EOF2
   exit 1

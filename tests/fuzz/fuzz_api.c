@@ -181,7 +181,7 @@ static void make_context(run *R)
     cd.disable_dither = (int)(u8(in) & 1);
     cd.engine_mrt = (int)(u8(in) & 1);
     if (R->gl) {
-        cd.gl.dialect = (fogvol_dialect)(u8(in) % 10 == 9 ? 0 : u8(in) % 9);
+        cd.gl.dialect = (fogvol_dialect)(u8(in) % 10 == 9 ? 0 : u8(in) % (FOGVOL_GLSL_COUNT + 1)); /* (+ 1: unknown) */
         e = (int)u8(in);
         cd.gl.mrt_highp = e & 1;
         if ((e >> 1) % 3 == 0) cd.gl.get_proc_address = glu_proc; /* the three kinds of loader */
@@ -190,7 +190,7 @@ static void make_context(run *R)
     } else {
         fogvol_null_backend_init(&R->nb, &cd.backend);
         cd.backend.caps = caps[u8(in) & 7];
-        cd.backend.dialect = (fogvol_dialect)(u8(in) % 9);
+        cd.backend.dialect = (fogvol_dialect)(u8(in) % (FOGVOL_GLSL_COUNT + 1));
         R->nb.queries = (int)(u8(in) & 1);
         R->nb.query_not_ready = (int)(u8(in) % 6);
         R->nb.query_samples = u8(in);
