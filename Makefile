@@ -133,6 +133,7 @@ GL_COMPILE = mkdir -p $(BUILD)/shaders_gl && rm -f $(BUILD)/shaders_gl/*.vert $(
 SCRIPT_RUNS = \
   "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
+  $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
   "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
   "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
@@ -187,13 +188,15 @@ VK_ENV   = $(if $(LVP_ICD),VK_ICD_FILENAMES=$(LVP_ICD) VK_DRIVER_FILES=$(LVP_ICD
 $(BUILD)/vulkan_backend: examples/vulkan_backend.c examples/fogvol_vulkan.h examples/vulkan_scene.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(CFLAGS) $(WARN) $(INC) $< -o $@ $(VK_LIBS) $(GL_LIBS)
 
-# the Vulkan pictures (FLOAT with the engine's depth, PS20, MRT), validation layers on
+# the Vulkan pictures (FLOAT with the engine's depth, PS20, MRT), validation layers on; each fails on
+# any validation message up to the end of the program (make test runs them too)
+VULKAN_PICTURES = float ps20 mrt
+VULKAN_PICTURE = mkdir -p $(BUILD)/vulkan && $(VK_ENV) $(BUILD)/vulkan_backend --tier $(1) $(BUILD)/vulkan/vulkan_$(1).png
 vulkan: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/vulkan_backend
-	@mkdir -p $(BUILD)/vulkan
-	$(VK_ENV) $(BUILD)/vulkan_backend $(BUILD)/vulkan/vulkan_float.png
-	$(VK_ENV) $(BUILD)/vulkan_backend --tier ps20 $(BUILD)/vulkan/vulkan_ps20.png
-	$(VK_ENV) $(BUILD)/vulkan_backend --tier mrt $(BUILD)/vulkan/vulkan_mrt.png
+	$(call VULKAN_PICTURE,float)
+	$(call VULKAN_PICTURE,ps20)
+	$(call VULKAN_PICTURE,mrt)
 
 # milliseconds per frame: the Vulkan backend on lavapipe beside the GL backend on llvmpipe, same scene
 vulkan-bench: deps-test

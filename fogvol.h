@@ -449,7 +449,9 @@ enum {
        colour channel (extinction density * extinction_color times signed depth) and their
        emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
        pass, and one composite pass blends them all (two full-screen draws, multiply then add,
-       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       when some extinction colour is not grey). Other ramps keep their own group, and so does,
+       for a frame, a ramp one of whose volumes has a density or colour texture in it (drawn as
+       without COLORS: the group's programs draw no texture). Model and
        error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
        target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
        per sample on multisampled framebuffers (fogvol_msaa_supported: use
@@ -508,6 +510,14 @@ typedef struct fogvol_gl_desc {
                                  must be highp as well). Left 0, a mediump output could round
                                  the depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
                                  precision). */
+    /* optional: the window system's current context as an opaque id (user_data as above), e.g.
+       eglGetCurrentContext, glfwGetCurrentContext, SDL_GL_GetCurrentContext, wglGetCurrentContext.
+       fogvol keeps what it returns at creation and refuses every call that would touch GL while it
+       returns something else (FOGVOL_ERROR_INVALID_STATE, logged; nothing is touched). Without it,
+       fogvol tells another context by its own vertex array object (GL 3 / GLES 3; on GL 2 / GLES 2 a
+       framebuffer object) not being there, which a context that does not share objects with
+       fogvol's always shows, and a context sharing them too (those objects are never shared). */
+    void *(*current_context)(void *user_data);
 } fogvol_gl_desc;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -752,6 +762,13 @@ typedef struct fogvol_frame_stats {
     int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
+    /* The thickness step of this frame's RGBA8 digit sums, in view depth: (zfar - znear) / 2^(3L)
+       (WIDE: 2^(6L)); every pixel's thickness is within about one step per pair of faces. 0 when no
+       group summed in digits (FLOAT, FOGVOL_SPEEDUP_EXACT_SUM). When it is coarser than 1/16 of the
+       view-depth extent of the bounds of the frame's smallest volume, a warning is logged (on the
+       first such frame, and again after a frame that was not): move znear out or zfar in, or use
+       fewer faces per target (fogvol_context_desc.encoding_bits) or the FLOAT tier. */
+    float depth_lsb;
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -789,7 +806,14 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
    FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
    so the projection's depth convention does not matter to it (only to the engine depth
    texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
+   orients the screen (mirrored x or y flip it). Matrices are column-major (m[column * 4 +
+   row], as glUniformMatrix4fv with transpose = GL_FALSE): a view matrix must be affine
+   (bottom row m[3], m[7], m[11], m[15] = 0, 0, 0, 1), and a perspective projection whose
+   w row stands in column 3 (m[14] = +-1, m[11] not) is taken for a transposed one; both
+   are refused (FOGVOL_ERROR_INVALID_ARGUMENT), and the log says "transposed?" with the
+   matrices that transposed would be accepted. Row-major engine matrices (raylib's Matrix,
+   DirectXMath's XMFLOAT4X4 in a row-vector convention) must be transposed when copied
+   (raylib: MatrixToFloat gives the column-major order). */
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
@@ -813,7 +837,12 @@ typedef struct fogvol_frame_desc {
        bottom to top, for the group of debug_ramp (NULL = the first group). Set
        debug_thickness to a width*height float buffer. Units: view-space w (the
        distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
+       scale), between znear and zfar; this read-back stalls, for debugging only.
+       A frame that draws no volume of debug_ramp (or none at all) writes 0
+       everywhere. The one-pass colour group (FOGVOL_VARIANT_COLORS) sums optical
+       depths of all its ramps: its read-back is the thickness of debug_ramp's
+       volumes alone (NULL: the ramp of the group's first volume), summed in one
+       more pass. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
@@ -858,11 +887,21 @@ typedef struct fogvol_frame_desc {
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
    restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); an occlusion or PRIMITIVES_GENERATED query the engine has running
+   the engine left pending are still pending after every fogvol call, and
+   nothing else (out-of-memory and context-loss codes cannot be raised again:
+   logged as a warning); they are raised again with GL_DEBUG_OUTPUT switched off
+   where the context has KHR_debug (GL 4.3, GLES 3.2 or the extension), so the
+   engine's debug callback and message log get no message for them (without
+   KHR_debug, e.g. ARB_debug_output alone, each raise reaches its callback as
+   one message). GL errors fogvol's own calls raise are the call's result
+   (FOGVOL_ERROR_BACKEND), logged, never left pending. fogvol must be called
+   with the GL context current that it was created in (a context sharing its
+   objects is not enough: vertex array and framebuffer objects are never
+   shared); with another current every call that would touch GL returns
+   FOGVOL_ERROR_INVALID_STATE, logged, and touches nothing (see
+   fogvol_gl_desc.current_context); an active transform feedback is paused
+   during the call (GL 4.0 / GLES 3.0; on GL 3.x, where it cannot be queried,
+   do not call fogvol inside one); an occlusion or PRIMITIVES_GENERATED query the engine has running
    counts fogvol's draws too (GL cannot pause those; fogvol then skips its
    own overflow query for the frame); fogvol must not be called between
    glBeginConditionalRender and glEndConditionalRender (not queryable: its
@@ -879,7 +918,10 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
 typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
 typedef struct fogvol_volume_desc {
     const fogvol_mesh *mesh;
-    float model[16];
+    float model[16];          /* column-major, affine (bottom row 0, 0, 0, 1), not singular (a zero
+                                 scale leaves no volume): else FOGVOL_ERROR_INVALID_ARGUMENT, logged
+                                 ("transposed?" when its transpose is affine). Occluder and light
+                                 model matrices: the same (an occluder may be flat, not all zero) */
     const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
     int negative;             /* 1: subtracts thickness from the volumes of its ramp */
     /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
@@ -1400,6 +1442,13 @@ typedef struct fogvol_backend {
     int (*begin_query)(void *user_data, fogvol_handle query);
     void (*end_query)(void *user_data, fogvol_handle query);
     int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+    /* optional: the first failure the backend met in its own calls since the last take_error, else
+       FOGVOL_SUCCESS, and forget it. fogvol calls it at the end of every public call that used the
+       backend and returns it when the call had no error of its own (the backend logs it). GL: a GL
+       error fogvol's own calls raised (FOGVOL_ERROR_BACKEND), read before the engine's pending errors
+       are raised again; an engine texture name that is no texture (FOGVOL_ERROR_INVALID_ARGUMENT);
+       another GL context current (FOGVOL_ERROR_INVALID_STATE). */
+    fogvol_result (*take_error)(void *user_data);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -2937,8 +2986,8 @@ static int fogvol__winding_at(const fogvol__wind *w, const double q[3], const do
         dist = (e2[0] * qq[0] + e2[1] * qq[1] + e2[2] * qq[2]) / det;
         if (dist <= 0.0 || u < 0.0 || v < 0.0 || u + v > 1.0) continue;
         if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9) return 0;
-        /* det = (e1 x e2) . d: > 0 when the face normal points along d (leaving) */
-        n += det > 0.0 ? 1 : -1;
+        /* det = e1 . (d x e2) = -(e1 x e2) . d: < 0 when the face normal points along d (leaving) */
+        n += det < 0.0 ? 1 : -1;
     }
     *wind = n;
     return 1;
@@ -3004,7 +3053,9 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
     int u = (a + 1) % 3, v = (a + 2) % 3, i, j, i0, i1, j0, j1, k;
     double area = (p[1][u] - p[0][u]) * (p[2][v] - p[0][v]) - (p[2][u] - p[0][u]) * (p[1][v] - p[0][v]);
     double umin = p[0][u], umax = p[0][u], vmin = p[0][v], vmax = p[0][v];
-    const double off = 0.5123;
+    /* a ray's offsets in its cell differ in u and v, and do not sum to 1: a ray never lies on a
+       diagonal of a quad whose corners are on grid lines (of any whole number of steps) */
+    const double offu = 0.5123, offv = 0.4671;
     if (area == 0.0) return;
     for (k = 1; k < 3; ++k) {
         if (p[k][u] < umin) umin = p[k][u];
@@ -3012,17 +3063,17 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
         if (p[k][v] < vmin) vmin = p[k][v];
         if (p[k][v] > vmax) vmax = p[k][v];
     }
-    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - off);
-    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - off) + 1;
-    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - off);
-    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - off) + 1;
+    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - offu);
+    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - offu) + 1;
+    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - offv);
+    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - offv) + 1;
     if (i0 < 0) i0 = 0;
     if (j0 < 0) j0 = 0;
     if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
     if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
     for (j = j0; j <= j1; ++j)
         for (i = i0; i <= i1; ++i) {
-            double qu = lo[u] + (i + off) * step[u], qv = lo[v] + (j + off) * step[v], e[3];
+            double qu = lo[u] + (i + offu) * step[u], qv = lo[v] + (j + offv) * step[v], e[3];
             int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
             for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
                 const double *p0 = p[k], *p1 = p[(k + 1) % 3];
@@ -3100,7 +3151,7 @@ static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_al
             fogvol__wind_tri(w, t, p);
             for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, xs, start);
         }
-    for (r = 0; r < NR; ++r) {
+    for (r = 0; xs && r < NR; ++r) { /* xs NULL: no ray crossed a face (xs + 0 would be undefined) */
         fogvol__xing *x = xs + start[r];
         int n = (int)count[r], i, j, sum = 0;
         if (skip[r] || n == 0) continue;
@@ -6944,6 +6995,8 @@ struct fogvol_ramp {
        frame's group_stamp; head and tail: its first and last volume in the frame's order */
     int64_t stamp;
     int head, tail;
+    int64_t textured;  /* the frame (fogvol__frame_state.serial) in which a volume of it has a density or
+                          colour texture: it leaves the one-pass colour group for that frame */
 };
 
 struct fogvol_volume_texture {
@@ -7032,6 +7085,7 @@ typedef struct fogvol__gpu {
 /* The frame between fogvol_begin_frame and fogvol_end_frame / fogvol_cancel_frame: its desc, camera,
    volumes, occluders and lights. */
 typedef struct fogvol__frame_state {
+    int64_t serial; /* fogvol_begin_frame calls (ramps mark the frame their volumes are textured in) */
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -7058,6 +7112,7 @@ typedef struct fogvol__frame_state {
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
 typedef struct fogvol__overflow_state {
     int counting, overflow_late, overflow_warned, qcur;
+    int coarse;        /* the last ended frame's digit step was coarse (fogvol_frame_stats.depth_lsb) */
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
@@ -7211,6 +7266,15 @@ static void fogvol__live_remove(fogvol__live *n, int *count)
     n->next->prev = n->prev;
     n->prev = n->next = n;
     (*count)--;
+}
+
+/* After the backend calls of a public call (outside a backend frame, or after its end_frame): the
+   backend's own failure since the last take (fogvol_backend.take_error, logged by the backend) is the
+   call's result when the call had none of its own. */
+static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
+{
+    fogvol_result e = ctx->be.take_error ? ctx->be.take_error(ctx->be.user_data) : FOGVOL_SUCCESS;
+    return r == FOGVOL_SUCCESS ? e : r;
 }
 
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
@@ -7677,6 +7741,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     r = fogvol__choose_tier(ctx, desc);
     if (r == FOGVOL_SUCCESS) fogvol__choose_speedups(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
+    r = fogvol__be_result(ctx, r);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
@@ -7986,10 +8051,12 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     fogvol__mesh_box(m, desc, used, nused);
     m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused) : -1;
     fogvol__free(&ctx->alloc, used);
-    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
+        if (m->handle) ctx->be.destroy_mesh(ctx->be.user_data, m->handle);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, m);
         return r;
     }
@@ -8028,6 +8095,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget(ctx, mesh, NULL);
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
     fogvol__live_remove(&mesh->live, &ctx->live_meshes);
     fogvol__free(&ctx->alloc, mesh);
 }
@@ -8083,9 +8151,11 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     td.filter = FOGVOL_FILTER_LINEAR;
     td.wrap = FOGVOL_WRAP_CLAMP;
     td.label = "fogvol colour ramp";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture));
     fogvol__free(&ctx->alloc, px);
     if (r != FOGVOL_SUCCESS) {
+        if (rp->texture) ctx->be.destroy_texture(ctx->be.user_data, rp->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, rp);
         return fogvol__refuse(ctx, r, "create_ramp: the backend could not make its texture");
     }
@@ -8110,6 +8180,7 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     if (!ctx || !ramp) return;
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     fogvol__live_remove(&ramp->live, &ctx->live_ramps);
     fogvol__free(&ctx->alloc, ramp);
 }
@@ -8139,9 +8210,11 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     if (!t) return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_volume_texture: out of memory");
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        if (t->texture) ctx->be.destroy_texture(ctx->be.user_data, t->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, t);
         return r;
     }
@@ -8162,6 +8235,7 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
         ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
     fogvol__live_remove(&texture->live, &ctx->live_textures);
     fogvol__free(&ctx->alloc, texture);
 }
@@ -8169,13 +8243,50 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 /* >>frame input =========================================================== */
 /* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
 
+/* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
+   next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->cur.in_frame = 0;
-    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.nvol = ctx->cur.nocc = ctx->cur.nlight = 0;
     ctx->cur.engine_occluders = 0;
+    ctx->cur.mrt_ready = 0;
     return FOGVOL_SUCCESS;
+}
+
+/* Matrices as fogvol reads them (column-major: m[column * 4 + row]). */
+static void fogvol__transpose(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* An affine transform: bottom row (m[3], m[7], m[11], m[15]) = (0, 0, 0, 1) within 1e-6 (of the
+   largest coefficient of the 3x3 part for the first three). A row-major matrix copied as it is has
+   its translation there. */
+static int fogvol__affine(const float m[16])
+{
+    double big = 0.0, tol;
+    int c, k;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 3; ++k)
+            if (FOGVOL_FABS(m[c * 4 + k]) > big) big = FOGVOL_FABS(m[c * 4 + k]);
+    tol = 1e-6 * big;
+    return FOGVOL_FABS(m[3]) <= tol && FOGVOL_FABS(m[7]) <= tol && FOGVOL_FABS(m[11]) <= tol &&
+           FOGVOL_FABS(m[15] - 1.0) <= 1e-6;
+}
+
+/* A perspective projection transposed: the w row (0, 0, -1, 0) (or +1, w = z) stands in column 3, so
+   m[14] is exactly +-1 and m[11] (the near/far term) is not, m[12] = m[13] = m[15] = 0 and the w row
+   read where it belongs, (m[3], m[7], m[11], m[15]), has the same (0, 0, c, 0) form. A projection as
+   written by glFrustum, gluPerspective, glm or D3D has m[11] = +-1 (reversed and infinite ones too),
+   so it is never taken for this. */
+static int fogvol__w_at_14(const float p[16])
+{
+    return FOGVOL_FABS(p[14]) == 1.0f && FOGVOL_FABS(p[11]) != 1.0f && p[11] != 0.0f && p[12] == 0.0f &&
+           p[13] == 0.0f && p[15] == 0.0f && p[3] == 0.0f && p[7] == 0.0f;
 }
 
 /* Camera axes in world space from the frame's input: eye, right X, up Y, forward F (view
@@ -8211,6 +8322,9 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
     if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
     if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16))
         return "non-finite view or projection matrix";
+    if (!fogvol__affine(d->view)) return "the view matrix's bottom row (m[3], m[7], m[11], m[15]) is not (0, 0, 0, 1)";
+    if (fogvol__w_at_14(d->projection))
+        return "the projection's clip w takes the view depth from m[14] (the z row), not m[11] (the w row)";
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
     fogvol__mul4(ctx->cur.viewproj, p, v);
@@ -8229,8 +8343,8 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
 /* The frame's camera: how clip w relates to view depth (perspective: w = s e, s > 0;
    orthographic: w constant > 0), whether the projection mirrors the screen (orientation
    of a camera-facing triangle, counter-clockwise as seen from the eye, after projection),
-   and the inverse view-projection. Logs and refuses what it cannot interpret. */
-static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+   and the inverse view-projection. Returns why it cannot interpret the camera, or NULL. */
+static const char *fogvol__camera_why(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
     const char *why = fogvol__camera_axes(ctx, d, ax);
@@ -8266,11 +8380,33 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
         if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
         else ctx->cur.mirrored = det < 0.0;
     }
-    if (why) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    return why;
+}
+
+/* The camera (fogvol__camera_why); a refusal is logged, and says which matrices transposed would be
+   accepted: row-major engine matrices (raylib's Matrix, DirectXMath) copied as they are. */
+static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    static const char *const which[4] = {"", "the view matrix", "the projection", "the view and projection matrices"};
+    const char *why = fogvol__camera_why(ctx, d);
+    fogvol_frame_desc t;
+    int k, hint = 0;
+    if (!why) return FOGVOL_SUCCESS;
+    for (k = d->camera == FOGVOL_CAMERA_VIEW_PROJECTION ? 3 : 1; k <= 3 && !hint; ++k) {
+        t = *d;
+        if (d->camera == FOGVOL_CAMERA_VIEW_PROJECTION) fogvol__transpose(t.view_projection, d->view_projection);
+        if (k & 1) fogvol__transpose(t.view, d->view);
+        if (k & 2) fogvol__transpose(t.projection, d->projection);
+        if (!fogvol__camera_why(ctx, &t)) hint = k;
     }
-    return FOGVOL_SUCCESS;
+    if (hint && d->camera == FOGVOL_CAMERA_VIEW_PROJECTION)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? view_projection "
+                    "transposed would be accepted: a row-major matrix copied as it is)", why);
+    else if (hint)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? %s transposed would be "
+                    "accepted: a row-major matrix copied as it is)", why, which[hint]);
+    else fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
 }
 
 FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
@@ -8367,7 +8503,9 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.frame = *d;
     ctx->cur.nvol = ctx->cur.nocc = 0;
     ctx->cur.in_frame = 1;
+    ctx->cur.serial++;
     ctx->cur.nlight = 0;
+    ctx->cur.mrt_ready = ctx->cur.engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -8390,8 +8528,35 @@ static fogvol_result fogvol__grow(fogvol_context *ctx, void **arr, int *cap, int
     return FOGVOL_SUCCESS;
 }
 
+/* What makes a model matrix unusable, or NULL: non-finite, all zero, not affine (a row-major matrix
+   copied as it is: transposed, told apart by its transpose being affine), and for a volume or a
+   light, singular (|det| of the 3x3 part at most 1e-7 of the product of its column lengths: a zero
+   scale, or two axes along each other, flattens the mesh to no volume). */
+static const char *fogvol__model_problem(const float m[16], int volume)
+{
+    double d[16], c[3];
+    float t[16];
+    int i, k, zero = 1;
+    if (!fogvol__finite_n(m, 16)) return "is not finite";
+    for (i = 0; i < 16; ++i) zero &= m[i] == 0.0f;
+    if (zero) return "is all zero";
+    if (!fogvol__affine(m)) {
+        fogvol__transpose(t, m);
+        return fogvol__affine(t) ? "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1) but its "
+                                   "right column is (transposed? a row-major matrix copied as it is)"
+                                 : "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1)";
+    }
+    if (!volume) return NULL;
+    fogvol__tod(d, m);
+    for (k = 0; k < 3; ++k) c[k] = FOGVOL_SQRT(d[4 * k] * d[4 * k] + d[4 * k + 1] * d[4 * k + 1] + d[4 * k + 2] * d[4 * k + 2]);
+    if (FOGVOL_FABS(fogvol__det3(d)) <= 1e-7 * c[0] * c[1] * c[2])
+        return "is singular (a zero scale or two axes along each other flatten the mesh: no volume)";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16])
 {
+    const char *why;
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
@@ -8404,8 +8569,8 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (!fogvol__finite_n(model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the occluder's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.occ;
@@ -8498,6 +8663,7 @@ static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *de
 
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
+    const char *why;
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
@@ -8510,8 +8676,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volume's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     r = fogvol__check_textures(ctx, desc);
@@ -8526,6 +8692,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     memcpy(v->model, desc->model, sizeof v->model);
     v->negative = desc->negative != 0;
     fogvol__set_textures(v, desc);
+    if (desc->density || desc->color) /* (a ramp of this context: its own object) */
+        ((fogvol_ramp *)(uintptr_t)desc->ramp)->textured = ctx->cur.serial;
     return FOGVOL_SUCCESS;
 }
 
@@ -8552,14 +8720,17 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
+    const char *why;
     fogvol_draw dr;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: model is NULL");
     if (!ctx->cur.in_occluder_pass)
         return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
                               "occluder_transform outside an occluder callback (fogvol_add_occluder_callback)");
-    if (!fogvol__finite_n(model, 16))
-        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: non-finite model matrix");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_transform: the model matrix %s", why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
     return FOGVOL_SUCCESS;
@@ -8608,8 +8779,10 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
     memset(info, 0, sizeof *info);
     info->draw_buffer = ctx->cur.frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
-    if (r != FOGVOL_SUCCESS)
+    if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    }
     return r;
 }
 
@@ -8622,9 +8795,11 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     if (r != FOGVOL_SUCCESS) return r;
     r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
     *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
+    ctx->gpu.o_far = 0; /* the engine writes O from here, whether or not this frame is ended */
     return FOGVOL_SUCCESS;
 }
 
@@ -9164,6 +9339,15 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
 static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
 {
     return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
+}
+
+/* After the groups: a debug read-back that no group made (the frame draws no volume of debug_ramp,
+   or no volume at all) is the thickness the frame draws for it, 0. */
+static void fogvol__debug_empty(fogvol_context *ctx, const fogvol__run *run)
+{
+    size_t n = (size_t)ctx->cur.frame.viewport[2] * (size_t)ctx->cur.frame.viewport[3], i;
+    if (!ctx->cur.frame.debug_thickness || run->captured) return;
+    for (i = 0; i < n; ++i) ctx->cur.frame.debug_thickness[i] = 0.0f;
 }
 
 /* Window rectangles (x, y, w, h) that hold every pixel some volumes can cover:
@@ -9829,6 +10013,7 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
 
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
 {
+    const char *why;
     fogvol__light *l;
     void *arr;
     fogvol_result r;
@@ -9849,9 +10034,12 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
                                               : "the mesh is too large for the convexity check");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour or intensity");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the light's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.lights;
@@ -9944,9 +10132,12 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 /* >>colour groups ========================================================= */
 /* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
 
+/* A ramp in the colour group this frame: a colour ramp none of whose volumes has a density or colour
+   texture this frame (the colour group's programs draw neither: such a ramp is a group of its own,
+   drawn as without COLORS). */
 static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
-    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
+    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
 }
 
 /* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
@@ -10022,6 +10213,24 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     }
 }
 
+/* The debug read-back of a colour group (its sums are optical depths of all its ramps): one more
+   pass sums the faces of the debug ramp's volumes (debug_ramp NULL: the ramp of the group's first
+   volume, g) into B as the FLOAT tier's groups do, and reads that back. */
+static void fogvol__color_debug(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    const fogvol_ramp *ramp = ctx->cur.frame.debug_ramp ? ctx->cur.frame.debug_ramp : ctx->cur.vols[g].ramp;
+    int i, has_pos = 0, has_neg = 0;
+    if (!fogvol__want_debug(ctx, ramp, run->captured) || !fogvol__color_member(ctx, ramp)) return;
+    for (i = g; i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].ramp == ramp) {
+            has_neg |= ctx->cur.vols[i].negative;
+            has_pos |= !ctx->cur.vols[i].negative;
+        }
+    if (!has_pos) return; /* (no thickness: the frame's end writes 0) */
+    run->xsum = 0;
+    fogvol__sum_passes(ctx, run, ramp, has_neg);
+}
+
 /* The colour group, drawn where its first member volume g comes in the frame's order (once), if it
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
@@ -10029,6 +10238,7 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
     if (g != ctx->cur.color_first || !ctx->cur.color_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
+    fogvol__color_debug(ctx, run, g);
 }
 
 /* >>end frame ============================================================= */
@@ -10129,11 +10339,38 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
+/* fogvol_frame_stats.depth_lsb, and its warning: the step of the digit sums against the view-depth
+   extent (within znear..zfar) of the bounds of the frame's smallest positive volume. */
+static void fogvol__frame_precision(fogvol_context *ctx, fogvol__run *run)
+{
+    int bits = ctx->gpu.tgt_b2 ? 2 * ctx->cfg.enc.precision_bits : ctx->cfg.enc.precision_bits, i, coarse;
+    double n = ctx->cur.frame.znear, f = ctx->cur.frame.zfar, lsb = (f - n) / (double)(1L << bits), small = 0.0;
+    if (!run->rgba8 || run->st.exact_sum >= run->st.groups) return;
+    run->st.depth_lsb = (float)lsb;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        double lo = 0.0, hi = 0.0;
+        if (ctx->cur.vols[i].negative) continue;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &lo, &hi);
+        lo = lo < n ? n : lo > f ? f : lo;
+        hi = hi < n ? n : hi > f ? f : hi;
+        if (hi > lo && (small == 0.0 || hi - lo < small)) small = hi - lo;
+    }
+    coarse = small > 0.0 && lsb > small / 16.0;
+    if (coarse && !ctx->ovf.coarse)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the %d-bit depth sums step by %g (one LSB: (zfar - znear) / 2^%d), more than 1/16 of "
+                    "the smallest volume's depth extent %g: its thickness is quantised that coarsely (move znear "
+                    "out or zfar in, or use fewer faces per target, or the FLOAT tier)",
+                    bits, lsb, bits, small);
+    ctx->ovf.coarse = coarse;
+}
+
 /* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
 static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run, fogvol_result r,
                                          fogvol_frame_stats *stats)
 {
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     run->st.frame = ctx->ovf.frame_no;
     run->st.overflow_pixels_late = ctx->ovf.overflow_late;
     run->st.overflow_frame = ctx->ovf.overflow_frame;
@@ -10181,6 +10418,8 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
         fogvol__opaque_pass(ctx, &run);
         fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
+        fogvol__debug_empty(ctx, &run);
+        fogvol__frame_precision(ctx, &run);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
@@ -10338,6 +10577,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
         (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout);
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
+            (void)fogvol__be_result(ctx, r);
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
                         labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
             ctx->gpu.post_prog[slot] = 0;
@@ -10400,6 +10640,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     info.draw_buffer = fd->draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, &info);
     if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
         return r;
     }
@@ -10423,7 +10664,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    return FOGVOL_SUCCESS;
+    return fogvol__be_result(ctx, FOGVOL_SUCCESS);
 }
 
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc)
@@ -10607,7 +10848,7 @@ enum {
     FOGVOL__GL_COLOR_ATTACHMENT0 = 0x8CE0, FOGVOL__GL_DEPTH_ATTACHMENT = 0x8D00,
     FOGVOL__GL_STENCIL_ATTACHMENT = 0x8D20, FOGVOL__GL_FRAMEBUFFER = 0x8D40, FOGVOL__GL_RENDERBUFFER = 0x8D41,
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
-    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
+    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126, FOGVOL__GL_DEBUG_OUTPUT = 0x92E0,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
@@ -10649,6 +10890,7 @@ enum {
     X(void, Enable, (fogvol__GLenum)) \
     X(void, Disable, (fogvol__GLenum)) \
     X(fogvol__GLboolean, IsEnabled, (fogvol__GLenum)) \
+    X(fogvol__GLboolean, IsTexture, (fogvol__GLuint)) \
     X(void, Viewport, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, Scissor, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, ClearColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
@@ -10710,6 +10952,7 @@ enum {
 /* Framebuffer objects: GL 3.0, ARB_framebuffer_object, GLES 2.0; EXT_framebuffer_object names as fallback. */
 #define FOGVOL__GL_FBO(X) \
     X(void, GenFramebuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsFramebuffer, (fogvol__GLuint)) \
     X(void, DeleteFramebuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindFramebuffer, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, FramebufferTexture2D, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint, fogvol__GLint)) \
@@ -10724,6 +10967,7 @@ enum {
 /* Vertex array objects: GL 3.0, GLES 3.0 (required in core profiles). */
 #define FOGVOL__GL_VAO(X) \
     X(void, GenVertexArrays, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsVertexArray, (fogvol__GLuint)) \
     X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindVertexArray, (fogvol__GLuint))
 
@@ -10965,7 +11209,13 @@ typedef struct fogvol__gl {
     int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
     int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
     fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
-    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error */
+    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error (err_fbo:
+                                                           made at creation without VAOs, the context's mark) */
+    int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
+    int skip_draws;                                     /* this pass has an engine texture that is none */
+    fogvol_result own;                                  /* fogvol's own first error since take_error */
+    void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
+    void *user_data, *context_id;                       /* and what it returned at creation */
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -11307,6 +11557,7 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
         gl->GetProgramiv(gl->err_shader, FOGVOL__GL_LINK_STATUS, &v);
         break;
     case FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION: /* clearing nothing through an FBO with no attachment */
+        if (!gl->BindFramebuffer) break; /* (a context creation that failed before loading them) */
         gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &v);
         if (!gl->err_fbo) gl->GenFramebuffers(1, &gl->err_fbo);
         gl->BindFramebuffer(fb, gl->err_fbo);
@@ -11320,14 +11571,62 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
     }
 }
 
+/* fogvol's own GL errors, read while the engine's are held: the first becomes the public call's result
+   (FOGVOL_ERROR_BACKEND, through the backend's take_error), logged. */
+static void fogvol__gl_drain(fogvol__gl *gl)
+{
+    fogvol__GLenum first = gl->GetError();
+    int more = 0;
+    if (first == FOGVOL__GL_NO_ERROR) return;
+    while (more < 8 && gl->GetError() != FOGVOL__GL_NO_ERROR) ++more; /* (a lost context repeats its code) */
+    if (gl->own != FOGVOL_SUCCESS) return;
+    gl->own = FOGVOL_ERROR_BACKEND;
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL error 0x%04x raised by fogvol's own GL calls (%d more after it)",
+                first, more);
+}
+
+/* The last exit: fogvol's errors read, then the engine's raised again with GL_DEBUG_OUTPUT off where
+   KHR_debug lets it be switched (the raising calls then reach no debug callback nor the message log;
+   the enable is put back). */
 static void fogvol__gl_host_leave(fogvol__gl *gl)
 {
-    int i;
+    int i, dbg;
     if (gl->host_depth <= 0 || --gl->host_depth > 0) return;
     if (gl->tf_paused) gl->ResumeTransformFeedback();
     gl->tf_paused = 0;
+    fogvol__gl_drain(gl);
+    dbg = gl->host_n > 0 && gl->has_debug_output && gl->IsEnabled(FOGVOL__GL_DEBUG_OUTPUT);
+    if (dbg) gl->Disable(FOGVOL__GL_DEBUG_OUTPUT);
     for (i = 0; i < gl->host_n; ++i) fogvol__gl_raise(gl, gl->host_errors[i]);
+    if (dbg) gl->Enable(FOGVOL__GL_DEBUG_OUTPUT);
     gl->host_n = 0;
+}
+
+/* Another GL context current than fogvol's: fogvol_gl_desc.current_context says so, or fogvol's own
+   per-context object is not there (its full-screen vertex array object; without VAOs a framebuffer
+   object made at creation; neither is shared between contexts). The first refusal of a call is
+   logged and is its result (INVALID_STATE, through take_error); the entry then touches nothing. */
+static int fogvol__gl_foreign(fogvol__gl *gl)
+{
+    int other = gl->current_context && gl->current_context(gl->user_data) != gl->context_id;
+    if (!other && gl->has_vao) other = gl->fullscreen.vao && !gl->IsVertexArray(gl->fullscreen.vao);
+    else if (!other) other = gl->err_fbo && !gl->IsFramebuffer(gl->err_fbo);
+    if (other && gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_STATE;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: another GL context is current than the one fogvol was "
+                                                "created in (its objects are not in it): nothing done; make "
+                                                "fogvol's context current");
+    }
+    return other;
+}
+
+/* fogvol_backend.take_error */
+static fogvol_result fogvol__gl_take_error(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol_result r = gl->own;
+    gl->own = FOGVOL_SUCCESS;
+    return r;
 }
 
 /* Vertex attribute 0 where there is no vertex array object to keep it. */
@@ -11506,6 +11805,7 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     fogvol__gl_host_enter(gl);
     fogvol__gl_save(gl, &gl->saved);
     r = fogvol__gl_check_draw_buffer(gl, info->draw_buffer);
@@ -11597,10 +11897,11 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
     fogvol__gl_texture *t;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     t = (fogvol__gl_texture *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, filt, wrap, d->pixels);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
@@ -11622,7 +11923,7 @@ static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_texture *t = (fogvol__gl_texture *)h;
     if (!t) return;
-    gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11630,9 +11931,11 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
 {
     if (!t) return;
     if (t->second) fogvol__gl_free_target(gl, t->second);
-    gl->DeleteFramebuffers(1, &t->fbo);
-    gl->DeleteTextures(1, &t->base.tex);
-    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    if (!fogvol__gl_foreign(gl)) {
+        gl->DeleteFramebuffers(1, &t->fbo);
+        gl->DeleteTextures(1, &t->base.tex);
+        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    }
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11705,7 +12008,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     t->height = d->height;
     t->format = d->format;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     if (d->samples > 1)
         t->base.tex = fogvol__gl_new_texture_ms(gl, d);
@@ -11798,10 +12101,12 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
     const char *label = d->label ? d->label : "program";
     int i;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     p = (fogvol__gl_program *)fogvol__alloc(&gl->alloc, sizeof *p);
     if (!p) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(p, 0, sizeof *p);
     fogvol__gl_enter(gl, &s);
+    fogvol__gl_drain(gl); /* (earlier calls' errors are theirs, not this program's) */
     vs = fogvol__gl_shader(gl, FOGVOL__GL_VERTEX_SHADER, d->vs, d->vs_count, label, &r);
     fs = r == FOGVOL_SUCCESS ? fogvol__gl_shader(gl, FOGVOL__GL_FRAGMENT_SHADER, d->fs, d->fs_count, label, &r) : 0;
     if (r == FOGVOL_SUCCESS) {
@@ -11853,7 +12158,7 @@ static void fogvol__gl_destroy_program(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_program *p = (fogvol__gl_program *)h;
     if (!p) return;
-    gl->DeleteProgram(p->id); /* deferred by GL while the engine's program is current: no state change */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteProgram(p->id); /* deferred while current: no state change */
     if (gl->program == p) gl->program = NULL;
     fogvol__free(&gl->alloc, p);
 }
@@ -11904,7 +12209,7 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     if (gl->has_vao) {
         gl->GenVertexArrays(1, &m->vao);
         gl->BindVertexArray(m->vao);
@@ -11951,6 +12256,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     fogvol__gl_mesh *m;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
     r = fogvol__gl_upload(gl, m, d);
@@ -11967,7 +12273,7 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_mesh *m = (fogvol__gl_mesh *)h;
     if (!m) return;
-    fogvol__gl_free_mesh(gl, m);
+    if (!fogvol__gl_foreign(gl)) fogvol__gl_free_mesh(gl, m);
     fogvol__free(&gl->alloc, m);
 }
 
@@ -12009,6 +12315,21 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
 }
 
 /* The program of a pass with its uniforms, and its textures on fogvol's units. */
+/* An engine texture of a pass (engine depth, post effect inputs): a name that is no texture of the
+   current context is not bound (in a compatibility profile binding it would make an empty one) and
+   the pass draws nothing; the call's result is INVALID_ARGUMENT, logged. */
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex)
+{
+    if (gl->IsTexture(tex)) return tex;
+    gl->skip_draws = 1;
+    if (gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: texture %u handed to fogvol (an engine depth, colour or "
+                    "normal texture) is not a texture of the current GL context: its passes draw nothing", tex);
+    }
+    return 0;
+}
+
 static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
@@ -12021,7 +12342,7 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
         if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
+        if (p->native_textures[i]) tex = fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
@@ -12044,6 +12365,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_target *t = (fogvol__gl_target *)p->target;
+    gl->skip_draws = 0;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
@@ -12103,7 +12425,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_mesh *m = (const fogvol__gl_mesh *)h;
-    if (!m) return;
+    if (!m || gl->skip_draws) return;
     fogvol__gl_set_draw(u, d);
     fogvol__gl_bind_mesh(gl, m);
     gl->DrawElements(FOGVOL__GL_TRIANGLES, m->count, m->index_type, NULL);
@@ -12112,6 +12434,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 static void fogvol__gl_draw_fullscreen(void *u)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
+    if (gl->skip_draws) return;
     fogvol__gl_bind_mesh(gl, &gl->fullscreen);
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
@@ -12203,7 +12526,12 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
                     rect[1]);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    gl->GetError();
+    if (src && !gl->IsFramebuffer(src)) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_framebuffer %u is not a framebuffer of the "
+                                                "current GL context", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
     format = fogvol__gl_depth_format(gl, src == 0);
     if (!format) {
@@ -12233,7 +12561,7 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     if (t->format == FOGVOL_FORMAT_R32F)
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
@@ -12251,6 +12579,7 @@ static fogvol_result fogvol__gl_create_query(void *u, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     gl->GenQueries(1, &id); /* names only: no state */
     *out = (fogvol_handle)id;
     return id ? FOGVOL_SUCCESS : FOGVOL_ERROR_BACKEND;
@@ -12260,7 +12589,7 @@ static void fogvol__gl_destroy_query(void *u, fogvol_handle q)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = (fogvol__GLuint)q;
-    gl->DeleteQueries(1, &id);
+    if (!fogvol__gl_foreign(gl)) gl->DeleteQueries(1, &id);
 }
 
 /* Not while the engine has an occlusion query running: BeginQuery would fail (and add its error to
@@ -12306,12 +12635,14 @@ static void fogvol__gl_destroy(void *u)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_allocator a;
     if (!gl) return;
-    fogvol__gl_free_mesh(gl, &gl->fullscreen);
-    if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-    if (gl->err_shader) gl->DeleteShader(gl->err_shader);
-    if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
-    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    if (!fogvol__gl_foreign(gl)) {
+        fogvol__gl_free_mesh(gl, &gl->fullscreen);
+        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader);
+        if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
+        if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+        if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    }
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -12436,7 +12767,13 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
         gl->major = desc->version_major;
         gl->minor = desc->version_minor;
         gl->gles = desc->gles != 0;
-        if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
+        if (gl->core && gl->major < 3) { /* (GL 3.x stays the core profile it is; GLES 3 has VAOs too) */
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: a core-profile context cannot be treated as %s %d.%d "
+                        "(drawn without vertex array objects, one GL_EXTENSIONS string): use a compatibility "
+                        "profile for that override", gl->gles ? "OpenGL ES" : "GL", gl->major, gl->minor);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+        if (gl->gles) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
@@ -12620,6 +12957,19 @@ static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *d
 }
 
 /* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+/* Without VAOs, the context's mark (fogvol__gl_foreign): a framebuffer object, which exists once bound
+   (also the one fogvol__gl_raise clears through); the bindings are put back. */
+static void fogvol__gl_mark(fogvol__gl *gl)
+{
+    fogvol__GLint draw = 0, read = 0;
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &read);
+    gl->GenFramebuffers(1, &gl->err_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->err_fbo);
+    gl->BindFramebuffer(gl->has_split_fbo ? FOGVOL__GL_DRAW_FRAMEBUFFER : FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)draw);
+    if (gl->has_split_fbo) gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)read);
+}
+
 static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
@@ -12645,10 +12995,15 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
+    gl->has_debug_output = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2)
+                                    : gl->major > 4 || (gl->major == 4 && gl->minor >= 3);
+    if (!gl->has_debug_output)
+        gl->has_debug_output = gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_KHR_debug") : fogvol__has_ext(ext, "GL_KHR_debug");
     memset(&tri_data, 0, sizeof tri_data);
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
+    if (r == FOGVOL_SUCCESS && !gl->has_vao) fogvol__gl_mark(gl);
     if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     return r;
 }
@@ -12677,6 +13032,7 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->draw_fullscreen = fogvol__gl_draw_fullscreen;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
+    out->take_error = fogvol__gl_take_error;
     if (gl->has_query) {
         out->create_query = fogvol__gl_create_query;
         out->destroy_query = fogvol__gl_destroy_query;
@@ -12737,11 +13093,24 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
     memset(gl, 0, sizeof *gl);
     if (alloc) gl->alloc = *alloc;
     gl->log = *logger;
+    gl->current_context = in->current_context;
+    gl->user_data = in->user_data; /* (the caller's, also with a plain loader) */
+    if (gl->current_context) gl->context_id = gl->current_context(gl->user_data);
     r = fogvol__gl_version(gl, desc, &ver);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) { /* (the engine's pending errors held: fogvol's own are this call's) */
+        fogvol__gl_host_enter(gl);
+        r = fogvol__gl_features(gl, desc, &ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+        fogvol__gl_host_leave(gl);
+        if (r == FOGVOL_SUCCESS && fogvol__gl_take_error(gl) != FOGVOL_SUCCESS) {
+            fogvol__gl_destroy(gl);
+            return FOGVOL_ERROR_BACKEND;
+        }
+    }
     if (r != FOGVOL_SUCCESS) {
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader); /* (made to raise the engine's error) */
+        if (gl->err_fbo && gl->DeleteFramebuffers) gl->DeleteFramebuffers(1, &gl->err_fbo);
         fogvol__free(alloc, gl);
         return r;
     }

@@ -95,11 +95,48 @@ static GLenum APIENTRY fake_get_error(void)
     g_fake_error = GL_NO_ERROR;
     return e != GL_NO_ERROR ? e : glGetError();
 }
+/* glDrawArrays that raises a GL error the test queues after drawing (fogvol's own call failing). */
+static GLenum g_draw_error;
+static void APIENTRY fake_draw_arrays(GLenum mode, GLint first, GLsizei count)
+{
+    glDrawArrays(mode, first, count);
+    if (g_draw_error == GL_INVALID_ENUM) glBindTexture(0x1234, 0);
+    g_draw_error = GL_NO_ERROR;
+}
 static void (*fake_proc(const char *name, void *user))(void)
 {
     if (strcmp(name, "glGetError") == 0) return (void (*)(void))fake_get_error;
+    if (strcmp(name, "glDrawArrays") == 0) return (void (*)(void))fake_draw_arrays;
     return glu_proc(name, user);
 }
+
+/* The engine's KHR_debug callback: GL_DEBUG_TYPE_ERROR messages counted (the last kept). */
+static int g_dbg_errors;
+static char g_dbg_last[256];
+static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
+                              const GLchar *message, const void *user)
+{
+    (void)source;
+    (void)id;
+    (void)severity;
+    (void)length;
+    (void)user;
+    if (type != GL_DEBUG_TYPE_ERROR) return;
+    g_dbg_errors++;
+    snprintf(g_dbg_last, sizeof g_dbg_last, "%s", message);
+}
+static void debug_on(void)
+{
+    glEnable(GL_DEBUG_OUTPUT);
+    glDebugMessageCallback(debug_cb, NULL);
+    g_dbg_errors = 0;
+}
+static void no_debug_errors(const char *after)
+{
+    if (g_dbg_errors) fail_msg("%s: %d KHR_debug error messages reached the engine's callback, the last: %s", after,
+                               g_dbg_errors, g_dbg_last);
+}
+static unsigned g_variants; /* fogvol_context_desc.variants of make_fogvol */
 
 static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
 {
@@ -109,6 +146,7 @@ static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
     cd.logger.func = logger;
     cd.logger.user_data = &e->lc;
     cd.tier = tier;
+    cd.variants = g_variants;
     cd.disable_dither = 1;
     if (e->v21) {
         cd.gl.version_major = 2;
@@ -892,6 +930,13 @@ static void raise_engine_error(GLenum code)
     }
 }
 
+/* the engine's error, its own KHR_debug message not counted */
+static void engine_error(GLenum code)
+{
+    raise_engine_error(code);
+    g_dbg_errors = 0;
+}
+
 static void errors_case(int prof)
 {
     static const GLenum codes[4] = {GL_INVALID_ENUM, GL_INVALID_VALUE, GL_INVALID_OPERATION,
@@ -902,13 +947,15 @@ static void errors_case(int prof)
     int c, f;
     eng_open(&e, prof, FOGVOL_TIER_PS20);
     add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on(); /* raising the engine's errors again reaches no KHR_debug callback (issue 31 3c) */
     for (c = 0; c < 4; ++c) {
         snap before, after;
         for (f = 0; f < 3; ++f) { /* every frame, with and without the debug read-back */
             take_snap(&e, &before);
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             frame_desc(&e, &fd);
             assert_int_equal(run(&e, &fd, f == 1 ? thick : NULL), FOGVOL_SUCCESS);
+            no_debug_errors("end_frame");
             assert_int_equal(glGetError(), codes[c]);
             assert_int_equal(glGetError(), GL_NO_ERROR);
             take_snap(&e, &after);
@@ -927,22 +974,31 @@ static void errors_case(int prof)
             md.vertex_count = s.vcount;
             md.indices = (const uint32_t *)s.idx;
             md.index_count = s.icount;
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(fogvol_create_mesh(e.fv, &md, &m, NULL), FOGVOL_SUCCESS);
+            no_debug_errors("create_mesh");
             assert_int_equal(glGetError(), codes[c]);
             memset(&rd, 0, sizeof rd);
             rd.density = 1.0f;
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(fogvol_create_ramp(e.fv, &rd, &r), FOGVOL_SUCCESS);
+            no_debug_errors("create_ramp");
             assert_int_equal(glGetError(), codes[c]);
+            engine_error(codes[c]);
             fogvol_destroy_ramp(e.fv, r);
             fogvol_destroy_mesh(e.fv, m);
+            no_debug_errors("destroy_ramp, destroy_mesh");
+            assert_int_equal(glGetError(), codes[c]);
             shp_free(&s);
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(make_fogvol(&e, FOGVOL_TIER_PS20), FOGVOL_SUCCESS); /* a second context */
+            no_debug_errors("create_context");
             assert_int_equal(glGetError(), codes[c]);
             assert_int_equal(glGetError(), GL_NO_ERROR);
+            engine_error(codes[c]);
             fogvol_destroy_context(e.fv);
+            no_debug_errors("destroy_context");
+            assert_int_equal(glGetError(), codes[c]);
             e.fv = fv2;
         }
         print_message("# %s: engine error 0x%04x still pending after end_frame (3 frames), create_mesh, "
@@ -962,6 +1018,266 @@ static void test_errors_21(void **st)
 {
     (void)st;
     errors_case(PROF_21);
+}
+
+/* Issue 31 3c: fogvol's own GL errors. Each public call that touches GL reports the errors its own GL
+   calls raised (a result code and a log line) and leaves exactly the engine's pending errors:
+   - fogvol's own draw failing (glDrawArrays made to raise GL_INVALID_ENUM): BACKEND, the code
+     logged, the engine's GL_INVALID_VALUE still pending and nothing else (before: fogvol's code was
+     left pending as if the engine's);
+   - an engine depth texture name that is no texture: INVALID_ARGUMENT, logged, no GL call on it
+     (before: success, no fog, the error swallowed; in a compatibility context binding the name
+     made an empty texture);
+   - post_dof given a colour texture that does not exist: INVALID_ARGUMENT (before: success,
+     GL_INVALID_OPERATION left pending);
+   - engine_depth_framebuffer 999: INVALID_ARGUMENT with nothing left pending (before:
+     GL_INVALID_OPERATION left pending). */
+static void test_own_errors(void **st)
+{
+    eng e;
+    fogvol_frame_desc fd;
+    fogvol_dof_desc dd;
+    float *thick = (float *)calloc(NPIX, sizeof(float));
+    GLuint color = 0, depth = 0, fbo = 0;
+    (void)st;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on();
+    glLineWidth(-1.0f); /* the engine's GL_INVALID_VALUE */
+    g_dbg_errors = 0;
+    g_draw_error = GL_INVALID_ENUM;
+    frame_desc(&e, &fd);
+    e.lc.errors = 0;
+    e.lc.last[0] = 0;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_BACKEND);
+    print_message("# fogvol's draw failing: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "0x0500"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_int_equal(g_dbg_errors, 1); /* fogvol's own failing call, and no re-raise */
+    g_dbg_errors = 0;
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS); /* the next frame is clean */
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("the next frame");
+    eng_close(&e);
+
+    g_variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_FLOAT);
+    g_variants = 0;
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on();
+    fx_color_depth_fbo(W, H, GL_DEPTH_COMPONENT24, GL_UNSIGNED_INT, &color, &depth, &fbo);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    frame_desc(&e, &fd);
+    fd.engine_depth_texture = depth;
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    /* a depth texture name that is no texture */
+    glLineWidth(-1.0f);
+    g_dbg_errors = 0;
+    e.lc.last[0] = 0;
+    fd.engine_depth_texture = 4242;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# engine depth texture 4242: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "4242"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("a bad engine depth texture");
+    /* post_dof: the colour texture 4243 does not exist */
+    fd.engine_depth_texture = depth;
+    memset(&dd, 0, sizeof dd);
+    dd.frame = &fd;
+    dd.color_texture = color;
+    dd.focus_distance = 6.0f;
+    dd.focus_range = 2.0f;
+    assert_int_equal(fogvol_post_dof(e.fv, &dd), FOGVOL_SUCCESS);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    dd.color_texture = 4243;
+    glLineWidth(-1.0f);
+    g_dbg_errors = 0;
+    e.lc.last[0] = 0;
+    assert_int_equal(fogvol_post_dof(e.fv, &dd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# post_dof colour texture 4243: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "4243"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("post_dof with a bad texture");
+    /* engine_depth_framebuffer 999 */
+    fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT;
+    fd.engine_depth_framebuffer = 999;
+    e.lc.last[0] = 0;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# engine_depth_framebuffer 999: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "999"));
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("engine_depth_framebuffer 999");
+    fd.engine_depth_framebuffer = fbo; /* the same through the framebuffer: fine */
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &color);
+    glDeleteTextures(1, &depth);
+    eng_close(&e);
+    free(thick);
+}
+
+/* Issue 31 3c: version overrides that a core-profile context cannot honour. OpenGL ES 2.0 and GL 2.1
+   draw without vertex array objects and read one GL_EXTENSIONS string, which a core profile has not:
+   refused (UNSUPPORTED, logged) with nothing left pending (before: ES 2.0 was accepted and left
+   GL_INVALID_OPERATION, 2.1 refused but left GL_INVALID_ENUM). GL 3.0 is drawn as the core profile
+   it is (before: refused as a backend error leaving GL_INVALID_ENUM: fogvol touched the
+   compatibility profile's alpha test and polygon stipple). */
+static void test_override_core(void **st)
+{
+    static const struct {
+        int major, minor, gles;
+        fogvol_result want;
+    } cases[] = {{2, 0, 1, FOGVOL_ERROR_UNSUPPORTED}, {2, 1, 0, FOGVOL_ERROR_UNSUPPORTED},
+                 {3, 0, 0, FOGVOL_SUCCESS},           {3, 1, 0, FOGVOL_SUCCESS},
+                 {3, 0, 1, FOGVOL_SUCCESS}};
+    eng e;
+    int i;
+    (void)st;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    debug_on();
+    for (i = 0; i < (int)(sizeof cases / sizeof cases[0]); ++i) {
+        fogvol_context_desc cd;
+        fogvol_context *fv = NULL;
+        fogvol_result r;
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.logger.func = logger;
+        cd.logger.user_data = &e.lc;
+        cd.gl.version_major = cases[i].major;
+        cd.gl.version_minor = cases[i].minor;
+        cd.gl.gles = cases[i].gles;
+        e.lc.last[0] = 0;
+        g_dbg_errors = 0;
+        r = fogvol_create_context(&cd, &fv);
+        print_message("# core profile treated as %s %d.%d: %s%s%s\n", cases[i].gles ? "OpenGL ES" : "GL",
+                      cases[i].major, cases[i].minor, fogvol_result_string(r), e.lc.last[0] ? ": " : "", e.lc.last);
+        assert_int_equal(r, cases[i].want);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        no_debug_errors("create_context");
+        if (r == FOGVOL_SUCCESS) { /* and it draws: the sphere's chord through its centre */
+            fogvol_context *own = e.fv;
+            fogvol_ramp *own_ramp = e.ramp[0];
+            fogvol_frame_desc fd;
+            float *thick = (float *)calloc(NPIX, sizeof(float));
+            e.fv = fv;
+            make_ramp(&e, 0, NULL);
+            add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+            frame_desc(&e, &fd);
+            assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+            assert_true(fabs(thick[(H / 2) * W + W / 2] - 4.0) < 0.05);
+            assert_int_equal(glGetError(), GL_NO_ERROR);
+            no_debug_errors("a frame");
+            fogvol_destroy_mesh(fv, e.o[0].m);
+            shp_free(&e.o[0].mesh);
+            e.n = 0;
+            fogvol_destroy_ramp(fv, e.ramp[0]);
+            fogvol_destroy_context(fv);
+            e.fv = own;
+            e.ramp[0] = own_ramp;
+            free(thick);
+        } else {
+            assert_non_null(strstr(e.lc.last, "core"));
+        }
+    }
+    eng_close(&e);
+}
+
+/* Issue 31 3i: fogvol called with another GL context current (one that does not share objects with
+   fogvol's). Before: end_frame returned success and deleted two of that context's textures whose
+   names were those of fogvol's targets. Now every entry that would touch GL refuses
+   (INVALID_STATE, logged: "another GL context is current?") and touches nothing: the other
+   context's textures and buffers all exist afterwards and no GL error is left there; fogvol works
+   again once its context is current. Told by a per-context object of fogvol's own (its vertex
+   array object, or on GL 2 a framebuffer object) and, when the desc has one, by
+   fogvol_gl_desc.current_context. */
+static void other_context_case(int with_callback)
+{
+    eng e;
+    glu_ctx other;
+    fogvol_frame_desc fd;
+    fogvol_mesh_desc md;
+    fogvol_mesh *m = NULL;
+    GLuint tex[8], buf[8];
+    float *thick = (float *)calloc(NPIX, sizeof(float));
+    shp_mesh s = shp_sphere(1.0f, 16, 8);
+    int k, size;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    if (with_callback) { /* the same, told by the callback */
+        fogvol_context_desc cd;
+        fogvol_destroy_ramp(e.fv, e.ramp[0]);
+        fogvol_destroy_ramp(e.fv, e.ramp[1]);
+        fogvol_destroy_context(e.fv);
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.gl.current_context = glu_current_context;
+        cd.logger.func = logger;
+        cd.logger.user_data = &e.lc;
+        cd.tier = FOGVOL_TIER_PS20;
+        assert_int_equal(fogvol_create_context(&cd, &e.fv), FOGVOL_SUCCESS);
+        make_ramp(&e, 0, NULL);
+        make_ramp(&e, 1, NULL);
+    }
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    frame_desc(&e, &fd);
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_true(glu_create(&other, W, H, 1)); /* now current */
+    glGenTextures(8, tex);
+    glGenBuffers(8, buf);
+    for (k = 0; k < 8; ++k) {
+        static const unsigned char px[16] = {0};
+        glBindTexture(GL_TEXTURE_2D, tex[k]);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 2, 2, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        glBindBuffer(GL_ARRAY_BUFFER, buf[k]);
+        glBufferData(GL_ARRAY_BUFFER, 16, px, GL_STATIC_DRAW);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    for (size = 0; size < 2; ++size) { /* the same viewport, and one that would make new targets */
+        frame_desc(&e, &fd);
+        fd.viewport[2] = size ? W / 2 : W;
+        e.lc.last[0] = 0;
+        assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_STATE);
+        assert_non_null(strstr(e.lc.last, "context"));
+    }
+    print_message("# %s: %s\n", with_callback ? "with current_context" : "fingerprint", e.lc.last);
+    fx_mesh_desc(&md, &s, 0);
+    assert_int_equal(fogvol_create_mesh(e.fv, &md, &m, NULL), FOGVOL_ERROR_INVALID_STATE);
+    fogvol_destroy_mesh(e.fv, e.o[0].m); /* forgotten, its GL objects not deleted here */
+    e.o[0].m = NULL;
+    for (k = 0; k < 8; ++k) {
+        assert_true(glIsTexture(tex[k]));
+        assert_true(glIsBuffer(buf[k]));
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_true(glu_make_current(&e.g));
+    glu_destroy(&other);
+    assert_true(glu_make_current(&e.g));
+    e.o[0].m = NULL;
+    assert_int_equal(fogvol_create_mesh(e.fv, &md, &e.o[0].m, NULL), FOGVOL_SUCCESS);
+    frame_desc(&e, &fd);
+    memset(thick, 0, NPIX * sizeof(float));
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS); /* back in its own context: a sphere of radius 1 */
+    assert_true(fabs(thick[(H / 2) * W + W / 2] - 2.0) < 0.05);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    shp_free(&s);
+    free(thick);
+    eng_close(&e);
+}
+
+static void test_other_context(void **st)
+{
+    (void)st;
+    other_context_case(0);
+    other_context_case(1);
 }
 
 /* Codes GL cannot raise again on demand (out of memory, stack over/underflow, context loss) are logged. */
@@ -1106,6 +1422,8 @@ int main(void)
         cmocka_unit_test(test_state_compat),      cmocka_unit_test(test_transform_feedback),
         cmocka_unit_test(test_errors_core),       cmocka_unit_test(test_errors_21),
         cmocka_unit_test(test_errors_unraisable),
+        cmocka_unit_test(test_own_errors),        cmocka_unit_test(test_override_core),
+        cmocka_unit_test(test_other_context),
         cmocka_unit_test(test_alpha),             cmocka_unit_test(test_srgb),
         cmocka_unit_test(test_srgb_own_targets),
     };

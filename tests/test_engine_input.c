@@ -715,6 +715,116 @@ static void test_engine_occluder_refusals(void **state)
     free_objs(o, n);
 }
 
+/* Issue 31 3d: what a cancelled frame leaves behind. fogvol_occluder_prepare hands O to the engine;
+   the engine writes it (here: cleared to the near plane, which hides every volume), and the frame
+   is cancelled. The next frame has no occluders: O must be the far plane again, so the sphere's
+   thickness is its ray-cast chord (before: the previous frame without occluders had left "O holds
+   the far plane" set, the cleared O was reused and the thickness was 0). MRT: after mrt_prepare
+   and cancel_frame, the next frame without mrt_prepare is refused (before: drawn with the
+   cancelled frame's O). */
+static void cancelled_frame(fogvol_tier tier, unsigned speedups_off, const tobj *o, const double *gt,
+                            const unsigned char *interior, float *thick)
+{
+    static const float near_plane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    rc_camera c = camera();
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_occluder_info oi;
+    GLuint fbo = 0;
+    double lsb = tier == FOGVOL_TIER_FLOAT ? 1e-4 * (c.zfar - c.znear) : (c.zfar - c.znear) / 4096.0, e;
+    int frame, pixels;
+    g_speedups_off = speedups_off;
+    fv = make_ctx(tier, 0);
+    g_speedups_off = 0;
+    vol = mesh_of(fv, &o[0].m, 0);
+    ramp = ramp_of(fv);
+    frame_of(&fd, &c, thick);
+    glGenFramebuffers(1, &fbo);
+    for (frame = 0; frame < 3; ++frame) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        if (frame == 1) { /* the engine draws O (cleared to the near plane), then the frame is cancelled */
+            assert_int_equal(fogvol_occluder_prepare(fv, &oi), FOGVOL_SUCCESS);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
+            assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+            glClearBufferfv(GL_COLOR, 0, near_plane);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+            continue;
+        }
+        add_volume(fv, vol, o[0].model, ramp);
+        assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+        e = max_err(thick, gt, interior, &pixels);
+        print_message("  %s, speed-ups off 0x%x, frame %d%s: max |thickness - ray cast| %.3f LSB (%d fogged pixels)\n",
+                      fogvol_tier_name(tier), speedups_off, frame, frame == 2 ? " (after the cancelled frame)" : "",
+                      e / lsb, pixels);
+        assert_true(pixels > 1000);
+        assert_true(e <= lsb);
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    glDeleteFramebuffers(1, &fbo);
+    fogvol_destroy_mesh(fv, vol);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+}
+
+static void test_cancelled_frames(void **state)
+{
+    rc_camera c = camera();
+    tobj o[2];
+    int n = scene(o);
+    double *gt = (double *)malloc(sizeof(double) * W * H);
+    unsigned char *interior = (unsigned char *)malloc((size_t)W * H);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_mrt_info mi;
+    glu_ctx g;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    truth(&c, o, 1, gt, interior); /* the sphere alone */
+    cancelled_frame(FOGVOL_TIER_PS20, FOGVOL_SPEEDUP_SPECIALIZE, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_PS20, FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_FLOAT_O, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_FLOAT, FOGVOL_SPEEDUP_SPECIALIZE, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_PS20, 0, o, gt, interior, thick);
+    /* MRT: the engine's O of a cancelled frame is not this frame's */
+    fv = make_ctx(FOGVOL_TIER_MRT, 0);
+    vol = mesh_of(fv, &o[0].m, 0);
+    ramp = ramp_of(fv);
+    frame_of(&fd, &c, NULL);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_mrt_prepare(fv, &mi), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_volume(fv, vol, o[0].model, ramp);
+    g_log[0] = 0;
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_ERROR_INVALID_STATE);
+    assert_non_null(strstr(g_log, "mrt_prepare"));
+    /* ... nor is an ended frame's */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_mrt_prepare(fv, &mi), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_volume(fv, vol, o[0].model, ramp);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_ERROR_INVALID_STATE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    fogvol_destroy_mesh(fv, vol);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free_objs(o, n);
+    free(gt);
+    free(interior);
+    free(thick);
+}
+
 /* ==== 3. meshes as engines store them ======================================== */
 
 /* An engine's UV sphere: (slices + 1) x (stacks + 1) vertices, the seam column
@@ -1109,6 +1219,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_engine_depth_buffers),     cmocka_unit_test(test_engine_depth_refusals),
         cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluder_refusals),
+        cmocka_unit_test(test_cancelled_frames),
         cmocka_unit_test(test_weld_seam_sphere),         cmocka_unit_test(test_weld_face_cube),
         cmocka_unit_test(test_interleaved_16bit),        cmocka_unit_test(test_mesh_bad_layouts),
     };
