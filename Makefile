@@ -14,7 +14,7 @@ CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
 CFLAGS  ?= -O2 -g
-SAN      = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+SAN      = -O1 -g -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=all
 INC      = -I.
 GL_LIBS  = -lOSMesa -lm
 LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
@@ -57,7 +57,7 @@ $(BUILD):
 #   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
-TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post cpu
+TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post limits cpu
 CXX_TESTS = cpu
 JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
 
@@ -105,11 +105,22 @@ $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
 $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
+# API sequences on the null and the GL backend (OSMesa): libFuzzer under ASan+UBSan with
+# float-cast-overflow, and its corpus replayed by the sanitizer build of the tests (GL under
+# valgrind would take minutes). make test's short run starts from the seeds (tests/fuzz/seed_api.py
+# writes them; loading the whole corpus into libFuzzer takes a minute), make fuzz from the corpus.
+FUZZ_API_DEPS = tests/fuzz/fuzz_api.c fogvol.h tests/gl_util.h tests/shapes.h
+$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) | $(BUILD)
+	clang -g -O1 -fsanitize=fuzzer,address,undefined,float-cast-overflow -fno-sanitize-recover=all $(INC) $< -o $@ \
+	  -lOSMesa -lm
+$(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE $(SAN) $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_api.c -o $@ -lOSMesa -lm
 
 TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
             $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
+            $(BUILD)/replay_api_san $(BUILD)/fuzz_api \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless \
             $(BUILD)/vulkan_backend
 
@@ -137,7 +148,9 @@ SCRIPT_RUNS = \
   "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
   "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
   "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
-  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
+  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
+  "fuzz_api_corpus_asan_ubsan=$(LSAN_ENV) $(BUILD)/replay_api_san tests/fuzz/corpus_api" \
+  "fuzz_api_5s=rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
@@ -223,7 +236,7 @@ $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
 # driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with
 # test_gles (EGL's surfaceless platform, OpenGL ES) and the headless demo
-EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post
+EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post limits
 $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
 	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm
@@ -266,13 +279,16 @@ $(BUILD)/bench_analytic: bench/bench_analytic.c fogvol.h | $(BUILD)
 bench-analytic: $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic
 
-# libFuzzer on mesh validation and the analytic fog input, FUZZ_TIME seconds per target; new inputs go to
+# libFuzzer on mesh validation, the analytic fog input and API call sequences (null and GL backends; -detect_leaks=0:
+# the target counts its context's allocations and backend objects itself), FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)
-fuzz: deps-test $(BUILD)/fuzz_mesh $(BUILD)/fuzz_analytic
-	@mkdir -p $(BUILD)/fuzz/mesh $(BUILD)/fuzz/analytic
+fuzz: deps-test $(BUILD)/fuzz_mesh $(BUILD)/fuzz_analytic $(BUILD)/fuzz_api
+	@mkdir -p $(BUILD)/fuzz/mesh $(BUILD)/fuzz/analytic $(BUILD)/fuzz/api
 	$(BUILD)/fuzz_mesh -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh
 	$(BUILD)/fuzz_analytic -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/analytic \
 	  tests/fuzz/corpus_analytic
+	$(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=$(FUZZ_TIME) -detect_leaks=0 -print_final_stats=1 $(BUILD)/fuzz/api \
+	  tests/fuzz/corpus_api
 
 # the README pictures, regenerated from the demo
 images: demo

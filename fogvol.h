@@ -223,8 +223,8 @@
        fogvol_occluder_info oi; fogvol_occluder_prepare(fv, &oi); // O texture, size, clear colour, uniforms
        // engine FBO: colour oi.texture + its own depth; shader: fogvol_occluder_snippet(),
        // fogvol_mrt[2] = oi.uniforms, colour = fogvol_occluder_color(-view_space_z)
-       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
-       //         weld_distance > 0 for seams and per-face vertices
+       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16 or no
+       //         index array (triangles in vertex order), weld_distance > 0 for seams and per-face vertices
 
    ANALYTIC FOG VOLUMES (no render passes; FOGVOL_NO_ANALYTIC leaves them out)
    ====================
@@ -569,6 +569,10 @@ typedef struct fogvol_context_desc fogvol_context_desc;
 
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+/* Frees everything the context owns, host memory and backend objects: its targets, programs and
+   lookup textures, and the meshes, ramps and volume textures made with it that are still alive
+   (destroyed with it; a warning in the log counts them: destroy them first). An open frame is
+   dropped. */
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
 FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
@@ -587,7 +591,10 @@ typedef struct fogvol_mesh_desc {
     const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
     int vertex_count;
     int stride;                /* bytes between vertices, 0 = 12; at least 12 */
-    const uint32_t *indices;   /* 3 per triangle */
+    const uint32_t *indices;   /* 3 per triangle. No index array (indices and indices16 NULL, index_count
+                                  0): the triangles are the vertices in order, (0, 1, 2), (3, 4, 5), ...
+                                  (vertex_count a multiple of 3: glDrawArrays order, raylib's Mesh
+                                  without indices); usually with weld_distance, as its corners repeat */
     int index_count;
     int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
     /* Engine vertex buffers as they are: offset is the byte offset of x inside
@@ -630,17 +637,20 @@ typedef struct fogvol_mesh_report {
     int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
                                   vertices counts the rest */
     /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
-       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
-       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
-       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
-       2^26 triangle x vertex pairs). */
+       every vertex the triangles use lies on the inner side of the plane of every non-degenerate
+       triangle (both after the weld: triangles it collapses have no plane; vertices of a shared
+       buffer that no triangle uses do not count), within 1e-5 of the used vertices' bounding box
+       diagonal (a convex hull: usable by fogvol_add_light); 0 when some vertex lies outside some face
+       plane (concave); -1 not checked (not a valid hull, or more than 2^26 triangle x vertex
+       pairs). */
     int convex;
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
-   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   (about 40 bytes per triangle, + 4 per index with 16-bit indices, without an
+   index array or when welding, + about 26 per vertex when welding; the weld takes
+   O(n) time) comes from alloc (NULL = default). Never reads outside
    the vertex_count vertices (stride, offset) or indices[0 .. index_count).
    FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
    stride, unknown index_type, missing arrays, bad weld_distance). */
@@ -812,7 +822,8 @@ typedef struct fogvol_frame_desc {
     float projection[16];
     float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
                                depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
-    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer: x and y within -32768..32767,
+                               width and height 1..16384 (else FOGVOL_ERROR_INVALID_ARGUMENT) */
     fogvol_composite composite;
     /* The engine's draw buffer the composite writes (index into its
        glDrawBuffers list; 0 = the first, the only one for most engines); the
@@ -2663,67 +2674,141 @@ static int fogvol__mesh_stride(const fogvol_mesh_desc *d)
     return d->stride ? d->stride : 12;
 }
 
+/* No index array (fogvol_mesh_desc): the triangles are the vertices 0, 1, 2, then 3, 4, 5, ... */
+static int fogvol__non_indexed(const fogvol_mesh_desc *d)
+{
+    return !d->indices && !d->indices16 && d->index_count == 0;
+}
+
+/* Indices the mesh's triangles have (vertex_count without an index array). */
+static int fogvol__index_count(const fogvol_mesh_desc *d)
+{
+    return fogvol__non_indexed(d) ? d->vertex_count : d->index_count;
+}
+
 /* NULL for a usable layout, else what is wrong with it. */
 static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
 {
     int stride;
     if (!d || !d->positions) return "no positions";
-    if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
-        return "vertex_count must be > 0 and index_count a positive multiple of 3";
+    if (d->vertex_count <= 0 || fogvol__index_count(d) <= 0 || fogvol__index_count(d) % 3 != 0)
+        return fogvol__non_indexed(d) ? "no index array: vertex_count must be a positive multiple of 3"
+                                      : "vertex_count must be > 0 and index_count a positive multiple of 3";
     if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
     stride = fogvol__mesh_stride(d);
     if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
     if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
-    if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
+    if (!fogvol__non_indexed(d) && (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16))
+        return "no index array of index_type (leave both arrays NULL and index_count 0 for none)";
     if (!fogvol__finite(d->weld_distance) || d->weld_distance < 0) return "weld_distance negative or not finite";
     return NULL;
 }
 
+/* The weld's sweep order: each vertex's coordinate on the sweep axis as an unsigned key in the order
+   of the floats (-0 as +0), with its number. */
 typedef struct fogvol__wkey {
-    float key;
+    uint32_t key;
     uint32_t i;
 } fogvol__wkey;
 
-static int fogvol__wkey_less(const fogvol__wkey *x, const fogvol__wkey *y)
+static uint32_t fogvol__sweep_key(float f)
 {
-    return x->key < y->key || (x->key == y->key && x->i < y->i);
+    uint32_t b;
+    f += 0.0f; /* -0 -> +0 */
+    memcpy(&b, &f, sizeof b);
+    return (b & 0x80000000u) ? ~b : b | 0x80000000u;
 }
 
-static void fogvol__sift_wkeys(fogvol__wkey *k, int root, int n)
+/* Stable LSD radix sort of k by key, 8 bits a pass (tmp: n entries), so that equal keys keep their
+   vertices' order: O(n). */
+static void fogvol__sort_wkeys(fogvol__wkey *k, fogvol__wkey *tmp, int n)
 {
-    int child;
-    fogvol__wkey t;
-    for (; (child = 2 * root + 1) < n; root = child) {
-        if (child + 1 < n && fogvol__wkey_less(&k[child], &k[child + 1])) ++child;
-        if (!fogvol__wkey_less(&k[root], &k[child])) return;
-        t = k[root];
-        k[root] = k[child];
-        k[child] = t;
+    size_t cnt[256], sum, c;
+    fogvol__wkey *src = k, *dst = tmp, *t;
+    int pass, i;
+    for (pass = 0; pass < 4; ++pass) { /* (an even count: the result ends in k) */
+        unsigned sh = 8u * (unsigned)pass;
+        memset(cnt, 0, sizeof cnt);
+        for (i = 0; i < n; ++i) cnt[(src[i].key >> sh) & 255u]++;
+        for (i = 0, sum = 0; i < 256; ++i) {
+            c = cnt[i];
+            cnt[i] = sum;
+            sum += c;
+        }
+        for (i = 0; i < n; ++i) dst[cnt[(src[i].key >> sh) & 255u]++] = src[i];
+        t = src;
+        src = dst;
+        dst = t;
     }
 }
 
-/* In-place heap sort (no allocation, O(n log n)). */
-static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
+/* The weld's sweep: the kept vertices in a hash of their cells on the two axes across the sweep
+   (cells dist wide: floor(coordinate / dist) as a double; the quotient of two floats is exact
+   enough in double that coordinates within dist of each other lie in the same or neighbouring
+   cells, for any floats), chained newest first (heads: mask + 1 buckets, next: per vertex). */
+typedef struct fogvol__weld_grid {
+    const unsigned char *base;
+    int stride, axis; /* axis: the sweep's */
+    float dist;
+    uint32_t *heads, *next, mask;
+} fogvol__weld_grid;
+
+#define FOGVOL__NONE 0xffffffffu
+
+/* v's cell across the sweep: floor(coordinate / dist) on the two other axes. */
+static void fogvol__weld_cell(const fogvol__weld_grid *g, const float v[3], double c[2])
 {
-    int i;
-    fogvol__wkey t;
-    for (i = n / 2 - 1; i >= 0; --i) fogvol__sift_wkeys(k, i, n);
-    for (i = n - 1; i > 0; --i) {
-        t = k[0];
-        k[0] = k[i];
-        k[i] = t;
-        fogvol__sift_wkeys(k, 0, i);
-    }
+    c[0] = FOGVOL_FLOOR((double)v[(g->axis + 1) % 3] / g->dist);
+    c[1] = FOGVOL_FLOOR((double)v[(g->axis + 2) % 3] / g->dist);
 }
 
-/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on
-   every axis (i itself when none). A sweep along the axis of largest extent
-   (sorted keys) limits the candidates. Non-finite vertices stay alone. Returns
-   how many vertices were merged. */
-static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, uint32_t *rep, fogvol__wkey *keys)
+/* The bucket of cell c moved by (du, dv) (-0 made +0; cells beyond 32-bit integers hashed by their
+   bits). Neighbours along the second axis land in neighbouring buckets. */
+static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const double c[2], int du, int dv)
 {
-    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3], w[3];
-    int i, a, b, k, axis = 0, merged = 0, any = 0;
+    uint32_t h[2], w[2];
+    int k;
+    for (k = 0; k < 2; ++k) {
+        double x = c[k] + (k ? dv : du) + 0.0;
+        if (x > -2147483648.0 && x < 2147483648.0) {
+            h[k] = (uint32_t)(int32_t)x;
+        } else {
+            memcpy(w, &x, sizeof w);
+            h[k] = (w[0] ^ w[1]) * 0x9e3779b1u;
+        }
+    }
+    return (h[0] * 0x9e3779b1u + h[1]) & g->mask;
+}
+
+/* The lowest-numbered kept vertex within dist of v on every axis among those the sweep has met, from
+   the 9 cells around v's cell c across the sweep, FOGVOL__NONE: none. A vertex more than dist behind v
+   along the sweep is behind every vertex to come as well: the chain is cut there (it and every older
+   entry), so the chains hold the last dist of the sweep only. */
+static uint32_t fogvol__weld_find(fogvol__weld_grid *g, const float v[3], const double c[2])
+{
+    uint32_t best = FOGVOL__NONE, j, *link;
+    float w[3];
+    int d;
+    for (d = 0; d < 9; ++d)
+        for (link = &g->heads[fogvol__weld_bucket(g, c, d % 3 - 1, d / 3 - 1)]; (j = *link) != FOGVOL__NONE;
+             link = &g->next[j]) {
+            memcpy(w, g->base + (size_t)j * g->stride, sizeof w);
+            if ((double)v[g->axis] - w[g->axis] > g->dist) {
+                *link = FOGVOL__NONE;
+                break;
+            }
+            if (j < best && FOGVOL_FABS((double)w[0] - v[0]) <= g->dist &&
+                FOGVOL_FABS((double)w[1] - v[1]) <= g->dist && FOGVOL_FABS((double)w[2] - v[2]) <= g->dist)
+                best = j;
+        }
+    return best;
+}
+
+/* The axis of largest extent of the finite vertices (rep[i] = i on the way). */
+static int fogvol__weld_axis(const unsigned char *base, int stride, int nv, uint32_t *rep)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3];
+    int i, k, axis = 0, any = 0;
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
         rep[i] = (uint32_t)i;
@@ -2736,63 +2821,95 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     }
     for (k = 1; k < 3; ++k)
         if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    return axis;
+}
+
+/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on every axis among those
+   before it in the sweep (i itself when none): the sweep takes the vertices in order of their
+   coordinate on the axis of largest extent (then of their number) and keeps a vertex that finds
+   none. Non-finite vertices stay alone. The candidates come from fogvol__weld_find, so vertices
+   sharing the sweep's coordinate (a face of a subdivided cube) cost no more than others: O(n) but for
+   hash collisions. Scratch memory from alloc: 20 bytes per vertex and 4 per hash bucket (one bucket
+   per 2 to 4 vertices).
+   Returns how many vertices were merged, -1: out of memory. */
+static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, const fogvol_allocator *alloc,
+                        uint32_t *rep)
+{
+    fogvol__weld_grid g;
+    fogvol__wkey *keys;
+    size_t buckets = 2;
+    float v[3];
+    int i, merged = 0;
+    while (buckets < (size_t)nv / 4u && buckets < ((size_t)1 << 30)) buckets <<= 1; /* (the chains hold the
+                                                       sweep's last dist only: small, cached buckets) */
+    keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * 2u * (size_t)nv); /* (+ the sort's) */
+    g.heads = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (buckets + (size_t)nv));
+    if (!keys || !g.heads) {
+        fogvol__free(alloc, keys);
+        fogvol__free(alloc, g.heads);
+        return -1;
+    }
+    g.base = base;
+    g.stride = stride;
+    g.dist = dist;
+    g.next = g.heads + buckets;
+    g.mask = (uint32_t)(buckets - 1u);
+    memset(g.heads, 0xff, sizeof(uint32_t) * buckets);
+    g.axis = fogvol__weld_axis(base, stride, nv, rep);
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
-        keys[i].key = fogvol__finite_n(v, 3) ? v[axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].key = fogvol__sweep_key(fogvol__finite_n(v, 3) ? v[g.axis] : 3.0e38f); /* non-finite: skipped */
         keys[i].i = (uint32_t)i;
     }
-    fogvol__sort_wkeys(keys, nv);
-    for (a = 0; a < nv; ++a) {
-        uint32_t self = keys[a].i, best = 0xffffffffu;
+    fogvol__sort_wkeys(keys, keys + nv, nv);
+    for (i = 0; i < nv; ++i) {
+        uint32_t self = keys[i].i, best, h;
+        double c[2];
         memcpy(v, base + (size_t)self * stride, sizeof v);
         if (!fogvol__finite_n(v, 3)) continue;
-        for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
-            uint32_t j = keys[b].i;
-            if (rep[j] != j || j > best) continue;
-            memcpy(w, base + (size_t)j * stride, sizeof w);
-            if (FOGVOL_FABS((double)w[0] - v[0]) <= dist && FOGVOL_FABS((double)w[1] - v[1]) <= dist &&
-                FOGVOL_FABS((double)w[2] - v[2]) <= dist)
-                best = j;
+        fogvol__weld_cell(&g, v, c);
+        best = fogvol__weld_find(&g, v, c);
+        if (best != FOGVOL__NONE) {
+            rep[self] = best;
+            merged++;
+            continue;
         }
-        if (best == 0xffffffffu) continue; /* kept */
-        rep[self] = best;
-        merged++;
+        h = fogvol__weld_bucket(&g, c, 0, 0); /* kept: a candidate for the vertices after it */
+        g.next[self] = g.heads[h];
+        g.heads[h] = self;
     }
+    fogvol__free(alloc, keys);
+    fogvol__free(alloc, g.heads);
     return merged;
 }
 
-/* The desc's indices as 32 bits, welded when asked: *out is NULL when the
-   desc's own 32-bit array serves as it is, else an array from alloc. */
+/* The desc's indices as 32 bits (0, 1, 2, ... without an index array), welded when asked: *out is NULL
+   when the desc's own 32-bit array serves as it is, else an array from alloc. */
 static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvol_allocator *alloc, uint32_t **out,
                                           int *welded)
 {
     const unsigned char *base = (const unsigned char *)d->positions + d->offset;
-    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0;
+    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0, n = fogvol__index_count(d);
     uint32_t *idx, *rep = NULL;
-    fogvol__wkey *keys = NULL;
     *out = NULL;
     *welded = 0;
-    if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
-    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
-    if (weld) {
-        rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
-        keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)d->vertex_count);
-    }
-    if (!idx || (weld && (!rep || !keys))) {
+    if (!weld && d->index_type == FOGVOL_INDEX_UINT32 && !fogvol__non_indexed(d)) return FOGVOL_SUCCESS;
+    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)n);
+    if (weld) rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
+    if (weld && rep && idx) *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, alloc, rep);
+    if (!idx || (weld && (!rep || *welded < 0))) {
         fogvol__free(alloc, idx);
         fogvol__free(alloc, rep);
-        fogvol__free(alloc, keys);
+        *welded = 0;
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < d->index_count; ++i)
-        idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
-    if (weld) {
-        *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, rep, keys);
-        for (i = 0; i < d->index_count; ++i)
-            if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
-    }
+    for (i = 0; i < n; ++i)
+        idx[i] = fogvol__non_indexed(d)                 ? (uint32_t)i
+                 : d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i]
+                                                        : d->indices[i];
+    for (i = 0; weld && i < n; ++i)
+        if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
     fogvol__free(alloc, rep);
-    fogvol__free(alloc, keys);
     *out = idx;
     return FOGVOL_SUCCESS;
 }
@@ -3238,7 +3355,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     w.stride = fogvol__mesh_stride(desc);
     w.base = (const unsigned char *)desc->positions + desc->offset;
     w.indices = indices;
-    w.ntri = desc->index_count / 3;
+    w.ntri = fogvol__index_count(desc) / 3;
     w.nvert = desc->vertex_count;
     rep->vertices = desc->vertex_count;
     rep->triangles = w.ntri;
@@ -6853,7 +6970,15 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
 /* >>context =============================================================== */
 /* The renderer's objects and the context: resolved configuration, targets, programs. */
 
+/* The objects a context hands out (meshes, ramps, volume textures) are on a list of its own per kind
+   (circular, the context's node the head), each object's node its first member, so that
+   fogvol_destroy_context destroys those the caller did not. */
+typedef struct fogvol__live {
+    struct fogvol__live *prev, *next;
+} fogvol__live;
+
 struct fogvol_mesh {
+    fogvol__live live;
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
@@ -6874,6 +6999,7 @@ typedef struct fogvol__spec_program {
 } fogvol__spec_program;
 
 struct fogvol_ramp {
+    fogvol__live live;
     fogvol_handle texture;
     int width;
     float max_thickness;
@@ -6883,11 +7009,16 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    /* its colour-ramp group in the frame being ended (fogvol__link_groups): valid while stamp is the
+       frame's group_stamp; head and tail: its first and last volume in the frame's order */
+    int64_t stamp;
+    int head, tail;
     int64_t textured;  /* the frame (fogvol__frame_state.serial) in which a volume of it has a density or
                           colour texture: it leaves the one-pass colour group for that frame */
 };
 
 struct fogvol_volume_texture {
+    fogvol__live live;
     fogvol_handle texture;
 };
 
@@ -6898,6 +7029,7 @@ typedef struct fogvol__volume {
     int negative;
     const fogvol_volume_texture *density, *color; /* NULL: none */
     float density_map[8], color_map[6];
+    int next; /* the next volume of the same ramp in the frame's order, -1: none (fogvol__link_groups) */
 } fogvol__volume;
 
 typedef struct fogvol__light {
@@ -6990,6 +7122,9 @@ typedef struct fogvol__frame_state {
     int nlight, caplight;
     int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
+    int64_t group_stamp;    /* fogvol__link_groups: which end_frame the ramps' group lists belong to */
+    int color_first;        /* the first volume of the one-pass colour group, -1: none (FOGVOL_VARIANT_COLORS) */
+    int color_pos;          /* the colour group holds a positive volume */
 } fogvol__frame_state;
 
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
@@ -7006,7 +7141,8 @@ struct fogvol_context {
     fogvol_logger log;
     fogvol_backend be;
     int owns_backend;
-    int live_meshes, live_ramps;
+    fogvol__live meshes, ramps, textures; /* the objects alive (fogvol__live), counted: */
+    int live_meshes, live_ramps, live_textures;
     int msaa_warned;
     fogvol__config cfg;       /* resolved configuration */
     fogvol__gpu gpu;          /* GPU resources */
@@ -7123,6 +7259,32 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 }
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
+
+/* A refusal of a public call: logged (error level) with why, the result returned, so that no refusal
+   goes unexplained. */
+static fogvol_result fogvol__refuse(const fogvol_context *ctx, fogvol_result r, const char *why)
+{
+    fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s (%s)", why, fogvol_result_string(r));
+    return r;
+}
+
+/* An object joins (count +1) or leaves (count -1) its kind's list. */
+static void fogvol__live_add(fogvol__live *head, fogvol__live *n, int *count)
+{
+    n->prev = head;
+    n->next = head->next;
+    head->next->prev = n;
+    head->next = n;
+    (*count)++;
+}
+
+static void fogvol__live_remove(fogvol__live *n, int *count)
+{
+    n->prev->next = n->next;
+    n->next->prev = n->prev;
+    n->prev = n->next = n;
+    (*count)--;
+}
 
 /* After the backend calls of a public call (outside a backend frame, or after its end_frame): the
    backend's own failure since the last take (fogvol_backend.take_error, logged by the backend) is the
@@ -7476,6 +7638,11 @@ static fogvol_result fogvol__attach_backend(fogvol_context *ctx, const fogvol_co
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend table lacks a required entry");
             return FOGVOL_ERROR_INVALID_ARGUMENT;
         }
+        if ((int)b->dialect < 0 || (int)b->dialect >= FOGVOL_GLSL_COUNT) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in the backend table "
+                        "(FOGVOL_GLSL_*)", (int)b->dialect);
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
         ctx->be = *b;
         return FOGVOL_SUCCESS;
     }
@@ -7575,6 +7742,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(ctx, 0, sizeof *ctx);
+    ctx->meshes.prev = ctx->meshes.next = &ctx->meshes;
+    ctx->ramps.prev = ctx->ramps.next = &ctx->ramps;
+    ctx->textures.prev = ctx->textures.next = &ctx->textures;
     ctx->alloc = desc->allocator;
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
@@ -7610,10 +7780,16 @@ FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx)
 {
     fogvol_allocator a;
     if (!ctx) return;
-    if (ctx->live_meshes || ctx->live_ramps)
+    if (ctx->live_meshes || ctx->live_ramps || ctx->live_textures)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: context destroyed with %d meshes and %d ramps alive (their GPU objects leak)",
-                    ctx->live_meshes, ctx->live_ramps);
+                    "fogvol: context destroyed with %d meshes, %d ramps and %d volume textures alive: destroyed with "
+                    "it (destroy them before the context)",
+                    ctx->live_meshes, ctx->live_ramps, ctx->live_textures);
+    ctx->cur.in_frame = 0; /* (nothing to drop from an open frame: it goes too) */
+    while (ctx->meshes.next != &ctx->meshes) fogvol_destroy_mesh(ctx, (fogvol_mesh *)(void *)ctx->meshes.next);
+    while (ctx->ramps.next != &ctx->ramps) fogvol_destroy_ramp(ctx, (fogvol_ramp *)(void *)ctx->ramps.next);
+    while (ctx->textures.next != &ctx->textures)
+        fogvol_destroy_volume_texture(ctx, (fogvol_volume_texture *)(void *)ctx->textures.next);
     a = ctx->alloc;
     fogvol__release(ctx);
     fogvol__free(&a, ctx);
@@ -7716,22 +7892,39 @@ static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
     ctx->cur.nlight = n;
 }
 
-/* The bounding box of the positions (finite: validated before). */
-static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
+/* The vertices the triangles use, each once (idx: the validated indices, all in range), in a list
+   from ctx's allocator of *count entries; NULL: out of memory. A shared vertex buffer's other
+   vertices are no part of the mesh: not in its bounds, not in its convexity. */
+static uint32_t *fogvol__referenced(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx, int *count)
+{
+    int i, n = 0, ni = fogvol__index_count(desc), nv = desc->vertex_count;
+    uint32_t *list = (uint32_t *)fogvol__alloc(&ctx->alloc, (sizeof(uint32_t) + 1u) * (size_t)nv);
+    unsigned char *seen;
+    *count = 0;
+    if (!list) return NULL;
+    seen = (unsigned char *)(list + nv);
+    memset(seen, 0, (size_t)nv);
+    for (i = 0; i < ni; ++i)
+        if (!seen[idx[i]]) {
+            seen[idx[i]] = 1;
+            list[n++] = idx[i];
+        }
+    *count = n;
+    return list;
+}
+
+/* The bounding box of the used vertices (finite: validated before). */
+static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc, const uint32_t *used, int nused)
 {
     size_t stride = (size_t)fogvol__mesh_stride(desc);
     const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
     int i, c;
-    for (c = 0; c < 3; ++c) {
-        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
-        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
-    }
-    for (i = 0; i < desc->vertex_count; ++i) {
+    for (i = 0; i < nused; ++i) {
         float p[3];
-        memcpy(p, base + (size_t)i * stride, sizeof p);
+        memcpy(p, base + (size_t)used[i] * stride, sizeof p);
         for (c = 0; c < 3; ++c) {
-            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
-            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
+            if (i == 0 || p[c] < m->bmin[c]) m->bmin[c] = p[c];
+            if (i == 0 || p[c] > m->bmax[c]) m->bmax[c] = p[c];
         }
     }
 }
@@ -7750,11 +7943,11 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     md.positions = desc->positions;
     md.vertex_count = desc->vertex_count;
     md.indices = idx ? idx : desc->indices;
-    md.index_count = desc->index_count;
+    md.index_count = fogvol__index_count(desc);
     if (ctx->be.caps & FOGVOL_CAP_MESH_LAYOUT) {
         md.stride = stride;
         md.offset = desc->offset;
-        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->weld_distance <= 0) { /* 16-bit as given */
+        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->indices16 && desc->weld_distance <= 0) { /* as given */
             md.index_type = FOGVOL_INDEX_UINT16;
             md.indices16 = desc->indices16;
             md.indices = NULL;
@@ -7781,16 +7974,18 @@ static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3]
     p[2] = f[2];
 }
 
-/* fogvol_mesh_report.convex of a valid hull: every vertex on the inner side of every face plane
-   (outward normals: counter-clockwise seen from outside), within 1e-5 of the box diagonal. */
-static int fogvol__convexity(const fogvol_mesh_desc *desc)
+/* fogvol_mesh_report.convex of a valid hull: every used vertex on the inner side of every face plane
+   (outward normals: counter-clockwise seen from outside), within 1e-5 of the used vertices' box
+   diagonal; decided on the triangles as validated (idx: welded), where the slivers that a weld closes
+   (repeated corners) have no plane. */
+static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused)
 {
-    int t, v, k, tris = desc->index_count / 3;
+    int t, v, k, tris = fogvol__index_count(desc) / 3;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0.0, tol;
-    if ((double)tris * (double)desc->vertex_count > 67108864.0) return -1;
-    for (v = 0; v < desc->vertex_count; ++v) {
+    if ((double)tris * (double)nused > 67108864.0) return -1;
+    for (v = 0; v < nused; ++v) {
         double p[3];
-        fogvol__vertex(desc, (uint32_t)v, p);
+        fogvol__vertex(desc, used[v], p);
         for (k = 0; k < 3; ++k) {
             if (p[k] < lo[k]) lo[k] = p[k];
             if (p[k] > hi[k]) hi[k] = p[k];
@@ -7801,12 +7996,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
     tol = 1e-5 * diag;
     for (t = 0; t < tris; ++t) {
         double a[3], b[3], c[3], n[3], len;
-        uint32_t ix[3];
-        for (k = 0; k < 3; ++k)
-            ix[k] = desc->index_type == FOGVOL_INDEX_UINT16 ? desc->indices16[3 * t + k] : desc->indices[3 * t + k];
-        fogvol__vertex(desc, ix[0], a);
-        fogvol__vertex(desc, ix[1], b);
-        fogvol__vertex(desc, ix[2], c);
+        fogvol__vertex(desc, idx[3 * t], a);
+        fogvol__vertex(desc, idx[3 * t + 1], b);
+        fogvol__vertex(desc, idx[3 * t + 2], c);
         for (k = 0; k < 3; ++k) {
             b[k] -= a[k];
             c[k] -= a[k];
@@ -7816,9 +8008,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
         n[2] = b[0] * c[1] - b[1] * c[0];
         len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
-        for (v = 0; v < desc->vertex_count; ++v) {
+        for (v = 0; v < nused; ++v) {
             double p[3];
-            fogvol__vertex(desc, (uint32_t)v, p);
+            fogvol__vertex(desc, used[v], p);
             if ((n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]) + n[2] * (p[2] - a[2])) / len > tol) return 0;
         }
     }
@@ -7830,11 +8022,13 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
 {
     fogvol_mesh_report rep;
     fogvol_mesh *m;
-    uint32_t *idx = NULL;
+    uint32_t *idx = NULL, *used;
     fogvol_result r;
     const char *problem;
+    int nused;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_mesh: desc or out is NULL");
     problem = fogvol__mesh_problem(desc);
     r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
     if (report) *report = rep;
@@ -7864,12 +8058,17 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
                     desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    if (!m) {
+    used = m ? fogvol__referenced(ctx, desc, idx ? idx : desc->indices, &nused) : NULL;
+    if (!m || !used) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: out of memory");
+        fogvol__free(&ctx->alloc, m);
         fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(m, 0, sizeof *m);
-    fogvol__mesh_box(m, desc);
+    fogvol__mesh_box(m, desc, used, nused);
+    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused) : -1;
+    fogvol__free(&ctx->alloc, used);
     r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
@@ -7880,11 +8079,10 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         return r;
     }
     m->vertex_count = desc->vertex_count;
-    m->index_count = desc->index_count;
+    m->index_count = fogvol__index_count(desc);
     m->volume = rep.valid;
-    m->convex = rep.valid ? fogvol__convexity(desc) : -1;
     if (report) report->convex = m->convex;
-    ctx->live_meshes++;
+    fogvol__live_add(&ctx->meshes, &m->live, &ctx->live_meshes);
     *out = m;
     return FOGVOL_SUCCESS;
 }
@@ -7916,7 +8114,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
     (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
-    ctx->live_meshes--;
+    fogvol__live_remove(&mesh->live, &ctx->live_meshes);
     fogvol__free(&ctx->alloc, mesh);
 }
 
@@ -7948,7 +8146,8 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     float tmax;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_ramp: desc or out is NULL");
     r = fogvol_make_color_ramp(desc, NULL, 0, &info, &tmax);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: invalid ramp description");
@@ -7959,7 +8158,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     if (!px || !rp) {
         fogvol__free(&ctx->alloc, px);
         fogvol__free(&ctx->alloc, rp);
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_ramp: out of memory");
     }
     memset(rp, 0, sizeof *rp);
     fogvol_make_color_ramp(desc, px, info.size, &info, &tmax);
@@ -7976,7 +8175,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
         if (rp->texture) ctx->be.destroy_texture(ctx->be.user_data, rp->texture);
         (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, rp);
-        return r;
+        return fogvol__refuse(ctx, r, "create_ramp: the backend could not make its texture");
     }
     rp->width = info.width;
     rp->max_thickness = tmax;
@@ -7989,7 +8188,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
         rp->exp_rgba[2] = fogvol__unorm8(desc->color[2]) / 255.0f;
         rp->exp_rgba[3] = desc->density;
     }
-    ctx->live_ramps++;
+    fogvol__live_add(&ctx->ramps, &rp->live, &ctx->live_ramps);
     *out = rp;
     return FOGVOL_SUCCESS;
 }
@@ -8000,7 +8199,7 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
     (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
-    ctx->live_ramps--;
+    fogvol__live_remove(&ramp->live, &ctx->live_ramps);
     fogvol__free(&ctx->alloc, ramp);
 }
 
@@ -8011,14 +8210,22 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     fogvol_texture_desc td;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_volume_texture: desc or out is NULL");
     if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
                     "(got %dx%d)", desc->width, desc->height);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    if ((desc->filter != FOGVOL_FILTER_NEAREST && desc->filter != FOGVOL_FILTER_LINEAR) ||
+        (desc->wrap != FOGVOL_WRAP_REPEAT && desc->wrap != FOGVOL_WRAP_CLAMP)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture filter %d or wrap %d unknown (FOGVOL_FILTER_*, "
+                    "FOGVOL_WRAP_*)", (int)desc->filter, (int)desc->wrap);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
-    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    if (!t) return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_volume_texture: out of memory");
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
     r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
@@ -8029,6 +8236,7 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
         fogvol__free(&ctx->alloc, t);
         return r;
     }
+    fogvol__live_add(&ctx->textures, &t->live, &ctx->live_textures);
     *out = t;
     return FOGVOL_SUCCESS;
 }
@@ -8046,6 +8254,7 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
     (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
+    fogvol__live_remove(&texture->live, &ctx->live_textures);
     fogvol__free(&ctx->alloc, texture);
 }
 
@@ -8255,6 +8464,16 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
     return FOGVOL_SUCCESS;
 }
 
+/* A viewport fogvol takes: its origin within -32768..32767 (the least viewport bounds range GL 4.1 /
+   ARB_viewport_array reports) and its size 1..16384, so that every sum of them is an int; else a
+   reason. */
+static const char *fogvol__viewport_problem(const int vp[4])
+{
+    if (vp[2] <= 0 || vp[3] <= 0 || vp[2] > 16384 || vp[3] > 16384) return "size outside 1..16384";
+    if (vp[0] < -32768 || vp[0] > 32767 || vp[1] < -32768 || vp[1] > 32767) return "origin outside -32768..32767";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     fogvol_result r;
@@ -8264,19 +8483,19 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
                     "fogvol: begin_frame without end_frame: the open frame is discarded");
         fogvol_cancel_frame(ctx);
     }
-    if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!d) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: desc is NULL");
     if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: need 0 < znear < zfar (got %g, %g)", (double)d->znear,
                     (double)d->zfar);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (d->viewport[2] <= 0 || d->viewport[3] <= 0 || d->viewport[2] > 16384 || d->viewport[3] > 16384) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport %dx%d outside 1..16384", d->viewport[2],
-                    d->viewport[3]);
+    if (fogvol__viewport_problem(d->viewport)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport (%d, %d) %dx%d: %s", d->viewport[0], d->viewport[1],
+                    d->viewport[2], d->viewport[3], fogvol__viewport_problem(d->viewport));
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: unknown composite");
     if (d->downsample < 0 || d->downsample > 2) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample %d is not 0, 1 or 2", d->downsample);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -8359,8 +8578,10 @@ FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_m
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!mesh || !model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder: mesh or model is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_occluder outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
@@ -8386,8 +8607,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fn) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder_callback: fn is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "add_occluder_callback outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
@@ -8461,8 +8685,11 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
-    if (!ctx || !desc || !desc->mesh || !desc->ramp) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh || !desc->ramp)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_volume: desc, its mesh or its ramp is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_volume outside a frame (after begin_frame only)");
     if (!desc->mesh->volume) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
@@ -8513,8 +8740,11 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
 {
     const char *why;
     fogvol_draw dr;
-    if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: model is NULL");
+    if (!ctx->cur.in_occluder_pass)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "occluder_transform outside an occluder callback (fogvol_add_occluder_callback)");
     if ((why = fogvol__model_problem(model, 0)) != NULL) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_transform: the model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -8595,7 +8825,8 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
 {
     fogvol_constants k;
     fogvol_result r;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "mrt_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     if (ctx->cfg.tier != FOGVOL_TIER_MRT || !ctx->cur.in_frame || !ctx->be.native_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
@@ -8696,7 +8927,8 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     fogvol_constants k;
     fogvol_result r;
     int fl;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     fl = ctx->cfg.tier == FOGVOL_TIER_FLOAT;
     if (!ctx->cur.in_frame || ctx->cur.nocc > 0 || !ctx->be.native_texture) {
@@ -8816,15 +9048,51 @@ static void fogvol__end_pass(fogvol_context *ctx)
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
 }
 
+static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp);
+
+/* The frame's colour-ramp groups as lists, once per end_frame, so that each group's passes visit its
+   own volumes only: each ramp's first and last volume (stamped with this end_frame), each volume's
+   next of the same ramp, in the frame's order; the one-pass colour group's first volume. (The ramps
+   belong to the context; the const of the volume desc is the caller's promise, not theirs.) */
+static void fogvol__link_groups(fogvol_context *ctx)
+{
+    int i;
+    ctx->cur.group_stamp++;
+    ctx->cur.color_first = -1;
+    ctx->cur.color_pos = 0;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        fogvol__volume *v = &ctx->cur.vols[i];
+        fogvol_ramp *rp = (fogvol_ramp *)(uintptr_t)v->ramp;
+        v->next = -1;
+        if (rp->stamp != ctx->cur.group_stamp) {
+            rp->stamp = ctx->cur.group_stamp;
+            rp->head = i;
+        } else {
+            ctx->cur.vols[rp->tail].next = i;
+        }
+        rp->tail = i;
+        if (fogvol__color_member(ctx, rp)) {
+            if (ctx->cur.color_first < 0) ctx->cur.color_first = i;
+            ctx->cur.color_pos |= !v->negative;
+        }
+    }
+}
+
+/* The first volume of a ramp's group in this frame (then vols[i].next), -1: none. */
+static int fogvol__first(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    return ramp->stamp == ctx->cur.group_stamp ? ramp->head : -1;
+}
+
 /* Draw the volumes of one ramp group into the current pass: negative = 0
    positives, 1 negatives, -1 both (FLOAT: the sign goes to the shader). */
 static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
     fogvol_draw dr;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || v->density) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
@@ -8886,11 +9154,11 @@ static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
         fogvol_pass ps;
         fogvol_draw dr;
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
         if (ps.read_target) { /* (the general program samples O) */
@@ -8918,9 +9186,9 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
 static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
     int i;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || !v->color) continue;
+        if (!v->color) continue;
         ps->textures[FOGVOL__UNIT_CTEX] = v->color->texture;
         memcpy(ps->uniforms[FOGVOL_U_COLOR_U], v->color_map, 3 * sizeof(float));
         memcpy(ps->uniforms[FOGVOL_U_COLOR_V], v->color_map + 3, 3 * sizeof(float));
@@ -9100,41 +9368,46 @@ static void fogvol__debug_empty(fogvol_context *ctx, const fogvol__run *run)
     for (i = 0; i < n; ++i) ctx->cur.frame.debug_thickness[i] = 0.0f;
 }
 
-/* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
-   ramp group can cover: the 8 corners of each mesh's box projected, rounded
-   out by a pixel, within the viewport. A corner nearer than the near plane
-   (perspective; NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole
-   viewport. An empty rectangle is 1x1 in the corner (nothing is drawn). */
-static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+/* Window rectangles (x, y, w, h) that hold every pixel some volumes can cover:
+   the 8 corners of each mesh's box projected (fogvol__rect_add, into the window
+   extent lo, hi), rounded out by a pixel, within the viewport
+   (fogvol__rect_finish). A corner nearer than the near plane (perspective;
+   NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole viewport
+   (rect_add returns 0). An empty rectangle is 1x1 in the corner (nothing is
+   drawn). */
+static int fogvol__rect_add(const fogvol_context *ctx, const fogvol__volume *v, double lo[2], double hi[2])
 {
     const int *vp = ctx->cur.frame.viewport;
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, wmin;
-    int i, k, c;
+    double m[16], mvp[16], wmin;
+    int k, c;
     wmin = ctx->cur.frame.projection[15] == 0.0f ? (double)ctx->cur.frame.znear * (1.0 - 1e-6) : 1e-12;
-    memcpy(rect, vp, 4 * sizeof(int));
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        const fogvol__volume *v = &ctx->cur.vols[i];
-        double m[16], mvp[16];
-        if (v->ramp != ramp) continue;
-        fogvol__tod(m, v->model);
-        fogvol__mul4(mvp, ctx->cur.viewproj, m);
-        for (k = 0; k < 8; ++k) {
-            double p[3], clip[4];
-            for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
-            for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
-            if (!(clip[3] >= wmin)) return; /* behind the near plane (or NaN): whole viewport */
-            for (c = 0; c < 2; ++c) {
-                double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
-                if (win < lo[c]) lo[c] = win;
-                if (win > hi[c]) hi[c] = win;
-            }
+    fogvol__tod(m, v->model);
+    fogvol__mul4(mvp, ctx->cur.viewproj, m);
+    for (k = 0; k < 8; ++k) {
+        double p[3], clip[4];
+        for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
+        for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
+        if (!(clip[3] >= wmin)) return 0; /* behind the near plane (or NaN): whole viewport */
+        for (c = 0; c < 2; ++c) {
+            double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
+            if (win < lo[c]) lo[c] = win;
+            if (win > hi[c]) hi[c] = win;
         }
     }
+    return 1;
+}
+
+/* The extent rounded out and clamped to the viewport in floating point before it becomes integers (a
+   volume far off screen projects to any double: 1e9 pixels and more, or infinite). */
+static void fogvol__rect_finish(const fogvol_context *ctx, const double lo[2], const double hi[2], int rect[4])
+{
+    const int *vp = ctx->cur.frame.viewport;
+    int c;
     for (c = 0; c < 2; ++c) { /* downsample 2: the bilinear read spreads a texel over 2 more pixels */
-        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0;
+        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0, v0 = vp[c], v1 = (double)vp[c] + vp[c + 2];
         double a = FOGVOL_FLOOR(lo[c]) - 1.0 - m, b = FOGVOL_FLOOR(hi[c]) + 2.0 + m;
-        if (a < vp[c]) a = vp[c];
-        if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
+        a = !(a >= v0) ? v0 : a > v1 ? v1 : a;
+        b = !(b >= v0) ? v0 : b > v1 ? v1 : b;
         rect[c] = (int)a;
         rect[c + 2] = b > a ? (int)(b - a) : 0;
     }
@@ -9143,6 +9416,17 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
         rect[1] = vp[1];
         rect[2] = rect[3] = 1;
     }
+}
+
+/* The rectangle of the volumes of a ramp group. */
+static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+{
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next)
+        if (!fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi)) return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
@@ -9752,8 +10036,10 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     void *arr;
     fogvol_result r;
     float k;
-    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_light: desc or its mesh is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_light outside a frame (after begin_frame only)");
     if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_LIGHT)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
@@ -9906,24 +10192,16 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
     return grey;
 }
 
-/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY): the union of their
-   ramps' rectangles. */
+/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY), each projected once. */
 static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
 {
-    int i, k, r[4], lo[2] = {0, 0}, hi[2] = {0, 0}, any = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        if (!fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) continue;
-        fogvol__group_rect(ctx, ctx->cur.vols[i].ramp, r);
-        for (k = 0; k < 2; ++k) {
-            if (!any || r[k] < lo[k]) lo[k] = r[k];
-            if (!any || r[k] + r[k + 2] > hi[k]) hi[k] = r[k] + r[k + 2];
-        }
-        any = 1;
-    }
-    rect[0] = lo[0];
-    rect[1] = lo[1];
-    rect[2] = hi[0] - lo[0];
-    rect[3] = hi[1] - lo[1];
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = ctx->cur.color_first; i >= 0 && i < ctx->cur.nvol; ++i)
+        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi))
+            return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 /* The composite of the colour group into the engine framebuffer: one FOG-blended draw when every
@@ -9975,11 +10253,7 @@ static void fogvol__color_debug(fogvol_context *ctx, fogvol__run *run, int g)
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 {
-    int i, has_pos = 0;
-    for (i = 0; i < g; ++i)
-        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) return;
-    for (i = g; i < ctx->cur.nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !ctx->cur.vols[i].negative;
-    if (!has_pos) return;
+    if (g != ctx->cur.color_first || !ctx->cur.color_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
     fogvol__color_debug(ctx, run, g);
@@ -10059,16 +10333,14 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
         fogvol__color_group(ctx, run, g);
         return;
     }
-    for (i = 0; i < g; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) return;
-    for (i = g; i < ctx->cur.nvol; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) {
-            if (ctx->cur.vols[i].negative) has_neg = 1;
-            else has_pos = 1;
-            convex &= ctx->cur.vols[i].mesh->convex == 1;
-            density |= ctx->cur.vols[i].density != NULL;
-            ++n;
-        }
+    if (fogvol__first(ctx, ramp) != g) return;
+    for (i = g; i >= 0; i = ctx->cur.vols[i].next) {
+        if (ctx->cur.vols[i].negative) has_neg = 1;
+        else has_pos = 1;
+        convex &= ctx->cur.vols[i].mesh->convex == 1;
+        density |= ctx->cur.vols[i].density != NULL;
+        ++n;
+    }
     if (!has_pos) return;
     /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
     run->xsum = ctx->cfg.exact_sum && !run->count && ctx->cur.samples <= 1 && !density && n < 128;
@@ -10140,7 +10412,9 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.overflow_frame = -1;
     if (stats) *stats = run.st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "end_frame without begin_frame (or after the frame was ended or cancelled)");
     r = fogvol__frame_refusal(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__begin_backend_frame(ctx, &run.info);
     if (r != FOGVOL_SUCCESS) {
@@ -10155,6 +10429,7 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.depth_tested = run.count;
     run.st.inline_resolved = ctx->cfg.inline_resolve;
     run.rgba8 = ctx->cfg.tier != FOGVOL_TIER_FLOAT;
+    fogvol__link_groups(ctx);
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {
         fogvol__frame_uniforms(ctx, &run);
@@ -10353,9 +10628,8 @@ static fogvol_result fogvol__post_check(fogvol_context *ctx, const fogvol_frame_
         why = "no depth texture (frame->engine_depth_texture)";
     else if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear))
         why = "need 0 < znear < zfar";
-    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || d->viewport[2] <= 0 || d->viewport[3] <= 0 ||
-             d->viewport[2] > 16384 || d->viewport[3] > 16384)
-        why = "viewport outside the framebuffer's 0..16384";
+    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || fogvol__viewport_problem(d->viewport))
+        why = "viewport origin outside 0..32767 or size outside 1..16384";
     else if (size[0] < 0 || size[1] < 0 || (size[0] && size[0] < d->viewport[0] + d->viewport[2]) ||
              (size[1] && size[1] < d->viewport[1] + d->viewport[3]))
         why = "texture_size smaller than the viewport's extent";
@@ -12875,8 +13149,16 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
                     "fogvol: the GL backend needs a loader (get_proc_address, get_proc or get_proc_pointer)");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (desc->dialect == FOGVOL_GLSL_VULKAN) return FOGVOL_ERROR_UNSUPPORTED; /* SPIR-V, not GL */
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in fogvol_gl_desc (FOGVOL_GLSL_*)",
+                    (int)desc->dialect);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->dialect == FOGVOL_GLSL_VULKAN) { /* SPIR-V, not GL */
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend cannot take FOGVOL_GLSL_VULKAN (a dialect for "
+                    "SPIR-V backends)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(gl, 0, sizeof *gl);
