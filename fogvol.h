@@ -7254,6 +7254,75 @@ static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
     return r == FOGVOL_SUCCESS ? e : r;
 }
 
+/* The FLOAT tier's targets: O (R32F with depth, unless the engine's depth is read), the signed sum B
+   (filtered at half resolution where the backend can), COLORS' two RGBA32F sums. */
+static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_desc td, int half)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    td.format = FOGVOL_FORMAT_R32F;
+    if (fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_ENCODE)) {
+        td.depth = 1;
+        td.label = "fogvol O (opaque depth, float)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
+    }
+    td.depth = 0;
+    td.label = "fogvol signed depth sum (float)";
+    td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
+    if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    ctx->gpu.target_filtered = r == FOGVOL_SUCCESS && td.linear;
+    if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
+                                                "the composite reads four texels instead");
+        td.linear = 0;
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    }
+    td.linear = 0;
+    if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_COLORS)) {
+        td.format = FOGVOL_FORMAT_RGBA32F;
+        td.color_count = 2;
+        td.label = "fogvol optical depth + emission sums (float, two attachments)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
+        if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
+            r = FOGVOL_ERROR_BACKEND;
+    }
+    return r;
+}
+
+/* The RGBA8 tiers' targets: O (its depth shared with the sums where faces are depth-tested), B and F
+   (or S), T for PS13's resolve pass, WIDE's second attachments. */
+static fogvol_result fogvol__digit_targets(fogvol_context *ctx, fogvol_target_desc td)
+{
+    fogvol_result r;
+    /* O's depth buffer: not where the engine writes O with its own depth (MRT) */
+    td.depth = fogvol__tier(ctx->cfg.tier)->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER;
+    td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
+    td.label = ctx->cfg.float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
+    td.format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
+    td.format = FOGVOL_FORMAT_RGBA8;
+    td.depth = 0;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
+        td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
+    td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
+    if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    td.label = "fogvol F (front faces)";
+    if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_f);
+    td.share_depth = 0;
+    td.color_count = 1;
+    td.label = "fogvol T (resolved thickness)";
+    if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_RESOLVE) &&
+        !ctx->cfg.inline_resolve)
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_t);
+    if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
+        ctx->gpu.tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_o, 1);
+        ctx->gpu.tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_b, 1);
+        ctx->gpu.tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_f, 1);
+        if (!ctx->gpu.tgt_o2 || !ctx->gpu.tgt_b2 || !ctx->gpu.tgt_f2) r = FOGVOL_ERROR_BACKEND;
+    }
+    return r;
+}
+
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
@@ -7268,63 +7337,8 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
     td.width = w;
     td.height = h;
     td.samples = ctx->cur.samples;
-    r = FOGVOL_SUCCESS;
-    if (fogvol__tier(ctx->cfg.tier)->sum_format == FOGVOL_FORMAT_R32F) {
-        td.format = FOGVOL_FORMAT_R32F;
-        if (fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_ENCODE)) {
-            td.depth = 1;
-            td.label = "fogvol O (opaque depth, float)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
-        }
-        td.depth = 0;
-        td.label = "fogvol signed depth sum (float)";
-        td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        ctx->gpu.target_filtered = r == FOGVOL_SUCCESS && td.linear;
-        if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
-                                                    "the composite reads four texels instead");
-            td.linear = 0;
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        }
-        td.linear = 0;
-        if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_COLORS)) {
-            td.format = FOGVOL_FORMAT_RGBA32F;
-            td.color_count = 2;
-            td.label = "fogvol optical depth + emission sums (float, two attachments)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
-            if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
-                r = FOGVOL_ERROR_BACKEND;
-        }
-    } else {
-        td.depth = fogvol__tier(ctx->cfg.tier)->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER; /* MRT: the engine's pass
-                                                                                   writes O with its own depth */
-        td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
-        td.label = ctx->cfg.float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
-        td.format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
-        td.format = FOGVOL_FORMAT_RGBA8;
-        td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
-            td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
-        td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        td.label = "fogvol F (front faces)";
-        if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_f);
-        td.share_depth = 0;
-        td.color_count = 1;
-        td.label = "fogvol T (resolved thickness)";
-        if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_RESOLVE) &&
-            !ctx->cfg.inline_resolve)
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_t);
-        if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
-            ctx->gpu.tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_o, 1);
-            ctx->gpu.tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_b, 1);
-            ctx->gpu.tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_f, 1);
-            if (!ctx->gpu.tgt_o2 || !ctx->gpu.tgt_b2 || !ctx->gpu.tgt_f2) r = FOGVOL_ERROR_BACKEND;
-        }
-    }
+    r = fogvol__tier(ctx->cfg.tier)->sum_format == FOGVOL_FORMAT_R32F ? fogvol__float_targets(ctx, td, half)
+                                                                     : fogvol__digit_targets(ctx, td);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create %dx%d render targets: %s", w, h,
                     fogvol_result_string(r));
