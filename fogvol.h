@@ -8201,6 +8201,7 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     }
     t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
     if (!t) return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_volume_texture: out of memory");
+    memset(t, 0, sizeof *t); /* (a failed create_texture leaves no handle to destroy) */
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
     r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
