@@ -111,7 +111,7 @@ tmp=$(mktemp)
 for name in "${names[@]}"; do
   wanted "$name" || continue
   files=$(grep -lx -- "<!-- figures:$name -->" "${docs[@]}" 2> /dev/null)
-  if [ -z "$files" ]; then [ ${#only[@]} = 0 ] || bad "no block $name in README.md or docs/"; continue; fi
+  if [ -z "$files" ]; then bad "no block $name in README.md or docs/"; continue; fi
   if [ "$shaders" = 0 ] && { [ "$name" = shaders ] || [ "$name" = vulkan-shaders ]; }; then
     skip "figures:$name" "--no-shaders"; continue
   fi
@@ -147,6 +147,34 @@ if [ ${#only[@]} = 0 ] && [ "$write" = 0 ]; then
   else bad "the doc block's first line does not name v$version" "$(head -1 fogvol.h)"; fi
   lines=$(wc -l < README.md)
   if [ "$lines" -le 350 ]; then ok "README.md has $lines lines (at most 350)"; else bad "README.md has $lines lines (at most 350)"; fi
+  # every relative link and picture points at a file that exists (and an anchor at a heading there)
+  broken=""
+  for f in "${docs[@]}"; do
+    for l in $(grep -oE '\]\([^) ]+\)' "$f" | sed 's/^](//; s/)$//' | grep -vE '^(https?|mailto):'); do
+      p=${l%%#*}; a=${l#"$p"}; a=${a#\#}
+      [ -n "$p" ] && t=$(dirname "$f")/$p || t=$f
+      if [ ! -e "$t" ]; then broken="$broken $f:$l"; continue; fi
+      if [ -n "$a" ] && ! grep -E '^#+ ' "$t" | tr 'A-Z' 'a-z' | sed -E 's/^#+ //; s/[^a-z0-9 -]//g; s/ /-/g' | grep -qx -- "$a"
+      then broken="$broken $f:$l"; fi
+    done
+  done
+  if [ -z "$broken" ]; then ok "the links and pictures of README.md and docs/*.md point at files and headings that exist"
+  else bad "broken links:$broken"; fi
+  # the speed-up table names each FOGVOL_SPEEDUP_* of the header once, and nothing else
+  have=$(grep -oE '^ +FOGVOL_SPEEDUP_[A-Z_]+ = 1u <<' fogvol.h | grep -oE 'SPEEDUP_[A-Z_]+' | sed 's/^SPEEDUP_//' | sort)
+  rows=$(grep -oE '^\| `[A-Z_]+` \|' docs/PERFORMANCE.md | grep -oE '[A-Z_]+' | sort)
+  d=$(diff <(echo "$have") <(echo "$rows"))
+  if [ -z "$d" ]; then ok "docs/PERFORMANCE.md's speed-up table names the $(echo "$have" | wc -l) FOGVOL_SPEEDUP_* once each"
+  else bad "docs/PERFORMANCE.md's speed-up table and the header's FOGVOL_SPEEDUP_* differ (< header, > table)" "$d"; fi
+  # the README's tier section names every tier and every variant
+  section=$(sed -n '/^## Which tier/,/^## /p' README.md)
+  miss=""
+  for v in $(grep -oE '^ +FOGVOL_VARIANT_[A-Z_]+ = 1u <<' fogvol.h | grep -oE 'VARIANT_[A-Z_]+' | sed 's/^VARIANT_//') \
+           $(grep -oE '^ +FOGVOL_TIER_[A-Z0-9]+ = [1-9]' fogvol.h | grep -v TIER_COUNT | grep -oE 'TIER_[A-Z0-9]+' | sed 's/^TIER_//'); do
+    echo "$section" | grep -q "\`$v\`" || miss="$miss $v"
+  done
+  if [ -z "$miss" ]; then ok "README.md's \"Which tier\" names every tier and variant of the header"
+  else bad "README.md's \"Which tier\" does not name:$miss"; fi
   qs=$(awk '/^```c[ \t]*$/ { on = 1; next } on && /^```/ { exit } on { n++ } END { print n + 0 }' README.md)
   if [ "$qs" -ge 1 ] && [ "$qs" -le 40 ]; then ok "README.md's quick start (its first C block) has $qs lines (at most 40)"
   else bad "README.md's quick start (its first C block) has $qs lines (1 to 40)"; fi
