@@ -145,6 +145,9 @@ if [ ${#only[@]} = 0 ] && [ "$write" = 0 ]; then
   else bad "CHANGELOG.md's first version heading is $first, fogvol.h says $version"; fi
   if head -1 fogvol.h | grep -q " v$version "; then ok "the doc block's first line names v$version"
   else bad "the doc block's first line does not name v$version" "$(head -1 fogvol.h)"; fi
+  wrong=$(grep -noE 'find_package\(fogvol [0-9]+\.[0-9]+' "${docs[@]}" CMakeLists.txt | grep -v "fogvol ${version%.*}\$")
+  if [ -z "$wrong" ]; then ok "every find_package(fogvol X.Y) in the docs and CMakeLists.txt asks for ${version%.*}"
+  else bad "find_package(fogvol X.Y) with another version than ${version%.*}" "$wrong"; fi
   lines=$(wc -l < README.md)
   if [ "$lines" -le 350 ]; then ok "README.md has $lines lines (at most 350)"; else bad "README.md has $lines lines (at most 350)"; fi
   # every relative link and picture points at a file that exists (and an anchor at a heading there)
