@@ -141,7 +141,7 @@ SCRIPT_RUNS = \
   "gl_compile=$(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
   "doc_index=tests/doc_index.sh" \
-  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh" \
+  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \

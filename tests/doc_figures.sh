@@ -18,17 +18,19 @@
 # Usage: tests/doc_figures.sh [--write] [--no-shaders] [NAME...]   (no NAME: every block)
 #   --write       rewrite the blocks instead of checking them (make docs)
 #   --no-shaders  leave out the blocks that need build/dump_shaders (make check)
+#   --no-tiers    leave out the tiers table (make test, which rewrites the log it would compare with)
 # The tiers table is checked when BUILD/logs/tiers.log holds a complete table newer than fogvol.h and
-# tests/test_tiers.c (make test writes it; during make test itself it is still being written), and
-# skipped otherwise, unless REQUIRE_TIERS_LOG=1 (CI, after make test). TAP.
+# tests/test_tiers.c (make test writes it: make check after make test compares it), and skipped
+# otherwise, unless REQUIRE_TIERS_LOG=1 (CI, after make test). TAP.
 set -u
 cd "$(dirname "$0")/.."
 b=${BUILD:-build}
-write=0; shaders=1; only=()
+write=0; shaders=1; tiers=1; only=()
 for a in "$@"; do
   case "$a" in
     --write) write=1 ;;
     --no-shaders) shaders=0 ;;
+    --no-tiers) tiers=0 ;;
     *) only+=("$a") ;;
   esac
 done
@@ -114,6 +116,9 @@ for name in "${names[@]}"; do
   if [ -z "$files" ]; then bad "no block $name in README.md or docs/"; continue; fi
   if [ "$shaders" = 0 ] && { [ "$name" = shaders ] || [ "$name" = vulkan-shaders ]; }; then
     skip "figures:$name" "--no-shaders"; continue
+  fi
+  if [ "$tiers" = 0 ] && [ "$name" = tiers-table ]; then
+    skip "figures:$name" "--no-tiers: make test writes the log it compares with while this runs"; continue
   fi
   if ! "gen_${name//-/_}" > "$tmp" 2> /dev/null || [ ! -s "$tmp" ]; then
     if [ "$name" = tiers-table ] && [ "${REQUIRE_TIERS_LOG:-0}" != 1 ]; then
