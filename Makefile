@@ -5,6 +5,7 @@
 #   make images refresh the README pictures in docs/ from the demo
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
+#   make docs   rewrite the figures in README.md and docs/*.md (tests/doc_figures.sh checks them)
 #   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
 #   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
 #   make vulkan the Vulkan example (examples/vulkan_backend.c, lavapipe) into build/vulkan/*.png
@@ -25,7 +26,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test docs demo images fuzz run examples bench bench-egl gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web vulkan vulkan-bench
 
 all: test
@@ -140,6 +141,7 @@ SCRIPT_RUNS = \
   "gl_compile=$(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
   "doc_index=tests/doc_index.sh" \
+  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \
@@ -168,7 +170,8 @@ TEST_RUNS = $(foreach t,$(TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)"
 check: deps-test
 	@$(MAKE) --no-print-directory -j$(JOBS) $(BUILD)/test_cpu $(BUILD)/test_backend
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(TAP) $(BUILD)/test_backend" \
-	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" "doc_index=tests/doc_index.sh"
+	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" "doc_index=tests/doc_index.sh" \
+	  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-shaders"
 
 # everything; the README's test command and CI
 test: deps-test deps-run
@@ -259,6 +262,7 @@ bench-egl: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/bench_egl $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic | tee $(BUILD)/bench_analytic.txt
 	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench_egl
+	BUILD=$(BUILD) tests/doc_figures.sh --write bench-gpu-summary
 
 # full run, 5-6 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run); the
 # analytic fog's figures (bench_analytic, run first) join its summary line
@@ -266,6 +270,14 @@ bench: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/bench $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic | tee $(BUILD)/bench_analytic.txt
 	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench
+	BUILD=$(BUILD) tests/doc_figures.sh --write bench-summary
+
+# the figures README.md and docs/*.md state, in their marked blocks, rewritten from their sources: the header,
+# the Makefile, dump_shaders, bench/RESULTS*.md and the error table of the last make test's test_tiers
+# ($(BUILD)/logs/tiers.log; without it that block stays as it is). tests/doc_figures.sh says what each block holds.
+docs:
+	@$(MAKE) --no-print-directory $(BUILD)/dump_shaders
+	@BUILD=$(BUILD) tests/doc_figures.sh --write
 
 # smoke test (smallest scene, a few frames), also part of make test
 bench-quick: deps-demo

@@ -457,7 +457,7 @@ enum {
        when some extinction colour is not grey). Other ramps keep their own group, and so does,
        for a frame, a ramp one of whose volumes has a density or colour texture in it (drawn as
        without COLORS: the group's programs draw no texture). Model and
-       error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
+       error: "One-pass colours" in docs/FEATURES.md. Needs the FLOAT tier, FOGVOL_CAP_MRT and
        target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
        per sample on multisampled framebuffers (fogvol_msaa_supported: use
        FOGVOL_MSAA_SINGLE_SAMPLE). */
@@ -467,7 +467,7 @@ enum {
 
 /* FOGVOL_SUCCESS if the tier with these variants exists in this dialect,
    else FOGVOL_ERROR_UNSUPPORTED (FLOAT and MRT need GLSL 130+ or 300 es, and
-   so on; see the table in the README). */
+   so on; the table in docs/ACCURACY.md). */
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* FOGVOL_SUCCESS if the tier with these variants can render into a
    multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
@@ -890,7 +890,7 @@ typedef struct fogvol_frame_desc {
        (rounded up): the O and face passes shade a quarter of the fragments and the composite
        upsamples the thickness bilinearly (FOGVOL_SPECIALIZE_DOWNSAMPLE); debug_thickness gets
        the same upsampled values. The edges of volumes and occluders blur over a low-resolution
-       pixel (the README's "Half resolution" gives the measured error). FLOAT tier without
+       pixel (docs/FEATURES.md, "half resolution", gives the measured error). FLOAT tier without
        ENGINE_DEPTH or COLORS, single-sample, no fogvol_add_light, no fogvol_occluder_prepare;
        otherwise end_frame returns FOGVOL_ERROR_UNSUPPORTED (logged). Other values:
        FOGVOL_ERROR_INVALID_ARGUMENT. */
@@ -1163,8 +1163,8 @@ FOGVOL_API fogvol_result fogvol_post_distance_fog(fogvol_context *ctx, const fog
    with a positive viewport height: the top row of memory), and fogvol's clip z
    is GL's [-w, w] (the Vulkan dialect maps it to [0, w]: the same window
    depth). examples/fogvol_vulkan.h is a complete backend on Vulkan,
-   examples/custom_backend.c wraps the GL one; the README's "Other graphics
-   APIs" says what each entry must do. */
+   examples/custom_backend.c wraps the GL one; docs/BACKENDS.md says what
+   each entry must do. */
 typedef uintptr_t fogvol_handle;
 
 /* The vec4 uniforms of fogvol's programs, X(FOGVOL_U_ suffix, GLSL name), in

@@ -11,6 +11,7 @@
 extern "C" {
 #endif
 fogvol_gl_proc my_get_proc(const char *name, void *user_data); /* your GL loader */
+fogvol_gl_proc glfwGetProcAddress(const char *procname); /* GLFW's (GLFWglproc is void (*)(void)) */
 extern const float verts[];       /* xyz per vertex */
 extern const uint32_t idx[];      /* 3 per triangle */
 extern const int nv, ni;          /* vertex and index counts */
