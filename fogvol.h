@@ -7952,14 +7952,16 @@ static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3]
 /* fogvol_mesh_report.convex of a valid hull: every used vertex on the inner side of every face plane
    (outward normals: counter-clockwise seen from outside), within 1e-5 of the used vertices' box
    diagonal; decided on the triangles as validated (idx: welded), where the slivers that a weld closes
-   (repeated corners) have no plane. */
-static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused)
+   (repeated corners) have no plane. The used vertices are read once into doubles (pts: 3 per used
+   vertex), as every face tests all of them. */
+static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused,
+                             double *pts)
 {
     int t, v, k, tris = fogvol__index_count(desc) / 3;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0.0, tol;
     if ((double)tris * (double)nused > 67108864.0) return -1;
     for (v = 0; v < nused; ++v) {
-        double p[3];
+        double *p = pts + 3 * v;
         fogvol__vertex(desc, used[v], p);
         for (k = 0; k < 3; ++k) {
             if (p[k] < lo[k]) lo[k] = p[k];
@@ -7984,8 +7986,7 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, 
         len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
         for (v = 0; v < nused; ++v) {
-            double p[3];
-            fogvol__vertex(desc, used[v], p);
+            const double *p = pts + 3 * v;
             if ((n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]) + n[2] * (p[2] - a[2])) / len > tol) return 0;
         }
     }
@@ -7998,6 +7999,7 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     fogvol_mesh_report rep;
     fogvol_mesh *m;
     uint32_t *idx = NULL, *used;
+    double *pts;
     fogvol_result r;
     const char *problem;
     int nused;
@@ -8034,15 +8036,18 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
                     desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
     used = m ? fogvol__referenced(ctx, desc, idx ? idx : desc->indices, &nused) : NULL;
-    if (!m || !used) {
+    pts = used ? (double *)fogvol__alloc(&ctx->alloc, sizeof(double) * 3u * (size_t)(nused > 0 ? nused : 1)) : NULL;
+    if (!m || !used || !pts) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: out of memory");
+        fogvol__free(&ctx->alloc, used);
         fogvol__free(&ctx->alloc, m);
         fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc, used, nused);
-    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused) : -1;
+    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused, pts) : -1;
+    fogvol__free(&ctx->alloc, pts);
     fogvol__free(&ctx->alloc, used);
     r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
