@@ -23,7 +23,7 @@ pass=0; fail=0; shown=0
 report() {
   local name=${names[$1]} log="$logdir/${names[$1]}.log" rc p f
   rc=$(cat "$logdir/$name.rc")
-  echo "=== $name ($(cat "$logdir/$name.time" 2> /dev/null || echo ?) s)"
+  echo "=== $name ($(cat "$logdir/$name.time" 2> /dev/null || echo ?))"
   cat "$log"
   p=$(grep -cE '^ok [0-9]+' "$log" || true)
   f=$(grep -E '^not ok [0-9]+' "$log" | grep -vc '# SKIP' || true) # cmocka writes a skipped test as "not ok N # SKIP"
@@ -47,10 +47,9 @@ for ((i = 0; i < total; ++i)); do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do
     wait -n; flush
   done
-  ( t0=$(date +%s%N)
-    bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1
+  ( TIMEFORMAT='%1R s, cpu %1U+%1S s'
+    { time bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1; } 2> "$logdir/${names[i]}.time"
     rc=$?
-    echo $(( ($(date +%s%N) - t0) / 100000000 )) | sed 's/.$/.&/; s/^\./0./' > "$logdir/${names[i]}.time"
     echo $rc > "$logdir/${names[i]}.rc.tmp" && mv "$logdir/${names[i]}.rc.tmp" "$logdir/${names[i]}.rc" ) &
 done
 wait
