@@ -271,140 +271,137 @@ static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
     return found;
 }
 
-static fogvol_result rec_begin_frame(void *u, fogvol_frame_info *info)
+/* What the recording wrapper checks (the call order fogvol must keep: counted in protocol_errors) and
+   records before it forwards a call, and what it records of a call that succeeded. */
+static void rec_frame_begun(rec *r)
 {
-    rec *r = (rec *)u;
     if (r->in_frame) r->protocol_errors++;
     r->in_frame = 1;
     r->ndraws = r->nset = 0;
     r->begin_pass_calls = r->end_pass_calls = 0;
-    return r->inner.begin_frame(r->inner.user_data, info);
 }
-static void rec_end_frame(void *u)
+static void rec_frame_ended(rec *r)
 {
-    rec *r = (rec *)u;
     if (!r->in_frame || r->nb.in_pass) r->protocol_errors++;
     r->in_frame = 0;
-    r->inner.end_frame(r->inner.user_data);
 }
-static fogvol_result rec_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
+static void rec_pass_begun(rec *r)
 {
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_texture(r->inner.user_data, d, out);
-    if (res == FOGVOL_SUCCESS && r->ntex < REC_MAX_RES) {
-        r->tex[r->ntex].h = *out;
-        r->tex[r->ntex].w = d->width;
-        r->tex[r->ntex].hgt = d->height;
-        r->tex[r->ntex].filter = d->filter;
-        r->tex[r->ntex].wrap = d->wrap;
-        r->ntex++;
-    }
-    return res;
-}
-static void rec_destroy_texture(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++; /* fogvol never hands back a handle it did not get */
-    r->inner.destroy_texture(r->inner.user_data, h);
-}
-static fogvol_result rec_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_target(r->inner.user_data, d, out);
-    if (res == FOGVOL_SUCCESS && r->ntgt < REC_MAX_RES) {
-        r->tgt[r->ntgt].h = *out;
-        r->tgt[r->ntgt].w = d->width;
-        r->tgt[r->ntgt].hgt = d->height;
-        r->tgt[r->ntgt].depth = d->depth;
-        r->ntgt++;
-    }
-    return res;
-}
-static void rec_destroy_target(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_target(r->inner.user_data, h);
-}
-static fogvol_result rec_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_program(r->inner.user_data, d, out);
-    fogvol_uniform_layout want;
-    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
-    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
-    if (res == FOGVOL_SUCCESS && r->nprog < REC_MAX_RES) {
-        r->prog[r->nprog].h = *out;
-        r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
-        r->nprog++;
-    }
-    return res;
-}
-static void rec_destroy_program(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_program(r->inner.user_data, h);
-}
-static fogvol_result rec_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    return r->inner.create_mesh(r->inner.user_data, d, out);
-}
-static void rec_destroy_mesh(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_mesh(r->inner.user_data, h);
-}
-static void rec_begin_pass(void *u, const fogvol_pass *p)
-{
-    rec *r = (rec *)u;
     if (!r->in_frame || r->nb.in_pass) r->protocol_errors++;
     r->begin_pass_calls++;
-    r->inner.begin_pass(r->inner.user_data, p);
 }
-static void rec_set_draw(void *u, const fogvol_draw *d)
+static void rec_pass_ended(rec *r)
 {
-    rec *r = (rec *)u;
     if (!r->nb.in_pass) r->protocol_errors++;
+    r->end_pass_calls++;
+}
+static void rec_in_pass(rec *r)
+{
+    if (!r->nb.in_pass) r->protocol_errors++;
+}
+static void rec_handle_given(rec *r, fogvol_handle h)
+{
+    if (!h) r->protocol_errors++; /* fogvol never hands back a handle it did not get */
+}
+static void rec_set_draw_call(rec *r, const fogvol_draw *d)
+{
+    rec_in_pass(r);
     if (r->nset < 16) {
         r->set_draws[r->nset] = *d;
         r->set_draw_pass[r->nset] = r->nb.pass_count - 1;
         r->nset++;
     }
-    r->inner.set_draw(r->inner.user_data, d);
 }
-static void rec_draw_mesh(void *u, fogvol_handle m, const fogvol_draw *d)
+static void rec_draw_call(rec *r, fogvol_handle m, const fogvol_draw *d)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
+    rec_in_pass(r);
     if (r->ndraws < REC_MAX_DRAWS) {
         r->draws[r->ndraws].pass = r->nb.pass_count - 1;
         r->draws[r->ndraws].mesh = m;
         r->draws[r->ndraws].d = *d;
         r->ndraws++;
     }
-    r->inner.draw_mesh(r->inner.user_data, m, d);
 }
-static void rec_draw_fullscreen(void *u)
+static void rec_layout_given(rec *r, const fogvol_program_desc *d)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
-    r->inner.draw_fullscreen(r->inner.user_data);
+    fogvol_uniform_layout want;
+    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
+    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
 }
-static void rec_end_pass(void *u)
+static void rec_texture_made(rec *r, const fogvol_texture_desc *d, fogvol_handle h)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
-    r->end_pass_calls++;
-    r->inner.end_pass(r->inner.user_data);
+    if (r->ntex >= REC_MAX_RES) return;
+    r->tex[r->ntex].h = h;
+    r->tex[r->ntex].w = d->width;
+    r->tex[r->ntex].hgt = d->height;
+    r->tex[r->ntex].filter = d->filter;
+    r->tex[r->ntex].wrap = d->wrap;
+    r->ntex++;
 }
-static fogvol_result rec_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
+static void rec_target_made(rec *r, const fogvol_target_desc *d, fogvol_handle h)
 {
-    rec *r = (rec *)u;
-    return r->inner.read_target(r->inner.user_data, t, rgba, size);
+    if (r->ntgt >= REC_MAX_RES) return;
+    r->tgt[r->ntgt].h = h;
+    r->tgt[r->ntgt].w = d->width;
+    r->tgt[r->ntgt].hgt = d->height;
+    r->tgt[r->ntgt].depth = d->depth;
+    r->ntgt++;
 }
+static void rec_program_made(rec *r, const fogvol_program_desc *d, fogvol_handle h)
+{
+    if (r->nprog >= REC_MAX_RES) return;
+    r->prog[r->nprog].h = h;
+    r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
+    r->nprog++;
+}
+
+/* The wrapper, one line a backend entry: RESULT(entry, parameters, the arguments forwarded (REC_U: the
+   null backend's user_data), before: checked and recorded before forwarding, after: recorded when
+   the call succeeded) for the entries that return a fogvol_result, VOID(entry, parameters, arguments,
+   before) for the others. REC_NONE: nothing. */
+#define REC_CALLS(RESULT, VOID)                                                                                      \
+    RESULT(begin_frame, (void *u, fogvol_frame_info *info), (REC_U, info), rec_frame_begun(r), REC_NONE)             \
+    VOID(end_frame, (void *u), (REC_U), rec_frame_ended(r))                                                          \
+    RESULT(create_texture, (void *u, const fogvol_texture_desc *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,   \
+           rec_texture_made(r, d, *out))                                                                             \
+    VOID(destroy_texture, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                            \
+    RESULT(create_target, (void *u, const fogvol_target_desc *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,     \
+           rec_target_made(r, d, *out))                                                                              \
+    VOID(destroy_target, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                             \
+    RESULT(create_program, (void *u, const fogvol_program_desc *d, fogvol_handle *out), (REC_U, d, out),             \
+           rec_layout_given(r, d), rec_program_made(r, d, *out))                                                     \
+    VOID(destroy_program, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                            \
+    RESULT(create_mesh, (void *u, const fogvol_mesh_data *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,         \
+           REC_NONE)                                                                                                 \
+    VOID(destroy_mesh, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                               \
+    VOID(begin_pass, (void *u, const fogvol_pass *p), (REC_U, p), rec_pass_begun(r))                                 \
+    VOID(set_draw, (void *u, const fogvol_draw *d), (REC_U, d), rec_set_draw_call(r, d))                             \
+    VOID(draw_mesh, (void *u, fogvol_handle m, const fogvol_draw *d), (REC_U, m, d), rec_draw_call(r, m, d))         \
+    VOID(draw_fullscreen, (void *u), (REC_U), rec_in_pass(r))                                                        \
+    VOID(end_pass, (void *u), (REC_U), rec_pass_ended(r))                                                            \
+    RESULT(read_target, (void *u, fogvol_handle t, unsigned char *rgba, size_t size), (REC_U, t, rgba, size),        \
+           REC_NONE, REC_NONE)
+
+#define REC_U r->inner.user_data
+#define REC_NONE (void)0
+#define REC_RESULT_FN(entry, params, args, before, after)                                                            \
+    static fogvol_result rec_##entry params                                                                          \
+    {                                                                                                                \
+        rec *r = (rec *)u;                                                                                           \
+        fogvol_result res;                                                                                           \
+        before;                                                                                                      \
+        res = r->inner.entry args;                                                                                   \
+        if (res == FOGVOL_SUCCESS) after;                                                                            \
+        return res;                                                                                                  \
+    }
+#define REC_VOID_FN(entry, params, args, before)                                                                     \
+    static void rec_##entry params                                                                                   \
+    {                                                                                                                \
+        rec *r = (rec *)u;                                                                                           \
+        before;                                                                                                      \
+        r->inner.entry args;                                                                                         \
+    }
+REC_CALLS(REC_RESULT_FN, REC_VOID_FN)
 
 static void rec_init(rec *r)
 {
@@ -412,22 +409,11 @@ static void rec_init(rec *r)
     fogvol_null_backend_init(&r->nb, &r->inner);
     r->table = r->inner;
     r->table.user_data = r;
-    r->table.begin_frame = rec_begin_frame;
-    r->table.end_frame = rec_end_frame;
-    r->table.create_texture = rec_create_texture;
-    r->table.destroy_texture = rec_destroy_texture;
-    r->table.create_target = rec_create_target;
-    r->table.destroy_target = rec_destroy_target;
-    r->table.create_program = rec_create_program;
-    r->table.destroy_program = rec_destroy_program;
-    r->table.create_mesh = rec_create_mesh;
-    r->table.destroy_mesh = rec_destroy_mesh;
-    r->table.begin_pass = rec_begin_pass;
-    r->table.set_draw = rec_set_draw;
-    r->table.draw_mesh = rec_draw_mesh;
-    r->table.draw_fullscreen = rec_draw_fullscreen;
-    r->table.end_pass = rec_end_pass;
-    r->table.read_target = rec_read_target;
+#define REC_INSTALL_RESULT(entry, params, args, before, after) r->table.entry = rec_##entry;
+#define REC_INSTALL_VOID(entry, params, args, before) r->table.entry = rec_##entry;
+    REC_CALLS(REC_INSTALL_RESULT, REC_INSTALL_VOID)
+#undef REC_INSTALL_RESULT
+#undef REC_INSTALL_VOID
 }
 
 static fogvol_handle rec_program(const rec *r, int kind)
@@ -1349,12 +1335,12 @@ static void test_frame_call_order(void **state)
 
 /* ---- bad input ---- */
 #define EXPECT_LOGGED(call, code)                                                                        \
-    do {                                                                                                 \
-        fogvol_result res_;                                                                              \
-        log_reset(&lc);                                                                                  \
-        res_ = (call);                                                                                   \
+    do {                                                                                                             \
+        fogvol_result res_;                                                                                          \
+        log_reset(&lc);                                                                                              \
+        res_ = (call);                                                                                               \
         if (res_ != (code)) fail_msg("%s returned %d (%s), want %d", #call, (int)res_, fogvol_result_string(res_), (int)(code)); \
-        if (!log_error_has(&lc, NULL)) fail_msg("%s: no error message was logged", #call);             \
+        if (!log_error_has(&lc, NULL)) fail_msg("%s: no error message was logged", #call);                           \
     } while (0)
 
 /* A mesh or ramp destroyed inside a frame drops only what uses it: the rest of
@@ -2308,19 +2294,32 @@ static const char *const g_obj_name[OBJ_KINDS] = {"textures", "buffers", "frameb
                                                   "vertex arrays", "shaders", "programs"};
 #define OBJ_MAX 1024
 
+/* The GL objects fogvol makes, one line a kind: GEN(kind, Name) for glGen<Name> / glDelete<Name>,
+   CREATE(kind, Name, parameters, arguments) for glCreate<Name> / glDelete<Name>. The loader hands fogvol
+   a wrapper of each that records the names made and deleted and forwards the call. */
+#define OBJ_CALLS(GEN, CREATE)                                                                                       \
+    GEN(OBJ_TEX, Textures)                                                                                           \
+    GEN(OBJ_BUF, Buffers)                                                                                            \
+    GEN(OBJ_FBO, Framebuffers)                                                                                       \
+    GEN(OBJ_RBO, Renderbuffers)                                                                                      \
+    GEN(OBJ_VAO, VertexArrays)                                                                                       \
+    CREATE(OBJ_SHADER, Shader, (GLenum type), (type))                                                                \
+    CREATE(OBJ_PROGRAM, Program, (void), ())
+
 typedef void (*gen_fn)(GLsizei, GLuint *);
 typedef void (*del_fn)(GLsizei, const GLuint *);
-typedef GLuint (*create_shader_fn)(GLenum);
-typedef GLuint (*create_program_fn)(void);
 typedef void (*delete_one_fn)(GLuint);
-
+#define OBJ_NONE(...)
+#define OBJ_CREATE_TYPEDEF(kind, Name, params, args) typedef GLuint(*create_##Name##_fn) params;
+OBJ_CALLS(OBJ_NONE, OBJ_CREATE_TYPEDEF)
+#define OBJ_GEN_FIELDS(kind, Name)                                                                                   \
+    gen_fn gen_##Name;                                                                                               \
+    del_fn delete_##Name;
+#define OBJ_CREATE_FIELDS(kind, Name, params, args)                                                                  \
+    create_##Name##_fn create_##Name;                                                                                \
+    delete_one_fn delete_##Name;
 static struct {
-    gen_fn gen[5];
-    del_fn del[5];
-    create_shader_fn create_shader;
-    delete_one_fn delete_shader;
-    create_program_fn create_program;
-    delete_one_fn delete_program;
+    OBJ_CALLS(OBJ_GEN_FIELDS, OBJ_CREATE_FIELDS)
     GLuint live[OBJ_KINDS][OBJ_MAX];
     int nlive[OBJ_KINDS];
     int bad_deletes;
@@ -2343,67 +2342,50 @@ static void obj_del(int kind, GLuint id)
     g_obj.bad_deletes++; /* deleting a name fogvol did not create (or twice) */
 }
 
-#define OBJ_WRAP(kind, Name)                                                    \
-    static void w_Gen##Name(GLsizei n, GLuint *ids)                             \
-    {                                                                           \
-        GLsizei i;                                                              \
-        g_obj.gen[kind](n, ids);                                                \
-        for (i = 0; i < n; ++i) obj_add(kind, ids[i]);                          \
-    }                                                                           \
-    static void w_Delete##Name(GLsizei n, const GLuint *ids)                    \
-    {                                                                           \
-        GLsizei i;                                                              \
-        for (i = 0; i < n; ++i) obj_del(kind, ids[i]);                          \
-        g_obj.del[kind](n, ids);                                                \
+#define OBJ_GEN_WRAP(kind, Name)                                                                                     \
+    static void w_Gen##Name(GLsizei n, GLuint *ids)                                                                  \
+    {                                                                                                                \
+        GLsizei i;                                                                                                   \
+        g_obj.gen_##Name(n, ids);                                                                                    \
+        for (i = 0; i < n; ++i) obj_add(kind, ids[i]);                                                               \
+    }                                                                                                                \
+    static void w_Delete##Name(GLsizei n, const GLuint *ids)                                                         \
+    {                                                                                                                \
+        GLsizei i;                                                                                                   \
+        for (i = 0; i < n; ++i) obj_del(kind, ids[i]);                                                               \
+        g_obj.delete_##Name(n, ids);                                                                                 \
     }
-OBJ_WRAP(OBJ_TEX, Textures)
-OBJ_WRAP(OBJ_BUF, Buffers)
-OBJ_WRAP(OBJ_FBO, Framebuffers)
-OBJ_WRAP(OBJ_RBO, Renderbuffers)
-OBJ_WRAP(OBJ_VAO, VertexArrays)
-static GLuint w_CreateShader(GLenum type)
-{
-    GLuint id = g_obj.create_shader(type);
-    obj_add(OBJ_SHADER, id);
-    return id;
-}
-static void w_DeleteShader(GLuint id)
-{
-    obj_del(OBJ_SHADER, id);
-    g_obj.delete_shader(id);
-}
-static GLuint w_CreateProgram(void)
-{
-    GLuint id = g_obj.create_program();
-    obj_add(OBJ_PROGRAM, id);
-    return id;
-}
-static void w_DeleteProgram(GLuint id)
-{
-    obj_del(OBJ_PROGRAM, id);
-    g_obj.delete_program(id);
-}
+#define OBJ_CREATE_WRAP(kind, Name, params, args)                                                                    \
+    static GLuint w_Create##Name params                                                                              \
+    {                                                                                                                \
+        GLuint id = g_obj.create_##Name args;                                                                        \
+        obj_add(kind, id);                                                                                           \
+        return id;                                                                                                   \
+    }                                                                                                                \
+    static void w_Delete##Name(GLuint id)                                                                            \
+    {                                                                                                                \
+        obj_del(kind, id);                                                                                           \
+        g_obj.delete_##Name(id);                                                                                     \
+    }
+OBJ_CALLS(OBJ_GEN_WRAP, OBJ_CREATE_WRAP)
 
+/* the driver's functions behind the wrappers */
 static void obj_init(void)
 {
-    static const char *const gens[5] = {"glGenTextures", "glGenBuffers", "glGenFramebuffers", "glGenRenderbuffers",
-                                        "glGenVertexArrays"};
-    static const char *const dels[5] = {"glDeleteTextures", "glDeleteBuffers", "glDeleteFramebuffers",
-                                        "glDeleteRenderbuffers", "glDeleteVertexArrays"};
-    int i;
     memset(&g_obj, 0, sizeof g_obj);
-    for (i = 0; i < 5; ++i) {
-        g_obj.gen[i] = (gen_fn)glu_proc(gens[i], NULL);
-        g_obj.del[i] = (del_fn)glu_proc(dels[i], NULL);
-        assert_non_null(g_obj.gen[i]);
-        assert_non_null(g_obj.del[i]);
-    }
-    g_obj.create_shader = (create_shader_fn)glu_proc("glCreateShader", NULL);
-    g_obj.delete_shader = (delete_one_fn)glu_proc("glDeleteShader", NULL);
-    g_obj.create_program = (create_program_fn)glu_proc("glCreateProgram", NULL);
-    g_obj.delete_program = (delete_one_fn)glu_proc("glDeleteProgram", NULL);
-    assert_non_null(g_obj.create_shader);
-    assert_non_null(g_obj.create_program);
+#define OBJ_GEN_LOAD(kind, Name)                                                                                     \
+    g_obj.gen_##Name = (gen_fn)glu_proc("glGen" #Name, NULL);                                                        \
+    g_obj.delete_##Name = (del_fn)glu_proc("glDelete" #Name, NULL);                                                  \
+    assert_non_null(g_obj.gen_##Name);                                                                               \
+    assert_non_null(g_obj.delete_##Name);
+#define OBJ_CREATE_LOAD(kind, Name, params, args)                                                                    \
+    g_obj.create_##Name = (create_##Name##_fn)glu_proc("glCreate" #Name, NULL);                                      \
+    g_obj.delete_##Name = (delete_one_fn)glu_proc("glDelete" #Name, NULL);                                           \
+    assert_non_null(g_obj.create_##Name);                                                                            \
+    assert_non_null(g_obj.delete_##Name);
+    OBJ_CALLS(OBJ_GEN_LOAD, OBJ_CREATE_LOAD)
+#undef OBJ_GEN_LOAD
+#undef OBJ_CREATE_LOAD
 }
 
 static int obj_live_total(void)
@@ -2435,20 +2417,13 @@ static fogvol_gl_proc test_loader(const char *name, void *user)
         const char *name;
         fogvol_gl_proc fn;
     } wrapped[] = {
-        {"glGenTextures", (fogvol_gl_proc)w_GenTextures},
-        {"glDeleteTextures", (fogvol_gl_proc)w_DeleteTextures},
-        {"glGenBuffers", (fogvol_gl_proc)w_GenBuffers},
-        {"glDeleteBuffers", (fogvol_gl_proc)w_DeleteBuffers},
-        {"glGenFramebuffers", (fogvol_gl_proc)w_GenFramebuffers},
-        {"glDeleteFramebuffers", (fogvol_gl_proc)w_DeleteFramebuffers},
-        {"glGenRenderbuffers", (fogvol_gl_proc)w_GenRenderbuffers},
-        {"glDeleteRenderbuffers", (fogvol_gl_proc)w_DeleteRenderbuffers},
-        {"glGenVertexArrays", (fogvol_gl_proc)w_GenVertexArrays},
-        {"glDeleteVertexArrays", (fogvol_gl_proc)w_DeleteVertexArrays},
-        {"glCreateShader", (fogvol_gl_proc)w_CreateShader},
-        {"glDeleteShader", (fogvol_gl_proc)w_DeleteShader},
-        {"glCreateProgram", (fogvol_gl_proc)w_CreateProgram},
-        {"glDeleteProgram", (fogvol_gl_proc)w_DeleteProgram},
+#define OBJ_GEN_ENTRY(kind, Name)                                                                                    \
+    {"glGen" #Name, (fogvol_gl_proc)w_Gen##Name}, {"glDelete" #Name, (fogvol_gl_proc)w_Delete##Name},
+#define OBJ_CREATE_ENTRY(kind, Name, params, args)                                                                   \
+    {"glCreate" #Name, (fogvol_gl_proc)w_Create##Name}, {"glDelete" #Name, (fogvol_gl_proc)w_Delete##Name},
+        OBJ_CALLS(OBJ_GEN_ENTRY, OBJ_CREATE_ENTRY)
+#undef OBJ_GEN_ENTRY
+#undef OBJ_CREATE_ENTRY
     };
     size_t i;
     if (l->nothing) return NULL;

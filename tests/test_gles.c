@@ -938,13 +938,6 @@ static void test_partial_extension(void **state)
     eglu_destroy(&c);
 }
 
-static int setup_all(void **state)
-{
-    (void)state;
-    gt_setup();
-    return 0;
-}
-
 /* The figures: per context, versions, automatic choice, and per combo the max error per scene. */
 static int print_table(void **state)
 {
@@ -1016,7 +1009,7 @@ static int run_context(int ci)
     if (g_ctx[ci].major == 3 && g_ctx[ci].override) /* GLES 3.0 */
         n = add_ctx_test(tests, names, n, ci, "partial_extension", test_partial_extension);
     snprintf(group, sizeof group, "gles_%s", g_ctx[ci].file);
-    return _cmocka_run_group_tests(group, tests, (size_t)n, setup_all, print_table);
+    return _cmocka_run_group_tests(group, tests, (size_t)n, gt_group_setup, print_table);
 }
 
 int main(void)

@@ -738,13 +738,6 @@ static int print_table(void **state)
     return 0;
 }
 
-static int setup_all(void **state)
-{
-    (void)state;
-    gt_setup();
-    return 0;
-}
-
 int main(void)
 {
     static tcase cases[NTIER_COMBO * NDIALECT];
@@ -776,5 +769,5 @@ int main(void)
             tests[n].initial_state = t;
             ++n;
         }
-    return cmocka_run_group_tests_name("tiers", tests, setup_all, print_table); /* zeroed entries are skipped */
+    return cmocka_run_group_tests_name("tiers", tests, gt_group_setup, print_table); /* zeroed entries are skipped */
 }
