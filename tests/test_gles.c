@@ -1015,6 +1015,7 @@ static int run_context(int ci)
 int main(void)
 {
     int ci, failed = 0;
+    gt_setup(); /* the ground truth once, before the contexts' processes: each inherits it */
     for (ci = 0; ci < NCTX; ++ci) {
         int status = 0;
         pid_t pid;
@@ -1031,5 +1032,6 @@ int main(void)
             failed = 1;
         }
     }
+    gt_teardown();
     return failed;
 }
