@@ -161,7 +161,7 @@ endif
 # at once), C++
 # SAN_SUBSET: the programs whose sanitizer build runs a subset of their cases (FOGVOL_TEST_SUBSET=1), chosen
 # so that the same lines of fogvol.h run as with every case (gcov); their plain build runs every case
-SAN_SUBSET = tiers
+SAN_SUBSET = tiers gles
 TEST_RUNS = $(foreach t,$(TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)" \
               "$(t)_asan_ubsan=BUILD=$(BUILD)/san $(TAP) $(LSAN_ENV) $(if $(filter $(t),$(SAN_SUBSET)),FOGVOL_TEST_SUBSET=1) \
                 $(BUILD)/test_$(t)_san") \
