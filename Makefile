@@ -179,10 +179,11 @@ TEST_RUNS = $(foreach t,$(TESTS),"$(t)=$(call built,$(BUILD)/test_$(t)) BUILD=$(
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
-check: deps-test
-	@$(MAKE) --no-print-directory -j$(JOBS) $(BUILD)/test_cpu $(BUILD)/test_backend
-	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(TAP) $(BUILD)/test_backend" \
-	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" "doc_index=tests/doc_index.sh"
+# (each entry builds its program as it starts: the two compile at once, and the scripts run beside them)
+check: deps-test | $(BUILD)
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(call built,$(BUILD)/test_backend) $(TAP) $(BUILD)/test_backend" \
+	  "cpu=$(call built,$(BUILD)/test_cpu) $(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
+	  "doc_index=tests/doc_index.sh"
 
 # everything; the README's test command and CI. The objects and programs that several entries use
 # (TEST_SHARED) are built first; every entry then builds its own programs (TEST_BINS) as it starts, so
