@@ -139,7 +139,7 @@ SCRIPT_RUNS = \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
   $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
   "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
-  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
+  $(foreach c,gcc clang g++ clang++,"compile_matrix_$(c)=BUILD=$(BUILD) tests/compile_matrix.sh $(c)") \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
   "gl_compile=$(call built,$(BUILD)/gl_compile) $(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
