@@ -138,7 +138,8 @@ SCRIPT_RUNS = \
   "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
   $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
-  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
+  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh examples" \
+  "examples_package=BUILD=$(BUILD) CC=$(CC) tests/examples.sh package" \
   $(foreach c,gcc clang g++ clang++,"compile_matrix_$(c)=BUILD=$(BUILD) tests/compile_matrix.sh $(c)") \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
   "gl_compile=$(call built,$(BUILD)/gl_compile) $(GL_COMPILE)" \
