@@ -5,7 +5,10 @@
 # Up to JOBS commands (default: the number of cores) run at once, each into its own
 # log under LOGDIR; the logs are printed in the order the commands were given, each
 # as soon as it and every one before it have finished, so the output is the same
-# whatever the timing. Give the longest commands first: they start first.
+# whatever the timing. The commands start longest first: by the CPU time (user + sys) each
+# took in the last run with this LOGDIR (LOGDIR/durations); those without one (a first run) start
+# first, in the order given: give the longest commands first. Each log's header line says the
+# command's wall and CPU time.
 set -u
 logdir=${LOGDIR:-build/logs}
 jobs=${JOBS:-$(nproc 2> /dev/null || echo 2)}
@@ -17,6 +20,13 @@ for spec in "$@"; do
 done
 total=${#names[@]}
 for ((i = 0; i < total; ++i)); do rm -f "$logdir/${names[i]}.log" "$logdir/${names[i]}.rc"; done
+order=() # the indices in the order the commands start
+while read -r _ i; do order+=("$i"); done < <(
+  for ((i = 0; i < total; ++i)); do
+    t=$(awk -v n="${names[i]}" '$1 == n { print $2 }' "$logdir/durations" 2> /dev/null)
+    echo "${t:-1e9} $i"
+  done | sort -s -k1,1gr)
+: > "$logdir/durations.new"
 
 pass=0; fail=0; shown=0
 # report I: print job I's log and add its counts
@@ -24,6 +34,8 @@ report() {
   local name=${names[$1]} log="$logdir/${names[$1]}.log" rc p f
   rc=$(cat "$logdir/$name.rc")
   echo "=== $name ($(cat "$logdir/$name.time" 2> /dev/null || echo ?))"
+  sed -n 's/.*cpu \([0-9.]*\)+\([0-9.]*\) s$/\1 \2/p' "$logdir/$name.time" 2> /dev/null |
+    awk -v n="$name" '{ print n, $1 + $2 }' >> "$logdir/durations.new"
   cat "$log"
   p=$(grep -cE '^ok [0-9]+' "$log" || true)
   f=$(grep -E '^not ok [0-9]+' "$log" | grep -vc '# SKIP' || true) # cmocka writes a skipped test as "not ok N # SKIP"
@@ -43,7 +55,7 @@ flush() {
     report "$shown"; shown=$((shown + 1))
   done
 }
-for ((i = 0; i < total; ++i)); do
+for i in "${order[@]}"; do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do
     wait -n; flush
   done
@@ -54,6 +66,10 @@ for ((i = 0; i < total; ++i)); do
 done
 wait
 flush
+# the times of this run, and those of commands it did not run (make check and make test share a LOGDIR)
+awk 'NR == FNR { seen[$1] = 1; next } !($1 in seen)' "$logdir/durations.new" "$logdir/durations" \
+  >> "$logdir/durations.new" 2> /dev/null
+mv "$logdir/durations.new" "$logdir/durations"
 echo
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]
