@@ -192,7 +192,7 @@ check: deps-test | $(BUILD)
 TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/dump_shaders $(BUILD)/vulkan_backend
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_SHARED)
-	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) DURATIONS=tests/durations tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
 
 # --- Vulkan ------------------------------------------------------------------------
 # examples/vulkan_backend.c: an engine on Vulkan with fogvol's backend examples/fogvol_vulkan.h (GLSL of

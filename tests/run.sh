@@ -6,9 +6,9 @@
 # log under LOGDIR; the logs are printed in the order the commands were given, each
 # as soon as it and every one before it have finished, so the output is the same
 # whatever the timing. The commands start longest first: by the CPU time (user + sys) each
-# took in the last run with this LOGDIR (LOGDIR/durations); those without one (a first run) start
-# first, in the order given: give the longest commands first. Each log's header line says the
-# command's wall and CPU time.
+# took in the last run with this LOGDIR (LOGDIR/durations, else the file DURATIONS names: make test's
+# tests/durations); those without one start first, in the order given. Each log's header line says
+# the command's wall and CPU time.
 set -u
 logdir=${LOGDIR:-build/logs}
 jobs=${JOBS:-$(nproc 2> /dev/null || echo 2)}
@@ -21,9 +21,11 @@ done
 total=${#names[@]}
 for ((i = 0; i < total; ++i)); do rm -f "$logdir/${names[i]}.log" "$logdir/${names[i]}.rc"; done
 order=() # the indices in the order the commands start
+durations=$logdir/durations
+[ -f "$durations" ] || durations=${DURATIONS:-/dev/null}
 while read -r _ i; do order+=("$i"); done < <(
   for ((i = 0; i < total; ++i)); do
-    t=$(awk -v n="${names[i]}" '$1 == n { print $2 }' "$logdir/durations" 2> /dev/null)
+    t=$(awk -v n="${names[i]}" '$1 == n { print $2 }' "$durations" 2> /dev/null)
     echo "${t:-1e9} $i"
   done | sort -s -k1,1gr)
 : > "$logdir/durations.new"
