@@ -68,6 +68,7 @@ for i in "${order[@]}"; do
 done
 wait
 flush
+awk '{ cpu += $2 } END { printf "# %d commands, %.0f s of CPU (user + sys)\n", NR, cpu }' "$logdir/durations.new"
 # the times of this run, and those of commands it did not run (make check and make test share a LOGDIR)
 awk 'NR == FNR { seen[$1] = 1; next } !($1 in seen)' "$logdir/durations.new" "$logdir/durations" \
   >> "$logdir/durations.new" 2> /dev/null
