@@ -64,6 +64,9 @@ for i in "${order[@]}"; do
   ( TIMEFORMAT='%1R s, cpu %1U+%1S s'
     { time bash -c "${cmds[i]}" > "$logdir/${names[i]}.log" 2>&1; } 2> "$logdir/${names[i]}.time"
     rc=$?
+    # the last line is the time; any before it is bash's word on the command (killed by a signal) for its log
+    head -n -1 "$logdir/${names[i]}.time" >> "$logdir/${names[i]}.log"
+    sed -i '$!d' "$logdir/${names[i]}.time"
     echo $rc > "$logdir/${names[i]}.rc.tmp" && mv "$logdir/${names[i]}.rc.tmp" "$logdir/${names[i]}.rc" ) &
 done
 wait
