@@ -249,7 +249,7 @@
        >>null backend   the recording backend (no GPU)
        >>context        the renderer's objects and the context: configuration, targets, programs
        >>resources      meshes (upload, bounds, convexity), colour ramps, volume textures
-       >>frame input    camera, begin_frame, volumes, occluders, MRT and engine-drawn O
+       >>frame input    camera, begin_frame, volumes, occluders, MRT and engine-drawn O, matrices
        >>passes         opaque O, the face sums, composite, debug read-back
        >>overflow       overflow check passes, occlusion queries, what a count changes
        >>lights         volume lights by compare
@@ -422,11 +422,16 @@ enum {
        opaque depth is added once per missing back face. The camera must be
        outside the volumes, and the near plane must not cut them: fogvol_end_frame
        checks each volume's bounds and refuses such a frame
-       (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). */
+       (FOGVOL_ERROR_UNSUPPORTED, logged, nothing drawn). Asked for, COUNT is
+       required of every frame; FOGVOL_SPEEDUP_DEPTH_TEST (on by default) draws
+       each frame that meets these conditions this way by itself and the others
+       with the min compare, so most engines should leave COUNT out. */
     FOGVOL_VARIANT_COUNT = 1u << 1,
     /* PS20/MRT, and PS13 in GLSL 330 / 300 es (highp integers): RGB-encode by
        arithmetic in the fragment shader instead of ramp textures ("newer
-       hardware can calculate the ramp values"). Same bytes. */
+       hardware can calculate the ramp values"). Same bytes. FOGVOL_SPEEDUP_ALU
+       (on by default) adds this variant wherever the dialect takes it, so asking
+       for it only makes a context that cannot have it fail. */
     FOGVOL_VARIANT_ALU = 1u << 2,
     /* Snap vertices behind the near plane onto it (Baker) instead of relying
        on near-plane clipping for a camera partly inside a volume. */
@@ -718,15 +723,14 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
 FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp);
 
 /* ---- frames: camera, occluders, volumes, lights; MRT and engine-drawn occluders ---- */
-/* Both composites write the same pixels with the same values and leave the
-   engine's stencil buffer alone. GEOMETRY limits the full-screen program to
-   the window rectangle of each ramp group's volumes (the 8 corners of each
-   mesh's bounding box projected; the whole viewport when a box reaches behind
-   the near plane), which saves fill rate when the volumes cover little of the
-   screen. */
+/* Since 0.2 the two values draw the same: one full-screen triangle per ramp group, scissored to the
+   window rectangle of the group's volumes (the 8 corners of each mesh's bounding box projected; the
+   whole viewport when a box reaches behind the near plane), which saves fill rate when the volumes
+   cover little of the screen; the engine's stencil buffer is left alone. (0.1 scissored FULLSCREEN
+   only with FOGVOL_SPEEDUP_SCISSOR, which is gone; GEOMETRY stays for source compatibility.) */
 typedef enum fogvol_composite {
-    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* one full-screen triangle over the viewport */
-    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same, scissored to the volumes' screen rectangle */
+    FOGVOL_COMPOSITE_FULLSCREEN = 0, /* the default */
+    FOGVOL_COMPOSITE_GEOMETRY = 1    /* the same as FULLSCREEN */
 } fogvol_composite;
 
 /* What the composite does to the alpha of the engine's colour target. */
@@ -1752,9 +1756,6 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  alpha = 1 - exp(-density t) instead of reading the ramp texture (the ramp holds
                  the same function in 8 bits: alpha differs by at most 1/255 plus the ramp's
                  interpolation error, rgb is the same).
-   SCISSOR       FOGVOL_COMPOSITE_FULLSCREEN is scissored to the volumes' screen rectangle like
-                 GEOMETRY (the composite discards every pixel outside it anyway: same pixels); the
-                 overflow check passes likewise.
    SPECIALIZE    each pass runs a program built for its configuration (fogvol_shader_desc.specialize:
                  no O read without occluders (and no test for it with them), no density texture
                  outside textured volumes, exp or
@@ -1851,7 +1852,7 @@ enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
     FOGVOL_SPEEDUP_EXP_COMPOSITE = 1u << 2,
-    FOGVOL_SPEEDUP_SCISSOR = 1u << 3,
+    /* 1u << 3 was SCISSOR (0.1): the composites are always scissored now; the bit is ignored */
     FOGVOL_SPEEDUP_SPECIALIZE = 1u << 4,
     FOGVOL_SPEEDUP_ALU = 1u << 5,
     FOGVOL_SPEEDUP_OVERFLOW_BANDS = 1u << 6,
@@ -5732,7 +5733,8 @@ FOGVOL_API int fogvol_analytic_snippet(const char **strings, int capacity)
    row's off[] (FOGVOL__NEVER there: not on this tier) and it holds all of need[].
    To add a tier: its value in fogvol_tier, its row here, and the passes that differ in the >>passes
    section. To add a speed-up or feature: its FOGVOL__F_ value, its off[] entry in each row, the
-   context's switch for it (>>context) and the one pass function that uses it. */
+   context's switch for it (>>context), its field in the frame's plan (fogvol__plan, filled by
+   fogvol__plan_frame in >>end frame) and the one pass function that follows that field. */
 
 enum {
     FOGVOL__F_ENCODE,         /* fogvol draws O itself with the ENCODE program (occluders, or the engine's depth) */
@@ -5748,6 +5750,7 @@ enum {
     FOGVOL__F_FETCH_O,        /* FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH: faces read O there (FOGVOL_SPECIALIZE_FETCH_O) */
     FOGVOL__F_EXACT_SUM,      /* FOGVOL_SPEEDUP_EXACT_SUM: 32-bit integer sums (FOGVOL_SPECIALIZE_EXACT_SUM) */
     FOGVOL__F_DEPTH_TEST,     /* FOGVOL_SPEEDUP_DEPTH_TEST: frames drawn as COUNT (FOGVOL_SPECIALIZE_COUNT) */
+    FOGVOL__F_DOWNSAMPLE,     /* fogvol_frame_desc.downsample 2: the sums at half resolution */
     FOGVOL__F_COUNT
 };
 #define FOGVOL__NEVER 0x80000000u /* in off[]: the tier has no such feature (no variant uses this bit) */
@@ -5759,6 +5762,7 @@ typedef struct fogvol__tier_row {
     unsigned char passes;       /* passes fogvol issues for one group, no variant */
     unsigned char targets;      /* targets fogvol allocates, no variant */
     unsigned char modern;       /* needs a dialect with float targets, two outputs and texelFetch */
+    unsigned char borrow;       /* RGBA8 sums: the decode's alpha digit borrows (PS13 resolves without) */
     fogvol_format sum_format;   /* the format of the face sums (RGBA8: encoded digits) */
     unsigned caps;              /* backend caps (FOGVOL_CAP_*) it needs */
     unsigned auto_caps;         /* ... for FOGVOL_TIER_AUTO to choose it */
@@ -5778,38 +5782,41 @@ typedef struct fogvol__tier_row {
 #define FOGVOL__K FOGVOL_VARIANT_COLORS
 #define FOGVOL__X FOGVOL__NEVER
 static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
-    {"auto", "", 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
+    {"auto", "", 0, 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
      {FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X,
-      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
+      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
      {0}},
     /* PS13: O, B, F, T resolved, composite; lowp/mediump (texture ramps, per-channel compare) */
-    {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
+    {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
      FOGVOL__A,
      /*       ENCODE RESOLVE CHECK DENSITY LIGHT COLORS MSAA                 ALU */
      {0, 0, 0, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W,
       /* INLINE_RESOLVE FLOAT_O                          FETCH_O */
       0, FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
       /* EXACT_SUM                                                     DEPTH_TEST */
-      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
+      /* DOWNSAMPLE */
+      FOGVOL__X},
      {0}},
     /* PS20: O, B, F, composite */
-    {"PS20", "", 5, 4, 3, 0, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
+    {"PS20", "", 5, 4, 3, 0, 1, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
      FOGVOL__S | FOGVOL__C | FOGVOL__A | FOGVOL__N | FOGVOL__E | FOGVOL__W, FOGVOL__E, 0,
      {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
       FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
-      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K},
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
+      FOGVOL__X},
      {0}},
     /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
-    {"MRT", "", 4, 3, 3, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
+    {"MRT", "", 4, 3, 3, 1, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
      {FOGVOL__X, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__X, FOGVOL__W, FOGVOL__X,
       FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
-      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X},
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X, FOGVOL__X},
      {0}},
     /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
-    {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
+    {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, 0, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
      FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
      {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X,
-      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
+      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__E | FOGVOL__K},
      {0, 0, 0, 0, 0, FOGVOL__K}}};
 #undef FOGVOL__S
 #undef FOGVOL__C
@@ -7120,8 +7127,6 @@ typedef struct fogvol__frame_state {
     int nocc, capocc;
     fogvol__light *lights;  /* fogvol_add_light, this frame */
     int nlight, caplight;
-    int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
-    unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
     int64_t group_stamp;    /* fogvol__link_groups: which end_frame the ramps' group lists belong to */
     int color_first;        /* the first volume of the one-pass colour group, -1: none (FOGVOL_VARIANT_COLORS) */
     int color_pos;          /* the colour group holds a positive volume */
@@ -7150,17 +7155,41 @@ struct fogvol_context {
     fogvol__overflow_state ovf; /* overflow counters */
 };
 
+/* The plan of one fogvol_end_frame: what the frame draws, resolved once (fogvol__plan_frame, >>end
+   frame) from the tier's row, the variants, the context's speed-ups and the frame's input. The passes
+   follow it; none of them asks which tier, variant or speed-up it is in. */
+typedef struct fogvol__plan {
+    int float_sums;   /* the row's sums are R32F: one signed pass per group (else RGBA8 digit sums) */
+    int single;       /* SINGLE_TARGET: back faces up and front faces down in one biased sum S */
+    int wide;         /* WIDE: six digits over two attachments (decoded without offset) */
+    int count;        /* faces depth-tested against O, counts in alpha: COUNT, or a DEPTH_TEST frame */
+    int own_o;        /* fogvol draws O (not where the engine wrote it: MRT, fogvol_occluder_prepare) */
+    int o_engine;     /* ... by encoding the engine's depth full-screen (ENGINE_DEPTH on a tier with O) */
+    int engine_read;  /* the faces, lights and colour sums read the engine's depth (ENGINE_DEPTH, no O) */
+    int no_opaque;    /* FOGVOL_SPEEDUP_SKIP_OPAQUE: no occluder, O is the far plane */
+    int float_o;      /* O is R32F (the FLOAT tier, FOGVOL_SPEEDUP_FLOAT_O) */
+    int resolve;      /* B - F resolved into T in a pass of its own (PS13 without INLINE_RESOLVE) */
+    int fetch_o;      /* the faces read O from the framebuffer (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
+    int exact_sum;    /* a group may sum in 32-bit integers (EXACT_SUM; fogvol__group decides per group) */
+    int borrow;       /* the decode's alpha digit borrows (not with counts in alpha, PS13's or WIDE's) */
+    int skip_check;   /* FOGVOL_SPEEDUP_SKIP_CHECK: groups that cannot saturate skip the check pass */
+    int colors;       /* FOGVOL_VARIANT_COLORS: the one-pass colour group */
+    int exp_composite, fast_exp, blend_color; /* the composite's speed-ups */
+    float near_clamp; /* fv_misc.w: NEAR_CLAMP */
+    unsigned origin_bit, dither_bit, count_bit, depth_from_z_bit; /* SPECIALIZE bits of the passes */
+} fogvol__plan;
+
 /* One fogvol_end_frame: what its passes share. */
 typedef struct fogvol__run {
+    fogvol__plan p;
     fogvol_frame_stats st;
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
     fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
-    int w, h, single, count, rgba8;
+    int w, h;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
     fogvol_result r;            /* the last error that did not stop the frame */
-    int no_opaque;              /* FOGVOL_SPEEDUP_SKIP_OPAQUE: O is the far plane this frame */
     int xsum;                   /* FOGVOL_SPEEDUP_EXACT_SUM: the current group sums as 32-bit integers */
     int rect[4];                /* the current group's window rectangle; rect[2] = 0: not scissored */
 } fogvol__run;
@@ -7170,76 +7199,6 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
 static fogvol_result fogvol__ensure_checks(fogvol_context *ctx);
 static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base, int first,
                                fogvol_frame_stats *st);
-
-/* column-major 4x4 helpers in double */
-static void fogvol__mul4(double *out, const double *a, const double *b)
-{
-    int c, r, k;
-    double t[16];
-    for (c = 0; c < 4; ++c)
-        for (r = 0; r < 4; ++r) {
-            double s = 0;
-            for (k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
-            t[c * 4 + r] = s;
-        }
-    memcpy(out, t, sizeof t);
-}
-
-static void fogvol__tod(double *out, const float *m)
-{
-    int i;
-    for (i = 0; i < 16; ++i) out[i] = m[i];
-}
-
-static double fogvol__det3(const double *m)
-{
-    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
-           m[8] * (m[1] * m[6] - m[5] * m[2]);
-}
-
-/* inverse of a 4x4 (cofactors; the layout does not matter: inv(A^T) = inv(A)^T);
-   0 if singular or not finite. a[r][c] below is m[r * 4 + c]. */
-static int fogvol__inv4(const double *m, double *out)
-{
-#define FOGVOL__A(r, c) m[(r) * 4 + (c)]
-    double s0 = FOGVOL__A(0, 0) * FOGVOL__A(1, 1) - FOGVOL__A(1, 0) * FOGVOL__A(0, 1);
-    double s1 = FOGVOL__A(0, 0) * FOGVOL__A(1, 2) - FOGVOL__A(1, 0) * FOGVOL__A(0, 2);
-    double s2 = FOGVOL__A(0, 0) * FOGVOL__A(1, 3) - FOGVOL__A(1, 0) * FOGVOL__A(0, 3);
-    double s3 = FOGVOL__A(0, 1) * FOGVOL__A(1, 2) - FOGVOL__A(1, 1) * FOGVOL__A(0, 2);
-    double s4 = FOGVOL__A(0, 1) * FOGVOL__A(1, 3) - FOGVOL__A(1, 1) * FOGVOL__A(0, 3);
-    double s5 = FOGVOL__A(0, 2) * FOGVOL__A(1, 3) - FOGVOL__A(1, 2) * FOGVOL__A(0, 3);
-    double c5 = FOGVOL__A(2, 2) * FOGVOL__A(3, 3) - FOGVOL__A(3, 2) * FOGVOL__A(2, 3);
-    double c4 = FOGVOL__A(2, 1) * FOGVOL__A(3, 3) - FOGVOL__A(3, 1) * FOGVOL__A(2, 3);
-    double c3 = FOGVOL__A(2, 1) * FOGVOL__A(3, 2) - FOGVOL__A(3, 1) * FOGVOL__A(2, 2);
-    double c2 = FOGVOL__A(2, 0) * FOGVOL__A(3, 3) - FOGVOL__A(3, 0) * FOGVOL__A(2, 3);
-    double c1 = FOGVOL__A(2, 0) * FOGVOL__A(3, 2) - FOGVOL__A(3, 0) * FOGVOL__A(2, 2);
-    double c0 = FOGVOL__A(2, 0) * FOGVOL__A(3, 1) - FOGVOL__A(3, 0) * FOGVOL__A(2, 1);
-    double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0, b[16];
-    int i;
-    if (!(det != 0.0) || det - det != 0.0) return 0;
-    b[0] = FOGVOL__A(1, 1) * c5 - FOGVOL__A(1, 2) * c4 + FOGVOL__A(1, 3) * c3;
-    b[1] = -FOGVOL__A(0, 1) * c5 + FOGVOL__A(0, 2) * c4 - FOGVOL__A(0, 3) * c3;
-    b[2] = FOGVOL__A(3, 1) * s5 - FOGVOL__A(3, 2) * s4 + FOGVOL__A(3, 3) * s3;
-    b[3] = -FOGVOL__A(2, 1) * s5 + FOGVOL__A(2, 2) * s4 - FOGVOL__A(2, 3) * s3;
-    b[4] = -FOGVOL__A(1, 0) * c5 + FOGVOL__A(1, 2) * c2 - FOGVOL__A(1, 3) * c1;
-    b[5] = FOGVOL__A(0, 0) * c5 - FOGVOL__A(0, 2) * c2 + FOGVOL__A(0, 3) * c1;
-    b[6] = -FOGVOL__A(3, 0) * s5 + FOGVOL__A(3, 2) * s2 - FOGVOL__A(3, 3) * s1;
-    b[7] = FOGVOL__A(2, 0) * s5 - FOGVOL__A(2, 2) * s2 + FOGVOL__A(2, 3) * s1;
-    b[8] = FOGVOL__A(1, 0) * c4 - FOGVOL__A(1, 1) * c2 + FOGVOL__A(1, 3) * c0;
-    b[9] = -FOGVOL__A(0, 0) * c4 + FOGVOL__A(0, 1) * c2 - FOGVOL__A(0, 3) * c0;
-    b[10] = FOGVOL__A(3, 0) * s4 - FOGVOL__A(3, 1) * s2 + FOGVOL__A(3, 3) * s0;
-    b[11] = -FOGVOL__A(2, 0) * s4 + FOGVOL__A(2, 1) * s2 - FOGVOL__A(2, 3) * s0;
-    b[12] = -FOGVOL__A(1, 0) * c3 + FOGVOL__A(1, 1) * c1 - FOGVOL__A(1, 2) * c0;
-    b[13] = FOGVOL__A(0, 0) * c3 - FOGVOL__A(0, 1) * c1 + FOGVOL__A(0, 2) * c0;
-    b[14] = -FOGVOL__A(3, 0) * s3 + FOGVOL__A(3, 1) * s1 - FOGVOL__A(3, 2) * s0;
-    b[15] = FOGVOL__A(2, 0) * s3 - FOGVOL__A(2, 1) * s1 + FOGVOL__A(2, 2) * s0;
-#undef FOGVOL__A
-    for (i = 0; i < 16; ++i) {
-        out[i] = b[i] / det;
-        if (out[i] - out[i] != 0.0) return 0;
-    }
-    return 1;
-}
 
 static void fogvol__destroy_targets(fogvol_context *ctx)
 {
@@ -7295,6 +7254,75 @@ static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
     return r == FOGVOL_SUCCESS ? e : r;
 }
 
+/* The FLOAT tier's targets: O (R32F with depth, unless the engine's depth is read), the signed sum B
+   (filtered at half resolution where the backend can), COLORS' two RGBA32F sums. */
+static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_desc td, int half)
+{
+    fogvol_result r = FOGVOL_SUCCESS;
+    td.format = FOGVOL_FORMAT_R32F;
+    if (fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_ENCODE)) {
+        td.depth = 1;
+        td.label = "fogvol O (opaque depth, float)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
+    }
+    td.depth = 0;
+    td.label = "fogvol signed depth sum (float)";
+    td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
+    if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    ctx->gpu.target_filtered = r == FOGVOL_SUCCESS && td.linear;
+    if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
+                                                "the composite reads four texels instead");
+        td.linear = 0;
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    }
+    td.linear = 0;
+    if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_COLORS)) {
+        td.format = FOGVOL_FORMAT_RGBA32F;
+        td.color_count = 2;
+        td.label = "fogvol optical depth + emission sums (float, two attachments)";
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
+        if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
+            r = FOGVOL_ERROR_BACKEND;
+    }
+    return r;
+}
+
+/* The RGBA8 tiers' targets: O (its depth shared with the sums where faces are depth-tested), B and F
+   (or S), T for PS13's resolve pass, WIDE's second attachments. */
+static fogvol_result fogvol__digit_targets(fogvol_context *ctx, fogvol_target_desc td)
+{
+    fogvol_result r;
+    /* O's depth buffer: not where the engine writes O with its own depth (MRT) */
+    td.depth = fogvol__tier(ctx->cfg.tier)->off[FOGVOL__F_ENCODE] != FOGVOL__NEVER;
+    td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
+    td.label = ctx->cfg.float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
+    td.format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+    r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
+    td.format = FOGVOL_FORMAT_RGBA8;
+    td.depth = 0;
+    if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
+        td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
+    td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
+    if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
+    td.label = "fogvol F (front faces)";
+    if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_f);
+    td.share_depth = 0;
+    td.color_count = 1;
+    td.label = "fogvol T (resolved thickness)";
+    if (r == FOGVOL_SUCCESS && fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_RESOLVE) &&
+        !ctx->cfg.inline_resolve)
+        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_t);
+    if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
+        ctx->gpu.tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_o, 1);
+        ctx->gpu.tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_b, 1);
+        ctx->gpu.tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_f, 1);
+        if (!ctx->gpu.tgt_o2 || !ctx->gpu.tgt_b2 || !ctx->gpu.tgt_f2) r = FOGVOL_ERROR_BACKEND;
+    }
+    return r;
+}
+
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
     fogvol_target_desc td;
@@ -7309,61 +7337,8 @@ static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, i
     td.width = w;
     td.height = h;
     td.samples = ctx->cur.samples;
-    r = FOGVOL_SUCCESS;
-    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) {
-        td.format = FOGVOL_FORMAT_R32F;
-        if (!fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) {
-            td.depth = 1;
-            td.label = "fogvol O (opaque depth, float)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
-        }
-        td.depth = 0;
-        td.label = "fogvol signed depth sum (float)";
-        td.linear = half && (ctx->be.caps & FOGVOL_CAP_FILTER_FLOAT); /* downsample 2: read bilinearly */
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        ctx->gpu.target_filtered = r == FOGVOL_SUCCESS && td.linear;
-        if (r == FOGVOL_ERROR_UNSUPPORTED && td.linear) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: the backend cannot filter the half-resolution sum: "
-                                                    "the composite reads four texels instead");
-            td.linear = 0;
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        }
-        td.linear = 0;
-        if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_COLORS)) {
-            td.format = FOGVOL_FORMAT_RGBA32F;
-            td.color_count = 2;
-            td.label = "fogvol optical depth + emission sums (float, two attachments)";
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
-            if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
-                r = FOGVOL_ERROR_BACKEND;
-        }
-    } else {
-        td.depth = ctx->cfg.tier != FOGVOL_TIER_MRT; /* MRT: the engine's pass writes O with its own depth */
-        td.color_count = fogvol__has(ctx, FOGVOL_VARIANT_WIDE) ? 2 : 1;
-        td.label = ctx->cfg.float_o ? "fogvol O (opaque depth, float)" : "fogvol O (opaque depth)";
-        td.format = ctx->cfg.float_o ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
-        r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_o);
-        td.format = FOGVOL_FORMAT_RGBA8;
-        td.depth = 0;
-        if (fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DEPTH_TEST))
-            td.share_depth = ctx->gpu.tgt_o; /* faces depth-tested (COUNT, FOGVOL_SPEEDUP_DEPTH_TEST) */
-        td.label = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET) ? "fogvol S (biased sum)" : "fogvol B (back faces)";
-        if (r == FOGVOL_SUCCESS) r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_b);
-        td.label = "fogvol F (front faces)";
-        if (r == FOGVOL_SUCCESS && !fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET))
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_f);
-        td.share_depth = 0;
-        td.color_count = 1;
-        td.label = "fogvol T (resolved thickness)";
-        if (r == FOGVOL_SUCCESS && ctx->cfg.tier == FOGVOL_TIER_PS13 && !ctx->cfg.inline_resolve)
-            r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_t);
-        if (r == FOGVOL_SUCCESS && fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) {
-            ctx->gpu.tgt_o2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_o, 1);
-            ctx->gpu.tgt_b2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_b, 1);
-            ctx->gpu.tgt_f2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_f, 1);
-            if (!ctx->gpu.tgt_o2 || !ctx->gpu.tgt_b2 || !ctx->gpu.tgt_f2) r = FOGVOL_ERROR_BACKEND;
-        }
-    }
+    r = fogvol__tier(ctx->cfg.tier)->sum_format == FOGVOL_FORMAT_R32F ? fogvol__float_targets(ctx, td, half)
+                                                                     : fogvol__digit_targets(ctx, td);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot create %dx%d render targets: %s", w, h,
                     fogvol_result_string(r));
@@ -8259,7 +8234,100 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 }
 
 /* >>frame input =========================================================== */
-/* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
+/* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O; the frame's matrices
+   (column-major 4x4 in double) and the per-draw values the passes take from them. */
+
+/* column-major 4x4 helpers in double */
+static void fogvol__mul4(double *out, const double *a, const double *b)
+{
+    int c, r, k;
+    double t[16];
+    for (c = 0; c < 4; ++c)
+        for (r = 0; r < 4; ++r) {
+            double s = 0;
+            for (k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+            t[c * 4 + r] = s;
+        }
+    memcpy(out, t, sizeof t);
+}
+
+static void fogvol__tod(double *out, const float *m)
+{
+    int i;
+    for (i = 0; i < 16; ++i) out[i] = m[i];
+}
+
+static double fogvol__det3(const double *m)
+{
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+           m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+/* inverse of a 4x4 (cofactors; the layout does not matter: inv(A^T) = inv(A)^T);
+   0 if singular or not finite. a[r][c] below is m[r * 4 + c]. */
+static int fogvol__inv4(const double *m, double *out)
+{
+#define FOGVOL__A(r, c) m[(r) * 4 + (c)]
+    double s0 = FOGVOL__A(0, 0) * FOGVOL__A(1, 1) - FOGVOL__A(1, 0) * FOGVOL__A(0, 1);
+    double s1 = FOGVOL__A(0, 0) * FOGVOL__A(1, 2) - FOGVOL__A(1, 0) * FOGVOL__A(0, 2);
+    double s2 = FOGVOL__A(0, 0) * FOGVOL__A(1, 3) - FOGVOL__A(1, 0) * FOGVOL__A(0, 3);
+    double s3 = FOGVOL__A(0, 1) * FOGVOL__A(1, 2) - FOGVOL__A(1, 1) * FOGVOL__A(0, 2);
+    double s4 = FOGVOL__A(0, 1) * FOGVOL__A(1, 3) - FOGVOL__A(1, 1) * FOGVOL__A(0, 3);
+    double s5 = FOGVOL__A(0, 2) * FOGVOL__A(1, 3) - FOGVOL__A(1, 2) * FOGVOL__A(0, 3);
+    double c5 = FOGVOL__A(2, 2) * FOGVOL__A(3, 3) - FOGVOL__A(3, 2) * FOGVOL__A(2, 3);
+    double c4 = FOGVOL__A(2, 1) * FOGVOL__A(3, 3) - FOGVOL__A(3, 1) * FOGVOL__A(2, 3);
+    double c3 = FOGVOL__A(2, 1) * FOGVOL__A(3, 2) - FOGVOL__A(3, 1) * FOGVOL__A(2, 2);
+    double c2 = FOGVOL__A(2, 0) * FOGVOL__A(3, 3) - FOGVOL__A(3, 0) * FOGVOL__A(2, 3);
+    double c1 = FOGVOL__A(2, 0) * FOGVOL__A(3, 2) - FOGVOL__A(3, 0) * FOGVOL__A(2, 2);
+    double c0 = FOGVOL__A(2, 0) * FOGVOL__A(3, 1) - FOGVOL__A(3, 0) * FOGVOL__A(2, 1);
+    double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0, b[16];
+    int i;
+    if (!(det != 0.0) || det - det != 0.0) return 0;
+    b[0] = FOGVOL__A(1, 1) * c5 - FOGVOL__A(1, 2) * c4 + FOGVOL__A(1, 3) * c3;
+    b[1] = -FOGVOL__A(0, 1) * c5 + FOGVOL__A(0, 2) * c4 - FOGVOL__A(0, 3) * c3;
+    b[2] = FOGVOL__A(3, 1) * s5 - FOGVOL__A(3, 2) * s4 + FOGVOL__A(3, 3) * s3;
+    b[3] = -FOGVOL__A(2, 1) * s5 + FOGVOL__A(2, 2) * s4 - FOGVOL__A(2, 3) * s3;
+    b[4] = -FOGVOL__A(1, 0) * c5 + FOGVOL__A(1, 2) * c2 - FOGVOL__A(1, 3) * c1;
+    b[5] = FOGVOL__A(0, 0) * c5 - FOGVOL__A(0, 2) * c2 + FOGVOL__A(0, 3) * c1;
+    b[6] = -FOGVOL__A(3, 0) * s5 + FOGVOL__A(3, 2) * s2 - FOGVOL__A(3, 3) * s1;
+    b[7] = FOGVOL__A(2, 0) * s5 - FOGVOL__A(2, 2) * s2 + FOGVOL__A(2, 3) * s1;
+    b[8] = FOGVOL__A(1, 0) * c4 - FOGVOL__A(1, 1) * c2 + FOGVOL__A(1, 3) * c0;
+    b[9] = -FOGVOL__A(0, 0) * c4 + FOGVOL__A(0, 1) * c2 - FOGVOL__A(0, 3) * c0;
+    b[10] = FOGVOL__A(3, 0) * s4 - FOGVOL__A(3, 1) * s2 + FOGVOL__A(3, 3) * s0;
+    b[11] = -FOGVOL__A(2, 0) * s4 + FOGVOL__A(2, 1) * s2 - FOGVOL__A(2, 3) * s0;
+    b[12] = -FOGVOL__A(1, 0) * c3 + FOGVOL__A(1, 1) * c1 - FOGVOL__A(1, 2) * c0;
+    b[13] = FOGVOL__A(0, 0) * c3 - FOGVOL__A(0, 1) * c1 + FOGVOL__A(0, 2) * c0;
+    b[14] = -FOGVOL__A(3, 0) * s3 + FOGVOL__A(3, 1) * s1 - FOGVOL__A(3, 2) * s0;
+    b[15] = FOGVOL__A(2, 0) * s3 - FOGVOL__A(2, 1) * s1 + FOGVOL__A(2, 2) * s0;
+#undef FOGVOL__A
+    for (i = 0; i < 16; ++i) {
+        out[i] = b[i] / det;
+        if (out[i] - out[i] != 0.0) return 0;
+    }
+    return 1;
+}
+
+/* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
+static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
+{
+    double m[16], mvp[16], range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
+    int j;
+    dr->sign = 1.0f;
+    memset(dr->extinction, 0, sizeof dr->extinction);
+    memset(dr->emission, 0, sizeof dr->emission);
+    fogvol__tod(m, model);
+    fogvol__mul4(mvp, ctx->cur.viewproj, m);
+    for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
+    /* view depth e = eyerow . (M p);  d = (e - near) / (far - near) */
+    for (j = 0; j < 4; ++j)
+        dr->depth[j] = (float)((ctx->cur.eyerow[0] * m[j * 4] + ctx->cur.eyerow[1] * m[j * 4 + 1] +
+                                ctx->cur.eyerow[2] * m[j * 4 + 2] + ctx->cur.eyerow[3] * m[j * 4 + 3] -
+                                (j == 3 ? ctx->cur.frame.znear : 0.0)) /
+                               range);
+    /* a mirroring model matrix or projection flips the winding */
+    dr->front_cw = (fogvol__det3(m) < 0) != (ctx->cur.mirrored != 0);
+}
+
 
 /* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
    next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
@@ -8715,27 +8783,6 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     return FOGVOL_SUCCESS;
 }
 
-/* Per-draw uniforms for a model matrix: mvp, the depth row d = dot(row, p), winding. */
-static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], fogvol_draw *dr)
-{
-    double m[16], mvp[16], range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
-    int j;
-    dr->sign = 1.0f;
-    memset(dr->extinction, 0, sizeof dr->extinction);
-    memset(dr->emission, 0, sizeof dr->emission);
-    fogvol__tod(m, model);
-    fogvol__mul4(mvp, ctx->cur.viewproj, m);
-    for (j = 0; j < 16; ++j) dr->mvp[j] = (float)mvp[j];
-    /* view depth e = eyerow . (M p);  d = (e - near) / (far - near) */
-    for (j = 0; j < 4; ++j)
-        dr->depth[j] = (float)((ctx->cur.eyerow[0] * m[j * 4] + ctx->cur.eyerow[1] * m[j * 4 + 1] +
-                                ctx->cur.eyerow[2] * m[j * 4 + 2] + ctx->cur.eyerow[3] * m[j * 4 + 3] -
-                                (j == 3 ? ctx->cur.frame.znear : 0.0)) /
-                               range);
-    /* a mirroring model matrix or projection flips the winding */
-    dr->front_cw = (fogvol__det3(m) < 0) != (ctx->cur.mirrored != 0);
-}
-
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
     const char *why;
@@ -9022,8 +9069,7 @@ static fogvol_result fogvol__frame_refusal(fogvol_context *ctx)
                                                  "pass a depth texture (engine_depth_texture)");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
-    if (fd->downsample == 2 && (ctx->cfg.tier != FOGVOL_TIER_FLOAT || ctx->cur.nlight > 0 ||
-                                fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COLORS))) {
+    if (fd->downsample == 2 && (ctx->cur.nlight > 0 || !fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_DOWNSAMPLE))) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: downsample 2 needs the FLOAT tier without ENGINE_DEPTH or COLORS and no "
                     "fogvol_add_light (tier %s, variants 0x%x, %d lights); nothing drawn",
@@ -9048,7 +9094,13 @@ static void fogvol__end_pass(fogvol_context *ctx)
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
 }
 
-static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp);
+/* A ramp in the one-pass colour group this frame (FOGVOL_VARIANT_COLORS): a colour ramp none of whose
+   volumes has a density or colour texture this frame (the colour group's programs draw neither: such
+   a ramp is a group of its own, drawn as without COLORS). */
+static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    return (ctx->cfg.variants & FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
+}
 
 /* The frame's colour-ramp groups as lists, once per end_frame, so that each group's passes visit its
    own volumes only: each ramp's first and last volume (stamped with this end_frame), each volume's
@@ -9151,7 +9203,8 @@ static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 /* After a sum pass (its state in *base): each density-textured volume of the group in a pass of
    its own with its texture and texture-coordinate rows (negative as in fogvol__draw_group).
    Returns the passes issued. */
-static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
+static int fogvol__draw_textured(fogvol_context *ctx, const fogvol__run *run, const fogvol_pass *base,
+                                 const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
     for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
@@ -9165,7 +9218,7 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
             ps.textures[FOGVOL__UNIT_OPAQUE] = ps.read_target;
             ps.read_target = 0;
         }
-        ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__origin_bit(ctx)); /* density texture */
+        ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, run->p.origin_bit); /* density texture */
         ps.textures[FOGVOL__UNIT_DENSITY] = v->density->texture;
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_U], v->density_map, 4 * sizeof(float));
         memcpy(ps.uniforms[FOGVOL_U_DENSITY_V], v->density_map + 4, 4 * sizeof(float));
@@ -9199,8 +9252,8 @@ static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ra
 
 /* One sum pass over a group: the faces culled by 'cull' are left out for the
    positive volumes; the negative volumes swap front and back. */
-static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, fogvol_handle target, int clear, fogvol_cull cull,
-                            fogvol_pass_blend blend, const fogvol_ramp *ramp, int has_neg)
+static int fogvol__sum_pass(fogvol_context *ctx, const fogvol__run *run, fogvol_pass *ps, fogvol_handle target,
+                            int clear, fogvol_cull cull, fogvol_pass_blend blend, const fogvol_ramp *ramp, int has_neg)
 {
     int passes = 1;
     ps->target = target;
@@ -9210,14 +9263,14 @@ static int fogvol__sum_pass(fogvol_context *ctx, fogvol_pass *ps, fogvol_handle 
     ctx->be.begin_pass(ctx->be.user_data, ps);
     fogvol__draw_group(ctx, ramp, 0);
     fogvol__end_pass(ctx);
-    passes += fogvol__draw_textured(ctx, ps, ramp, 0);
+    passes += fogvol__draw_textured(ctx, run, ps, ramp, 0);
     if (has_neg) {
         ps->clear = 0;
         ps->cull = cull == FOGVOL_CULL_FRONT ? FOGVOL_CULL_BACK : FOGVOL_CULL_FRONT;
         ctx->be.begin_pass(ctx->be.user_data, ps);
         fogvol__draw_group(ctx, ramp, 1);
         fogvol__end_pass(ctx);
-        passes += 1 + fogvol__draw_textured(ctx, ps, ramp, 1);
+        passes += 1 + fogvol__draw_textured(ctx, run, ps, ramp, 1);
     }
     return passes;
 }
@@ -9291,14 +9344,15 @@ static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double 
 
 /* Decoded thickness per pixel (world units) from the sum targets, and the
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
-static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned char *peak, int xsum, int *overflow)
+static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const fogvol__run *run, const unsigned char *peak,
+                                           int *overflow)
 {
     size_t n = (size_t)ctx->gpu.target_w * (size_t)ctx->gpu.target_h, i;
     unsigned char *b, *f, *o;
     float *fl;
     fogvol_result r;
     double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET), count = ctx->cur.count_frame;
+    int single = run->p.single, count = run->p.count;
     if (!ctx->be.read_target) return FOGVOL_ERROR_UNSUPPORTED;
     if (ctx->gpu.tgt_b2) return fogvol__debug_capture_wide(ctx, overflow);
     b = (unsigned char *)fogvol__alloc(&ctx->alloc, n * 12u);
@@ -9307,7 +9361,7 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
     o = f + n * 4u;
     *overflow = 0;
     r = ctx->be.read_target(ctx->be.user_data, ctx->gpu.tgt_b, b, n * 4u);
-    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) {
+    if (run->p.float_sums) {
         fl = (float *)(void *)b;
         if (r == FOGVOL_SUCCESS && ctx->cur.frame.downsample == 2) fogvol__debug_upsample(ctx, fl, range);
         else
@@ -9315,7 +9369,7 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const unsigned c
         fogvol__free(&ctx->alloc, b);
         return r;
     }
-    if (xsum) { /* FOGVOL_SPEEDUP_EXACT_SUM: a 32-bit integer (two's complement), 2^24 per depth range */
+    if (run->xsum) { /* FOGVOL_SPEEDUP_EXACT_SUM: a 32-bit integer (two's complement), 2^24 per depth range */
         for (i = 0; r == FOGVOL_SUCCESS && i < n; ++i) {
             const unsigned char *p = b + 4 * i;
             uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
@@ -9462,11 +9516,10 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
     ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->cfg.enc.dither_steps;
     ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.target_w; /* target space (downsample: half) */
     ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.target_h;
-    if (run->rgba8) {
+    if (!run->p.float_sums) {
         memcpy(ps->uniforms[FOGVOL_U_DECODE], k.decode, sizeof k.decode);
-        if (run->count || ctx->cfg.tier == FOGVOL_TIER_PS13 || fogvol__has(ctx, FOGVOL_VARIANT_WIDE))
-            ps->uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
-        if (fogvol__has(ctx, FOGVOL_VARIANT_WIDE)) { /* u = clamp(d, 0, 1 - N^-6), no offset */
+        if (!run->p.borrow) ps->uniforms[FOGVOL_U_DECODE][3] = 0.0f; /* alpha: counts, or no borrow */
+        if (run->p.wide) { /* u = clamp(d, 0, 1 - N^-6), no offset */
             double n6 = (double)ctx->cfg.enc.levels * ctx->cfg.enc.levels * ctx->cfg.enc.levels;
             n6 *= n6;
             ps->uniforms[FOGVOL_U_ENC][2] = 0.0f;
@@ -9482,6 +9535,7 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
     ps->uniforms[FOGVOL_U_NEARFAR][2] = (float)fd->viewport[0]; /* ENGINE_DEPTH: target pixel -> engine texel */
     ps->uniforms[FOGVOL_U_NEARFAR][3] = (float)fd->viewport[1];
     fogvol__target_space(ctx, ps);
+    run->p.depth_from_z_bit = fogvol__depth_from_z_bit(ps);
 }
 
 /* The opaque depth O, encoded like the volumes' depth: the occluders drawn by fogvol (or by the
@@ -9489,24 +9543,23 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
    drawn where the engine wrote O (MRT, fogvol_occluder_prepare) or the tier reads no O. */
 static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
 {
+    const fogvol__plan *p = &run->p;
     fogvol_pass ps = run->base;
-    int engine = fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH), i;
-    if (!fogvol_tier_uses_program(ctx->cfg.tier, ctx->cfg.variants, FOGVOL_PROGRAM_ENCODE) || ctx->cur.engine_occluders) {
-        ctx->gpu.o_far = 0; /* the engine wrote O */
+    int engine = p->o_engine, i;
+    if (!p->own_o) {
+        ctx->gpu.o_far = 0; /* the engine wrote O (or there is none) */
         return;
     }
-    run->no_opaque = !engine && !run->count && ctx->cur.nocc == 0 && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SKIP_OPAQUE);
-    if (run->no_opaque && ctx->gpu.o_far) return; /* O still holds the far plane of an earlier frame */
-    ctx->gpu.o_far = run->no_opaque;
+    if (p->no_opaque && ctx->gpu.o_far) return; /* O still holds the far plane of an earlier frame */
+    ctx->gpu.o_far = p->no_opaque;
     ps.target = ctx->gpu.tgt_o;
     ps.clear = 1;
-    if (run->rgba8 && !ctx->cfg.float_o) /* the far plane: every digit N - 1, or d = 1 */
+    if (!p->float_o) /* the far plane: every digit N - 1, or d = 1 */
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = (float)(ctx->cfg.enc.levels - 1) / 255.0f;
     else ps.clear_color[0] = 1.0f;
     ps.depth_test = ps.depth_write = 1;
-    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE,
-                                 (engine ? fogvol__origin_bit(ctx) | fogvol__depth_from_z_bit(&ps) : 0u) |
-                                     fogvol__dither_bit(ctx) | ctx->cur.count_bit);
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_ENCODE, (engine ? p->origin_bit | p->depth_from_z_bit : 0u) |
+                                                                 p->dither_bit | p->count_bit);
     if (engine) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ctx->be.begin_pass(ctx->be.user_data, &ps);
     run->st.passes++;
@@ -9533,8 +9586,7 @@ static void fogvol__opaque_pass(fogvol_context *ctx, fogvol__run *run)
    turns its speed-up off (the integer sum first) and the next is tried: digits, O sampled. */
 static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run, fogvol_pass *ps, unsigned spec)
 {
-    int fetch = ctx->cfg.fetch_o && !run->no_opaque && !run->count && ctx->cur.samples <= 1 && ctx->gpu.tgt_o &&
-                !(spec & FOGVOL_SPECIALIZE_NO_OPAQUE);
+    int fetch = run->p.fetch_o;
     for (;;) { /* the integer sum (FOGVOL_SPEEDUP_EXACT_SUM), O from the framebuffer, each dropped if it fails */
         unsigned bits = spec | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u) |
                         (fetch ? (unsigned)FOGVOL_SPECIALIZE_FETCH_O : 0u);
@@ -9549,9 +9601,9 @@ static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run,
                     run->xsum ? "the faces sum digits (FOGVOL_SPEEDUP_EXACT_SUM off)"
                               : "the faces sample O (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH off)");
         if (run->xsum) {
-            ctx->cfg.exact_sum = run->xsum = 0;
+            ctx->cfg.exact_sum = run->p.exact_sum = run->xsum = 0;
         } else {
-            ctx->cfg.fetch_o = 0;
+            ctx->cfg.fetch_o = run->p.fetch_o = 0;
             fetch = 0;
         }
     }
@@ -9562,36 +9614,35 @@ static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run,
    faces into F. The debug read-back, when asked for this group, follows the sums. */
 static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, int has_neg)
 {
+    const fogvol__plan *p = &run->p;
     fogvol_pass ps = run->base;
     unsigned char *peak = NULL;
     fogvol_result r;
-    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | fogvol__origin_bit(ctx); /* textured volumes: below */
-    if (run->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
-    else if (ctx->cfg.tier == FOGVOL_TIER_FLOAT) spec |= FOGVOL_SPECIALIZE_OPAQUE;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
-        spec |= fogvol__depth_from_z_bit(&ps); /* (FLOAT faces read the engine's depth) */
-    spec |= fogvol__dither_bit(ctx) | ctx->cur.count_bit;
+    unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | p->origin_bit; /* textured volumes: below */
+    if (p->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
+    else if (p->float_sums) spec |= FOGVOL_SPECIALIZE_OPAQUE;
+    if (p->engine_read) spec |= p->depth_from_z_bit; /* (the faces read the engine's depth) */
+    spec |= p->dither_bit | p->count_bit;
     ps.program = fogvol__face_program(ctx, run, &ps, spec);
-    ps.depth_test = run->count; /* COUNT: against the opaque depth shared from O */
-    ps.uniforms[FOGVOL_U_SPEEDUP][0] = run->no_opaque && ctx->cfg.tier == FOGVOL_TIER_FLOAT ? 1.0f : 0.0f;
-    ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
-        ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    ps.depth_test = p->count; /* COUNT: against the opaque depth shared from O */
+    ps.uniforms[FOGVOL_U_SPEEDUP][0] = p->no_opaque && p->float_sums ? 1.0f : 0.0f;
+    ps.uniforms[FOGVOL_U_MISC][3] = p->near_clamp;
+    if (p->engine_read) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     else if (!ps.read_target) ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
     ps.textures[FOGVOL__UNIT_OPAQUE2] = ctx->gpu.tgt_o2;
-    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT || run->xsum) { /* every face, signed by gl_FrontFacing */
+    if (p->float_sums || run->xsum) { /* every face, signed by gl_FrontFacing */
         ps.target = ctx->gpu.tgt_b;
         ps.clear = 1;
         ps.blend = run->xsum ? FOGVOL_PASS_BLEND_NONE : FOGVOL_PASS_BLEND_ADD; /* (EXACT_SUM: the program adds) */
         ctx->be.begin_pass(ctx->be.user_data, &ps);
         fogvol__draw_group(ctx, ramp, -1);
         fogvol__end_pass(ctx);
-        run->st.passes += 1 + fogvol__draw_textured(ctx, &ps, ramp, -1);
+        run->st.passes += 1 + fogvol__draw_textured(ctx, run, &ps, ramp, -1);
         run->st.exact_sum += run->xsum;
-    } else if (run->single) {
+    } else if (p->single) {
         ps.clear_color[0] = ps.clear_color[1] = ps.clear_color[2] = ps.clear_color[3] = 128.0f / 255.0f;
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, run, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
         if (run->checks) fogvol__check_pass(ctx, run, &ps, 1, &run->st); /* saturation at the peak of the sum */
         if (fogvol__want_debug(ctx, ramp, run->captured)) {
             peak = (unsigned char *)fogvol__alloc(&ctx->alloc, (size_t)run->w * (size_t)run->h);
@@ -9599,15 +9650,15 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
             if (r != FOGVOL_SUCCESS) run->r = r;
         }
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp, has_neg);
+            fogvol__sum_pass(ctx, run, &ps, ctx->gpu.tgt_b, 0, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_SUBTRACT, ramp, has_neg);
     } else {
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, run, &ps, ctx->gpu.tgt_b, 1, FOGVOL_CULL_FRONT, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
         run->st.passes +=
-            fogvol__sum_pass(ctx, &ps, ctx->gpu.tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
+            fogvol__sum_pass(ctx, run, &ps, ctx->gpu.tgt_f, 1, FOGVOL_CULL_BACK, FOGVOL_PASS_BLEND_ADD, ramp, has_neg);
     }
     if (fogvol__want_debug(ctx, ramp, run->captured)) {
-        r = fogvol__debug_capture(ctx, peak, run->xsum, &run->overflow);
+        r = fogvol__debug_capture(ctx, run, peak, &run->overflow);
         run->captured = 1;
         if (r != FOGVOL_SUCCESS) run->r = r;
     }
@@ -9615,7 +9666,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
 }
 
 /* *ps: target-space state reading the sums (composite texture units), scissored to the group's
-   window rectangle when the composite is (the passes after the sums read nothing outside it); PS13
+   window rectangle as the composite is (the passes after the sums read nothing outside it); PS13
    first resolves B - F into T, which the later passes read instead (not with
    FOGVOL_SPEEDUP_INLINE_RESOLVE: they resolve it themselves). */
 static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp, fogvol_pass *ps)
@@ -9624,24 +9675,22 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     int *rc = run->rect;
     *ps = run->base;
     memset(rc, 0, sizeof run->rect);
-    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY || !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SCISSOR)) {
-        fogvol__group_rect(ctx, ramp, rc);
-        if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
-            rc[1] = 2 * fd->viewport[1] + fd->viewport[3] - rc[1] - rc[3];
-        ps->scissor[0] = rc[0] - fd->viewport[0]; /* target pixel = window pixel - viewport origin */
-        ps->scissor[1] = rc[1] - fd->viewport[1];
-        ps->scissor[2] = rc[2];
-        ps->scissor[3] = rc[3];
-    }
+    fogvol__group_rect(ctx, ramp, rc);
+    if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
+        rc[1] = 2 * fd->viewport[1] + fd->viewport[3] - rc[1] - rc[3];
+    ps->scissor[0] = rc[0] - fd->viewport[0]; /* target pixel = window pixel - viewport origin */
+    ps->scissor[1] = rc[1] - fd->viewport[1];
+    ps->scissor[2] = rc[2];
+    ps->scissor[3] = rc[3];
     memset(ps->textures, 0, sizeof ps->textures);
     ps->textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_b;
     ps->textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_f;
-    ps->textures[FOGVOL__UNIT_COUNTS] = run->count ? ctx->gpu.tgt_o : 0;
+    ps->textures[FOGVOL__UNIT_COUNTS] = run->p.count ? ctx->gpu.tgt_o : 0;
     ps->textures[FOGVOL__UNIT_BACK2] = ctx->gpu.tgt_b2;
     ps->textures[FOGVOL__UNIT_FRONT2] = ctx->gpu.tgt_f2;
-    if (ctx->cfg.tier != FOGVOL_TIER_PS13 || ctx->cfg.inline_resolve) return;
+    if (!run->p.resolve) return;
     ps->target = ctx->gpu.tgt_t;
-    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, fogvol__origin_bit(ctx) | ctx->cur.count_bit);
+    ps->program = fogvol__program(ctx, FOGVOL_PROGRAM_RESOLVE, run->p.origin_bit | run->p.count_bit);
     ctx->be.begin_pass(ctx->be.user_data, ps);
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
@@ -9652,13 +9701,11 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
 
 /* FOGVOL_SPEEDUP_BLEND_COLOR: a composite of one colour (spec: EXP, no colour texture, no
    overflow test) takes it from the blend unit where the backend can. */
-static void fogvol__blend_color(const fogvol_context *ctx, fogvol_pass *ps, unsigned *spec)
+static void fogvol__blend_color(const fogvol__run *run, fogvol_pass *ps, unsigned *spec)
 {
     unsigned need = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW;
     ps->blend_constant = 0;
-    if ((*spec & need) != need || !(ctx->be.caps & FOGVOL_CAP_BLEND_CONSTANT) ||
-        (ctx->cfg.speedups_off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE)))
-        return;
+    if ((*spec & need) != need || !run->p.blend_color) return;
     *spec |= FOGVOL_SPECIALIZE_BLEND_COLOR;
     ps->blend_constant = 1;
     memcpy(ps->blend_color, ps->uniforms[FOGVOL_U_SPEEDUP], 3 * sizeof(float));
@@ -9680,21 +9727,19 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->blend = ramp->blend == FOGVOL_BLEND_LIGHT ? FOGVOL_PASS_BLEND_LIGHT : FOGVOL_PASS_BLEND_FOG;
     ps->draw_buffer = fd->draw_buffer;
     ps->alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-    if (!(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_EXP_COMPOSITE))
-        memcpy(ps->uniforms[FOGVOL_U_SPEEDUP], ramp->exp_rgba, sizeof ramp->exp_rgba);
+    if (run->p.exp_composite) memcpy(ps->uniforms[FOGVOL_U_SPEEDUP], ramp->exp_rgba, sizeof ramp->exp_rgba);
     ps->textures[FOGVOL__UNIT_RAMP] = ramp->texture;
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
     ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
     fogvol__group_color(ctx, ramp, ps);
     spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
-    if (spec == FOGVOL_SPECIALIZE_EXP && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FAST_EXP))
-        spec |= FOGVOL_SPECIALIZE_FAST_EXP;
+    if (spec == FOGVOL_SPECIALIZE_EXP && run->p.fast_exp) spec |= FOGVOL_SPECIALIZE_FAST_EXP;
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
-    spec |= fogvol__origin_bit(ctx) | ctx->cur.count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
+    spec |= run->p.origin_bit | run->p.count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
     ps->uniforms[FOGVOL_U_RAMP][3] = run->xsum ? (float)((double)(fd->zfar - fd->znear) / 16777216.0) : 0.0f;
-    fogvol__blend_color(ctx, ps, &spec);
+    fogvol__blend_color(run, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
         spec |= FOGVOL_SPECIALIZE_DOWNSAMPLE | (ctx->gpu.target_filtered ? (unsigned)FOGVOL_SPECIALIZE_FILTERED : 0u);
         ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)fd->viewport[2];
@@ -9708,7 +9753,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     if (run->xsum && ps->program == ctx->gpu.prog[FOGVOL_PROGRAM_COMPOSITE]) { /* the general one reads digits */
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no composite program for integer sums: group not drawn "
                                                  "(FOGVOL_SPEEDUP_EXACT_SUM off from the next frame)");
-        ctx->cfg.exact_sum = 0;
+        ctx->cfg.exact_sum = run->p.exact_sum = 0;
         ps->program = 0;
     }
     if (!ps->program) {
@@ -9742,7 +9787,7 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
     ctx->ovf.overflow_frame = -1;
     ctx->ovf.qcur = -1;
     fogvol__bands_forget(ctx);
-    if (ctx->cfg.tier == FOGVOL_TIER_FLOAT || policy == FOGVOL_OVERFLOW_OFF) return;
+    if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_CHECK) || policy == FOGVOL_OVERFLOW_OFF) return;
     if (!b->create_query || !b->destroy_query || !b->begin_query || !b->end_query || !b->query_result ||
         b->create_query(b->user_data, &ctx->ovf.qf[0].q[0]) != FOGVOL_SUCCESS) {
         ctx->ovf.qf[0].q[0] = 0;
@@ -9900,7 +9945,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
 {
     fogvol_pass cp = *base;
     fogvol_handle q;
-    int single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+    int single = run->p.single;
     if (ctx->ovf.qcur >= 0 && !fogvol__band_scissor(run, ctx->ovf.qf[ctx->ovf.qcur].band, cp.scissor)) return;
     cp.target = ctx->gpu.tgt_v;
     cp.read_target = 0; /* (SINGLE_TARGET: the state of the sum passes) */
@@ -9909,7 +9954,7 @@ static void fogvol__check_pass(fogvol_context *ctx, const fogvol__run *run, cons
     cp.blend = FOGVOL_PASS_BLEND_NONE;
     cp.cull = FOGVOL_CULL_NONE;
     cp.depth_test = cp.depth_write = single;
-    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, fogvol__origin_bit(ctx));
+    cp.program = fogvol__program(ctx, FOGVOL_PROGRAM_CHECK, run->p.origin_bit);
     memset(cp.native_textures, 0, sizeof cp.native_textures);
     if (single) { /* the one sum target; V is the target here, not a texture */
         memset(cp.textures, 0, sizeof cp.textures);
@@ -9986,10 +10031,9 @@ static void fogvol__overflow_react(fogvol_context *ctx, int fresh)
    of what a target sums leaves a margin for a mesh convex only within fogvol__convexity's tolerance,
    which a grazing ray could cross again), the faces are not folded onto the near plane
    (NEAR_CLAMP), and SINGLE_TARGET keeps its peak check. */
-static int fogvol__unsaturable(const fogvol_context *ctx, int volumes, int all_convex)
+static int fogvol__unsaturable(const fogvol_context *ctx, const fogvol__run *run, int volumes, int all_convex)
 {
-    return all_convex && 2 * volumes <= ctx->cfg.enc.max_faces && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SKIP_CHECK) &&
-           !fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP | FOGVOL_VARIANT_SINGLE_TARGET);
+    return all_convex && 2 * volumes <= ctx->cfg.enc.max_faces && run->p.skip_check;
 }
 
 /* The group's overflow check pass, its program and mask target made on first use (none while every
@@ -10011,7 +10055,7 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
 {
     fogvol_result r = run->r;
     if (run->counted) fogvol__overflow_close(ctx);
-    if (!run->rgba8) { /* float sums cannot saturate */
+    if (run->p.float_sums) { /* float sums cannot saturate */
         ctx->ovf.overflow_late = 0;
         ctx->ovf.overflow_frame = ctx->ovf.frame_no;
     }
@@ -10020,7 +10064,7 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: %d pixels have more faces along the ray than the %d-bit encoding sums (%d)",
                     run->overflow, ctx->cfg.enc.precision_bits,
-                    run->single ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces);
+                    run->p.single ? ctx->cfg.enc.max_faces_single : ctx->cfg.enc.max_faces);
         r = FOGVOL_ERROR_DEPTH_OVERFLOW;
     }
     return r;
@@ -10075,7 +10119,7 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
 }
 
 /* The program and the front-depth target L, made on first use. */
-static fogvol_result fogvol__light_setup(fogvol_context *ctx)
+static fogvol_result fogvol__light_setup(fogvol_context *ctx, const fogvol__run *run)
 {
     fogvol_target_desc td;
     fogvol_result r = FOGVOL_SUCCESS;
@@ -10086,7 +10130,7 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx)
         td.width = ctx->gpu.target_w;
         td.height = ctx->gpu.target_h;
         td.samples = ctx->cur.samples;
-        td.format = ctx->cfg.tier == FOGVOL_TIER_FLOAT ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
+        td.format = run->p.float_sums ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
         td.label = "fogvol L (light front depth)";
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_l);
         if (r != FOGVOL_SUCCESS) ctx->gpu.tgt_l = 0;
@@ -10108,7 +10152,7 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
     fogvol_result r;
     int i;
     if (!ctx->cur.nlight) return;
-    if ((r = fogvol__light_setup(ctx)) != FOGVOL_SUCCESS) {
+    if ((r = fogvol__light_setup(ctx, run)) != FOGVOL_SUCCESS) {
         run->r = r;
         return;
     }
@@ -10126,10 +10170,8 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
     bp.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     bp.uniforms[FOGVOL_U_NEARFAR][2] = bp.uniforms[FOGVOL_U_NEARFAR][3] = 0.0f; /* gl_FragCoord is the engine's */
     bp.draw_buffer = fd->draw_buffer;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && ctx->cfg.tier == FOGVOL_TIER_FLOAT)
-        bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    else
-        bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
+    if (run->p.engine_read) bp.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    else bp.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
     bp.textures[FOGVOL__UNIT_LFRONT] = ctx->gpu.tgt_l;
     bp.uniforms[FOGVOL_U_LIGHT][3] = 1.0f;
     for (i = 0; i < ctx->cur.nlight; ++i) {
@@ -10150,14 +10192,6 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 /* >>colour groups ========================================================= */
 /* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
 
-/* A ramp in the colour group this frame: a colour ramp none of whose volumes has a density or colour
-   texture this frame (the colour group's programs draw neither: such a ramp is a group of its own,
-   drawn as without COLORS). */
-static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
-{
-    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
-}
-
 /* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
    (optical depth per channel, emission per channel). Returns 1 if every member is grey. */
 static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
@@ -10166,8 +10200,8 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
     double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
     int i, c, grey = 1;
     ps.program = ctx->gpu.prog[FOGVOL_PROGRAM_COLOR_FACE];
-    ps.uniforms[FOGVOL_U_MISC][3] = fogvol__has(ctx, FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH)) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    ps.uniforms[FOGVOL_U_MISC][3] = run->p.near_clamp;
+    if (run->p.engine_read) ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     else ps.textures[FOGVOL__UNIT_OPAQUE] = ctx->gpu.tgt_o;
     ps.target = ctx->gpu.tgt_c;
     ps.clear = 1;
@@ -10192,7 +10226,7 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
     return grey;
 }
 
-/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY), each projected once. */
+/* The window rectangle of every member's volumes, each projected once. */
 static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
 {
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
@@ -10219,7 +10253,9 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     ps.uniforms[FOGVOL_U_SCREEN][3] = -(float)fd->viewport[1];
     ps.draw_buffer = fd->draw_buffer;
     ps.alpha_coverage = fd->alpha == FOGVOL_ALPHA_COVERAGE;
-    if (fd->composite == FOGVOL_COMPOSITE_GEOMETRY) fogvol__color_rect(ctx, ps.scissor);
+    fogvol__color_rect(ctx, ps.scissor);
+    if (run->info.clip_upper_left) /* NDC y points down the window: mirror the rectangle */
+        ps.scissor[1] = 2 * fd->viewport[1] + fd->viewport[3] - ps.scissor[1] - ps.scissor[3];
     ps.program = ctx->gpu.prog[FOGVOL_PROGRAM_COLOR_COMPOSITE];
     for (step = grey ? 0 : 1; step <= (grey ? 0 : 2); ++step) {
         ps.uniforms[FOGVOL_U_RAMP][2] = (float)step;
@@ -10260,8 +10296,8 @@ static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 }
 
 /* >>end frame ============================================================= */
-/* fogvol_end_frame: the frame checked and set up, each group summed and composited in turn (or
-   checked for overflow, or drawn as a colour group), the lights, the stats. */
+/* fogvol_end_frame: the frame checked, planned and set up, each group summed and composited in turn
+   (or checked for overflow, or drawn as a colour group), the lights, the stats. */
 
 /* FOGVOL_SPEEDUP_DEPTH_TEST: this frame drawn as COUNT (see the speed-up). Beyond the near-plane
    condition of COUNT, no volume crosses the far plane either: there the min compare drops the
@@ -10281,12 +10317,51 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
     return 1;
 }
 
-/* Inside the backend frame, before any pass: sample count, targets, the engine's depth, and the
+/* The frame's plan (fogvol__plan), once its sample count is known. Adding a speed-up: its FOGVOL__F_
+   entry in the tier table, the context's switch (fogvol__choose_speedups), its field here and the one
+   pass function that follows it. */
+static void fogvol__plan_frame(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol__plan *p = &run->p;
+    const fogvol__tier_row *t = fogvol__tier(ctx->cfg.tier);
+    unsigned v = ctx->cfg.variants, off = ctx->cfg.speedups_off;
+    int enc = fogvol__tier_has(ctx->cfg.tier, v, FOGVOL__F_ENCODE), engine = (v & FOGVOL_VARIANT_ENGINE_DEPTH) != 0;
+    int one_sample = ctx->cur.samples <= 1;
+    memset(p, 0, sizeof *p);
+    p->float_sums = t->sum_format == FOGVOL_FORMAT_R32F;
+    p->single = (v & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    p->wide = (v & FOGVOL_VARIANT_WIDE) != 0;
+    p->colors = (v & FOGVOL_VARIANT_COLORS) != 0;
+    p->near_clamp = (v & FOGVOL_VARIANT_NEAR_CLAMP) ? 1.0f : 0.0f;
+    p->count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
+    p->count = (v & FOGVOL_VARIANT_COUNT) || p->count_bit;
+    p->own_o = enc && !ctx->cur.engine_occluders;
+    p->o_engine = enc && engine;
+    p->engine_read = engine && !enc;
+    p->no_opaque = p->own_o && !engine && !p->count && ctx->cur.nocc == 0 && !(off & FOGVOL_SPEEDUP_SKIP_OPAQUE);
+    p->float_o = p->float_sums || ctx->cfg.float_o;
+    p->resolve = fogvol__tier_has(ctx->cfg.tier, v, FOGVOL__F_RESOLVE) && !ctx->cfg.inline_resolve;
+    p->fetch_o = ctx->cfg.fetch_o && !p->no_opaque && !p->count && one_sample && !p->engine_read;
+    p->exact_sum = ctx->cfg.exact_sum && !p->count && one_sample;
+    p->borrow = t->borrow && !p->count && !p->wide;
+    p->skip_check = !(off & FOGVOL_SPEEDUP_SKIP_CHECK) && !p->near_clamp && !p->single;
+    p->exp_composite = !(off & FOGVOL_SPEEDUP_EXP_COMPOSITE);
+    p->fast_exp = !(off & FOGVOL_SPEEDUP_FAST_EXP);
+    p->blend_color = (ctx->be.caps & FOGVOL_CAP_BLEND_CONSTANT) &&
+                     !(off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE));
+    p->origin_bit = fogvol__origin_bit(ctx);
+    p->dither_bit = fogvol__dither_bit(ctx);
+    run->st.depth_tested = p->count;
+    run->st.inline_resolved = ctx->cfg.inline_resolve;
+}
+
+/* Inside the backend frame, before any pass: sample count, plan, targets, the engine's depth, and the
    overflow count (earlier frames' queries polled without waiting; this frame's check passes). */
 static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
+    fogvol__plan_frame(ctx, run);
     if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->cur.samples > 1) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "
                                                  "sample (use FOGVOL_MSAA_SINGLE_SAMPLE); nothing drawn",
@@ -10298,7 +10373,7 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
                                 : fogvol__ensure_targets(ctx, run->w, run->h, 0);
     if (r != FOGVOL_SUCCESS) return r;
     run->engine_depth = fd->engine_depth_texture;
-    if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
+    if ((run->p.o_engine || run->p.engine_read) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
         r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
                                fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
                                ctx->cur.samples > 1 ? ctx->cur.samples : 0, &run->engine_depth);
@@ -10309,11 +10384,11 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
         }
     }
     run->fresh = ctx->ovf.counting ? fogvol__overflow_poll(ctx) : 0;
-    run->counted = run->rgba8 && fogvol__overflow_open(ctx);
-    run->checks = run->counted || (run->rgba8 && run->single && fd->show_overflow);
+    run->counted = !run->p.float_sums && fogvol__overflow_open(ctx);
+    run->checks = run->counted || (!run->p.float_sums && run->p.single && fd->show_overflow);
     /* SINGLE's peak check runs inside the sum passes; the others make the checks when a group first
        draws one (fogvol__group_check) */
-    if (run->checks && run->single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
+    if (run->checks && run->p.single && (r = fogvol__ensure_checks(ctx)) != FOGVOL_SUCCESS) { /* drawn without */
         run->counted = run->checks = 0;
         ctx->ovf.qcur = -1;
         run->r = r;
@@ -10343,17 +10418,17 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     }
     if (!has_pos) return;
     /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
-    run->xsum = ctx->cfg.exact_sum && !run->count && ctx->cur.samples <= 1 && !density && n < 128;
+    run->xsum = run->p.exact_sum && !density && n < 128;
     run->st.groups++;
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
-    if (run->single) {
+    if (run->p.single) {
         if (run->counted) fogvol__check_pass(ctx, run, &ps, 0, &run->st); /* after the subtractions */
-    } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, n, convex)) { /* (integers cannot saturate) */
+    } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, run, n, convex)) { /* (integers cannot saturate) */
         fogvol__group_check(ctx, run, &ps);
     }
-    if (run->single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_v; /* the peak check's mask, for show_overflow */
+    if (run->p.single) ps.textures[FOGVOL__UNIT_FRONT] = ctx->gpu.tgt_v; /* the peak check's mask, for show_overflow */
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
@@ -10363,7 +10438,7 @@ static void fogvol__frame_precision(fogvol_context *ctx, fogvol__run *run)
 {
     int bits = ctx->gpu.tgt_b2 ? 2 * ctx->cfg.enc.precision_bits : ctx->cfg.enc.precision_bits, i, coarse;
     double n = ctx->cur.frame.znear, f = ctx->cur.frame.zfar, lsb = (f - n) / (double)(1L << bits), small = 0.0;
-    if (!run->rgba8 || run->st.exact_sum >= run->st.groups) return;
+    if (run->p.float_sums || run->st.exact_sum >= run->st.groups) return;
     run->st.depth_lsb = (float)lsb;
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double lo = 0.0, hi = 0.0;
@@ -10423,12 +10498,6 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     }
     run.w = ctx->cur.frame.viewport[2];
     run.h = ctx->cur.frame.viewport[3];
-    run.single = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
-    ctx->cur.count_bit = fogvol__depth_test_frame(ctx) ? (unsigned)FOGVOL_SPECIALIZE_COUNT : 0u;
-    run.count = ctx->cur.count_frame = fogvol__has(ctx, FOGVOL_VARIANT_COUNT) || ctx->cur.count_bit;
-    run.st.depth_tested = run.count;
-    run.st.inline_resolved = ctx->cfg.inline_resolve;
-    run.rgba8 = ctx->cfg.tier != FOGVOL_TIER_FLOAT;
     fogvol__link_groups(ctx);
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {

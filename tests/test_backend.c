@@ -867,7 +867,7 @@ static void pass_scene_check(pass_scene *s, int geometry)
             for (c = 0; c < 4; ++c) assert_close(r->nb.passes[i].clear_color[c], 0.0, 1e-7, "B/F clear colour");
         }
     }
-    for (i = 5; i < 9; i += 3) { /* a scissor inside the viewport (full-screen too: FOGVOL_SPEEDUP_SCISSOR) */
+    for (i = 5; i < 9; i += 3) { /* a scissor inside the viewport (full-screen too: every composite is scissored) */
         const int *sc = r->nb.passes[i].scissor;
         (void)geometry;
         assert_true(sc[2] > 0 && sc[3] > 0);

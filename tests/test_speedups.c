@@ -1,5 +1,5 @@
 /* test_speedups.c - the speed-ups fogvol turns on by default (FOGVOL_SPEEDUP_*):
-   SKIP_OPAQUE, TEXEL_FETCH, SCISSOR (composite, resolve and overflow check passes) and SPECIALIZE
+   SKIP_OPAQUE, TEXEL_FETCH and SPECIALIZE
    (programs built per configuration) and ALU (PS20 encodes by arithmetic) give the same pixels as with them off, frame after frame
    while occluders come and go (O kept from an earlier frame must be the far plane, and redrawn
    when occluders return); SKIP_OPAQUE draws one pass less from the second frame on;
@@ -294,7 +294,7 @@ static int check_ground_truth(const tscene *s, const unsigned char *px)
 static const fogvol_tier g_tiers[] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20, FOGVOL_TIER_PS13};
 static const char *const g_tier_names[] = {"FLOAT", "PS20", "PS13"};
 #define ALL_OFF \
-    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | FOGVOL_SPEEDUP_SCISSOR | \
+    (FOGVOL_SPEEDUP_SKIP_OPAQUE | FOGVOL_SPEEDUP_TEXEL_FETCH | FOGVOL_SPEEDUP_EXP_COMPOSITE | \
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
      FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O | \
      FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_EXACT_SUM)
@@ -320,7 +320,7 @@ static void test_same_pixels_and_exp(void **state)
             run_frames(s, g_tiers[ti], ALL_OFF, &g, &off);
             for (f = 0; f < NFRAMES; ++f) {
                 int m;
-                /* SKIP_OPAQUE, TEXEL_FETCH, SCISSOR, SPECIALIZE, ALU: the same bytes as with every speed-up off */
+                /* SKIP_OPAQUE, TEXEL_FETCH, SPECIALIZE, ALU: the same bytes as with every speed-up off */
                 assert_int_equal(max_diff(noexp.px[f], off.px[f], &n), 0);
                 /* ... and the same sums: the encoded bytes (PS20: the integer ALU encode against the
                    lookup textures), decoded; the exp() speed-ups change only the composite */
