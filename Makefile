@@ -130,53 +130,71 @@ TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
 GL_COMPILE = mkdir -p $(BUILD)/shaders_gl && rm -f $(BUILD)/shaders_gl/*.vert $(BUILD)/shaders_gl/*.frag && \
              $(BUILD)/dump_shaders $(BUILD)/shaders_gl > /dev/null && $(BUILD)/gl_compile $(BUILD)/shaders_gl
 
+# an entry of make test builds its own programs first: $(call built,PROGRAMS) COMMAND
+BUILT = $(MAKE) --no-print-directory -s
+built = $(BUILT) $(1) &&
+
 # name=command lines for tests/run.sh, besides the cmocka programs
 SCRIPT_RUNS = \
   "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
   $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
-  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
-  "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
+  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh examples" \
+  "examples_package=BUILD=$(BUILD) CC=$(CC) tests/examples.sh package" \
+  $(foreach c,gcc clang g++ clang++,"compile_matrix_$(c)=BUILD=$(BUILD) tests/compile_matrix.sh $(c)") \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
-  "gl_compile=$(GL_COMPILE)" \
+  "gl_compile=$(call built,$(BUILD)/gl_compile) $(GL_COMPILE)" \
   "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
   "doc_index=tests/doc_index.sh" \
-  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
-  "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
-  "bench_quick=$(BUILD)/bench --quick" \
-  "raycast_selftest=$(BUILD)/test_raycast" \
-  "raycast_selftest_asan_ubsan=$(LSAN_ENV) $(BUILD)/test_raycast_san" \
-  "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
-  "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
-  "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
-  "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
-  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
-  "fuzz_api_corpus_asan_ubsan=$(LSAN_ENV) $(BUILD)/replay_api_san tests/fuzz/corpus_api" \
-  "fuzz_api_5s=rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
+  "doc_figures=$(call built,$(BUILD)/dump_shaders) BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
+  "demo_headless=$(call built,$(BUILD)/demo_headless) $(BUILD)/demo_headless $(BUILD)/demo --check" \
+  "bench_quick=$(call built,$(BUILD)/bench) $(BUILD)/bench --quick" \
+  "egl_builds=$(BUILT) $(BUILD)/bench_egl $(BUILD)/egl/demo_headless" \
+  "raycast_selftest=$(call built,$(BUILD)/test_raycast) $(BUILD)/test_raycast" \
+  "raycast_selftest_asan_ubsan=$(call built,$(BUILD)/test_raycast_san) $(LSAN_ENV) $(BUILD)/test_raycast_san" \
+  "cpu_valgrind=$(call built,$(BUILD)/test_cpu_vg) $(TAP) FOGVOL_TEST_SUBSET=1 $(VALGRIND) $(BUILD)/test_cpu_vg" \
+  "fuzz_corpus_valgrind=$(call built,$(BUILD)/replay_mesh) $(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
+  "fuzz_mesh_5s=$(call built,$(BUILD)/fuzz_mesh) mkdir -p $(BUILD)/fuzz/mesh && \
+    $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
+  "fuzz_analytic_corpus_valgrind=$(call built,$(BUILD)/replay_analytic) $(VALGRIND) $(BUILD)/replay_analytic \
+    tests/fuzz/corpus_analytic" \
+  "fuzz_analytic_5s=$(call built,$(BUILD)/fuzz_analytic) mkdir -p $(BUILD)/fuzz/analytic && \
+    $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
+  "fuzz_api_corpus_asan_ubsan=$(call built,$(BUILD)/replay_api_san) $(LSAN_ENV) $(BUILD)/replay_api_san \
+    tests/fuzz/corpus_api" \
+  "fuzz_api_5s=$(call built,$(BUILD)/fuzz_api) rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && \
+    $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
 TEST_BINS += $(BUILD)/web/demo_web.html
-SCRIPT_RUNS += "web=BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
+SCRIPT_RUNS += "web=$(call built,$(BUILD)/web/demo_web.html) BUILD=$(BUILD) CHROMIUM=$(CHROMIUM) tests/web_test.sh"
 endif
 # the cmocka programs: plain, under ASan+UBSan (their files go to $(BUILD)/san so that the two can run
 # at once), C++
-TEST_RUNS = $(foreach t,$(TESTS),"$(t)=BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)" \
-              "$(t)_asan_ubsan=BUILD=$(BUILD)/san $(TAP) $(LSAN_ENV) $(BUILD)/test_$(t)_san") \
-            $(foreach t,$(CXX_TESTS),"$(t)_cxx=$(TAP) $(BUILD)/test_$(t)_cpp")
+# SAN_SUBSET: the programs whose sanitizer build runs a subset of their cases (FOGVOL_TEST_SUBSET=1), chosen
+# so that the same lines of fogvol.h run as with every case (gcov); their plain build runs every case
+SAN_SUBSET = tiers gles
+TEST_RUNS = $(foreach t,$(TESTS),"$(t)=$(call built,$(BUILD)/test_$(t)) BUILD=$(BUILD) $(TAP) $(BUILD)/test_$(t)" \
+              "$(t)_asan_ubsan=$(call built,$(BUILD)/test_$(t)_san) BUILD=$(BUILD)/san $(TAP) $(LSAN_ENV) \
+                $(if $(filter $(t),$(SAN_SUBSET)),FOGVOL_TEST_SUBSET=1) $(BUILD)/test_$(t)_san") \
+            $(foreach t,$(CXX_TESTS),"$(t)_cxx=$(call built,$(BUILD)/test_$(t)_cpp) $(TAP) $(BUILD)/test_$(t)_cpp")
 
 # the fast inner loop (under a minute on two cores): CPU tests (encoding, dither, textures, mesh
 # validation), the renderer on the null backend plus the GL backend smoke tests, the README's code blocks
-check: deps-test
-	@$(MAKE) --no-print-directory -j$(JOBS) $(BUILD)/test_cpu $(BUILD)/test_backend
-	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(TAP) $(BUILD)/test_backend" \
-	  "cpu=$(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" "doc_index=tests/doc_index.sh" \
-	  "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-shaders"
+# (each entry builds its program as it starts: the two compile at once, and the scripts run beside them)
+check: deps-test | $(BUILD)
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh "backend=$(call built,$(BUILD)/test_backend) $(TAP) $(BUILD)/test_backend" \
+	  "cpu=$(call built,$(BUILD)/test_cpu) $(TAP) $(BUILD)/test_cpu" "readme_blocks=BUILD=$(BUILD) tests/readme_blocks.sh" \
+	  "doc_index=tests/doc_index.sh" "doc_figures=BUILD=$(BUILD) tests/doc_figures.sh --no-shaders"
 
-# everything; the README's test command and CI
+# everything; the README's test command and CI. The objects and programs that several entries use
+# (TEST_SHARED) are built first; every entry then builds its own programs (TEST_BINS) as it starts, so
+# that compiling and testing overlap on the JOBS that tests/run.sh runs at once.
+TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/dump_shaders $(BUILD)/vulkan_backend
 test: deps-test deps-run
-	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_BINS)
-	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
+	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_SHARED)
+	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) DURATIONS=tests/durations tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
 
 # --- Vulkan ------------------------------------------------------------------------
 # examples/vulkan_backend.c: an engine on Vulkan with fogvol's backend examples/fogvol_vulkan.h (GLSL of

@@ -2,6 +2,8 @@
 # The header compiles clean (-Wall -Wextra -pedantic -Werror) as C99, C11, C++11,
 # C++17 with gcc and clang: implementation in one TU, static mode, FOGVOL_NO_GL, FOGVOL_NO_ANALYTIC,
 # and implementation in one of two TUs (linked and run).
+# Usage: tests/compile_matrix.sh [COMPILER...] (default: gcc clang g++ clang++; make test runs one
+# compiler an entry, so that they run at once)
 set -u
 out=${BUILD:-build}/compile
 mkdir -p "$out"
@@ -11,7 +13,8 @@ check() { # description, command...
   if msg=$("$@" 2>&1); then echo "ok $n - $desc"; else echo "not ok $n - $desc"; echo "$msg" | head -20 | sed 's/^/#   /'; fi
 }
 flags="-Wall -Wextra -pedantic -Werror -I."
-for cc in gcc clang g++ clang++; do
+[ $# -gt 0 ] || set -- gcc clang g++ clang++
+for cc in "$@"; do
   case $cc in *++) stds="c++11 c++17"; lang="-x c++";; *) stds="c99 c11"; lang="";; esac
   for std in $stds; do
     tag="$cc-$std"

@@ -10,8 +10,10 @@
 #    consumers build and run; pkg-config --cflags fogvol; the tests build and pass under ctest
 # Needs gcc, libglfw3-dev, libgl-dev, xvfb, xauth, libosmesa6-dev, libstb-dev, and
 # cmake + pkg-config for the packaging tests (skipped when absent).
-# Usage: BUILD=build CC=cc tests/examples.sh
+# Usage: BUILD=build CC=cc tests/examples.sh [examples|package] (one part: the examples, or the CMake
+# package and pkg-config; make test runs the two as entries of their own, at once; none: both)
 set -u
+part=${1:-all}
 cd "$(dirname "$0")/.."
 root=$(pwd)
 build=${BUILD:-build}
@@ -21,7 +23,7 @@ cc=${CC:-cc}
 mkdir -p "$out"
 n=0
 fails=0
-log=$out/last.log
+log=$out/last_$part.log
 
 ok() { n=$((n + 1)); echo "ok $n - $1"; }
 not_ok() {
@@ -45,6 +47,7 @@ png_ok() { # a PNG file of at least 10 kB
 xrun=(xvfb-run -a -s "-screen 0 1280x1024x24")
 CTEST_PROGRAMS=${CTEST_PROGRAMS:-glstate} # the cmocka programs the CMake test builds and runs
 
+if [ "$part" != package ]; then # the examples: build, run, check
 # ---- build ---------------------------------------------------------------------------
 flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
 # name, libraries: OSMesa for the headless ones (every GL call must reach OSMesa), GLFW + libGL for the windows
@@ -125,8 +128,12 @@ note '^  (begin_pass|draw_mesh|draw_fullscreen) |^  [0-9]+ |differ|violations'
 expect "custom_backend: same pixels as the default GL backend" ' 0 of [0-9]+ pixels differ'
 run "custom_backend --tier float" "$out/custom_backend" --tier float "$out/custom_backend_float.png"
 
+fi # the examples
+
 # ---- CMake package and pkg-config ------------------------------------------------------------
-if ! command -v cmake > /dev/null; then
+if [ "$part" = examples ]; then
+  : # the examples only
+elif ! command -v cmake > /dev/null; then
   skip "CMake package: install, find_package, add_subdirectory" "cmake not installed"
 else
   cm=$out/cmake
@@ -190,10 +197,11 @@ EOF
   run "cmake: add_subdirectory consumer builds and runs (examples off)" bash -c "cmake -S '$cm/consumer' \
     -B '$cm/subdir' -DFOGVOL_SOURCE_DIR='$root' && cmake --build '$cm/subdir' && '$cm/subdir/consumer'"
   # the tests through CMake: configure, build and ctest (one cmocka program, the ray-cast self-test and
-  # the shader script here; `make test` runs the whole list)
+  # a script test, the README blocks: the cheapest; `make test` runs the whole list, the shader script
+  # with the dump_shaders that this build makes too among them)
   RUN_TIMEOUT=900 run "cmake -B b && cmake --build b && ctest --test-dir b (tests: $CTEST_PROGRAMS)" bash -c "cmake -S '$root' \
     -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=ON -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
-    cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|shaders)\$' \
+    cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|readme_blocks)\$' \
     --output-on-failure"
   expect "ctest: every test passed" '100% tests passed, 0 tests failed out of [3-9]'
   if command -v pkg-config > /dev/null; then
@@ -222,6 +230,6 @@ EOF
     skip "pkg-config --cflags fogvol" "pkg-config not installed"
   fi
 fi
-rm -f "$out/last.log"
+rm -f "$log"
 echo "1..$n"
 [ "$fails" = 0 ]

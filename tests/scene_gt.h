@@ -5,6 +5,7 @@
 #define FOGVOL_TESTS_SCENE_GT_H
 
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct gt_cache {
     double *gt, *slope;
@@ -16,10 +17,12 @@ typedef struct gt_cache {
 
 static gt_cache g_gt[NSCENE];
 
-/* the scenes, then each one's ray-cast thickness, face pairs, interior and covered pixels */
+/* the scenes, then each one's ray-cast thickness, face pairs, interior and covered pixels (once: a
+   process that has them, or whose parent had them before fork, keeps them) */
 static inline void gt_setup(void)
 {
     int i;
+    if (g_gt[0].gt) return;
     build_scenes();
     for (i = 0; i < NSCENE; ++i) {
         gt_cache *t = &g_gt[i];
@@ -33,6 +36,15 @@ static inline void gt_setup(void)
     }
 }
 
+/* the cmocka group set-up of the tier tests: gt_setup (their group teardowns print their tables, then
+   call gt_teardown) */
+static inline int gt_group_setup(void **state)
+{
+    (void)state;
+    gt_setup();
+    return 0;
+}
+
 static inline void gt_teardown(void)
 {
     int i;
@@ -42,6 +54,7 @@ static inline void gt_teardown(void)
         free(g_gt[i].pairs);
         free(g_gt[i].interior);
         free(g_gt[i].covered);
+        memset(&g_gt[i], 0, sizeof g_gt[i]);
     }
     free_scenes();
 }

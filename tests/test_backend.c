@@ -1,10 +1,10 @@
 /* test_backend.c - fogvol's renderer seen through its backend table: the recording
  * null backend (no GL at all) and the GL backend under OSMesa.
  *
- * Part A - null backend (every expectation below is worked out by hand from the
+ * The null backend (every expectation below is worked out by hand from the
  * PS20 pass sequence of the seed, not read back from the code; the contexts ask for
  * FOGVOL_TIER_PS20 explicitly, since AUTO picks a tier from the backend's caps):
- *   A1 pass structure of one frame: occluders and volumes of two colour ramps, one
+ *   The passes of one frame (test_passes_of_a_frame_*): occluders and volumes of two colour ramps, one
  *      group with a negative volume. Pass 0 = O (depth test+write, clear (N-1)/255
  *      RGB / 0 alpha, encode program, lookup textures on units 0..2), then per ramp
  *      group in order of first appearance: B (ADD, cull FRONT, clear), [B without
@@ -14,14 +14,14 @@
  *      Draw lists per pass, frame stats, viewports, fv_screen, fv_enc, fv_dith,
  *      fv_dec, fv_rampmap, per-draw depth rows (d = (w - near)/(far - near) at hand
  *      computed points), clip w, mirror winding (front_cw).
- *   A2 a ramp group with only negative volumes renders nothing and counts nothing.
- *   A3 frame protocol: add_* outside a frame, begin_frame twice, end_frame without
+ *   A ramp group with only negative volumes renders nothing and counts nothing.
+ *   The order of calls in a frame: add_* outside a frame, begin_frame twice, end_frame without
  *      begin, cancel_frame, fogvol_occluder_transform outside/inside the O pass.
- *   A4 bad input: the documented code, an error in the logger, no crash.
- *   A5 fault injection: n-th backend create failing, k-th allocation failing
+ *   Bad input: the documented code, an error in the logger, no crash.
+ *   Fault injection: n-th backend create failing, k-th allocation failing
  *      (context, mesh, ramp, frame lists), target creation failing in end_frame.
- * Part B - GL backend under OSMesa:
- *   B6 every required entry point missing in turn, the sets taken from the header's
+ * The GL backend under OSMesa (test_gl_*):
+ *   Every required entry point missing in turn, the sets taken from the header's
  *      own X-macro lists (3.3 core: BASE, FBO, VAO, SAMPLER, GL_3 when the header has
  *      it, DESKTOP; GL 2.1 override in the compatibility context, whose extension
  *      string has ARB_framebuffer_object: BASE, FBO, DESKTOP) ->
@@ -29,11 +29,11 @@
  *      object left (Gen/Delete and Create/Delete counted through the loader); the
  *      VAO, sampler, GL 3 and ES entries missing do not matter on GL 2.1 (the
  *      context renders); a loader that finds nothing -> glGetString named.
- *   B7 GLSL dialect from the context version and the overrides (through
+ *   The GLSL dialect from the context version and the overrides (through
  *      fogvol_gl_backend_create); GLSL ES 1.00 in the core context and the 2.1
  *      override compile (every program's first line checked) and render a sphere
  *      whose centre thickness is the analytic chord within 1%.
- *   B8 a fragment shader that fails to compile -> FOGVOL_ERROR_SHADER_COMPILE with
+ *   A fragment shader that fails to compile -> FOGVOL_ERROR_SHADER_COMPILE with
  *      the driver's info log in the logger, no leak, backend still usable.
  *   plus allocation failures during GL context creation (no memory, no GL object left).
  *
@@ -206,7 +206,7 @@ static fogvol_result make_ramp(fogvol_context *fv, fogvol_blend blend, fogvol_ra
     return fogvol_create_ramp(fv, &rd, out);
 }
 
-/* ==== Part A: recording wrapper around the null backend ================ */
+/* ==== the null backend, behind a recording wrapper ===================== */
 
 #define REC_MAX_DRAWS 256
 #define REC_MAX_RES 64
@@ -271,140 +271,137 @@ static int program_kind(const fogvol_program_desc *d, fogvol_dialect dialect)
     return found;
 }
 
-static fogvol_result rec_begin_frame(void *u, fogvol_frame_info *info)
+/* What the recording wrapper checks (the call order fogvol must keep: counted in protocol_errors) and
+   records before it forwards a call, and what it records of a call that succeeded. */
+static void rec_frame_begun(rec *r)
 {
-    rec *r = (rec *)u;
     if (r->in_frame) r->protocol_errors++;
     r->in_frame = 1;
     r->ndraws = r->nset = 0;
     r->begin_pass_calls = r->end_pass_calls = 0;
-    return r->inner.begin_frame(r->inner.user_data, info);
 }
-static void rec_end_frame(void *u)
+static void rec_frame_ended(rec *r)
 {
-    rec *r = (rec *)u;
     if (!r->in_frame || r->nb.in_pass) r->protocol_errors++;
     r->in_frame = 0;
-    r->inner.end_frame(r->inner.user_data);
 }
-static fogvol_result rec_create_texture(void *u, const fogvol_texture_desc *d, fogvol_handle *out)
+static void rec_pass_begun(rec *r)
 {
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_texture(r->inner.user_data, d, out);
-    if (res == FOGVOL_SUCCESS && r->ntex < REC_MAX_RES) {
-        r->tex[r->ntex].h = *out;
-        r->tex[r->ntex].w = d->width;
-        r->tex[r->ntex].hgt = d->height;
-        r->tex[r->ntex].filter = d->filter;
-        r->tex[r->ntex].wrap = d->wrap;
-        r->ntex++;
-    }
-    return res;
-}
-static void rec_destroy_texture(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++; /* fogvol never hands back a handle it did not get */
-    r->inner.destroy_texture(r->inner.user_data, h);
-}
-static fogvol_result rec_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_target(r->inner.user_data, d, out);
-    if (res == FOGVOL_SUCCESS && r->ntgt < REC_MAX_RES) {
-        r->tgt[r->ntgt].h = *out;
-        r->tgt[r->ntgt].w = d->width;
-        r->tgt[r->ntgt].hgt = d->height;
-        r->tgt[r->ntgt].depth = d->depth;
-        r->ntgt++;
-    }
-    return res;
-}
-static void rec_destroy_target(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_target(r->inner.user_data, h);
-}
-static fogvol_result rec_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    fogvol_result res = r->inner.create_program(r->inner.user_data, d, out);
-    fogvol_uniform_layout want;
-    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
-    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
-    if (res == FOGVOL_SUCCESS && r->nprog < REC_MAX_RES) {
-        r->prog[r->nprog].h = *out;
-        r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
-        r->nprog++;
-    }
-    return res;
-}
-static void rec_destroy_program(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_program(r->inner.user_data, h);
-}
-static fogvol_result rec_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
-{
-    rec *r = (rec *)u;
-    return r->inner.create_mesh(r->inner.user_data, d, out);
-}
-static void rec_destroy_mesh(void *u, fogvol_handle h)
-{
-    rec *r = (rec *)u;
-    if (!h) r->protocol_errors++;
-    r->inner.destroy_mesh(r->inner.user_data, h);
-}
-static void rec_begin_pass(void *u, const fogvol_pass *p)
-{
-    rec *r = (rec *)u;
     if (!r->in_frame || r->nb.in_pass) r->protocol_errors++;
     r->begin_pass_calls++;
-    r->inner.begin_pass(r->inner.user_data, p);
 }
-static void rec_set_draw(void *u, const fogvol_draw *d)
+static void rec_pass_ended(rec *r)
 {
-    rec *r = (rec *)u;
     if (!r->nb.in_pass) r->protocol_errors++;
+    r->end_pass_calls++;
+}
+static void rec_in_pass(rec *r)
+{
+    if (!r->nb.in_pass) r->protocol_errors++;
+}
+static void rec_handle_given(rec *r, fogvol_handle h)
+{
+    if (!h) r->protocol_errors++; /* fogvol never hands back a handle it did not get */
+}
+static void rec_set_draw_call(rec *r, const fogvol_draw *d)
+{
+    rec_in_pass(r);
     if (r->nset < 16) {
         r->set_draws[r->nset] = *d;
         r->set_draw_pass[r->nset] = r->nb.pass_count - 1;
         r->nset++;
     }
-    r->inner.set_draw(r->inner.user_data, d);
 }
-static void rec_draw_mesh(void *u, fogvol_handle m, const fogvol_draw *d)
+static void rec_draw_call(rec *r, fogvol_handle m, const fogvol_draw *d)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
+    rec_in_pass(r);
     if (r->ndraws < REC_MAX_DRAWS) {
         r->draws[r->ndraws].pass = r->nb.pass_count - 1;
         r->draws[r->ndraws].mesh = m;
         r->draws[r->ndraws].d = *d;
         r->ndraws++;
     }
-    r->inner.draw_mesh(r->inner.user_data, m, d);
 }
-static void rec_draw_fullscreen(void *u)
+static void rec_layout_given(rec *r, const fogvol_program_desc *d)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
-    r->inner.draw_fullscreen(r->inner.user_data);
+    fogvol_uniform_layout want;
+    (void)fogvol_dialect_layout(r->table.dialect, &want); /* Vulkan: where the values are; GL: all -1 */
+    if (memcmp(&d->layout, &want, sizeof want) != 0) r->protocol_errors++;
 }
-static void rec_end_pass(void *u)
+static void rec_texture_made(rec *r, const fogvol_texture_desc *d, fogvol_handle h)
 {
-    rec *r = (rec *)u;
-    if (!r->nb.in_pass) r->protocol_errors++;
-    r->end_pass_calls++;
-    r->inner.end_pass(r->inner.user_data);
+    if (r->ntex >= REC_MAX_RES) return;
+    r->tex[r->ntex].h = h;
+    r->tex[r->ntex].w = d->width;
+    r->tex[r->ntex].hgt = d->height;
+    r->tex[r->ntex].filter = d->filter;
+    r->tex[r->ntex].wrap = d->wrap;
+    r->ntex++;
 }
-static fogvol_result rec_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
+static void rec_target_made(rec *r, const fogvol_target_desc *d, fogvol_handle h)
 {
-    rec *r = (rec *)u;
-    return r->inner.read_target(r->inner.user_data, t, rgba, size);
+    if (r->ntgt >= REC_MAX_RES) return;
+    r->tgt[r->ntgt].h = h;
+    r->tgt[r->ntgt].w = d->width;
+    r->tgt[r->ntgt].hgt = d->height;
+    r->tgt[r->ntgt].depth = d->depth;
+    r->ntgt++;
 }
+static void rec_program_made(rec *r, const fogvol_program_desc *d, fogvol_handle h)
+{
+    if (r->nprog >= REC_MAX_RES) return;
+    r->prog[r->nprog].h = h;
+    r->prog[r->nprog].kind = program_kind(d, r->table.dialect);
+    r->nprog++;
+}
+
+/* The wrapper, one line a backend entry: RESULT(entry, parameters, the arguments forwarded (REC_U: the
+   null backend's user_data), before: checked and recorded before forwarding, after: recorded when
+   the call succeeded) for the entries that return a fogvol_result, VOID(entry, parameters, arguments,
+   before) for the others. REC_NONE: nothing. */
+#define REC_CALLS(RESULT, VOID)                                                                                      \
+    RESULT(begin_frame, (void *u, fogvol_frame_info *info), (REC_U, info), rec_frame_begun(r), REC_NONE)             \
+    VOID(end_frame, (void *u), (REC_U), rec_frame_ended(r))                                                          \
+    RESULT(create_texture, (void *u, const fogvol_texture_desc *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,   \
+           rec_texture_made(r, d, *out))                                                                             \
+    VOID(destroy_texture, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                            \
+    RESULT(create_target, (void *u, const fogvol_target_desc *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,     \
+           rec_target_made(r, d, *out))                                                                              \
+    VOID(destroy_target, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                             \
+    RESULT(create_program, (void *u, const fogvol_program_desc *d, fogvol_handle *out), (REC_U, d, out),             \
+           rec_layout_given(r, d), rec_program_made(r, d, *out))                                                     \
+    VOID(destroy_program, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                            \
+    RESULT(create_mesh, (void *u, const fogvol_mesh_data *d, fogvol_handle *out), (REC_U, d, out), REC_NONE,         \
+           REC_NONE)                                                                                                 \
+    VOID(destroy_mesh, (void *u, fogvol_handle h), (REC_U, h), rec_handle_given(r, h))                               \
+    VOID(begin_pass, (void *u, const fogvol_pass *p), (REC_U, p), rec_pass_begun(r))                                 \
+    VOID(set_draw, (void *u, const fogvol_draw *d), (REC_U, d), rec_set_draw_call(r, d))                             \
+    VOID(draw_mesh, (void *u, fogvol_handle m, const fogvol_draw *d), (REC_U, m, d), rec_draw_call(r, m, d))         \
+    VOID(draw_fullscreen, (void *u), (REC_U), rec_in_pass(r))                                                        \
+    VOID(end_pass, (void *u), (REC_U), rec_pass_ended(r))                                                            \
+    RESULT(read_target, (void *u, fogvol_handle t, unsigned char *rgba, size_t size), (REC_U, t, rgba, size),        \
+           REC_NONE, REC_NONE)
+
+#define REC_U r->inner.user_data
+#define REC_NONE (void)0
+#define REC_RESULT_FN(entry, params, args, before, after)                                                            \
+    static fogvol_result rec_##entry params                                                                          \
+    {                                                                                                                \
+        rec *r = (rec *)u;                                                                                           \
+        fogvol_result res;                                                                                           \
+        before;                                                                                                      \
+        res = r->inner.entry args;                                                                                   \
+        if (res == FOGVOL_SUCCESS) after;                                                                            \
+        return res;                                                                                                  \
+    }
+#define REC_VOID_FN(entry, params, args, before)                                                                     \
+    static void rec_##entry params                                                                                   \
+    {                                                                                                                \
+        rec *r = (rec *)u;                                                                                           \
+        before;                                                                                                      \
+        r->inner.entry args;                                                                                         \
+    }
+REC_CALLS(REC_RESULT_FN, REC_VOID_FN)
 
 static void rec_init(rec *r)
 {
@@ -412,22 +409,11 @@ static void rec_init(rec *r)
     fogvol_null_backend_init(&r->nb, &r->inner);
     r->table = r->inner;
     r->table.user_data = r;
-    r->table.begin_frame = rec_begin_frame;
-    r->table.end_frame = rec_end_frame;
-    r->table.create_texture = rec_create_texture;
-    r->table.destroy_texture = rec_destroy_texture;
-    r->table.create_target = rec_create_target;
-    r->table.destroy_target = rec_destroy_target;
-    r->table.create_program = rec_create_program;
-    r->table.destroy_program = rec_destroy_program;
-    r->table.create_mesh = rec_create_mesh;
-    r->table.destroy_mesh = rec_destroy_mesh;
-    r->table.begin_pass = rec_begin_pass;
-    r->table.set_draw = rec_set_draw;
-    r->table.draw_mesh = rec_draw_mesh;
-    r->table.draw_fullscreen = rec_draw_fullscreen;
-    r->table.end_pass = rec_end_pass;
-    r->table.read_target = rec_read_target;
+#define REC_INSTALL_RESULT(entry, params, args, before, after) r->table.entry = rec_##entry;
+#define REC_INSTALL_VOID(entry, params, args, before) r->table.entry = rec_##entry;
+    REC_CALLS(REC_INSTALL_RESULT, REC_INSTALL_VOID)
+#undef REC_INSTALL_RESULT
+#undef REC_INSTALL_VOID
 }
 
 static fogvol_handle rec_program(const rec *r, int kind)
@@ -473,7 +459,7 @@ static fogvol_context *rec_context(rec *r, logcap *lc, counting *cnt)
     return fv;
 }
 
-/* The camera of part A, worked out by hand: eye at (5,0,0) looking down -x, up +y.
+/* The camera of the null-backend tests, worked out by hand: eye at (5,0,0) looking down -x, up +y.
    View rows: x_v = -z, y_v = y, z_v = x - 5, so the view depth is w = 5 - x (world).
    near 0.5, far 10.5: d = (w - 0.5) / 10. Viewport at (10, 20), 64 x 48. */
 #define A_W 64
@@ -629,9 +615,9 @@ static void check_depth_row(const fogvol_draw *d, const double p[3], double w, c
     if (fabs(got - w) > 1e-5) fail_msg("%s: clip w at (%g,%g,%g) = %.7f, want %g", what, p[0], p[1], p[2], got, w);
 }
 
-/* ---- A1: the pass structure of one frame ---- */
+/* ---- the passes of one frame ---- */
 
-typedef struct a1_scene {
+typedef struct pass_scene {
     rec r;
     logcap lc;
     fogvol_context *fv;
@@ -639,7 +625,7 @@ typedef struct a1_scene {
     fogvol_mesh *vol[5], *occ[2];
     fogvol_ramp *fog, *light;
     float vmodel[5][16], omodel[2][16];
-} a1_scene;
+} pass_scene;
 
 /* Volumes in submission order:
      V0 light +  T(1,2,-3) S(2)     (its depth row is checked at hand-computed points)
@@ -648,7 +634,7 @@ typedef struct a1_scene {
      V3 light +  T(0,1,0) S(-1,1,1) (mirror: front_cw = 1)
      V4 fog   +  T(0,-1,0)
    Occluders: O0 open plane T(0,0,-2), O1 box T(-2,0,0). */
-static void a1_build(a1_scene *s)
+static void pass_scene_build(pass_scene *s)
 {
     int i;
     memset(s, 0, sizeof *s);
@@ -670,7 +656,7 @@ static void a1_build(a1_scene *s)
     mat_ts(s->omodel[1], -2, 0, 0, 1, 1, 1);
 }
 
-static void a1_submit(a1_scene *s, fogvol_composite comp, fogvol_frame_stats *st)
+static void pass_scene_submit(pass_scene *s, fogvol_composite comp, fogvol_frame_stats *st)
 {
     static const int ramp_of[5] = {1, 0, 1, 1, 0}; /* 1 = light */
     static const int neg[5] = {0, 0, 1, 0, 0};
@@ -692,7 +678,7 @@ static void a1_submit(a1_scene *s, fogvol_composite comp, fogvol_frame_stats *st
     assert_int_equal(fogvol_end_frame(s->fv, st), FOGVOL_SUCCESS);
 }
 
-static void a1_free(a1_scene *s)
+static void pass_scene_free(pass_scene *s)
 {
     int i;
     for (i = 0; i < 5; ++i) fogvol_destroy_mesh(s->fv, s->vol[i]);
@@ -738,7 +724,7 @@ static fogvol_handle mh(const fogvol_mesh *m)
     return 0;
 }
 
-static void a1_check(a1_scene *s, int geometry)
+static void pass_scene_check(pass_scene *s, int geometry)
 {
     rec *r = &s->r;
     fogvol_frame_stats st;
@@ -765,7 +751,7 @@ static void a1_check(a1_scene *s, int geometry)
     }
 
     log_reset(&s->lc);
-    a1_submit(s, geometry ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN, &st);
+    pass_scene_submit(s, geometry ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN, &st);
     assert_int_equal(s->lc.errors + s->lc.warnings, 0);
     assert_int_equal(r->protocol_errors, 0);
 
@@ -933,13 +919,13 @@ static void a1_check(a1_scene *s, int geometry)
     }
 }
 
-static void test_a1_pass_structure_fullscreen(void **state)
+static void test_passes_of_a_frame_fullscreen(void **state)
 {
-    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
+    pass_scene *s = (pass_scene *)calloc(1, sizeof *s);
     (void)state;
-    a1_build(s);
-    a1_check(s, 0);
-    a1_free(s);
+    pass_scene_build(s);
+    pass_scene_check(s, 0);
+    pass_scene_free(s);
     free(s);
 }
 
@@ -993,9 +979,9 @@ static void box_scene_close(box_scene *b)
 
 /* FOGVOL_SPEEDUP_DEPTH_TEST takes a frame only where the face count holds: occluders drawn by fogvol,
    and every volume's box wholly between the planes or wholly outside them, on PS20 and PS13 (FLOAT
-   keeps the min compare). The camera of part A (w = 5 - x, near 0.5, far 10.5) and a box of
+   keeps the min compare). The camera of the null-backend tests (w = 5 - x, near 0.5, far 10.5) and a box of
    half-size 0.5 at x = tx: w from 4.5 - tx to 5.5 - tx. */
-static void test_a1_depth_test_frames(void **state)
+static void test_depth_test_only_where_count_holds(void **state)
 {
     static const struct {
         float tx;
@@ -1042,7 +1028,7 @@ static void test_a1_depth_test_frames(void **state)
 /* A backend of the Vulkan dialect (the recording backend says FOGVOL_GLSL_VULKAN): every tier builds its
    programs from Vulkan strings and hands each one the dialect's layout (fogvol_program_desc.layout),
    and a frame with an occluder, a volume and the overflow check runs through the same passes. */
-static void test_a1_vulkan_dialect(void **state)
+static void test_vulkan_dialect_programs_and_passes(void **state)
 {
     static const fogvol_tier tiers[4] = {FOGVOL_TIER_PS13, FOGVOL_TIER_PS20, FOGVOL_TIER_MRT, FOGVOL_TIER_FLOAT};
     int t;
@@ -1089,49 +1075,49 @@ static void test_a1_vulkan_dialect(void **state)
 }
 
 /* The same frame drawn with the min compare (FOGVOL_SPEEDUP_DEPTH_TEST off): the faces read O. */
-static void test_a1_pass_structure_min_compare(void **state)
+static void test_passes_of_a_frame_min_compare(void **state)
 {
-    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
+    pass_scene *s = (pass_scene *)calloc(1, sizeof *s);
     (void)state;
     g_rec_speedups_off = FOGVOL_SPEEDUP_DEPTH_TEST;
-    a1_build(s);
-    a1_check(s, 0);
-    a1_free(s);
+    pass_scene_build(s);
+    pass_scene_check(s, 0);
+    pass_scene_free(s);
     free(s);
     g_rec_speedups_off = 0;
 }
 
-static void test_a1_pass_structure_geometry(void **state)
+static void test_passes_of_a_frame_geometry(void **state)
 {
-    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
+    pass_scene *s = (pass_scene *)calloc(1, sizeof *s);
     (void)state;
-    a1_build(s);
-    a1_check(s, 1);
-    a1_free(s);
+    pass_scene_build(s);
+    pass_scene_check(s, 1);
+    pass_scene_free(s);
     free(s);
 }
 
 /* A geometry composite: no warning, the full-screen triangle under a scissor. */
-static void test_a1_geometry_without_stencil(void **state)
+static void test_geometry_composite_under_scissor(void **state)
 {
-    a1_scene *s = (a1_scene *)calloc(1, sizeof *s);
+    pass_scene *s = (pass_scene *)calloc(1, sizeof *s);
     fogvol_frame_stats st;
     (void)state;
-    a1_build(s);
+    pass_scene_build(s);
     log_reset(&s->lc);
-    a1_submit(s, FOGVOL_COMPOSITE_GEOMETRY, &st);
+    pass_scene_submit(s, FOGVOL_COMPOSITE_GEOMETRY, &st);
     assert_int_equal(st.passes, 9);
     assert_int_equal(s->lc.warnings, 0);
     assert_true(s->r.nb.passes[5].scissor[2] > 0);
     assert_int_equal(s->r.nb.fullscreen[5], 1);
     assert_int_equal(s->r.nb.draws[5], 0);
     assert_int_equal(s->r.nb.fullscreen[8], 1);
-    a1_free(s);
+    pass_scene_free(s);
     free(s);
 }
 
-/* ---- A2: a group of negative volumes only ---- */
-static void test_a2_negative_only_group(void **state)
+/* ---- a group of negative volumes only ---- */
+static void test_negative_only_group_draws_nothing(void **state)
 {
     rec r;
     logcap lc;
@@ -1208,7 +1194,7 @@ static void test_a2_negative_only_group(void **state)
                  volumes1, volumes2);
 }
 
-/* ---- A3: frame protocol ---- */
+/* ---- the order of calls in a frame ---- */
 typedef struct occ_cb {
     rec *r;
     int calls, pass_count_at_call, in_pass_at_call;
@@ -1233,7 +1219,7 @@ static void occluder_callback(fogvol_context *ctx, void *user)
     c->nan_result = fogvol_occluder_transform(ctx, bad);
 }
 
-static void test_a3_frame_protocol(void **state)
+static void test_frame_call_order(void **state)
 {
     rec r;
     logcap lc;
@@ -1347,19 +1333,19 @@ static void test_a3_frame_protocol(void **state)
     shp_free(&box);
 }
 
-/* ---- A4: bad input ---- */
+/* ---- bad input ---- */
 #define EXPECT_LOGGED(call, code)                                                                        \
-    do {                                                                                                 \
-        fogvol_result res_;                                                                              \
-        log_reset(&lc);                                                                                  \
-        res_ = (call);                                                                                   \
+    do {                                                                                                             \
+        fogvol_result res_;                                                                                          \
+        log_reset(&lc);                                                                                              \
+        res_ = (call);                                                                                               \
         if (res_ != (code)) fail_msg("%s returned %d (%s), want %d", #call, (int)res_, fogvol_result_string(res_), (int)(code)); \
-        if (!log_error_has(&lc, NULL)) fail_msg("%s: no error message was logged", #call);             \
+        if (!log_error_has(&lc, NULL)) fail_msg("%s: no error message was logged", #call);                           \
     } while (0)
 
 /* A mesh or ramp destroyed inside a frame drops only what uses it: the rest of
    the frame renders (a streamed-out asset must not kill the fog). */
-static void test_a3_destroy_inside_frame(void **state)
+static void test_destroy_inside_frame_drops_its_users(void **state)
 {
     rec r;
     logcap lc;
@@ -1436,7 +1422,7 @@ static void test_a3_destroy_inside_frame(void **state)
 }
 
 /* Encoding settings that cannot sum correctly are refused; WIDE's default is its exact setting. */
-static void test_a4_encoding_combinations(void **state)
+static void test_encoding_refuses_inexact_sums(void **state)
 {
     rec r;
     logcap lc;
@@ -1524,7 +1510,7 @@ static void tier_choice(rec *r, fogvol_dialect dialect, unsigned caps, unsigned 
     assert_int_equal(r->nb.creates, r->nb.destroys);
 }
 
-static void test_a4_tier_choice(void **state)
+static void test_tier_choice_required_and_preferred(void **state)
 {
     const unsigned ed = FOGVOL_VARIANT_ENGINE_DEPTH, st = FOGVOL_VARIANT_SINGLE_TARGET;
     const unsigned hp = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_DEPTH_TEXTURE, fl = hp | FOGVOL_CAP_FLOAT_BLEND;
@@ -1549,7 +1535,7 @@ static void test_a4_tier_choice(void **state)
                 0, &lc);
 }
 
-static void test_a4_bad_input(void **state)
+static void test_bad_input_code_and_log(void **state)
 {
     rec r;
     logcap lc;
@@ -1826,7 +1812,7 @@ static void transposed(float out[16], const float m[16])
    view-projection whose transpose is the camera that was meant. A volume or light model matrix
    that is singular (all zero, a zero scale) has no volume: refused; an occluder flattened to a
    plane still hides, an all-zero one does not. */
-static void test_a4_transposed_and_degenerate(void **state)
+static void test_transposed_and_singular_matrices(void **state)
 {
     rec r;
     logcap lc;
@@ -1955,7 +1941,7 @@ static int log_warning_has(const logcap *c, const char *needle)
    pixels), and nothing said so. Now: fogvol_frame_stats.depth_lsb is the step (hand-computed:
    (far - near) / 2^(3L)) and a warning is logged when it is coarser than 1/16 of the depth extent
    of the frame's smallest volume, once until a frame is fine again. */
-static void test_a4_coarse_lsb(void **state)
+static void test_coarse_depth_lsb_warned(void **state)
 {
     rec r;
     logcap lc;
@@ -2014,12 +2000,12 @@ static void test_a4_coarse_lsb(void **state)
     shp_free(&b);
 }
 
-/* ---- A5: fault injection ---- */
+/* ---- fault injection ---- */
 
 /* n-th backend create call failing during context creation: PS20 encodes by arithmetic by default
    (FOGVOL_SPEEDUP_ALU): 1 lookup texture (dither index) and 3 programs (encode, face, composite) = 4
    creates, so n = 1..4 fail and n = 5 succeeds. */
-static void test_a5_backend_create_faults(void **state)
+static void test_backend_create_faults(void **state)
 {
     int n;
     (void)state;
@@ -2060,7 +2046,7 @@ static void test_a5_backend_create_faults(void **state)
 }
 
 /* k-th allocation failing in context creation, for every k until creation succeeds. */
-static void test_a5_alloc_faults_context(void **state)
+static void test_alloc_faults_context(void **state)
 {
     long k;
     (void)state;
@@ -2101,7 +2087,7 @@ static void test_a5_alloc_faults_context(void **state)
 
 /* k-th allocation failing in mesh creation (validation scratch, the mesh, and the
    repacked positions when stride != 12) and in ramp creation (pixels, the ramp). */
-static void test_a5_alloc_faults_mesh_ramp(void **state)
+static void test_alloc_faults_mesh_ramp(void **state)
 {
     rec r;
     logcap lc;
@@ -2218,7 +2204,7 @@ static void test_a5_alloc_faults_mesh_ramp(void **state)
 }
 
 /* The first end_frame creates the three targets; each of them failing in turn. */
-static void test_a5_target_faults(void **state)
+static void test_target_create_faults(void **state)
 {
     int which;
     (void)state;
@@ -2297,7 +2283,7 @@ static void test_a5_target_faults(void **state)
     }
 }
 
-/* ==== Part B: the GL backend under OSMesa ================================ */
+/* ==== the GL backend under OSMesa ======================================== */
 
 #define G_W 64
 #define G_H 64
@@ -2308,19 +2294,32 @@ static const char *const g_obj_name[OBJ_KINDS] = {"textures", "buffers", "frameb
                                                   "vertex arrays", "shaders", "programs"};
 #define OBJ_MAX 1024
 
+/* The GL objects fogvol makes, one line a kind: GEN(kind, Name) for glGen<Name> / glDelete<Name>,
+   CREATE(kind, Name, parameters, arguments) for glCreate<Name> / glDelete<Name>. The loader hands fogvol
+   a wrapper of each that records the names made and deleted and forwards the call. */
+#define OBJ_CALLS(GEN, CREATE)                                                                                       \
+    GEN(OBJ_TEX, Textures)                                                                                           \
+    GEN(OBJ_BUF, Buffers)                                                                                            \
+    GEN(OBJ_FBO, Framebuffers)                                                                                       \
+    GEN(OBJ_RBO, Renderbuffers)                                                                                      \
+    GEN(OBJ_VAO, VertexArrays)                                                                                       \
+    CREATE(OBJ_SHADER, Shader, (GLenum type), (type))                                                                \
+    CREATE(OBJ_PROGRAM, Program, (void), ())
+
 typedef void (*gen_fn)(GLsizei, GLuint *);
 typedef void (*del_fn)(GLsizei, const GLuint *);
-typedef GLuint (*create_shader_fn)(GLenum);
-typedef GLuint (*create_program_fn)(void);
 typedef void (*delete_one_fn)(GLuint);
-
+#define OBJ_NONE(...)
+#define OBJ_CREATE_TYPEDEF(kind, Name, params, args) typedef GLuint(*create_##Name##_fn) params;
+OBJ_CALLS(OBJ_NONE, OBJ_CREATE_TYPEDEF)
+#define OBJ_GEN_FIELDS(kind, Name)                                                                                   \
+    gen_fn gen_##Name;                                                                                               \
+    del_fn delete_##Name;
+#define OBJ_CREATE_FIELDS(kind, Name, params, args)                                                                  \
+    create_##Name##_fn create_##Name;                                                                                \
+    delete_one_fn delete_##Name;
 static struct {
-    gen_fn gen[5];
-    del_fn del[5];
-    create_shader_fn create_shader;
-    delete_one_fn delete_shader;
-    create_program_fn create_program;
-    delete_one_fn delete_program;
+    OBJ_CALLS(OBJ_GEN_FIELDS, OBJ_CREATE_FIELDS)
     GLuint live[OBJ_KINDS][OBJ_MAX];
     int nlive[OBJ_KINDS];
     int bad_deletes;
@@ -2343,67 +2342,50 @@ static void obj_del(int kind, GLuint id)
     g_obj.bad_deletes++; /* deleting a name fogvol did not create (or twice) */
 }
 
-#define OBJ_WRAP(kind, Name)                                                    \
-    static void w_Gen##Name(GLsizei n, GLuint *ids)                             \
-    {                                                                           \
-        GLsizei i;                                                              \
-        g_obj.gen[kind](n, ids);                                                \
-        for (i = 0; i < n; ++i) obj_add(kind, ids[i]);                          \
-    }                                                                           \
-    static void w_Delete##Name(GLsizei n, const GLuint *ids)                    \
-    {                                                                           \
-        GLsizei i;                                                              \
-        for (i = 0; i < n; ++i) obj_del(kind, ids[i]);                          \
-        g_obj.del[kind](n, ids);                                                \
+#define OBJ_GEN_WRAP(kind, Name)                                                                                     \
+    static void w_Gen##Name(GLsizei n, GLuint *ids)                                                                  \
+    {                                                                                                                \
+        GLsizei i;                                                                                                   \
+        g_obj.gen_##Name(n, ids);                                                                                    \
+        for (i = 0; i < n; ++i) obj_add(kind, ids[i]);                                                               \
+    }                                                                                                                \
+    static void w_Delete##Name(GLsizei n, const GLuint *ids)                                                         \
+    {                                                                                                                \
+        GLsizei i;                                                                                                   \
+        for (i = 0; i < n; ++i) obj_del(kind, ids[i]);                                                               \
+        g_obj.delete_##Name(n, ids);                                                                                 \
     }
-OBJ_WRAP(OBJ_TEX, Textures)
-OBJ_WRAP(OBJ_BUF, Buffers)
-OBJ_WRAP(OBJ_FBO, Framebuffers)
-OBJ_WRAP(OBJ_RBO, Renderbuffers)
-OBJ_WRAP(OBJ_VAO, VertexArrays)
-static GLuint w_CreateShader(GLenum type)
-{
-    GLuint id = g_obj.create_shader(type);
-    obj_add(OBJ_SHADER, id);
-    return id;
-}
-static void w_DeleteShader(GLuint id)
-{
-    obj_del(OBJ_SHADER, id);
-    g_obj.delete_shader(id);
-}
-static GLuint w_CreateProgram(void)
-{
-    GLuint id = g_obj.create_program();
-    obj_add(OBJ_PROGRAM, id);
-    return id;
-}
-static void w_DeleteProgram(GLuint id)
-{
-    obj_del(OBJ_PROGRAM, id);
-    g_obj.delete_program(id);
-}
+#define OBJ_CREATE_WRAP(kind, Name, params, args)                                                                    \
+    static GLuint w_Create##Name params                                                                              \
+    {                                                                                                                \
+        GLuint id = g_obj.create_##Name args;                                                                        \
+        obj_add(kind, id);                                                                                           \
+        return id;                                                                                                   \
+    }                                                                                                                \
+    static void w_Delete##Name(GLuint id)                                                                            \
+    {                                                                                                                \
+        obj_del(kind, id);                                                                                           \
+        g_obj.delete_##Name(id);                                                                                     \
+    }
+OBJ_CALLS(OBJ_GEN_WRAP, OBJ_CREATE_WRAP)
 
+/* the driver's functions behind the wrappers */
 static void obj_init(void)
 {
-    static const char *const gens[5] = {"glGenTextures", "glGenBuffers", "glGenFramebuffers", "glGenRenderbuffers",
-                                        "glGenVertexArrays"};
-    static const char *const dels[5] = {"glDeleteTextures", "glDeleteBuffers", "glDeleteFramebuffers",
-                                        "glDeleteRenderbuffers", "glDeleteVertexArrays"};
-    int i;
     memset(&g_obj, 0, sizeof g_obj);
-    for (i = 0; i < 5; ++i) {
-        g_obj.gen[i] = (gen_fn)glu_proc(gens[i], NULL);
-        g_obj.del[i] = (del_fn)glu_proc(dels[i], NULL);
-        assert_non_null(g_obj.gen[i]);
-        assert_non_null(g_obj.del[i]);
-    }
-    g_obj.create_shader = (create_shader_fn)glu_proc("glCreateShader", NULL);
-    g_obj.delete_shader = (delete_one_fn)glu_proc("glDeleteShader", NULL);
-    g_obj.create_program = (create_program_fn)glu_proc("glCreateProgram", NULL);
-    g_obj.delete_program = (delete_one_fn)glu_proc("glDeleteProgram", NULL);
-    assert_non_null(g_obj.create_shader);
-    assert_non_null(g_obj.create_program);
+#define OBJ_GEN_LOAD(kind, Name)                                                                                     \
+    g_obj.gen_##Name = (gen_fn)glu_proc("glGen" #Name, NULL);                                                        \
+    g_obj.delete_##Name = (del_fn)glu_proc("glDelete" #Name, NULL);                                                  \
+    assert_non_null(g_obj.gen_##Name);                                                                               \
+    assert_non_null(g_obj.delete_##Name);
+#define OBJ_CREATE_LOAD(kind, Name, params, args)                                                                    \
+    g_obj.create_##Name = (create_##Name##_fn)glu_proc("glCreate" #Name, NULL);                                      \
+    g_obj.delete_##Name = (delete_one_fn)glu_proc("glDelete" #Name, NULL);                                           \
+    assert_non_null(g_obj.create_##Name);                                                                            \
+    assert_non_null(g_obj.delete_##Name);
+    OBJ_CALLS(OBJ_GEN_LOAD, OBJ_CREATE_LOAD)
+#undef OBJ_GEN_LOAD
+#undef OBJ_CREATE_LOAD
 }
 
 static int obj_live_total(void)
@@ -2435,20 +2417,13 @@ static fogvol_gl_proc test_loader(const char *name, void *user)
         const char *name;
         fogvol_gl_proc fn;
     } wrapped[] = {
-        {"glGenTextures", (fogvol_gl_proc)w_GenTextures},
-        {"glDeleteTextures", (fogvol_gl_proc)w_DeleteTextures},
-        {"glGenBuffers", (fogvol_gl_proc)w_GenBuffers},
-        {"glDeleteBuffers", (fogvol_gl_proc)w_DeleteBuffers},
-        {"glGenFramebuffers", (fogvol_gl_proc)w_GenFramebuffers},
-        {"glDeleteFramebuffers", (fogvol_gl_proc)w_DeleteFramebuffers},
-        {"glGenRenderbuffers", (fogvol_gl_proc)w_GenRenderbuffers},
-        {"glDeleteRenderbuffers", (fogvol_gl_proc)w_DeleteRenderbuffers},
-        {"glGenVertexArrays", (fogvol_gl_proc)w_GenVertexArrays},
-        {"glDeleteVertexArrays", (fogvol_gl_proc)w_DeleteVertexArrays},
-        {"glCreateShader", (fogvol_gl_proc)w_CreateShader},
-        {"glDeleteShader", (fogvol_gl_proc)w_DeleteShader},
-        {"glCreateProgram", (fogvol_gl_proc)w_CreateProgram},
-        {"glDeleteProgram", (fogvol_gl_proc)w_DeleteProgram},
+#define OBJ_GEN_ENTRY(kind, Name)                                                                                    \
+    {"glGen" #Name, (fogvol_gl_proc)w_Gen##Name}, {"glDelete" #Name, (fogvol_gl_proc)w_Delete##Name},
+#define OBJ_CREATE_ENTRY(kind, Name, params, args)                                                                   \
+    {"glCreate" #Name, (fogvol_gl_proc)w_Create##Name}, {"glDelete" #Name, (fogvol_gl_proc)w_Delete##Name},
+        OBJ_CALLS(OBJ_GEN_ENTRY, OBJ_CREATE_ENTRY)
+#undef OBJ_GEN_ENTRY
+#undef OBJ_CREATE_ENTRY
     };
     size_t i;
     if (l->nothing) return NULL;
@@ -2586,7 +2561,7 @@ static void expect_not_needed(const char *name, int v_major, int v_minor)
     obj_expect_none(name);
 }
 
-static void test_b6_missing_core33(void **state)
+static void test_gl_missing_entry_core33(void **state)
 {
     int i, n = 0;
     (void)state;
@@ -2603,7 +2578,7 @@ static void test_b6_missing_core33(void **state)
     for (i = 0; i < COUNT_OF(g_es_names); ++i) expect_not_needed(g_es_names[i], 0, 0);
 }
 
-static void test_b6_missing_gl21(void **state)
+static void test_gl_missing_entry_gl21(void **state)
 {
     int i, n = 0;
     const char *ext = (const char *)glGetString(GL_EXTENSIONS);
@@ -2624,7 +2599,7 @@ static void test_b6_missing_gl21(void **state)
 #endif
 }
 
-static void test_b6_loader_finds_nothing(void **state)
+static void test_gl_loader_finds_nothing(void **state)
 {
     loader l;
     logcap lc;
@@ -2667,7 +2642,7 @@ static void *plain_pointer(const char *name)
     return p;
 }
 
-static void test_b6_plain_loaders(void **state)
+static void test_gl_plain_loaders(void **state)
 {
     int k;
     (void)state;
@@ -2697,7 +2672,7 @@ static void test_b6_plain_loaders(void **state)
     }
 }
 
-/* ---- B7: dialects ---- */
+/* ---- GLSL dialects ---- */
 static void expect_dialect(const fogvol_gl_desc *in, fogvol_dialect want, const char *what)
 {
     fogvol_backend be;
@@ -2725,7 +2700,7 @@ static void expect_dialect(const fogvol_gl_desc *in, fogvol_dialect want, const 
     }
 }
 
-static void test_b7_dialects_core(void **state)
+static void test_gl_dialect_choice_core(void **state)
 {
     fogvol_gl_desc d;
     loader l;
@@ -2760,7 +2735,7 @@ static void test_b7_dialects_core(void **state)
     }
 }
 
-static void test_b7_dialects_compat(void **state)
+static void test_gl_dialect_choice_compat(void **state)
 {
     fogvol_gl_desc d;
     loader l;
@@ -2894,7 +2869,7 @@ static fogvol_result version_check_create_program(void *u, const fogvol_program_
     return g_inner_gl.create_program(u, d, out);
 }
 
-static void test_b7_glsl100_renders_in_core(void **state)
+static void test_gl_glsl100_renders_in_core(void **state)
 {
     fogvol_gl_desc gd;
     loader l;
@@ -2992,13 +2967,13 @@ static void override_renders(int major, int minor, const char *version_line)
     obj_expect_none(what);
 }
 
-static void test_b7_override21_renders(void **state)
+static void test_gl_override21_renders(void **state)
 {
     (void)state;
     override_renders(2, 1, "#version 120\n");
 }
 
-/* ---- B8: a shader that does not compile ---- */
+/* ---- a shader that does not compile ---- */
 static fogvol_result broken_create_program(void *u, const fogvol_program_desc *d, fogvol_handle *out)
 {
     fogvol_program_desc b = *d;
@@ -3031,7 +3006,7 @@ static void driver_info_log(const char *src, char *log, size_t cap)
     assert_true(got > 0);
 }
 
-static void test_b8_shader_compile_failure(void **state)
+static void test_gl_shader_compile_failure(void **state)
 {
     static const char broken[] = "#version 330 core\nout vec4 c;\nvoid main() { c = vec4(fogvol_undeclared); }\n";
     fogvol_gl_desc gd;
@@ -3096,7 +3071,7 @@ static void test_b8_shader_compile_failure(void **state)
 }
 
 /* ---- allocation failures while the GL backend and context come up ---- */
-static void test_b_gl_alloc_faults(void **state)
+static void test_gl_alloc_faults(void **state)
 {
     long k;
     int fails = 0;
@@ -3135,7 +3110,7 @@ static void test_b_gl_alloc_faults(void **state)
 /* fogvol_frame_desc.downsample: 2 puts the FLOAT sums at half the viewport (rounded up), the O and
    face passes in that target space, the composite at the viewport with a program of its own
    (FOGVOL_SPECIALIZE_DOWNSAMPLE); other values and the configurations it does not cover are refused. */
-static void test_a6_half_resolution(void **state)
+static void test_downsample_half_resolution(void **state)
 {
     static box_scene b;
     logcap lc;
@@ -3249,7 +3224,7 @@ static void test_a6_half_resolution(void **state)
 /* fogvol's targets are made once per size: FLOAT + ENGINE_DEPTH, which has no O target, kept making
    its sum target again in every frame (found in review). Every tier and the variants that change the
    set of targets, three frames each: targets only at the first. */
-static void test_a6_targets_once(void **state)
+static void test_targets_made_once_per_size(void **state)
 {
     static const struct {
         fogvol_tier t;
@@ -3281,38 +3256,38 @@ static void test_a6_targets_once(void **state)
 int main(void)
 {
     const struct CMUnitTest null_tests[] = {
-        cmocka_unit_test(test_a1_pass_structure_fullscreen),
-        cmocka_unit_test(test_a1_pass_structure_min_compare),
-        cmocka_unit_test(test_a1_depth_test_frames),
-        cmocka_unit_test(test_a1_vulkan_dialect),
-        cmocka_unit_test(test_a1_pass_structure_geometry),
-        cmocka_unit_test(test_a1_geometry_without_stencil),
-        cmocka_unit_test(test_a2_negative_only_group),
-        cmocka_unit_test(test_a3_frame_protocol),
-        cmocka_unit_test(test_a3_destroy_inside_frame),
-        cmocka_unit_test(test_a4_encoding_combinations),
-        cmocka_unit_test(test_a4_tier_choice),
-        cmocka_unit_test(test_a4_bad_input),
-        cmocka_unit_test(test_a4_transposed_and_degenerate),
-        cmocka_unit_test(test_a4_coarse_lsb),
-        cmocka_unit_test(test_a5_backend_create_faults),
-        cmocka_unit_test(test_a5_alloc_faults_context),
-        cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),
-        cmocka_unit_test(test_a5_target_faults),
-        cmocka_unit_test(test_a6_half_resolution),
-        cmocka_unit_test(test_a6_targets_once),
+        cmocka_unit_test(test_passes_of_a_frame_fullscreen),
+        cmocka_unit_test(test_passes_of_a_frame_min_compare),
+        cmocka_unit_test(test_depth_test_only_where_count_holds),
+        cmocka_unit_test(test_vulkan_dialect_programs_and_passes),
+        cmocka_unit_test(test_passes_of_a_frame_geometry),
+        cmocka_unit_test(test_geometry_composite_under_scissor),
+        cmocka_unit_test(test_negative_only_group_draws_nothing),
+        cmocka_unit_test(test_frame_call_order),
+        cmocka_unit_test(test_destroy_inside_frame_drops_its_users),
+        cmocka_unit_test(test_encoding_refuses_inexact_sums),
+        cmocka_unit_test(test_tier_choice_required_and_preferred),
+        cmocka_unit_test(test_bad_input_code_and_log),
+        cmocka_unit_test(test_transposed_and_singular_matrices),
+        cmocka_unit_test(test_coarse_depth_lsb_warned),
+        cmocka_unit_test(test_backend_create_faults),
+        cmocka_unit_test(test_alloc_faults_context),
+        cmocka_unit_test(test_alloc_faults_mesh_ramp),
+        cmocka_unit_test(test_target_create_faults),
+        cmocka_unit_test(test_downsample_half_resolution),
+        cmocka_unit_test(test_targets_made_once_per_size),
     };
     const struct CMUnitTest gl_tests[] = {
-        cmocka_unit_test_setup_teardown(test_b6_missing_core33, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b6_missing_gl21, setup_compat, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b6_loader_finds_nothing, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b6_plain_loaders, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b7_dialects_core, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b7_dialects_compat, setup_compat, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b7_glsl100_renders_in_core, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b7_override21_renders, setup_compat, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b8_shader_compile_failure, setup_core, teardown_gl),
-        cmocka_unit_test_setup_teardown(test_b_gl_alloc_faults, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_missing_entry_core33, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_missing_entry_gl21, setup_compat, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_loader_finds_nothing, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_plain_loaders, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_dialect_choice_core, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_dialect_choice_compat, setup_compat, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_glsl100_renders_in_core, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_override21_renders, setup_compat, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_shader_compile_failure, setup_core, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_alloc_faults, setup_core, teardown_gl),
     };
     int fails = 0;
     fails += cmocka_run_group_tests_name("null backend", null_tests, NULL, NULL);

@@ -15,7 +15,7 @@
  *      indices are the reference's representatives of the given ones.
  *   L4 colour-ramp groups at large counts: 120 ramps over 360 volumes (negatives, groups of
  *      negatives only), PS20: the passes in order of first appearance, each drawing its group's
- *      volumes in the frame's order (the pass structure of test_backend A1 for many groups).
+ *      volumes in the frame's order (test_backend's test_passes_of_a_frame_* for many groups).
  *   L5 lifetime: fogvol_destroy_context with meshes, ramps and volume textures alive (and a frame
  *      open) frees every allocation and backend object (null backend) and every GL object
  *      (OSMesa, names counted through the loader), and logs what was left.
