@@ -57,7 +57,7 @@ $(BUILD):
 #   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
-TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post cpu
+TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks cpu
 CXX_TESTS = cpu
 JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
 
@@ -217,7 +217,7 @@ $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
 # driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with
 # test_gles (EGL's surfaceless platform, OpenGL ES) and the headless demo
-EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post
+EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks
 $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
 	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm

@@ -689,6 +689,25 @@ typedef struct fogvol_ramp_desc {
        grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
        density alone (create_ramp logs a warning for a non-grey colour without the variant). */
     float extinction_color[3];
+    /* Soft edges (0 = off: uniform density up to the boundary, the old behaviour; else finite, > 0;
+       in the units of thickness: view depth, world units for a view matrix without scale). The
+       density rises linearly from 0 over a distance s = softness from both ends of every chord of
+       the fog along a ray (entry and exit: the volume's faces, the opaque surface that cuts it, the
+       near plane), so silhouettes and the places where fog meets opaque geometry fade:
+           density(x) = density * min(1, (x - a) / s, (b - x) / s)   on a chord [a, b]
+       whose optical thickness is f(b - a), f(t) = t^2 / (4 s) for t < 2 s, t - s for t >= 2 s.
+       The composite applies f to the group's summed thickness t and looks the ramp up at f(t)
+       (every model: the gradient's keys are at the softened thickness). Exact where a ray
+       crosses one chord of the group's volumes (one convex volume, or volumes apart on screen).
+       Where it crosses k > 1 chords (a concave volume, overlapping volumes of one ramp) f(sum)
+       >= sum f (f is convex, f(0) = 0): the fog is denser than the model by at most (k - 1) s
+       of thickness (each inner end counts as inside); negative volumes subtract their chord
+       before f. A density-textured volume sums rho * chord (see fogvol_volume_desc.density):
+       f(rho t) = rho f_{s/rho}(t), its edge ramp is s / rho long where the density factor is rho.
+       Every tier and variant (the composite does it); a soft ramp does not join the one-pass
+       colour group of FOGVOL_VARIANT_COLORS (it keeps a group of its own). The debug read-back
+       (fogvol_frame_desc.debug_thickness) gives t, not f(t). README: "Soft edges". */
+    float softness;
 } fogvol_ramp_desc;
 
 FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
@@ -1129,7 +1148,9 @@ typedef uintptr_t fogvol_handle;
    LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
    SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
                         COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
-                        not the ramp texture */
+                        not the ramp texture
+   SOFT      fv_soft:   COMPOSITE: (s, 1/(4s), 2s, 0), s the ramp's softness (0: off): the thickness t
+                        looked up is t^2/(4s) below 2s, t - s above (fogvol_ramp_desc.softness) */
 #define FOGVOL_UNIFORMS(X) \
     X(ENC, fv_enc) \
     X(DITHER, fv_dith) \
@@ -1150,7 +1171,8 @@ typedef uintptr_t fogvol_handle;
     X(COLOR_U, fv_ctex_u) \
     X(COLOR_V, fv_ctex_v) \
     X(LIGHT, fv_light) \
-    X(SPEEDUP, fv_speed)
+    X(SPEEDUP, fv_speed) \
+    X(SOFT, fv_soft)
 
 typedef enum fogvol_uniform {
 #define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
@@ -2464,6 +2486,7 @@ static fogvol_result fogvol__ramp_check(const fogvol_ramp_desc *d)
     if (d->width != 0 && (d->width < 2 || d->width > 4096)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!fogvol__finite(d->max_thickness) || d->max_thickness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (d->blend != FOGVOL_BLEND_FOG && d->blend != FOGVOL_BLEND_LIGHT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite(d->softness) || d->softness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
     switch (d->model) {
     case FOGVOL_RAMP_EXTINCTION:
     case FOGVOL_RAMP_LINEAR:
@@ -6140,6 +6163,12 @@ static const char fogvol__fs_composite[] =
     "FV_UNIFORM(vec4, fv_speed)\n"
     "FV_UNIFORM(vec4, fv_ctex_u)\n"
     "FV_UNIFORM(vec4, fv_ctex_v)\n"
+    /* soft edges (fogvol_ramp_desc.softness): the optical thickness of a chord t whose density rises
+       over s from both ends, fv_soft = (s, 1/(4s), 2s, 0); s = 0: t */
+    "FV_UNIFORM(vec4, fv_soft)\n"
+    "float fv_soften(float t) {\n"
+    "    return fv_soft.x <= 0.0 || t <= 0.0 ? t : t < fv_soft.z ? t * t * fv_soft.y : t - fv_soft.x;\n"
+    "}\n"
     "#ifdef FV_WIDE\n"
     "FV_BINDING(4) uniform sampler2D fv_back2;\n"
     "FV_BINDING(5) uniform sampler2D fv_front2;\n"
@@ -6231,6 +6260,7 @@ static const char fogvol__fs_composite_main[] =
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
     "    vec4 c;\n"
+    "    t = fv_soften(t);\n"
     "#if defined(FV_EXP) && defined(FV_BLEND_COLOR)\n" /* the colour: fogvol_pass.blend_color */
     "    c = vec4(1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
     "#elif defined(FV_EXP)\n"
@@ -6814,6 +6844,7 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    float softness;    /* fogvol_ramp_desc.softness (0: hard edges) */
 };
 
 struct fogvol_volume_texture {
@@ -7840,7 +7871,7 @@ static void fogvol__ramp_colors(fogvol_context *ctx, const fogvol_ramp_desc *des
 {
     const float *ec = desc->extinction_color;
     int c, unset = ec[0] == 0.0f && ec[1] == 0.0f && ec[2] == 0.0f;
-    rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG;
+    rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG && desc->softness == 0.0f;
     for (c = 0; c < 3; ++c) {
         rp->sigma[c] = desc->density * (unset ? 1.0f : ec[c]);
         rp->emit[c] = desc->color[c] < 0.0f ? 0.0f : desc->color[c] > 1.0f ? 1.0f : desc->color[c];
@@ -7893,6 +7924,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     rp->width = info.width;
     rp->max_thickness = tmax;
     rp->blend = desc->blend;
+    rp->softness = desc->softness;
     fogvol__ramp_colors(ctx, desc, rp);
     if (desc->model == FOGVOL_RAMP_EXTINCTION && (double)tmax * desc->density >= 7.0 * (1.0 - 1e-6))
     {
@@ -9163,6 +9195,16 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT] = 0;
 }
 
+/* fv_soft of a ramp's composite: (s, 1/(4s), 2s, 0), zeros for hard edges (fogvol_ramp_desc.softness) */
+static void fogvol__soft_uniforms(const fogvol_ramp *ramp, fogvol_pass *ps)
+{
+    float s = ramp->softness;
+    ps->uniforms[FOGVOL_U_SOFT][0] = s;
+    ps->uniforms[FOGVOL_U_SOFT][1] = s > 0.0f ? 0.25f / s : 0.0f;
+    ps->uniforms[FOGVOL_U_SOFT][2] = 2.0f * s;
+    ps->uniforms[FOGVOL_U_SOFT][3] = 0.0f;
+}
+
 /* FOGVOL_SPEEDUP_BLEND_COLOR: a composite of one colour (spec: EXP, no colour texture, no
    overflow test) takes it from the blend unit where the backend can. */
 static void fogvol__blend_color(const fogvol_context *ctx, fogvol_pass *ps, unsigned *spec)
@@ -9199,6 +9241,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
     ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
+    fogvol__soft_uniforms(ramp, ps);
     fogvol__group_color(ctx, ramp, ps);
     spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
     if (spec == FOGVOL_SPECIALIZE_EXP && !(ctx->cfg.speedups_off & FOGVOL_SPEEDUP_FAST_EXP))
