@@ -953,6 +953,19 @@ typedef struct fogvol_light_desc {
     float model[16];
     float color[3];           /* added to lit pixels */
     float intensity;          /* 0 = 1 */
+    /* Falloff with distance (falloff_radius 0 = none: the same colour on every lit pixel, the old
+       behaviour; else finite, > 0): each lit pixel gets colour * intensity * w(r), r the world
+       distance from its scene point to position (world space), w(r) = (1 - (r / R)^2)^2 for
+       r < R = falloff_radius and 0 beyond (a smooth window: 1 at the light, no slope at R). The
+       scene point is rebuilt from the pixel's ray and its opaque depth (any camera fogvol_frame_desc
+       accepts; RGBA8 tiers: the decoded depth, 12 bits by default). */
+    float position[3];
+    float falloff_radius;
+    /* Soft edge (0 = none; else finite, > 0, view depth units): the lit colour is also multiplied by
+       clamp(m / edge_softness, 0, 1), m the distance along the view axis from the scene point to the
+       nearer of the light volume's front and back faces on its ray (only the back face for a camera
+       inside the light), so the lit region fades where the scene surface meets the light's walls. */
+    float edge_softness;
 } fogvol_light_desc;
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
@@ -1150,7 +1163,11 @@ typedef uintptr_t fogvol_handle;
                         COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
                         not the ramp texture
    SOFT      fv_soft:   COMPOSITE: (s, 1/(4s), 2s, 0), s the ramp's softness (0: off): the thickness t
-                        looked up is t^2/(4s) below 2s, t - s above (fogvol_ramp_desc.softness) */
+                        looked up is t^2/(4s) below 2s, t - s above (fogvol_ramp_desc.softness)
+   LIGHT_Q0..5 fv_lq0..5: LIGHT compare pass: the lit point relative to the light's falloff sphere,
+                        q = (P - position) / radius = lq0 + lq1 s + lq2 t + o (lq3 + lq4 s + lq5 t),
+                        (s, t) = fv_st(), o the normalised opaque depth; lq0.w = 1: falloff on;
+                        lq1.w = (far - near) / edge_softness (0: no soft edge) */
 #define FOGVOL_UNIFORMS(X) \
     X(ENC, fv_enc) \
     X(DITHER, fv_dith) \
@@ -1172,7 +1189,13 @@ typedef uintptr_t fogvol_handle;
     X(COLOR_V, fv_ctex_v) \
     X(LIGHT, fv_light) \
     X(SPEEDUP, fv_speed) \
-    X(SOFT, fv_soft)
+    X(SOFT, fv_soft) \
+    X(LIGHT_Q0, fv_lq0) \
+    X(LIGHT_Q1, fv_lq1) \
+    X(LIGHT_Q2, fv_lq2) \
+    X(LIGHT_Q3, fv_lq3) \
+    X(LIGHT_Q4, fv_lq4) \
+    X(LIGHT_Q5, fv_lq5)
 
 typedef enum fogvol_uniform {
 #define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
@@ -6307,6 +6330,26 @@ static const char fogvol__fs_light[] =
     "    return fv_light_depth(FV_O_DIGITS(fv_opaque));\n"
     "#endif\n"
     "}\n"
+    /* falloff with distance and the soft edge (fogvol_light_desc): q the scene point relative to the
+       falloff sphere (fv_lq0..5), f and d the light's front and back depths on the ray */
+    "FV_UNIFORM(vec4, fv_lq0)\n"
+    "FV_UNIFORM(vec4, fv_lq1)\n"
+    "FV_UNIFORM(vec4, fv_lq2)\n"
+    "FV_UNIFORM(vec4, fv_lq3)\n"
+    "FV_UNIFORM(vec4, fv_lq4)\n"
+    "FV_UNIFORM(vec4, fv_lq5)\n"
+    "float fv_light_weight(float o, float f, float d) {\n"
+    "    float w = 1.0;\n"
+    "    if (fv_lq0.w > 0.5) {\n"
+    "        vec2 st = fv_st();\n"
+    "        vec3 q = fv_lq0.xyz + fv_lq1.xyz * st.x + fv_lq2.xyz * st.y +\n"
+    "                 o * (fv_lq3.xyz + fv_lq4.xyz * st.x + fv_lq5.xyz * st.y);\n"
+    "        float r2 = min(dot(q, q), 1.0);\n"
+    "        w = (1.0 - r2) * (1.0 - r2);\n"
+    "    }\n"
+    "    if (fv_lq1.w > 0.0) w *= clamp((f > 0.0 ? min(o - f, d - o) : d - o) * fv_lq1.w, 0.0, 1.0);\n"
+    "    return w;\n"
+    "}\n"
     "void main() {\n"
     "    float d = max(fv_d, 0.0);\n"
     "    if (fv_light.w < 0.5) {\n"
@@ -6318,9 +6361,9 @@ static const char fogvol__fs_light[] =
     "        FV_FRAGCOLOR = fv_encode(d);\n"
     "#endif\n"
     "    } else {\n"
-    "        float o = fv_light_opaque();\n"
-    "        if (o < fv_light_depth(FV_SCREEN(fv_lfront)) || o > d) discard;\n"
-    "        FV_FRAGCOLOR = vec4(fv_light.rgb, 1.0);\n"
+    "        float o = fv_light_opaque(), f = fv_light_depth(FV_SCREEN(fv_lfront));\n"
+    "        if (o < f || o > d) discard;\n"
+    "        FV_FRAGCOLOR = vec4(fv_light.rgb * fv_light_weight(o, f, d), 1.0);\n"
     "    }\n"
     "}\n";
 
@@ -6864,6 +6907,7 @@ typedef struct fogvol__light {
     const fogvol_mesh *mesh;
     float model[16];
     float rgb[3];
+    float position[3], radius, edge; /* fogvol_light_desc.position, falloff_radius, edge_softness */
 } fogvol__light;
 
 typedef struct fogvol__occluder {
@@ -9606,8 +9650,11 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
         return FOGVOL_ERROR_INVALID_MESH;
     }
     if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour or intensity");
+        !fogvol__finite_n(&desc->intensity, 1) || !fogvol__finite_n(desc->position, 3) ||
+        !fogvol__finite(desc->falloff_radius) || desc->falloff_radius < 0.0f ||
+        !fogvol__finite(desc->edge_softness) || desc->edge_softness < 0.0f) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour, intensity or position, "
+                    "or a negative falloff_radius or edge_softness");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.lights;
@@ -9621,6 +9668,9 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     l->rgb[0] = desc->color[0] * k;
     l->rgb[1] = desc->color[1] * k;
     l->rgb[2] = desc->color[2] * k;
+    memcpy(l->position, desc->position, sizeof l->position);
+    l->radius = desc->falloff_radius;
+    l->edge = desc->edge_softness;
     return FOGVOL_SUCCESS;
 }
 
@@ -9645,6 +9695,66 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx)
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
                     fogvol_result_string(r));
     return r;
+}
+
+/* The world point on the ray of viewport position (s, t) in [0,1]^2 at view depth e: clip x = (2s - 1) w,
+   clip y = sy (2t - 1) w and eyerow . (P, 1) = e, three linear equations in P (Cramer's rule).
+   0 where they are singular. */
+static int fogvol__ray_point(const fogvol_context *ctx, double s, double t, double sy, double e, double out[3])
+{
+    const double *m = ctx->cur.viewproj;
+    double x = 2.0 * s - 1.0, y = sy * (2.0 * t - 1.0), a[3][3], b[3], det;
+    int j, k;
+    for (j = 0; j < 3; ++j) {
+        a[0][j] = m[j * 4] - x * m[j * 4 + 3];
+        a[1][j] = m[j * 4 + 1] - y * m[j * 4 + 3];
+        a[2][j] = ctx->cur.eyerow[j];
+    }
+    b[0] = x * m[15] - m[12];
+    b[1] = y * m[15] - m[13];
+    b[2] = e - ctx->cur.eyerow[3];
+    det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+          a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(det != 0.0) || det - det != 0.0) return 0;
+    for (k = 0; k < 3; ++k) { /* column k replaced by b */
+        double c[3][3];
+        memcpy(c, a, sizeof c);
+        for (j = 0; j < 3; ++j) c[j][k] = b[j];
+        out[k] = (c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+                  c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])) / det;
+    }
+    return 1;
+}
+
+/* fv_lq0..5 of a light's compare pass: the scene point P(s, t, o) = A + B s + C t + o (D + E s + F t)
+   (P is affine in the screen position at a given view depth and affine in the depth along a ray, for
+   perspective and orthographic cameras alike), taken from the ray points at the near and far planes
+   of three screen corners, as (P - position) / falloff_radius; the soft edge's scale in lq1.w. */
+static void fogvol__light_uniforms(const fogvol_context *ctx, const fogvol__run *run, const fogvol__light *l,
+                                   fogvol_pass *ps)
+{
+    static const double corner[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
+    double p[3][2][3], sy = run->info.clip_upper_left ? -1.0 : 1.0, q[6][3];
+    int c, k, j, ok = 1;
+    for (k = FOGVOL_U_LIGHT_Q0; k <= FOGVOL_U_LIGHT_Q5; ++k) memset(ps->uniforms[k], 0, sizeof ps->uniforms[k]);
+    if (l->edge > 0.0f) ps->uniforms[FOGVOL_U_LIGHT_Q1][3] = (fd->zfar - fd->znear) / l->edge;
+    if (!(l->radius > 0.0f)) return;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 2; ++k)
+            ok &= fogvol__ray_point(ctx, corner[c][0], corner[c][1], sy, k ? fd->zfar : fd->znear, p[c][k]);
+    if (!ok) return; /* (the camera was validated: not reached) */
+    for (j = 0; j < 3; ++j) {
+        q[0][j] = p[0][0][j] - l->position[j];
+        q[1][j] = p[1][0][j] - p[0][0][j];
+        q[2][j] = p[2][0][j] - p[0][0][j];
+        q[3][j] = p[0][1][j] - p[0][0][j];
+        q[4][j] = p[1][1][j] - p[1][0][j] - q[3][j];
+        q[5][j] = p[2][1][j] - p[2][0][j] - q[3][j];
+    }
+    for (k = 0; k < 6; ++k)
+        for (j = 0; j < 3; ++j) ps->uniforms[FOGVOL_U_LIGHT_Q0 + k][j] = (float)(q[k][j] / l->radius);
+    ps->uniforms[FOGVOL_U_LIGHT_Q0][3] = 1.0f;
 }
 
 /* Per light: its front faces' depth into L (cleared to 0: the near plane, for a camera inside),
@@ -9689,6 +9799,7 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
         ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
         fogvol__end_pass(ctx);
         memcpy(bp.uniforms[FOGVOL_U_LIGHT], l->rgb, sizeof l->rgb);
+        fogvol__light_uniforms(ctx, run, l, &bp);
         ctx->be.begin_pass(ctx->be.user_data, &bp);
         ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
         fogvol__end_pass(ctx);
