@@ -859,6 +859,17 @@ typedef struct fogvol_frame_desc {
        otherwise end_frame returns FOGVOL_ERROR_UNSUPPORTED (logged). Other values:
        FOGVOL_ERROR_INVALID_ARGUMENT. */
     int downsample;
+    /* The dither pattern's frame (RGBA8 tiers with dithering on; engines that accumulate frames,
+       e.g. TAA): 0 = the fixed 8x8 ordered pattern, the same every frame. Any other value n rotates
+       every pixel's rounding threshold by bitrev3(n mod 8) / 8 of an LSB (n mod 8 = 0, 1, 2, ... ->
+       0, 1/2, 1/4, 3/4, 1/8, 5/8, 3/8, 7/8: period 8, each run of 2, 4, 8 frames stratified), so a
+       pixel's values over 8 consecutive frames average to within 1/8 LSB of the exact depth and the
+       block bias of the fixed pattern on depth gradients averages away: pass the engine's frame
+       counter. Measured (test_cpu, every slope, offset and block position): the 8x8 block mean of a
+       pair of faces (B - F) averaged over 1 / 4 / 8 frames is within 0.44 / 0.094 / 0.048 LSB
+       (single face 0.27 / 0.083 / 0.033). The MRT and occluder snippets' uniforms carry it
+       (fogvol_mrt_prepare, fogvol_occluder_prepare after begin_frame). FLOAT: no effect. */
+    int dither_frame;
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -1135,7 +1146,7 @@ typedef uintptr_t fogvol_handle;
    the order of their fogvol_uniform values (0, 1, ...); add new ones at the
    end. fogvol_uniform_name gives the name.
    ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
-   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, row offset of the frame: fogvol__dither_offset)
    SCREEN   fv_screen:  (1/w, 1/h, -x0, -y0): gl_FragCoord + zw = pixel of fogvol's targets,
                         (gl_FragCoord + zw) * xy in [0,1]
    DECODE   fv_dec:     decode weights (world units)
@@ -5847,7 +5858,7 @@ static const char fogvol__vs_fullscreen[] =
 static const char fogvol__fs_common[] =
     "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
     "FV_UNIFORM(vec4, fv_enc)\n"    /* (N, N^2, depth offset, depth max) */
-    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, 0) */
+    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, the frame's row offset) */
     "FV_UNIFORM(vec4, fv_screen)\n"
     "FV_UNIFORM(vec4, fv_dec)\n"
     /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
@@ -5923,14 +5934,14 @@ static const char fogvol__fs_encode_common[] =
     FOGVOL__IALU_TEXT
     "float fv_dither_row() {\n"
     "    highp int dd = FV_DD_I;\n"
-    "    return fv_dith.x > 0.5 ? float((fogvol_dither_scaled(dd) + (dd >> 1)) & (dd - 1)) : 0.0;\n"
+    "    return fv_dith.x > 0.5 ? float((fogvol_dither_scaled(dd) + (dd >> 1) + int(fv_dith.w)) & (dd - 1)) : 0.0;\n"
     "}\n"
-    /* the encode's offset (row + D/2) mod D = (v D) >> 6 (the dither off: D/2) */
+    /* the encode's offset (row + D/2) mod D = ((v D) >> 6) + the frame's offset (the dither off: D/2) */
     "highp int fv_dither_offset_i() {\n"
     "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
-    "    return fogvol_dither_scaled(FV_DD_I);\n"
+    "    return (fogvol_dither_scaled(FV_DD_I) + int(fv_dith.w)) & (FV_DD_I - 1);\n"
     "#else\n"
-    "    return fv_dith.x > 0.5 ? fogvol_dither_scaled(FV_DD_I) : FV_DD_I >> 1;\n"
+    "    return fv_dith.x > 0.5 ? (fogvol_dither_scaled(FV_DD_I) + int(fv_dith.w)) & (FV_DD_I - 1) : FV_DD_I >> 1;\n"
     "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
@@ -5940,10 +5951,12 @@ static const char fogvol__fs_encode_common[] =
     "    float v = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
     "              abs(b2.x - b2.y) * 2.0 + b2.y;\n"    /* 8x8 Bayer index by bit interleaving */
     "    float dd = FV_DD;\n"
-    "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5), dd) : 0.0;\n"
+    "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5) + fv_dith.w, dd) : 0.0;\n"
     "}\n"
     "#else\n"
-    "float fv_dither_row() { return floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5); }\n"
+    "float fv_dither_row() {\n"
+    "    return mod(floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5) + fv_dith.w, FV_DD);\n"
+    "}\n"
     "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
@@ -6629,7 +6642,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
     "    if (fogvol_mrt[0].z == 0.0) return fogvol_view_depth_r32f(view_depth);\n" \
     "    highp int ln = fogvol_log2i(fogvol_mrt[0].z), ld = fogvol_log2i(fogvol_mrt[1].z), dd = 1 << ld;\n" \
-    "    highp int k = fogvol_mrt[1].w > 0.5 ? fogvol_dither_scaled(dd) : dd >> 1;\n" \
+    "    highp int k = fogvol_mrt[1].w > 0.5 ? (fogvol_dither_scaled(dd) + int(fogvol_mrt[1].w) - 1) & (dd - 1) : dd >> 1;\n" \
     "    float u = clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
     "    return fogvol_encode_int(int(u * (fogvol_mrt[0].w * fogvol_mrt[0].z * fogvol_mrt[1].z)), ln, ld, k);\n" \
     "}\n" \
@@ -6641,7 +6654,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n" \
     "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n" \
     "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n" \
-    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n" \
+    "    float k = fogvol_mrt[1].w > 0.5 ? mod(floor(bayer * dd / 64.0) + fogvol_mrt[1].w - 1.0, dd) : dd * 0.5;\n" \
     "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
     "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
     "    float t = u * fogvol_mrt[0].w * n;\n" \
@@ -8036,6 +8049,15 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
 /* >>frame input =========================================================== */
 /* One frame's input: the camera, volumes, occluders, the MRT and engine-drawn O. */
 
+/* The dither rows' offset of the open frame (fogvol_frame_desc.dither_frame): bitrev3(n mod 8) * D / 8
+   (a threshold rotation by bitrev3(n mod 8) / 8 of an LSB; D, a power of two >= 8, divides evenly) */
+static float fogvol__dither_offset(const fogvol_context *ctx)
+{
+    unsigned n = (unsigned)ctx->cur.frame.dither_frame & 7u;
+    unsigned r = ((n & 1u) << 2) | (n & 2u) | (n >> 2);
+    return (float)(r * (unsigned)ctx->cfg.enc.dither_steps / 8u);
+}
+
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -8499,7 +8521,7 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     info->uniforms[4] = k.depth_offset;
     info->uniforms[5] = k.depth_max;
     info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
-    info->uniforms[7] = ctx->cfg.dither ? 1.0f : 0.0f;
+    info->uniforms[7] = ctx->cfg.dither ? 1.0f + fogvol__dither_offset(ctx) : 0.0f; /* (+ the frame's offset) */
     ctx->cur.mrt_ready = 1;
     return FOGVOL_SUCCESS;
 }
@@ -8614,7 +8636,7 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     info->uniforms[4] = fl ? 0.0f : k.depth_offset;
     info->uniforms[5] = fl ? 1.0f : k.depth_max;
     info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
-    info->uniforms[7] = ctx->cfg.dither && !fl ? 1.0f : 0.0f;
+    info->uniforms[7] = ctx->cfg.dither && !fl ? 1.0f + fogvol__dither_offset(ctx) : 0.0f;
     ctx->cur.engine_occluders = 1;
     return FOGVOL_SUCCESS;
 }
@@ -9049,6 +9071,7 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
     ps->uniforms[FOGVOL_U_DITHER][0] = ctx->cfg.dither ? 255.0f : 0.0f;
     ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->cfg.enc.dither_steps;
     ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->cfg.enc.dither_steps;
+    ps->uniforms[FOGVOL_U_DITHER][3] = ctx->cfg.dither ? fogvol__dither_offset(ctx) : 0.0f;
     ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.target_w; /* target space (downsample: half) */
     ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.target_h;
     if (run->rgba8) {
