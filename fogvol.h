@@ -1070,14 +1070,22 @@ typedef enum fogvol_post_effect {
 } fogvol_post_effect;
 
 /* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
-   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
-   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
-   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
-   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
-   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
-   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
-   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
-   without blending (in-focus pixels keep their colour exactly). */
+   Rendering Techniques"), gathered over the whole circle of confusion.
+   Out-of-focus amount c(e) = clamp(|e - focus_distance| / focus_range, 0, 1);
+   the centre pixel's radius r = c(e0) * max_radius; taps k = 0 .. taps-1 on a
+   golden-angle spiral that covers the disc of radius r evenly: at offsets
+   round(r sqrt((k + u) / taps) (cos t_k, sin t_k)) pixels, t_k = 2.39996 k + a,
+   the spiral turned and its radii jittered per pixel by a = 2 pi IGN(p),
+   u = IGN(p.yx + (37, 91)), p = pixel + 5.588238 (dither_frame mod 64)
+   (interleaved gradient noise): neighbouring pixels' taps never line up, so
+   blurred regions show fine grain instead of copies of the taps or a pattern,
+   and an engine that accumulates frames (TAA) averages the grain away by passing
+   its frame counter in frame->dither_frame. Each tap enters as mix(C0, Ck, c(ek)),
+   weighted by its own out-of-focus amount so in-focus pixels never bleed into
+   blurred ones, and out = sum_k mix(C0, Ck, c(ek)) / taps on RGBA, written without
+   blending (in-focus pixels keep their colour exactly). Against a continuous disc
+   blur (README "Depth of field": measured by test_post): the grain's RMS and the
+   error of 4x4 block means, one frame and 8 frames. */
 typedef struct fogvol_dof_desc {
     const fogvol_frame_desc *frame;
     fogvol_native color_texture; /* the scene's colour (GL texture name), required */
@@ -1085,7 +1093,7 @@ typedef struct fogvol_dof_desc {
     float focus_distance;    /* view depth in focus (> 0) */
     float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
     float max_radius;        /* pixels, 0 = 4, at most 64 */
-    int taps;                /* 0 = 6; 3, 6 or 12 */
+    int taps;                /* 0 = 24; 3, 6, 12, 24 or 48 (more taps: less grain, more time) */
 } fogvol_dof_desc;
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
 
@@ -6932,9 +6940,10 @@ typedef struct fogvol__occluder {
     float model[16];
 } fogvol__occluder;
 
-/* image-space effect programs: depth of field with 3, 6, 12 taps; outlines from depth, from depth and
-   normals; distance fog */
-#define FOGVOL__POST_PROGRAMS 6
+/* image-space effect programs: depth of field with 3, 6, 12, 24, 48 taps; outlines from depth, from
+   depth and normals; distance fog */
+#define FOGVOL__DOF_TAPSETS 5
+#define FOGVOL__POST_PROGRAMS (FOGVOL__DOF_TAPSETS + 3)
 
 /* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
 #define FOGVOL__QFRAMES 4
@@ -10112,35 +10121,28 @@ static const char fogvol__fs_post_common[] =
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
     "}\n";
 
-/* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
+/* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, frame phase).
+   FV_TAPS taps on a golden-angle (Vogel) spiral covering the disc of radius r evenly, tap i at radius
+   r sqrt((i + u) / FV_TAPS), angle i 2.39996 + a, the spiral turned per pixel by a = 2 pi
+   IGN(p) and its radii jittered by u = IGN(p.yx + (37, 91)), p = pixel + 5.588238 phase (interleaved
+   gradient noise, Jimenez 2014): no pixel's taps line up with its neighbours', so the blur shows no
+   copies of its taps and no pattern, the taps' expectation is the disc itself (stratified in angle and
+   in r^2), and the phase (fogvol_frame_desc.dither_frame) turns it again every frame. */
 static const char fogvol__fs_post_dof[] =
     "FV_BINDING(0) uniform sampler2D fv_pscene;\n"
     "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
-    "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
-    "    vec2 o = floor(dir * r + 0.5);\n"
-    "    return mix(c0, fv_ptex(fv_pscene, o), fv_coc(fv_view_depth(o)));\n"
-    "}\n"
+    "float fv_ign(vec2 p) { return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715)))); }\n"
     "void main() {\n"
-    "    vec4 c0 = fv_ptex(fv_pscene, vec2(0.0));\n"
+    "    vec4 c0 = fv_ptex(fv_pscene, vec2(0.0)), sum = vec4(0.0);\n"
     "    float r = fv_coc(fv_view_depth(vec2(0.0))) * fv_pparams.z;\n"
-    "    vec4 sum = c0;\n"
-    "    sum += fv_dof_tap(vec2(0.0, 1.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.8660254, -0.5), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.8660254, -0.5), r, c0);\n"
-    "#if FV_TAPS >= 6\n"
-    "    sum += fv_dof_tap(vec2(0.0, -1.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.8660254, 0.5), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.8660254, 0.5), r, c0);\n"
-    "#endif\n"
-    "#if FV_TAPS >= 12\n"
-    "    sum += fv_dof_tap(vec2(0.5, 0.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.25, 0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.25, 0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.5, 0.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.25, -0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.25, -0.4330127), r, c0);\n"
-    "#endif\n"
-    "    FV_FRAGCOLOR = sum / float(FV_TAPS + 1);\n"
+    "    vec2 p = floor(gl_FragCoord.xy) + 5.588238 * fv_pparams.w;\n"
+    "    float a = 6.2831853 * fv_ign(p), u = fv_ign(p.yx + vec2(37.0, 91.0));\n"
+    "    for (int i = 0; i < FV_TAPS; ++i) {\n"
+    "        float fi = float(i), t = a + 2.3999632 * fi;\n"
+    "        vec2 o = floor(vec2(cos(t), sin(t)) * (r * sqrt((fi + u) / float(FV_TAPS))) + 0.5);\n"
+    "        sum += mix(c0, fv_ptex(fv_pscene, o), fv_coc(fv_view_depth(o)));\n"
+    "    }\n"
+    "    FV_FRAGCOLOR = sum / float(FV_TAPS);\n"
     "}\n";
 
 /* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
@@ -10181,17 +10183,25 @@ static const char fogvol__fs_post_fog[] =
     "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
     "}\n";
 
+/* The depth of field's program slot of a tap count (3, 6, 12, 24, 48), -1 for other counts. */
+static int fogvol__dof_slot(int taps)
+{
+    return taps == 3 ? 0 : taps == 6 ? 1 : taps == 12 ? 2 : taps == 24 ? 3 : taps == 48 ? 4 : -1;
+}
+
 FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
                                                     fogvol_stage stage, const char **strings, int *count)
 {
-    static const char *const taps[3] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n", "#define FV_TAPS 12\n"};
+    static const char *const taps[FOGVOL__DOF_TAPSETS] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n",
+                                                          "#define FV_TAPS 12\n", "#define FV_TAPS 24\n",
+                                                          "#define FV_TAPS 48\n"};
     const fogvol__dialect_info *di;
     int n = 0;
     if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if ((int)dialect <= FOGVOL_GLSL_AUTO || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
-    if (!(effect == FOGVOL_POST_DOF && (variant == 3 || variant == 6 || variant == 12)) &&
+    if (!(effect == FOGVOL_POST_DOF && fogvol__dof_slot(variant) >= 0) &&
         !(effect == FOGVOL_POST_OUTLINES && (variant == 0 || variant == 1)) &&
         !(effect == FOGVOL_POST_DISTANCE_FOG && variant == 0))
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -10205,7 +10215,7 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
         strings[n++] = di->fs;
         strings[n++] = di->decl;
         strings[n++] = fogvol__fs_post_common;
-        if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
+        if (effect == FOGVOL_POST_DOF) strings[n++] = taps[fogvol__dof_slot(variant)];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
         strings[n++] = effect == FOGVOL_POST_DOF        ? fogvol__fs_post_dof
                        : effect == FOGVOL_POST_OUTLINES ? fogvol__fs_post_outlines
@@ -10221,9 +10231,9 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
 {
     static const char *const labels[FOGVOL_POST_EFFECT_COUNT] = {"fogvol depth of field", "fogvol outlines",
                                                                   "fogvol distance fog"};
-    int slot = effect == FOGVOL_POST_DOF ? (variant == 3 ? 0 : variant == 6 ? 1 : 2)
-               : effect == FOGVOL_POST_OUTLINES ? 3 + variant
-                                                : 5;
+    int slot = effect == FOGVOL_POST_DOF        ? fogvol__dof_slot(variant)
+               : effect == FOGVOL_POST_OUTLINES ? FOGVOL__DOF_TAPSETS + variant
+                                                : FOGVOL__DOF_TAPSETS + 2;
     fogvol_program_desc pd;
     fogvol_result r;
     if (!ctx->gpu.post_prog[slot]) {
@@ -10344,12 +10354,12 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
     }
     r = fogvol__post_check(ctx, desc->frame, desc->texture_size, "post_dof");
     if (r != FOGVOL_SUCCESS) return r;
-    taps = desc->taps ? desc->taps : 6;
+    taps = desc->taps ? desc->taps : 24;
     radius = desc->max_radius != 0.0f ? desc->max_radius : 4.0f;
-    if (!desc->color_texture || (taps != 3 && taps != 6 && taps != 12) || !fogvol__finite(desc->focus_distance) ||
+    if (!desc->color_texture || fogvol__dof_slot(taps) < 0 || !fogvol__finite(desc->focus_distance) ||
         !(desc->focus_distance > 0.0f) || !fogvol__finite(desc->focus_range) || !(desc->focus_range > 0.0f) ||
         !(radius > 0.0f && radius <= 64.0f)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: need color_texture, taps 3, 6 or 12, "
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: need color_texture, taps 3, 6, 12, 24 or 48, "
                     "focus_distance > 0, focus_range > 0, 0 < max_radius <= 64");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
@@ -10362,6 +10372,7 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
     ps.uniforms[FOGVOL_U_POST_PARAMS][0] = desc->focus_distance;
     ps.uniforms[FOGVOL_U_POST_PARAMS][1] = 1.0f / desc->focus_range;
     ps.uniforms[FOGVOL_U_POST_PARAMS][2] = radius;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][3] = (float)((unsigned)desc->frame->dither_frame & 63u);
     return fogvol__post_run(ctx, desc->frame, desc->texture_size, &ps);
 }
 

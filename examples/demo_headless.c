@@ -341,7 +341,7 @@ static int post_effect(demo *d, fogvol_context *fv, const fogvol_frame_desc *fd,
     dd.focus_distance = 9.0f; /* the pillars in the middle sharp, the front and the back blurred */
     dd.focus_range = 5.0f;
     dd.max_radius = 5.0f;
-    dd.taps = 12;
+    dd.taps = 24;
     od.color[0] = 0.05f, od.color[1] = 0.04f, od.color[2] = 0.08f, od.color[3] = 0.9f;
     gd.ramp = ramp;
     gd.start = 4.0f;
