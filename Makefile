@@ -277,6 +277,7 @@ images: demo
 	cp $(BUILD)/demo/tiers.png $(BUILD)/demo/dither.png $(BUILD)/demo/ramps.png $(BUILD)/demo/thickness.png docs/
 	cp $(BUILD)/demo/textured_fog.png $(BUILD)/demo/light_compare.png $(BUILD)/demo/dof.png \
 	   $(BUILD)/demo/outlines.png $(BUILD)/demo/distance_fog.png docs/
+	cp $(BUILD)/demo/soft_edges.png $(BUILD)/demo/before_after.png docs/
 
 # --- browser build: emscripten (Debian's emcc ships its system libraries prebuilt), one page for
 # WebGL1 (?webgl1) and WebGL2 (?webgl2, the default), the wasm embedded so it loads from file://.

@@ -14,7 +14,8 @@
      DS_BANK   a low mist bank over the back of the courtyard, with DS_HOLE, a
                negative sphere, carving a clearing into it;
      DS_LIGHT  a sunbeam slanting onto the path and the cone of the lamp post,
-               blended additively.
+               blended additively; each fades along its length (ds_object.fade:
+               a density texture of ds_fade_texels along its axis, fogvol_volume_desc.density).
 
    Use:  ds_scene s; ds_scene_build(&s); ds_scene_animate(&s, t);
          ds_gl g; ds_gl_init(&g, &s);        once per GL 3.3 context
@@ -42,6 +43,8 @@ typedef struct ds_object {
     int mesh, kind, material;
     float color[3];
     float model[16];
+    int fade;          /* 1: light that fades along its axis: density texture of ds_fade_texels with */
+    float fade_map[8]; /*    these texture-coordinate rows (fogvol_volume_desc.density_map) */
 } ds_object;
 
 typedef struct ds_scene {
@@ -219,12 +222,38 @@ static inline void ds__nature(ds_scene *s, int box, int trunk, int cone)
     ds__add(s, box, DS_OPAQUE, DS_WOOD, 0.22f, 0.20f, 0.18f, m);
 }
 
+/* The density of a light fading along its axis, 1 texel high (RGBA8, red): s in [0, 1] from its
+   base to its top; faint where it meets the ground, full in the middle, gone at the top end. */
+#define DS_FADE_TEXELS 64
+static inline void ds_fade_texels(unsigned char *rgba)
+{
+    int i;
+    for (i = 0; i < DS_FADE_TEXELS; ++i) {
+        double u = (i + 0.5) / DS_FADE_TEXELS, a = u > 0.4 ? 1 : u / 0.4;
+        double b = u < 0.72 ? 0 : u > 1.0 ? 1 : (u - 0.72) / 0.28;
+        double f = (0.4 + 0.6 * a * a * (3 - 2 * a)) * (1 - b * b * (3 - 2 * b));
+        rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = (unsigned char)(255.0 * f + 0.5);
+        rgba[4 * i + 3] = 255;
+    }
+}
+
+/* fade_map for a light whose model-space axis is y from y0 to y1, the texture's s from s0 to s1 */
+static inline void ds__fade(ds_object *o, float y0, float y1, float s0, float s1)
+{
+    memset(o->fade_map, 0, sizeof o->fade_map);
+    o->fade = 1;
+    o->fade_map[1] = (s1 - s0) / (y1 - y0);
+    o->fade_map[3] = s0 - o->fade_map[1] * y0;
+    o->fade_map[7] = 0.5f;
+}
+
 /* the fog volumes */
 static inline void ds__volumes(ds_scene *s)
 {
     float m[16];
-    int sphere = ds__mesh(s, shp_sphere(1.0f, 64, 32)), ring = ds__mesh(s, shp_torus(1.3f, 0.3f, 96, 32));
+    int sphere = ds__mesh(s, shp_sphere(1.0f, 64, 32)), ring = ds__mesh(s, shp_torus(1.25f, 0.42f, 96, 32));
     int box = ds__mesh(s, shp_box(1, 1, 1)), lamp = ds__mesh(s, ds_frustum(1.0f, 0.12f, 2.6f, 48));
+    int beam = ds__mesh(s, ds_frustum(1.0f, 1.0f, 2.0f, 48)), k;
     s->blob_mesh = ds__mesh(s, shp_sphere(0.9f, 48, 24));
     s->blob_base = (float *)malloc(sizeof(float) * 3 * (size_t)s->mesh[s->blob_mesh].vcount);
     memcpy(s->blob_base, s->mesh[s->blob_mesh].pos, sizeof(float) * 3 * (size_t)s->mesh[s->blob_mesh].vcount);
@@ -235,10 +264,11 @@ static inline void ds__volumes(ds_scene *s)
     ds_trs(m, 0, 0.25f, -7.0f, 0, 0, 1, 0, 12.0f, 0.55f, 6.0f); /* the mist bank: y -0.3 .. 0.8, z -13 .. -1 */
     ds__add(s, box, DS_BANK, 0, 0, 0, 0, m);
     s->hole_obj = ds__add(s, sphere, DS_HOLE, 0, 0, 0, 0, m);
+    for (k = 0; k < s->mesh[beam].vcount; ++k) s->mesh[beam].pos[3 * k + 1] -= 1.0f; /* a cylinder, y -1 .. 1 */
     ds_trs(m, -0.6f, 2.6f, -1.6f, -22, 0.3f, 0, 1, 0.45f, 3.6f, 0.45f); /* sunbeam */
-    ds__add(s, box, DS_LIGHT, 0, 0, 0, 0, m);
+    ds__fade(&s->obj[ds__add(s, beam, DS_LIGHT, 0, 0, 0, 0, m)], -1.0f, 1.0f, 0.0f, 1.0f);
     ds_trs(m, 1.6f, 0, 2.6f, 0, 0, 1, 0, 1, 1, 1); /* the lamp's cone, from the ground up to the lantern */
-    ds__add(s, lamp, DS_LIGHT, 0, 0, 0, 0, m);
+    ds__fade(&s->obj[ds__add(s, lamp, DS_LIGHT, 0, 0, 0, 0, m)], 0.0f, 2.6f, 0.08f, 0.5f);
 }
 
 /* Pose the animated volumes at time t (seconds): the ring turns in the gate, the
