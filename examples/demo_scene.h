@@ -318,20 +318,10 @@ static inline void ds_scene_free(ds_scene *s)
     memset(s, 0, sizeof *s);
 }
 
-/* ---- the opaque renderer (GL 3.3 core) --------------------------------------------- */
-
-typedef struct ds_gl {
-    GLuint prog, sky, vao[DS_MAX_MESHES], vbo[DS_MAX_MESHES], ebo[DS_MAX_MESHES], empty_vao;
-    GLuint shadow_prog, shadow_fbo, shadow_tex; /* the sun's shadow map, rendered once */
-    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv, u_shadow_vp, u_shadow_map, u_shadow_mvp;
-    int count[DS_MAX_MESHES];
-    float shadow_vp[16];
-} ds_gl;
-
-#define DS_SHADOW_SIZE 2048
-
-#define DS_GLSL_COMMON                                                                                              \
-    "#version 330 core\n"                                                                                           \
+/* The shaders' shared functions (noise, the sky) and the surfaces' albedos, in the GLSL that GLSL 330
+   core and GLSL ES 1.00 share (the browser demo draws the place with them too); DS_GLSL_ALBEDO reads
+   wp (world position), color and material. */
+#define DS_GLSL_FUNCS                                                                                               \
     "const vec3 sun = normalize(" DS_SUN ");\n"                                                                     \
     "float hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }\n"                        \
     "float noise(vec2 p) { vec2 i = floor(p), f = fract(p); f = f * f * (3.0 - 2.0 * f);\n"                       \
@@ -347,43 +337,60 @@ typedef struct ds_gl {
     "  return c + vec3(1.0, 0.8, 0.5) * 0.5 * pow(max(dot(d, sun), 0.0), 24.0);\n"                                \
     "}\n"
 
+#define DS_GLSL_ALBEDO \
+    "vec3 ground() {\n" \
+    "  vec2 q = wp.xz; float g = fbm(q * 1.7);\n" \
+    "  vec3 c = mix(vec3(0.17, 0.30, 0.08), vec3(0.38, 0.48, 0.15), g);\n" \
+    "  c = mix(c, vec3(0.40, 0.33, 0.22), 0.8 * smoothstep(0.58, 0.72, fbm(q * 0.22 + 7.0)));\n" \
+    "  float px = abs(q.x - 1.0 - 1.2 * sin(q.y * 0.28)), plaza = length((q - vec2(-1.0, -3.2)) * vec2(0.55, 0.8));\n" \
+    "  float path = max(smoothstep(1.05, 0.9, px), smoothstep(3.1, 2.9, plaza));\n" \
+    "  vec2 b = q / vec2(0.5, 0.36); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b) - 0.5;\n" \
+    "  float e = smoothstep(0.5, 0.36, max(abs(f.x), abs(f.y)));\n" \
+    "  vec3 st = mix(vec3(0.40, 0.38, 0.35), vec3(0.62, 0.58, 0.52), hash(floor(b))) * (0.45 + 0.55 * e);\n" \
+    "  return mix(c, st * (0.85 + 0.3 * g), path * smoothstep(0.15, 0.4, fbm(q * 0.9 + 2.0) + 0.3));\n" \
+    "}\n" \
+    "vec2 face_uv(vec3 n) { return abs(n.x) > 0.7 ? wp.zy : abs(n.y) > 0.7 ? wp.xz : wp.xy; }\n" \
+    "vec3 albedo(vec3 n) {\n" \
+    "  vec2 uv = face_uv(n);\n" \
+    "  if (material == 0) return ground();\n" \
+    "  if (material == 1) { vec2 b = uv / vec2(0.7, 0.35); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b);\n" \
+    "    float m = smoothstep(0.0, 0.05, f.x) * smoothstep(1.0, 0.95, f.x) * smoothstep(0.0, 0.09, f.y)\n" \
+    "      * smoothstep(1.0, 0.91, f.y);\n" \
+    "    return color * (0.82 + 0.3 * hash(floor(b))) * mix(0.6, 1.0, m) * (0.85 + 0.3 * fbm(uv * 5.0)); }\n" \
+    "  if (material == 2) return color * (0.8 + 0.3 * fbm(uv * 3.0)) * (0.9 + 0.1 * smoothstep(0.3, 0.6, wp.y));\n" \
+    "  if (material == 3) { float r = fract(dot(wp, vec3(0.0, 4.0, 4.0))), c = fract(wp.x * 3.0 + 0.5 * floor(dot(wp, vec3(0.0, 4.0, 4.0))));\n" \
+    "    return color * (0.75 + 0.3 * hash(floor(vec2(wp.x * 3.0, dot(wp, vec3(0.0, 4.0, 4.0)))))) * mix(0.55, 1.0, smoothstep(0.0, 0.15, r))\n" \
+    "      * mix(0.8, 1.0, smoothstep(0.0, 0.06, c)); }\n" \
+    "  if (material == 4) return color * (0.6 + 0.6 * fbm(uv * 2.5 + wp.y)) * mix(vec3(1.0), vec3(0.75, 0.85, 0.6),\n" \
+    "    smoothstep(0.3, 0.9, n.y) * 0.8);\n" \
+    "  if (material == 5) return color * (0.7 + 0.4 * noise(vec2(atan(n.z, n.x) * 6.0, wp.y * 3.0)));\n" \
+    "  if (material == 6) return color * (0.65 + 0.6 * fbm(vec2(atan(n.z, n.x) * 3.0, wp.y * 6.0)));\n" \
+    "  if (material == 8) return color * (0.75 + 0.35 * noise(vec2(uv.x * 14.0, uv.y * 1.5)));\n" \
+    "  return color;\n" \
+    "}\n"
+
+/* ---- the opaque renderer (GL 3.3 core; left out with DS_SCENE_ONLY) ----------------- */
+#ifndef DS_SCENE_ONLY
+
+typedef struct ds_gl {
+    GLuint prog, sky, vao[DS_MAX_MESHES], vbo[DS_MAX_MESHES], ebo[DS_MAX_MESHES], empty_vao;
+    GLuint shadow_prog, shadow_fbo, shadow_tex; /* the sun's shadow map, rendered once */
+    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv, u_shadow_vp, u_shadow_map, u_shadow_mvp;
+    int count[DS_MAX_MESHES];
+    float shadow_vp[16];
+} ds_gl;
+
+#define DS_SHADOW_SIZE 2048
+
+#define DS_GLSL_COMMON "#version 330 core\n" DS_GLSL_FUNCS
+
 static const char *const ds__vs = "#version 330 core\n"
                             "layout(location = 0) in vec3 p;\n"
                             "uniform mat4 mvp, model; out vec3 wp;\n"
                             "void main() { wp = (model * vec4(p, 1.0)).xyz; gl_Position = mvp * vec4(p, 1.0); }\n";
 
 static const char *const ds__fs_albedo =
-    "in vec3 wp; uniform vec3 color, eye; uniform int material; out vec4 o;\n"
-    "vec3 ground() {\n"
-    "  vec2 q = wp.xz; float g = fbm(q * 1.7);\n"
-    "  vec3 c = mix(vec3(0.17, 0.30, 0.08), vec3(0.38, 0.48, 0.15), g);\n"
-    "  c = mix(c, vec3(0.40, 0.33, 0.22), 0.8 * smoothstep(0.58, 0.72, fbm(q * 0.22 + 7.0)));\n"
-    "  float px = abs(q.x - 1.0 - 1.2 * sin(q.y * 0.28)), plaza = length((q - vec2(-1.0, -3.2)) * vec2(0.55, 0.8));\n"
-    "  float path = max(smoothstep(1.05, 0.9, px), smoothstep(3.1, 2.9, plaza));\n"
-    "  vec2 b = q / vec2(0.5, 0.36); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b) - 0.5;\n"
-    "  float e = smoothstep(0.5, 0.36, max(abs(f.x), abs(f.y)));\n"
-    "  vec3 st = mix(vec3(0.40, 0.38, 0.35), vec3(0.62, 0.58, 0.52), hash(floor(b))) * (0.45 + 0.55 * e);\n"
-    "  return mix(c, st * (0.85 + 0.3 * g), path * smoothstep(0.15, 0.4, fbm(q * 0.9 + 2.0) + 0.3));\n"
-    "}\n"
-    "vec2 face_uv(vec3 n) { return abs(n.x) > 0.7 ? wp.zy : abs(n.y) > 0.7 ? wp.xz : wp.xy; }\n"
-    "vec3 albedo(vec3 n) {\n"
-    "  vec2 uv = face_uv(n);\n"
-    "  if (material == 0) return ground();\n"
-    "  if (material == 1) { vec2 b = uv / vec2(0.7, 0.35); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b);\n"
-    "    float m = smoothstep(0.0, 0.05, f.x) * smoothstep(1.0, 0.95, f.x) * smoothstep(0.0, 0.09, f.y)\n"
-    "      * smoothstep(1.0, 0.91, f.y);\n"
-    "    return color * (0.82 + 0.3 * hash(floor(b))) * mix(0.6, 1.0, m) * (0.85 + 0.3 * fbm(uv * 5.0)); }\n"
-    "  if (material == 2) return color * (0.8 + 0.3 * fbm(uv * 3.0)) * (0.9 + 0.1 * smoothstep(0.3, 0.6, wp.y));\n"
-    "  if (material == 3) { float r = fract(dot(wp, vec3(0.0, 4.0, 4.0))), c = fract(wp.x * 3.0 + 0.5 * floor(dot(wp, vec3(0.0, 4.0, 4.0))));\n"
-    "    return color * (0.75 + 0.3 * hash(floor(vec2(wp.x * 3.0, dot(wp, vec3(0.0, 4.0, 4.0)))))) * mix(0.55, 1.0, smoothstep(0.0, 0.15, r))\n"
-    "      * mix(0.8, 1.0, smoothstep(0.0, 0.06, c)); }\n"
-    "  if (material == 4) return color * (0.6 + 0.6 * fbm(uv * 2.5 + wp.y)) * mix(vec3(1.0), vec3(0.75, 0.85, 0.6),\n"
-    "    smoothstep(0.3, 0.9, n.y) * 0.8);\n"
-    "  if (material == 5) return color * (0.7 + 0.4 * noise(vec2(atan(n.z, n.x) * 6.0, wp.y * 3.0)));\n"
-    "  if (material == 6) return color * (0.65 + 0.6 * fbm(vec2(atan(n.z, n.x) * 3.0, wp.y * 6.0)));\n"
-    "  if (material == 8) return color * (0.75 + 0.35 * noise(vec2(uv.x * 14.0, uv.y * 1.5)));\n"
-    "  return color;\n"
-    "}\n";
+    "in vec3 wp; uniform vec3 color, eye; uniform int material; out vec4 o;\n" DS_GLSL_ALBEDO;
 
 static const char *const ds__fs_main =
     "uniform mat4 shadow_vp; uniform sampler2DShadow shadow_map;\n"
@@ -620,4 +627,5 @@ static inline void ds_draw(ds_gl *g, const ds_scene *s, const float view[16], co
     glBindVertexArray(0);
 }
 
+#endif /* DS_SCENE_ONLY */
 #endif /* DEMO_SCENE_H */
