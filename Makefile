@@ -6,7 +6,7 @@
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
 #   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
-#   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
+#   make web    the browser demo (emscripten, WebGL1 + WebGL2: the courtyard to fly through) into build/web/demo_web.html
 #   make vulkan the Vulkan example (examples/vulkan_backend.c, lavapipe) into build/vulkan/*.png
 # Adding a test program: one name in TESTS (see "test programs" below). JOBS=n sets how many
 # compilers and tests run at once (default: the number of cores).
@@ -284,13 +284,14 @@ images: demo
 # NODE_PATH: Debian's emscripten finds its node modules (acorn) there even under a node from elsewhere
 WEB_FLAGS = -std=c99 -O2 $(WARN) $(INC) -I/usr/include/stb -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 \
             -sSINGLE_FILE=1 -sWASM_ASYNC_COMPILATION=0 -sALLOW_MEMORY_GROWTH=1 -sMINIFY_HTML=0
-$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/shell.html fogvol.h examples/example_gl.h tests/raycast.h tests/shapes.h
+$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/courtyard.h examples/web/shell.html fogvol.h \
+	  examples/example_gl.h examples/demo_scene.h tests/raycast.h tests/shapes.h
 	@mkdir -p $(BUILD)/web
 	NODE_PATH=/usr/share/nodejs $(EMCC) $(WEB_FLAGS) $< --shell-file examples/web/shell.html -o $@
 
 web: deps-web
 	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html
-	@echo "open $(BUILD)/web/demo_web.html?webgl1 or ?webgl2 in a browser"
+	@echo "open $(BUILD)/web/demo_web.html (WebGL2) or demo_web.html?webgl1 in a browser; ?test&webgl1 / ?test&webgl2: its self-test"
 
 test-web: deps-web
 	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html

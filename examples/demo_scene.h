@@ -369,6 +369,28 @@ static inline void ds_scene_free(ds_scene *s)
     "  return color;\n" \
     "}\n"
 
+/* general 4x4 inverse (column-major); returns 0 for a singular matrix */
+static inline int ds_invert(float out[16], const float m[16])
+{
+    double a[4][8], t;
+    int c, r, k, piv;
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 8; ++c) a[r][c] = c < 4 ? m[c * 4 + r] : (c - 4 == r);
+    for (c = 0; c < 4; ++c) {
+        for (piv = c, r = c + 1; r < 4; ++r)
+            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
+        if (fabs(a[piv][c]) < 1e-30) return 0;
+        for (k = 0; k < 8; ++k) t = a[c][k], a[c][k] = a[piv][k], a[piv][k] = t;
+        for (t = a[c][c], k = 0; k < 8; ++k) a[c][k] /= t;
+        for (r = 0; r < 4; ++r)
+            if (r != c)
+                for (t = a[r][c], k = 0; k < 8; ++k) a[r][k] -= t * a[c][k];
+    }
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 4; ++c) out[c * 4 + r] = (float)a[r][c + 4];
+    return 1;
+}
+
 /* ---- the opaque renderer (GL 3.3 core; left out with DS_SCENE_ONLY) ----------------- */
 #ifndef DS_SCENE_ONLY
 
@@ -557,28 +579,6 @@ static inline void ds_gl_free(ds_gl *g)
     glDeleteProgram(g->prog);
     glDeleteProgram(g->sky);
     memset(g, 0, sizeof *g);
-}
-
-/* general 4x4 inverse (column-major); returns 0 for a singular matrix */
-static inline int ds_invert(float out[16], const float m[16])
-{
-    double a[4][8], t;
-    int c, r, k, piv;
-    for (r = 0; r < 4; ++r)
-        for (c = 0; c < 8; ++c) a[r][c] = c < 4 ? m[c * 4 + r] : (c - 4 == r);
-    for (c = 0; c < 4; ++c) {
-        for (piv = c, r = c + 1; r < 4; ++r)
-            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
-        if (fabs(a[piv][c]) < 1e-30) return 0;
-        for (k = 0; k < 8; ++k) t = a[c][k], a[c][k] = a[piv][k], a[piv][k] = t;
-        for (t = a[c][c], k = 0; k < 8; ++k) a[c][k] /= t;
-        for (r = 0; r < 4; ++r)
-            if (r != c)
-                for (t = a[r][c], k = 0; k < 8; ++k) a[r][k] -= t * a[c][k];
-    }
-    for (r = 0; r < 4; ++r)
-        for (c = 0; c < 4; ++c) out[c * 4 + r] = (float)a[r][c + 4];
-    return 1;
 }
 
 /* The engine's opaque pass: clears the bound framebuffer's colour and depth to the
