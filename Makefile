@@ -14,7 +14,7 @@ CC      ?= cc
 BUILD   ?= build
 WARN     = -Wall -Wextra -pedantic -Werror
 CFLAGS  ?= -O2 -g
-SAN      = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+SAN      = -O1 -g -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer -fno-sanitize-recover=all
 INC      = -I.
 GL_LIBS  = -lOSMesa -lm
 LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
@@ -57,7 +57,7 @@ $(BUILD):
 #   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
-TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks cpu
+TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks limits cpu
 CXX_TESTS = cpu
 JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
 
@@ -99,15 +99,28 @@ $(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)
 
 $(BUILD)/test_raycast: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -Itests $< -o $@ -lm
+$(BUILD)/test_raycast_san: tests/test_raycast_selftest.c tests/raycast.h tests/shapes.h | $(BUILD)
+	$(CC) -std=c99 -DRC_SANITIZE $(SAN) $(WARN) $(INC) -Itests $< -o $@ -lm
 $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
 $(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
+# API sequences on the null and the GL backend (OSMesa): libFuzzer under ASan+UBSan with
+# float-cast-overflow, and its corpus replayed by the sanitizer build of the tests (GL under
+# valgrind would take minutes). make test's short run starts from the seeds (tests/fuzz/seed_api.py
+# writes them; loading the whole corpus into libFuzzer takes a minute), make fuzz from the corpus.
+FUZZ_API_DEPS = tests/fuzz/fuzz_api.c fogvol.h tests/gl_util.h tests/shapes.h
+$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) | $(BUILD)
+	clang -g -O1 -fsanitize=fuzzer,address,undefined,float-cast-overflow -fno-sanitize-recover=all $(INC) $< -o $@ \
+	  -lOSMesa -lm
+$(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE $(SAN) $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_api.c -o $@ -lOSMesa -lm
 
 TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
-            $(BUILD)/test_raycast $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
+            $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
+            $(BUILD)/replay_api_san $(BUILD)/fuzz_api \
             $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless \
             $(BUILD)/vulkan_backend
 
@@ -120,6 +133,7 @@ GL_COMPILE = mkdir -p $(BUILD)/shaders_gl && rm -f $(BUILD)/shaders_gl/*.vert $(
 SCRIPT_RUNS = \
   "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
+  $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
   "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh" \
   "compile_matrix=BUILD=$(BUILD) tests/compile_matrix.sh" \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
@@ -129,11 +143,14 @@ SCRIPT_RUNS = \
   "demo_headless=$(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(BUILD)/bench --quick" \
   "raycast_selftest=$(BUILD)/test_raycast" \
+  "raycast_selftest_asan_ubsan=$(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(TAP) $(VALGRIND) $(BUILD)/test_cpu_vg" \
   "fuzz_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
   "fuzz_mesh_5s=mkdir -p $(BUILD)/fuzz/mesh && $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
   "fuzz_analytic_corpus_valgrind=$(VALGRIND) $(BUILD)/replay_analytic tests/fuzz/corpus_analytic" \
-  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic"
+  "fuzz_analytic_5s=mkdir -p $(BUILD)/fuzz/analytic && $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
+  "fuzz_api_corpus_asan_ubsan=$(LSAN_ENV) $(BUILD)/replay_api_san tests/fuzz/corpus_api" \
+  "fuzz_api_5s=rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
@@ -171,13 +188,15 @@ VK_ENV   = $(if $(LVP_ICD),VK_ICD_FILENAMES=$(LVP_ICD) VK_DRIVER_FILES=$(LVP_ICD
 $(BUILD)/vulkan_backend: examples/vulkan_backend.c examples/fogvol_vulkan.h examples/vulkan_scene.h $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -D_POSIX_C_SOURCE=200809L $(CFLAGS) $(WARN) $(INC) $< -o $@ $(VK_LIBS) $(GL_LIBS)
 
-# the Vulkan pictures (FLOAT with the engine's depth, PS20, MRT), validation layers on
+# the Vulkan pictures (FLOAT with the engine's depth, PS20, MRT), validation layers on; each fails on
+# any validation message up to the end of the program (make test runs them too)
+VULKAN_PICTURES = float ps20 mrt
+VULKAN_PICTURE = mkdir -p $(BUILD)/vulkan && $(VK_ENV) $(BUILD)/vulkan_backend --tier $(1) $(BUILD)/vulkan/vulkan_$(1).png
 vulkan: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/vulkan_backend
-	@mkdir -p $(BUILD)/vulkan
-	$(VK_ENV) $(BUILD)/vulkan_backend $(BUILD)/vulkan/vulkan_float.png
-	$(VK_ENV) $(BUILD)/vulkan_backend --tier ps20 $(BUILD)/vulkan/vulkan_ps20.png
-	$(VK_ENV) $(BUILD)/vulkan_backend --tier mrt $(BUILD)/vulkan/vulkan_mrt.png
+	$(call VULKAN_PICTURE,float)
+	$(call VULKAN_PICTURE,ps20)
+	$(call VULKAN_PICTURE,mrt)
 
 # milliseconds per frame: the Vulkan backend on lavapipe beside the GL backend on llvmpipe, same scene
 vulkan-bench: deps-test
@@ -217,7 +236,7 @@ $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
 # driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with
 # test_gles (EGL's surfaceless platform, OpenGL ES) and the headless demo
-EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks
+EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks limits
 $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
 	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm
@@ -260,13 +279,16 @@ $(BUILD)/bench_analytic: bench/bench_analytic.c fogvol.h | $(BUILD)
 bench-analytic: $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic
 
-# libFuzzer on mesh validation and the analytic fog input, FUZZ_TIME seconds per target; new inputs go to
+# libFuzzer on mesh validation, the analytic fog input and API call sequences (null and GL backends; -detect_leaks=0:
+# the target counts its context's allocations and backend objects itself), FUZZ_TIME seconds per target; new inputs go to
 # build/fuzz (merge them into tests/fuzz/corpus_* with -merge=1 when they matter)
-fuzz: deps-test $(BUILD)/fuzz_mesh $(BUILD)/fuzz_analytic
-	@mkdir -p $(BUILD)/fuzz/mesh $(BUILD)/fuzz/analytic
+fuzz: deps-test $(BUILD)/fuzz_mesh $(BUILD)/fuzz_analytic $(BUILD)/fuzz_api
+	@mkdir -p $(BUILD)/fuzz/mesh $(BUILD)/fuzz/analytic $(BUILD)/fuzz/api
 	$(BUILD)/fuzz_mesh -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh
 	$(BUILD)/fuzz_analytic -max_total_time=$(FUZZ_TIME) -print_final_stats=1 $(BUILD)/fuzz/analytic \
 	  tests/fuzz/corpus_analytic
+	$(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=$(FUZZ_TIME) -detect_leaks=0 -print_final_stats=1 $(BUILD)/fuzz/api \
+	  tests/fuzz/corpus_api
 
 # the README pictures, regenerated from the demo
 images: demo

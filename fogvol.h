@@ -223,8 +223,8 @@
        fogvol_occluder_info oi; fogvol_occluder_prepare(fv, &oi); // O texture, size, clear colour, uniforms
        // engine FBO: colour oi.texture + its own depth; shader: fogvol_occluder_snippet(),
        // fogvol_mrt[2] = oi.uniforms, colour = fogvol_occluder_color(-view_space_z)
-       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16,
-       //         weld_distance > 0 for seams and per-face vertices
+       // meshes: fogvol_mesh_desc.stride/offset (interleaved), index_type + indices16 or no
+       //         index array (triangles in vertex order), weld_distance > 0 for seams and per-face vertices
 
    ANALYTIC FOG VOLUMES (no render passes; FOGVOL_NO_ANALYTIC leaves them out)
    ====================
@@ -449,7 +449,9 @@ enum {
        colour channel (extinction density * extinction_color times signed depth) and their
        emission (that optical depth times the ramp colour) into two RGBA32F targets in one sum
        pass, and one composite pass blends them all (two full-screen draws, multiply then add,
-       when some extinction colour is not grey). Other ramps keep their own group. Model and
+       when some extinction colour is not grey). Other ramps keep their own group, and so does,
+       for a frame, a ramp one of whose volumes has a density or colour texture in it (drawn as
+       without COLORS: the group's programs draw no texture). Model and
        error: see "One-pass colours" in the README. Needs the FLOAT tier, FOGVOL_CAP_MRT and
        target_attachment (else the context is refused, FOGVOL_ERROR_UNSUPPORTED, logged); not
        per sample on multisampled framebuffers (fogvol_msaa_supported: use
@@ -464,9 +466,10 @@ enum {
 FOGVOL_API fogvol_result fogvol_combination_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 /* FOGVOL_SUCCESS if the tier with these variants can render into a
    multisampled engine framebuffer per sample (fogvol_shader_desc.samples > 1):
-   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT
-   (not with ENGINE_DEPTH), PS20 or PS13, not WIDE. GLSL 110/120/130 and ES
-   100/300 es have no multisample textures with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
+   GLSL 150 or 330 (with GL_ARB_sample_shading, core in GL 4.0) and tier FLOAT,
+   PS20 or PS13 (with ENGINE_DEPTH: the engine's depth read per sample), not WIDE
+   or COLORS. GLSL 110/120/130 and ES 100/300 es have no multisample textures
+   with gl_SampleID: FOGVOL_ERROR_UNSUPPORTED. */
 FOGVOL_API fogvol_result fogvol_msaa_supported(fogvol_tier tier, unsigned variants, fogvol_dialect dialect);
 
 typedef struct fogvol_tier_info {
@@ -508,6 +511,14 @@ typedef struct fogvol_gl_desc {
                                  must be highp as well). Left 0, a mediump output could round
                                  the depth to fp16, so O stays RGBA8. Desktop GL: ignored (always full
                                  precision). */
+    /* optional: the window system's current context as an opaque id (user_data as above), e.g.
+       eglGetCurrentContext, glfwGetCurrentContext, SDL_GL_GetCurrentContext, wglGetCurrentContext.
+       fogvol keeps what it returns at creation and refuses every call that would touch GL while it
+       returns something else (FOGVOL_ERROR_INVALID_STATE, logged; nothing is touched). Without it,
+       fogvol tells another context by its own vertex array object (GL 3 / GLES 3; on GL 2 / GLES 2 a
+       framebuffer object) not being there, which a context that does not share objects with
+       fogvol's always shows, and a context sharing them too (those objects are never shared). */
+    void *(*current_context)(void *user_data);
 } fogvol_gl_desc;
 
 /* Multisampled engine framebuffers (GL_SAMPLES > 1 on the framebuffer bound at
@@ -525,7 +536,9 @@ typedef struct fogvol_gl_desc {
    fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
    3.9-4.6x the time of the same scene on a single-sample framebuffer, one
    run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
-   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample. */
+   29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample; with
+   ENGINE_DEPTH (its depth copied or read per sample) mean 0.8, max 2, where
+   the single-sample fallback's resolved depth gives mean 35.6, max 100. */
 typedef enum fogvol_msaa {
     FOGVOL_MSAA_AUTO = 0,
     FOGVOL_MSAA_SINGLE_SAMPLE = 1,
@@ -556,6 +569,10 @@ typedef struct fogvol_context_desc fogvol_context_desc;
 
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out);
+/* Frees everything the context owns, host memory and backend objects: its targets, programs and
+   lookup textures, and the meshes, ramps and volume textures made with it that are still alive
+   (destroyed with it; a warning in the log counts them: destroy them first). An open frame is
+   dropped. */
 FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx);
 FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled);
 FOGVOL_API fogvol_tier fogvol_context_tier(const fogvol_context *ctx, unsigned *variants);
@@ -574,7 +591,10 @@ typedef struct fogvol_mesh_desc {
     const float *positions;    /* x, y, z floats per vertex (with offset: the start of the vertex buffer) */
     int vertex_count;
     int stride;                /* bytes between vertices, 0 = 12; at least 12 */
-    const uint32_t *indices;   /* 3 per triangle */
+    const uint32_t *indices;   /* 3 per triangle. No index array (indices and indices16 NULL, index_count
+                                  0): the triangles are the vertices in order, (0, 1, 2), (3, 4, 5), ...
+                                  (vertex_count a multiple of 3: glDrawArrays order, raylib's Mesh
+                                  without indices); usually with weld_distance, as its corners repeat */
     int index_count;
     int allow_open;            /* 1: accept open or inconsistent meshes (occluders only) */
     /* Engine vertex buffers as they are: offset is the byte offset of x inside
@@ -617,17 +637,20 @@ typedef struct fogvol_mesh_report {
     int welded_vertices;       /* vertices merged into others by the weld (weld_distance > 0), else 0;
                                   vertices counts the rest */
     /* Filled by fogvol_create_mesh for valid volume hulls (fogvol_validate_mesh leaves 0): 1 when
-       every vertex lies on the inner side of the plane of every non-degenerate triangle, within
-       1e-5 of the bounding box's diagonal (a convex hull: usable by fogvol_add_light); 0 when some
-       vertex lies outside some face plane (concave); -1 not checked (not a valid hull, or more than
-       2^26 triangle x vertex pairs). */
+       every vertex the triangles use lies on the inner side of the plane of every non-degenerate
+       triangle (both after the weld: triangles it collapses have no plane; vertices of a shared
+       buffer that no triangle uses do not count), within 1e-5 of the used vertices' bounding box
+       diagonal (a convex hull: usable by fogvol_add_light); 0 when some vertex lies outside some face
+       plane (concave); -1 not checked (not a valid hull, or more than 2^26 triangle x vertex
+       pairs). */
     int convex;
 } fogvol_mesh_report;
 
 /* Checks the mesh; fills *report. Returns FOGVOL_SUCCESS for a valid volume
    hull, FOGVOL_ERROR_INVALID_MESH otherwise (report says why). Scratch memory
-   (about 40 bytes per triangle, + 12 per vertex and 4 per index when welding or
-   with 16-bit indices) comes from alloc (NULL = default). Never reads outside
+   (about 40 bytes per triangle, + 4 per index with 16-bit indices, without an
+   index array or when welding, + about 26 per vertex when welding; the weld takes
+   O(n) time) comes from alloc (NULL = default). Never reads outside
    the vertex_count vertices (stride, offset) or indices[0 .. index_count).
    FOGVOL_ERROR_INVALID_ARGUMENT for a bad layout (stride < 12, offset + 12 >
    stride, unknown index_type, missing arrays, bad weld_distance). */
@@ -761,6 +784,13 @@ typedef struct fogvol_frame_stats {
     int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
+    /* The thickness step of this frame's RGBA8 digit sums, in view depth: (zfar - znear) / 2^(3L)
+       (WIDE: 2^(6L)); every pixel's thickness is within about one step per pair of faces. 0 when no
+       group summed in digits (FLOAT, FOGVOL_SPEEDUP_EXACT_SUM). When it is coarser than 1/16 of the
+       view-depth extent of the bounds of the frame's smallest volume, a warning is logged (on the
+       first such frame, and again after a frame that was not): move znear out or zfar in, or use
+       fewer faces per target (fogvol_context_desc.encoding_bits) or the FLOAT tier. */
+    float depth_lsb;
 } fogvol_frame_stats;
 
 typedef enum fogvol_depth_source {
@@ -798,13 +828,21 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
    FOGVOL_ERROR_INVALID_ARGUMENT. fogvol computes its own clip depth from znear and zfar,
    so the projection's depth convention does not matter to it (only to the engine depth
    texture, see fogvol_frame_info), and decides the winding from how the projection
-   orients the screen (mirrored x or y flip it). */
+   orients the screen (mirrored x or y flip it). Matrices are column-major (m[column * 4 +
+   row], as glUniformMatrix4fv with transpose = GL_FALSE): a view matrix must be affine
+   (bottom row m[3], m[7], m[11], m[15] = 0, 0, 0, 1), and a perspective projection whose
+   w row stands in column 3 (m[14] = +-1, m[11] not) is taken for a transposed one; both
+   are refused (FOGVOL_ERROR_INVALID_ARGUMENT), and the log says "transposed?" with the
+   matrices that transposed would be accepted. Row-major engine matrices (raylib's Matrix,
+   DirectXMath's XMFLOAT4X4 in a row-vector convention) must be transposed when copied
+   (raylib: MatrixToFloat gives the column-major order). */
 typedef struct fogvol_frame_desc {
     float view[16];
     float projection[16];
     float znear, zfar;      /* the planes the thickness is measured between; 0 < znear < zfar (view
                                depth from the eye; fogvol clips at znear, counts beyond zfar as at zfar) */
-    int viewport[4];        /* x, y, width, height in the engine framebuffer */
+    int viewport[4];        /* x, y, width, height in the engine framebuffer: x and y within -32768..32767,
+                               width and height 1..16384 (else FOGVOL_ERROR_INVALID_ARGUMENT) */
     fogvol_composite composite;
     /* The engine's draw buffer the composite writes (index into its
        glDrawBuffers list; 0 = the first, the only one for most engines); the
@@ -821,7 +859,12 @@ typedef struct fogvol_frame_desc {
        bottom to top, for the group of debug_ramp (NULL = the first group). Set
        debug_thickness to a width*height float buffer. Units: view-space w (the
        distance along the view axis, world units when the view matrix has no
-       scale), between znear and zfar; this read-back stalls, for debugging only. */
+       scale), between znear and zfar; this read-back stalls, for debugging only.
+       A frame that draws no volume of debug_ramp (or none at all) writes 0
+       everywhere. The one-pass colour group (FOGVOL_VARIANT_COLORS) sums optical
+       depths of all its ramps: its read-back is the thickness of debug_ramp's
+       volumes alone (NULL: the ramp of the group's first volume), summed in one
+       more pass. */
     float *debug_thickness;
     const fogvol_ramp *debug_ramp; /* (not with a multisampled engine framebuffer drawn per
                                       sample: end_frame returns FOGVOL_ERROR_UNSUPPORTED) */
@@ -829,7 +872,10 @@ typedef struct fogvol_frame_desc {
        object, GL: texture name), sampled with its .r; its window depth is mapped back
        to view depth through the inverse of projection * view (any projection above) and
        the depth conventions the backend reports (fogvol_frame_info) unless overridden by
-       the two fields below */
+       the two fields below. In a frame drawn per sample (a multisampled engine
+       framebuffer, FOGVOL_MSAA_AUTO) it is a multisample texture of the framebuffer's
+       sample count (GL: GL_TEXTURE_2D_MULTISAMPLE), read at each sample. It is read as
+       it is at each end_frame. */
     fogvol_native engine_depth_texture;
     int engine_depth_zero_to_one; /* 0 = as reported; 1: NDC z in [0,1]; -1: NDC z in [-1,1] */
     float engine_depth_range[2];  /* both 0 = as reported; else the glDepthRange it was drawn with */
@@ -841,12 +887,17 @@ typedef struct fogvol_frame_desc {
     float eye[3], forward[3];
     /* FOGVOL_VARIANT_ENGINE_DEPTH: where the depth comes from (0 = engine_depth_texture).
        The other sources are depth buffers that cannot be sampled (the default
-       framebuffer's, renderbuffers, multisampled ones): at end_frame fogvol
-       copies the viewport's depth into a single-sample depth texture of its own
+       framebuffer's, renderbuffers, multisampled ones): at every end_frame fogvol
+       copies the viewport's depth as it is then into a depth texture of its own
        (GL: glBlitFramebuffer into a texture of the source's exact depth/stencil
-       format, which resolves a multisampled source to one sample per pixel;
-       needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
-       FOGVOL_ERROR_UNSUPPORTED). */
+       format; needs GL 3.0 / GLES 3.0 / ARB_framebuffer_object, else
+       FOGVOL_ERROR_UNSUPPORTED), so every frame and every view of a frame (split
+       screen: one begin/end_frame per viewport) reads its own depth. Single-sample
+       frames: a multisampled source is resolved to one sample per pixel. Frames drawn
+       per sample: every sample is copied, from a source of the engine framebuffer's
+       sample count (the bound framebuffer, or that framebuffer by name); a single-sample
+       source gives each pixel's depth to all its samples (desktop GL; OpenGL ES:
+       FOGVOL_ERROR_UNSUPPORTED); another sample count: FOGVOL_ERROR_INVALID_ARGUMENT. */
     fogvol_depth_source engine_depth_source;
     fogvol_native engine_depth_framebuffer; /* FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT: its API object
                                            (GL: framebuffer name, 0 = the default framebuffer) */
@@ -879,11 +930,21 @@ typedef struct fogvol_frame_desc {
    open frame (logged as a warning).
    GL backend, the engine's state (restored, or set for fogvol's passes and
    restored: the list is at FOGVOL__GL_ENABLES in the GL backend): GL errors
-   the engine left pending are still pending after every fogvol call
-   (out-of-memory and context-loss codes cannot be raised again: logged as a
-   warning); an active transform feedback is paused during the call (GL 4.0 /
-   GLES 3.0; on GL 3.x, where it cannot be queried, do not call fogvol inside
-   one); an occlusion or PRIMITIVES_GENERATED query the engine has running
+   the engine left pending are still pending after every fogvol call, and
+   nothing else (out-of-memory and context-loss codes cannot be raised again:
+   logged as a warning); they are raised again with GL_DEBUG_OUTPUT switched off
+   where the context has KHR_debug (GL 4.3, GLES 3.2 or the extension), so the
+   engine's debug callback and message log get no message for them (without
+   KHR_debug, e.g. ARB_debug_output alone, each raise reaches its callback as
+   one message). GL errors fogvol's own calls raise are the call's result
+   (FOGVOL_ERROR_BACKEND), logged, never left pending. fogvol must be called
+   with the GL context current that it was created in (a context sharing its
+   objects is not enough: vertex array and framebuffer objects are never
+   shared); with another current every call that would touch GL returns
+   FOGVOL_ERROR_INVALID_STATE, logged, and touches nothing (see
+   fogvol_gl_desc.current_context); an active transform feedback is paused
+   during the call (GL 4.0 / GLES 3.0; on GL 3.x, where it cannot be queried,
+   do not call fogvol inside one); an occlusion or PRIMITIVES_GENERATED query the engine has running
    counts fogvol's draws too (GL cannot pause those; fogvol then skips its
    own overflow query for the frame); fogvol must not be called between
    glBeginConditionalRender and glEndConditionalRender (not queryable: its
@@ -900,7 +961,10 @@ FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const fl
 typedef struct fogvol_volume_texture fogvol_volume_texture; /* fogvol_create_volume_texture */
 typedef struct fogvol_volume_desc {
     const fogvol_mesh *mesh;
-    float model[16];
+    float model[16];          /* column-major, affine (bottom row 0, 0, 0, 1), not singular (a zero
+                                 scale leaves no volume): else FOGVOL_ERROR_INVALID_ARGUMENT, logged
+                                 ("transposed?" when its transpose is affine). Occluder and light
+                                 model matrices: the same (an occluder may be flat, not all zero) */
     const fogvol_ramp *ramp;  /* volumes sharing a ramp sum their thickness */
     int negative;             /* 1: subtracts thickness from the volumes of its ramp */
     /* Density texture (NULL = none: uniform density, the old behaviour). Its red channel is a
@@ -1436,12 +1500,15 @@ typedef struct fogvol_backend {
     /* optional (WIDE): the second colour attachment of a two-attachment target,
        as a target handle of its own (sampled and read back like any target) */
     fogvol_handle (*target_attachment)(void *user_data, fogvol_handle target, int index);
-    /* optional (ENGINE_DEPTH from a framebuffer), called inside a frame: copies
-       the depth of rect (x, y, w, h) of the engine framebuffer (bound: the one
-       bound at begin_frame; else framebuffer, an API object) into a
-       single-sample depth texture the backend owns, with the same texel
-       coordinates, and returns that texture's API object in *texture. */
-    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4],
+    /* optional (ENGINE_DEPTH from a framebuffer), called inside every frame that reads it, before
+       the first pass: copies the depth of rect (x, y, w, h) of the engine framebuffer as it is now
+       (bound: the one bound at begin_frame; else framebuffer, an API object) into a depth texture
+       the backend owns, with the same texel coordinates, and returns that texture's API object in
+       *texture. samples 0: a single-sample texture (a multisampled source resolved to one sample
+       per pixel); samples > 1 (a frame drawn per sample): a multisample texture of that many
+       samples, each sample copied (GL: GL_TEXTURE_2D_MULTISAMPLE). The texture may be reused
+       from frame to frame, its contents never: each call copies again. */
+    fogvol_result (*copy_depth)(void *user_data, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                 fogvol_native *texture);
     /* optional (overflow counting without read-back; all five or none): occlusion queries that count
        the samples passing between begin_query and end_query, which fogvol calls around the draws of
@@ -1455,6 +1522,13 @@ typedef struct fogvol_backend {
     int (*begin_query)(void *user_data, fogvol_handle query);
     void (*end_query)(void *user_data, fogvol_handle query);
     int (*query_result)(void *user_data, fogvol_handle query, uint64_t *samples);
+    /* optional: the first failure the backend met in its own calls since the last take_error, else
+       FOGVOL_SUCCESS, and forget it. fogvol calls it at the end of every public call that used the
+       backend and returns it when the call had no error of its own (the backend logs it). GL: a GL
+       error fogvol's own calls raised (FOGVOL_ERROR_BACKEND), read before the engine's pending errors
+       are raised again; an engine texture name that is no texture (FOGVOL_ERROR_INVALID_ARGUMENT);
+       another GL context current (FOGVOL_ERROR_INVALID_STATE). */
+    fogvol_result (*take_error)(void *user_data);
 } fogvol_backend;
 
 /* Recording null backend: no GPU, every call counted and the passes kept. */
@@ -2667,67 +2741,141 @@ static int fogvol__mesh_stride(const fogvol_mesh_desc *d)
     return d->stride ? d->stride : 12;
 }
 
+/* No index array (fogvol_mesh_desc): the triangles are the vertices 0, 1, 2, then 3, 4, 5, ... */
+static int fogvol__non_indexed(const fogvol_mesh_desc *d)
+{
+    return !d->indices && !d->indices16 && d->index_count == 0;
+}
+
+/* Indices the mesh's triangles have (vertex_count without an index array). */
+static int fogvol__index_count(const fogvol_mesh_desc *d)
+{
+    return fogvol__non_indexed(d) ? d->vertex_count : d->index_count;
+}
+
 /* NULL for a usable layout, else what is wrong with it. */
 static const char *fogvol__mesh_problem(const fogvol_mesh_desc *d)
 {
     int stride;
     if (!d || !d->positions) return "no positions";
-    if (d->vertex_count <= 0 || d->index_count <= 0 || d->index_count % 3 != 0)
-        return "vertex_count must be > 0 and index_count a positive multiple of 3";
+    if (d->vertex_count <= 0 || fogvol__index_count(d) <= 0 || fogvol__index_count(d) % 3 != 0)
+        return fogvol__non_indexed(d) ? "no index array: vertex_count must be a positive multiple of 3"
+                                      : "vertex_count must be > 0 and index_count a positive multiple of 3";
     if (d->stride < 0 || (d->stride != 0 && d->stride < 12)) return "stride below the 12 bytes of a position";
     stride = fogvol__mesh_stride(d);
     if (d->offset < 0 || d->offset > stride - 12) return "offset + 12 beyond the stride";
     if (d->index_type != FOGVOL_INDEX_UINT32 && d->index_type != FOGVOL_INDEX_UINT16) return "unknown index_type";
-    if (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16) return "no index array of index_type";
+    if (!fogvol__non_indexed(d) && (d->index_type == FOGVOL_INDEX_UINT32 ? !d->indices : !d->indices16))
+        return "no index array of index_type (leave both arrays NULL and index_count 0 for none)";
     if (!fogvol__finite(d->weld_distance) || d->weld_distance < 0) return "weld_distance negative or not finite";
     return NULL;
 }
 
+/* The weld's sweep order: each vertex's coordinate on the sweep axis as an unsigned key in the order
+   of the floats (-0 as +0), with its number. */
 typedef struct fogvol__wkey {
-    float key;
+    uint32_t key;
     uint32_t i;
 } fogvol__wkey;
 
-static int fogvol__wkey_less(const fogvol__wkey *x, const fogvol__wkey *y)
+static uint32_t fogvol__sweep_key(float f)
 {
-    return x->key < y->key || (x->key == y->key && x->i < y->i);
+    uint32_t b;
+    f += 0.0f; /* -0 -> +0 */
+    memcpy(&b, &f, sizeof b);
+    return (b & 0x80000000u) ? ~b : b | 0x80000000u;
 }
 
-static void fogvol__sift_wkeys(fogvol__wkey *k, int root, int n)
+/* Stable LSD radix sort of k by key, 8 bits a pass (tmp: n entries), so that equal keys keep their
+   vertices' order: O(n). */
+static void fogvol__sort_wkeys(fogvol__wkey *k, fogvol__wkey *tmp, int n)
 {
-    int child;
-    fogvol__wkey t;
-    for (; (child = 2 * root + 1) < n; root = child) {
-        if (child + 1 < n && fogvol__wkey_less(&k[child], &k[child + 1])) ++child;
-        if (!fogvol__wkey_less(&k[root], &k[child])) return;
-        t = k[root];
-        k[root] = k[child];
-        k[child] = t;
+    size_t cnt[256], sum, c;
+    fogvol__wkey *src = k, *dst = tmp, *t;
+    int pass, i;
+    for (pass = 0; pass < 4; ++pass) { /* (an even count: the result ends in k) */
+        unsigned sh = 8u * (unsigned)pass;
+        memset(cnt, 0, sizeof cnt);
+        for (i = 0; i < n; ++i) cnt[(src[i].key >> sh) & 255u]++;
+        for (i = 0, sum = 0; i < 256; ++i) {
+            c = cnt[i];
+            cnt[i] = sum;
+            sum += c;
+        }
+        for (i = 0; i < n; ++i) dst[cnt[(src[i].key >> sh) & 255u]++] = src[i];
+        t = src;
+        src = dst;
+        dst = t;
     }
 }
 
-/* In-place heap sort (no allocation, O(n log n)). */
-static void fogvol__sort_wkeys(fogvol__wkey *k, int n)
+/* The weld's sweep: the kept vertices in a hash of their cells on the two axes across the sweep
+   (cells dist wide: floor(coordinate / dist) as a double; the quotient of two floats is exact
+   enough in double that coordinates within dist of each other lie in the same or neighbouring
+   cells, for any floats), chained newest first (heads: mask + 1 buckets, next: per vertex). */
+typedef struct fogvol__weld_grid {
+    const unsigned char *base;
+    int stride, axis; /* axis: the sweep's */
+    float dist;
+    uint32_t *heads, *next, mask;
+} fogvol__weld_grid;
+
+#define FOGVOL__NONE 0xffffffffu
+
+/* v's cell across the sweep: floor(coordinate / dist) on the two other axes. */
+static void fogvol__weld_cell(const fogvol__weld_grid *g, const float v[3], double c[2])
 {
-    int i;
-    fogvol__wkey t;
-    for (i = n / 2 - 1; i >= 0; --i) fogvol__sift_wkeys(k, i, n);
-    for (i = n - 1; i > 0; --i) {
-        t = k[0];
-        k[0] = k[i];
-        k[i] = t;
-        fogvol__sift_wkeys(k, 0, i);
-    }
+    c[0] = FOGVOL_FLOOR((double)v[(g->axis + 1) % 3] / g->dist);
+    c[1] = FOGVOL_FLOOR((double)v[(g->axis + 2) % 3] / g->dist);
 }
 
-/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on
-   every axis (i itself when none). A sweep along the axis of largest extent
-   (sorted keys) limits the candidates. Non-finite vertices stay alone. Returns
-   how many vertices were merged. */
-static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, uint32_t *rep, fogvol__wkey *keys)
+/* The bucket of cell c moved by (du, dv) (-0 made +0; cells beyond 32-bit integers hashed by their
+   bits). Neighbours along the second axis land in neighbouring buckets. */
+static uint32_t fogvol__weld_bucket(const fogvol__weld_grid *g, const double c[2], int du, int dv)
 {
-    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3], w[3];
-    int i, a, b, k, axis = 0, merged = 0, any = 0;
+    uint32_t h[2], w[2];
+    int k;
+    for (k = 0; k < 2; ++k) {
+        double x = c[k] + (k ? dv : du) + 0.0;
+        if (x > -2147483648.0 && x < 2147483648.0) {
+            h[k] = (uint32_t)(int32_t)x;
+        } else {
+            memcpy(w, &x, sizeof w);
+            h[k] = (w[0] ^ w[1]) * 0x9e3779b1u;
+        }
+    }
+    return (h[0] * 0x9e3779b1u + h[1]) & g->mask;
+}
+
+/* The lowest-numbered kept vertex within dist of v on every axis among those the sweep has met, from
+   the 9 cells around v's cell c across the sweep, FOGVOL__NONE: none. A vertex more than dist behind v
+   along the sweep is behind every vertex to come as well: the chain is cut there (it and every older
+   entry), so the chains hold the last dist of the sweep only. */
+static uint32_t fogvol__weld_find(fogvol__weld_grid *g, const float v[3], const double c[2])
+{
+    uint32_t best = FOGVOL__NONE, j, *link;
+    float w[3];
+    int d;
+    for (d = 0; d < 9; ++d)
+        for (link = &g->heads[fogvol__weld_bucket(g, c, d % 3 - 1, d / 3 - 1)]; (j = *link) != FOGVOL__NONE;
+             link = &g->next[j]) {
+            memcpy(w, g->base + (size_t)j * g->stride, sizeof w);
+            if ((double)v[g->axis] - w[g->axis] > g->dist) {
+                *link = FOGVOL__NONE;
+                break;
+            }
+            if (j < best && FOGVOL_FABS((double)w[0] - v[0]) <= g->dist &&
+                FOGVOL_FABS((double)w[1] - v[1]) <= g->dist && FOGVOL_FABS((double)w[2] - v[2]) <= g->dist)
+                best = j;
+        }
+    return best;
+}
+
+/* The axis of largest extent of the finite vertices (rep[i] = i on the way). */
+static int fogvol__weld_axis(const unsigned char *base, int stride, int nv, uint32_t *rep)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, v[3];
+    int i, k, axis = 0, any = 0;
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
         rep[i] = (uint32_t)i;
@@ -2740,63 +2888,95 @@ static int fogvol__weld(const unsigned char *base, int stride, int nv, float dis
     }
     for (k = 1; k < 3; ++k)
         if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    return axis;
+}
+
+/* Weld: rep[i] = the lowest-numbered kept vertex within dist of vertex i on every axis among those
+   before it in the sweep (i itself when none): the sweep takes the vertices in order of their
+   coordinate on the axis of largest extent (then of their number) and keeps a vertex that finds
+   none. Non-finite vertices stay alone. The candidates come from fogvol__weld_find, so vertices
+   sharing the sweep's coordinate (a face of a subdivided cube) cost no more than others: O(n) but for
+   hash collisions. Scratch memory from alloc: 20 bytes per vertex and 4 per hash bucket (one bucket
+   per 2 to 4 vertices).
+   Returns how many vertices were merged, -1: out of memory. */
+static int fogvol__weld(const unsigned char *base, int stride, int nv, float dist, const fogvol_allocator *alloc,
+                        uint32_t *rep)
+{
+    fogvol__weld_grid g;
+    fogvol__wkey *keys;
+    size_t buckets = 2;
+    float v[3];
+    int i, merged = 0;
+    while (buckets < (size_t)nv / 4u && buckets < ((size_t)1 << 30)) buckets <<= 1; /* (the chains hold the
+                                                       sweep's last dist only: small, cached buckets) */
+    keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * 2u * (size_t)nv); /* (+ the sort's) */
+    g.heads = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (buckets + (size_t)nv));
+    if (!keys || !g.heads) {
+        fogvol__free(alloc, keys);
+        fogvol__free(alloc, g.heads);
+        return -1;
+    }
+    g.base = base;
+    g.stride = stride;
+    g.dist = dist;
+    g.next = g.heads + buckets;
+    g.mask = (uint32_t)(buckets - 1u);
+    memset(g.heads, 0xff, sizeof(uint32_t) * buckets);
+    g.axis = fogvol__weld_axis(base, stride, nv, rep);
     for (i = 0; i < nv; ++i) {
         memcpy(v, base + (size_t)i * stride, sizeof v);
-        keys[i].key = fogvol__finite_n(v, 3) ? v[axis] : 3.0e38f; /* non-finite: sorted last, skipped */
+        keys[i].key = fogvol__sweep_key(fogvol__finite_n(v, 3) ? v[g.axis] : 3.0e38f); /* non-finite: skipped */
         keys[i].i = (uint32_t)i;
     }
-    fogvol__sort_wkeys(keys, nv);
-    for (a = 0; a < nv; ++a) {
-        uint32_t self = keys[a].i, best = 0xffffffffu;
+    fogvol__sort_wkeys(keys, keys + nv, nv);
+    for (i = 0; i < nv; ++i) {
+        uint32_t self = keys[i].i, best, h;
+        double c[2];
         memcpy(v, base + (size_t)self * stride, sizeof v);
         if (!fogvol__finite_n(v, 3)) continue;
-        for (b = a - 1; b >= 0 && keys[a].key - keys[b].key <= dist; --b) {
-            uint32_t j = keys[b].i;
-            if (rep[j] != j || j > best) continue;
-            memcpy(w, base + (size_t)j * stride, sizeof w);
-            if (FOGVOL_FABS((double)w[0] - v[0]) <= dist && FOGVOL_FABS((double)w[1] - v[1]) <= dist &&
-                FOGVOL_FABS((double)w[2] - v[2]) <= dist)
-                best = j;
+        fogvol__weld_cell(&g, v, c);
+        best = fogvol__weld_find(&g, v, c);
+        if (best != FOGVOL__NONE) {
+            rep[self] = best;
+            merged++;
+            continue;
         }
-        if (best == 0xffffffffu) continue; /* kept */
-        rep[self] = best;
-        merged++;
+        h = fogvol__weld_bucket(&g, c, 0, 0); /* kept: a candidate for the vertices after it */
+        g.next[self] = g.heads[h];
+        g.heads[h] = self;
     }
+    fogvol__free(alloc, keys);
+    fogvol__free(alloc, g.heads);
     return merged;
 }
 
-/* The desc's indices as 32 bits, welded when asked: *out is NULL when the
-   desc's own 32-bit array serves as it is, else an array from alloc. */
+/* The desc's indices as 32 bits (0, 1, 2, ... without an index array), welded when asked: *out is NULL
+   when the desc's own 32-bit array serves as it is, else an array from alloc. */
 static fogvol_result fogvol__mesh_indices(const fogvol_mesh_desc *d, const fogvol_allocator *alloc, uint32_t **out,
                                           int *welded)
 {
     const unsigned char *base = (const unsigned char *)d->positions + d->offset;
-    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0;
+    int i, stride = fogvol__mesh_stride(d), weld = d->weld_distance > 0, n = fogvol__index_count(d);
     uint32_t *idx, *rep = NULL;
-    fogvol__wkey *keys = NULL;
     *out = NULL;
     *welded = 0;
-    if (!weld && d->index_type == FOGVOL_INDEX_UINT32) return FOGVOL_SUCCESS;
-    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->index_count);
-    if (weld) {
-        rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
-        keys = (fogvol__wkey *)fogvol__alloc(alloc, sizeof(fogvol__wkey) * (size_t)d->vertex_count);
-    }
-    if (!idx || (weld && (!rep || !keys))) {
+    if (!weld && d->index_type == FOGVOL_INDEX_UINT32 && !fogvol__non_indexed(d)) return FOGVOL_SUCCESS;
+    idx = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)n);
+    if (weld) rep = (uint32_t *)fogvol__alloc(alloc, sizeof(uint32_t) * (size_t)d->vertex_count);
+    if (weld && rep && idx) *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, alloc, rep);
+    if (!idx || (weld && (!rep || *welded < 0))) {
         fogvol__free(alloc, idx);
         fogvol__free(alloc, rep);
-        fogvol__free(alloc, keys);
+        *welded = 0;
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < d->index_count; ++i)
-        idx[i] = d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i] : d->indices[i];
-    if (weld) {
-        *welded = fogvol__weld(base, stride, d->vertex_count, d->weld_distance, rep, keys);
-        for (i = 0; i < d->index_count; ++i)
-            if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
-    }
+    for (i = 0; i < n; ++i)
+        idx[i] = fogvol__non_indexed(d)                 ? (uint32_t)i
+                 : d->index_type == FOGVOL_INDEX_UINT16 ? (uint32_t)d->indices16[i]
+                                                        : d->indices[i];
+    for (i = 0; weld && i < n; ++i)
+        if (idx[i] < (uint32_t)d->vertex_count) idx[i] = rep[idx[i]];
     fogvol__free(alloc, rep);
-    fogvol__free(alloc, keys);
     *out = idx;
     return FOGVOL_SUCCESS;
 }
@@ -2887,8 +3067,8 @@ static int fogvol__winding_at(const fogvol__wind *w, const double q[3], const do
         dist = (e2[0] * qq[0] + e2[1] * qq[1] + e2[2] * qq[2]) / det;
         if (dist <= 0.0 || u < 0.0 || v < 0.0 || u + v > 1.0) continue;
         if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9) return 0;
-        /* det = (e1 x e2) . d: > 0 when the face normal points along d (leaving) */
-        n += det > 0.0 ? 1 : -1;
+        /* det = e1 . (d x e2) = -(e1 x e2) . d: < 0 when the face normal points along d (leaving) */
+        n += det < 0.0 ? 1 : -1;
     }
     *wind = n;
     return 1;
@@ -2954,7 +3134,9 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
     int u = (a + 1) % 3, v = (a + 2) % 3, i, j, i0, i1, j0, j1, k;
     double area = (p[1][u] - p[0][u]) * (p[2][v] - p[0][v]) - (p[2][u] - p[0][u]) * (p[1][v] - p[0][v]);
     double umin = p[0][u], umax = p[0][u], vmin = p[0][v], vmax = p[0][v];
-    const double off = 0.5123;
+    /* a ray's offsets in its cell differ in u and v, and do not sum to 1: a ray never lies on a
+       diagonal of a quad whose corners are on grid lines (of any whole number of steps) */
+    const double offu = 0.5123, offv = 0.4671;
     if (area == 0.0) return;
     for (k = 1; k < 3; ++k) {
         if (p[k][u] < umin) umin = p[k][u];
@@ -2962,17 +3144,17 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
         if (p[k][v] < vmin) vmin = p[k][v];
         if (p[k][v] > vmax) vmax = p[k][v];
     }
-    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - off);
-    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - off) + 1;
-    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - off);
-    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - off) + 1;
+    i0 = (int)FOGVOL_FLOOR((umin - lo[u]) / step[u] - offu);
+    i1 = (int)FOGVOL_FLOOR((umax - lo[u]) / step[u] - offu) + 1;
+    j0 = (int)FOGVOL_FLOOR((vmin - lo[v]) / step[v] - offv);
+    j1 = (int)FOGVOL_FLOOR((vmax - lo[v]) / step[v] - offv) + 1;
     if (i0 < 0) i0 = 0;
     if (j0 < 0) j0 = 0;
     if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
     if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
     for (j = j0; j <= j1; ++j)
         for (i = i0; i <= i1; ++i) {
-            double qu = lo[u] + (i + off) * step[u], qv = lo[v] + (j + off) * step[v], e[3];
+            double qu = lo[u] + (i + offu) * step[u], qv = lo[v] + (j + offv) * step[v], e[3];
             int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
             for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
                 const double *p0 = p[k], *p1 = p[(k + 1) % 3];
@@ -3050,7 +3232,7 @@ static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_al
             fogvol__wind_tri(w, t, p);
             for (a = 0; a < 3; ++a) fogvol__grid_tri(p, a, lo, step, t, count, skip, xs, start);
         }
-    for (r = 0; r < NR; ++r) {
+    for (r = 0; xs && r < NR; ++r) { /* xs NULL: no ray crossed a face (xs + 0 would be undefined) */
         fogvol__xing *x = xs + start[r];
         int n = (int)count[r], i, j, sum = 0;
         if (skip[r] || n == 0) continue;
@@ -3240,7 +3422,7 @@ static fogvol_result fogvol__validate(const fogvol_mesh_desc *desc, const uint32
     w.stride = fogvol__mesh_stride(desc);
     w.base = (const unsigned char *)desc->positions + desc->offset;
     w.indices = indices;
-    w.ntri = desc->index_count / 3;
+    w.ntri = fogvol__index_count(desc) / 3;
     w.nvert = desc->vertex_count;
     rep->vertices = desc->vertex_count;
     rep->triangles = w.ntri;
@@ -5693,7 +5875,7 @@ static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
     /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
     {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
      FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
-     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__X,
+     {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X,
       FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X},
      {0, 0, 0, 0, 0, FOGVOL__K}}};
 #undef FOGVOL__S
@@ -5799,10 +5981,12 @@ FOGVOL_API fogvol_result fogvol_tier_costs(fogvol_tier tier, unsigned v, fogvol_
 
 /* FV_MSAA: fogvol's targets are sampler2DMS (FV_TARGET_SAMPLER); FV_TEXTURE
    overloads on the sampler type, so a target read fetches this fragment's
-   own sample and the ramps keep their filtered lookups. */
+   own sample and the ramps keep their filtered lookups. The engine's depth
+   (ENGINE_DEPTH) is a multisample texture too, read at this sample. */
 static const char fogvol__fs_msaa[] =
     "#define FV_MSAA\n"
     "#define FV_TARGET_SAMPLER sampler2DMS\n"
+    "#define FV_ENGINE_Z(s) texelFetch(s, FV_ENGINE_TEXEL, gl_SampleID).r\n"
     "vec4 fv_tex(sampler2D s, vec2 st) { return texture(s, st); }\n"
     "vec4 fv_tex(sampler2DMS s, vec2 st) {\n"
     "    return texelFetch(s, ivec2(floor(st * vec2(textureSize(s)))), gl_SampleID);\n"
@@ -5877,6 +6061,8 @@ static const char fogvol__fs_common[] =
     "#ifdef FV_ORIGIN\n#define FV_PIXEL gl_FragCoord.xy\n#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy)\n#else\n"
     "#define FV_PIXEL (gl_FragCoord.xy + fv_screen.zw)\n"
     "#define FV_ENGINE_TEXEL ivec2(gl_FragCoord.xy + fv_nf.zw)\n#endif\n"
+    /* FV_ENGINE_Z(s): the engine's window depth at this pixel (FV_MSAA: at this sample) */
+    "#ifndef FV_ENGINE_Z\n#define FV_ENGINE_Z(s) texelFetch(s, FV_ENGINE_TEXEL, 0).r\n#endif\n"
     "vec2 fv_st() { return FV_PIXEL * fv_screen.xy; }\n"
     /* FV_SCREEN(s): fogvol's target s at this pixel; texelFetch where the dialect has it */
     "#if __VERSION__ >= 130 && !defined(FV_MSAA) && !defined(FV_NO_FETCH)\n"
@@ -6018,10 +6204,10 @@ static const char fogvol__fs_encode_common[] =
 
 static const char fogvol__fs_encode[] =
     "#ifdef FV_ENGINE_DEPTH\n"                   /* PS20: O from the engine's depth, full-screen */
-    "FV_BINDING(3) uniform sampler2D fv_opaque;\n"
+    "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
-    "    float depth = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float depth = FV_ENGINE_Z(fv_opaque);\n"
     "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
     "}\n"
     "#else\n"
@@ -6070,7 +6256,7 @@ static const char fogvol__fs_face[] =
     "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = 1.0;\n"                     /* fv_speed.x = 1: no opaque depth, O is the far plane */
@@ -6347,7 +6533,7 @@ static const char fogvol__fs_light[] =
     "}\n"
     "float fv_light_opaque() {\n"
     "#if defined(FV_FLOAT) && defined(FV_ENGINE_DEPTH)\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    return fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    return fv_light_depth(FV_O_DIGITS(fv_opaque));\n"
@@ -6402,7 +6588,7 @@ static const char fogvol__fs_color_face[] =
     "FV_UNIFORM(vec4, fv_emit)\n"
     "void main() {\n"
     "#ifdef FV_ENGINE_DEPTH\n"
-    "    float z = texelFetch(fv_opaque, FV_ENGINE_TEXEL, 0).r;\n"
+    "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
     "#else\n"
     "    float o = FV_TEXTURE(fv_opaque, fv_st()).r;\n"
@@ -6880,7 +7066,15 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
 /* >>context =============================================================== */
 /* The renderer's objects and the context: resolved configuration, targets, programs. */
 
+/* The objects a context hands out (meshes, ramps, volume textures) are on a list of its own per kind
+   (circular, the context's node the head), each object's node its first member, so that
+   fogvol_destroy_context destroys those the caller did not. */
+typedef struct fogvol__live {
+    struct fogvol__live *prev, *next;
+} fogvol__live;
+
 struct fogvol_mesh {
+    fogvol__live live;
     fogvol_handle handle;
     int vertex_count, index_count;
     int volume; /* 1: a valid closed hull (usable as a volume) */
@@ -6901,6 +7095,7 @@ typedef struct fogvol__spec_program {
 } fogvol__spec_program;
 
 struct fogvol_ramp {
+    fogvol__live live;
     fogvol_handle texture;
     int width;
     float max_thickness;
@@ -6911,9 +7106,16 @@ struct fogvol_ramp {
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
     float softness;    /* fogvol_ramp_desc.softness (0: hard edges) */
+    /* its colour-ramp group in the frame being ended (fogvol__link_groups): valid while stamp is the
+       frame's group_stamp; head and tail: its first and last volume in the frame's order */
+    int64_t stamp;
+    int head, tail;
+    int64_t textured;  /* the frame (fogvol__frame_state.serial) in which a volume of it has a density or
+                          colour texture: it leaves the one-pass colour group for that frame */
 };
 
 struct fogvol_volume_texture {
+    fogvol__live live;
     fogvol_handle texture;
 };
 
@@ -6924,6 +7126,7 @@ typedef struct fogvol__volume {
     int negative;
     const fogvol_volume_texture *density, *color; /* NULL: none */
     float density_map[8], color_map[6];
+    int next; /* the next volume of the same ramp in the frame's order, -1: none (fogvol__link_groups) */
 } fogvol__volume;
 
 typedef struct fogvol__light {
@@ -6999,6 +7202,7 @@ typedef struct fogvol__gpu {
 /* The frame between fogvol_begin_frame and fogvol_end_frame / fogvol_cancel_frame: its desc, camera,
    volumes, occluders and lights. */
 typedef struct fogvol__frame_state {
+    int64_t serial; /* fogvol_begin_frame calls (ramps mark the frame their volumes are textured in) */
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     fogvol_frame_desc frame;
@@ -7017,11 +7221,15 @@ typedef struct fogvol__frame_state {
     int nlight, caplight;
     int count_frame;        /* this frame counts faces: COUNT, or FOGVOL_SPEEDUP_DEPTH_TEST (count_bit) */
     unsigned count_bit;     /* FOGVOL_SPECIALIZE_COUNT in a FOGVOL_SPEEDUP_DEPTH_TEST frame, else 0 */
+    int64_t group_stamp;    /* fogvol__link_groups: which end_frame the ramps' group lists belong to */
+    int color_first;        /* the first volume of the one-pass colour group, -1: none (FOGVOL_VARIANT_COLORS) */
+    int color_pos;          /* the colour group holds a positive volume */
 } fogvol__frame_state;
 
 /* Overflow counting across frames: the queries in flight, the last count, the bands. */
 typedef struct fogvol__overflow_state {
     int counting, overflow_late, overflow_warned, qcur;
+    int coarse;        /* the last ended frame's digit step was coarse (fogvol_frame_stats.depth_lsb) */
     int64_t frame_no, overflow_frame, overflow_epoch; /* epoch: first frame drawn with the current L */
     fogvol__qframe qf[FOGVOL__QFRAMES];
     int64_t band_count[FOGVOL_OVERFLOW_BANDS], band_frame[FOGVOL_OVERFLOW_BANDS]; /* -1: not counted */
@@ -7032,7 +7240,8 @@ struct fogvol_context {
     fogvol_logger log;
     fogvol_backend be;
     int owns_backend;
-    int live_meshes, live_ramps;
+    fogvol__live meshes, ramps, textures; /* the objects alive (fogvol__live), counted: */
+    int live_meshes, live_ramps, live_textures;
     int msaa_warned;
     fogvol__config cfg;       /* resolved configuration */
     fogvol__gpu gpu;          /* GPU resources */
@@ -7149,6 +7358,41 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
 }
 
 static int fogvol__has(const fogvol_context *ctx, unsigned variant) { return (ctx->cfg.variants & variant) != 0; }
+
+/* A refusal of a public call: logged (error level) with why, the result returned, so that no refusal
+   goes unexplained. */
+static fogvol_result fogvol__refuse(const fogvol_context *ctx, fogvol_result r, const char *why)
+{
+    fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: %s (%s)", why, fogvol_result_string(r));
+    return r;
+}
+
+/* An object joins (count +1) or leaves (count -1) its kind's list. */
+static void fogvol__live_add(fogvol__live *head, fogvol__live *n, int *count)
+{
+    n->prev = head;
+    n->next = head->next;
+    head->next->prev = n;
+    head->next = n;
+    (*count)++;
+}
+
+static void fogvol__live_remove(fogvol__live *n, int *count)
+{
+    n->prev->next = n->next;
+    n->next->prev = n->prev;
+    n->prev = n->next = n;
+    (*count)--;
+}
+
+/* After the backend calls of a public call (outside a backend frame, or after its end_frame): the
+   backend's own failure since the last take (fogvol_backend.take_error, logged by the backend) is the
+   call's result when the call had none of its own. */
+static fogvol_result fogvol__be_result(fogvol_context *ctx, fogvol_result r)
+{
+    fogvol_result e = ctx->be.take_error ? ctx->be.take_error(ctx->be.user_data) : FOGVOL_SUCCESS;
+    return r == FOGVOL_SUCCESS ? e : r;
+}
 
 static fogvol_result fogvol__ensure_targets(fogvol_context *ctx, int w, int h, int half)
 {
@@ -7493,6 +7737,11 @@ static fogvol_result fogvol__attach_backend(fogvol_context *ctx, const fogvol_co
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend table lacks a required entry");
             return FOGVOL_ERROR_INVALID_ARGUMENT;
         }
+        if ((int)b->dialect < 0 || (int)b->dialect >= FOGVOL_GLSL_COUNT) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in the backend table "
+                        "(FOGVOL_GLSL_*)", (int)b->dialect);
+            return FOGVOL_ERROR_INVALID_ARGUMENT;
+        }
         ctx->be = *b;
         return FOGVOL_SUCCESS;
     }
@@ -7592,6 +7841,9 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(ctx, 0, sizeof *ctx);
+    ctx->meshes.prev = ctx->meshes.next = &ctx->meshes;
+    ctx->ramps.prev = ctx->ramps.next = &ctx->ramps;
+    ctx->textures.prev = ctx->textures.next = &ctx->textures;
     ctx->alloc = desc->allocator;
     ctx->log = desc->logger;
     ctx->cfg.dither = !desc->disable_dither;
@@ -7606,6 +7858,7 @@ FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, 
     r = fogvol__choose_tier(ctx, desc);
     if (r == FOGVOL_SUCCESS) fogvol__choose_speedups(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__context_resources(ctx);
+    r = fogvol__be_result(ctx, r);
     if (r == FOGVOL_SUCCESS) fogvol__overflow_init(ctx, desc->overflow_policy);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: context creation failed: %s", fogvol_result_string(r));
@@ -7626,10 +7879,16 @@ FOGVOL_API void fogvol_destroy_context(fogvol_context *ctx)
 {
     fogvol_allocator a;
     if (!ctx) return;
-    if (ctx->live_meshes || ctx->live_ramps)
+    if (ctx->live_meshes || ctx->live_ramps || ctx->live_textures)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
-                    "fogvol: context destroyed with %d meshes and %d ramps alive (their GPU objects leak)",
-                    ctx->live_meshes, ctx->live_ramps);
+                    "fogvol: context destroyed with %d meshes, %d ramps and %d volume textures alive: destroyed with "
+                    "it (destroy them before the context)",
+                    ctx->live_meshes, ctx->live_ramps, ctx->live_textures);
+    ctx->cur.in_frame = 0; /* (nothing to drop from an open frame: it goes too) */
+    while (ctx->meshes.next != &ctx->meshes) fogvol_destroy_mesh(ctx, (fogvol_mesh *)(void *)ctx->meshes.next);
+    while (ctx->ramps.next != &ctx->ramps) fogvol_destroy_ramp(ctx, (fogvol_ramp *)(void *)ctx->ramps.next);
+    while (ctx->textures.next != &ctx->textures)
+        fogvol_destroy_volume_texture(ctx, (fogvol_volume_texture *)(void *)ctx->textures.next);
     a = ctx->alloc;
     fogvol__release(ctx);
     fogvol__free(&a, ctx);
@@ -7732,22 +7991,39 @@ static void fogvol__forget_lights(fogvol_context *ctx, const fogvol_mesh *mesh)
     ctx->cur.nlight = n;
 }
 
-/* The bounding box of the positions (finite: validated before). */
-static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc)
+/* The vertices the triangles use, each once (idx: the validated indices, all in range), in a list
+   from ctx's allocator of *count entries; NULL: out of memory. A shared vertex buffer's other
+   vertices are no part of the mesh: not in its bounds, not in its convexity. */
+static uint32_t *fogvol__referenced(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx, int *count)
+{
+    int i, n = 0, ni = fogvol__index_count(desc), nv = desc->vertex_count;
+    uint32_t *list = (uint32_t *)fogvol__alloc(&ctx->alloc, (sizeof(uint32_t) + 1u) * (size_t)nv);
+    unsigned char *seen;
+    *count = 0;
+    if (!list) return NULL;
+    seen = (unsigned char *)(list + nv);
+    memset(seen, 0, (size_t)nv);
+    for (i = 0; i < ni; ++i)
+        if (!seen[idx[i]]) {
+            seen[idx[i]] = 1;
+            list[n++] = idx[i];
+        }
+    *count = n;
+    return list;
+}
+
+/* The bounding box of the used vertices (finite: validated before). */
+static void fogvol__mesh_box(fogvol_mesh *m, const fogvol_mesh_desc *desc, const uint32_t *used, int nused)
 {
     size_t stride = (size_t)fogvol__mesh_stride(desc);
     const unsigned char *base = (const unsigned char *)desc->positions + desc->offset;
     int i, c;
-    for (c = 0; c < 3; ++c) {
-        m->bmin[c] = desc->vertex_count > 0 ? 1e30f : 0.0f;
-        m->bmax[c] = desc->vertex_count > 0 ? -1e30f : 0.0f;
-    }
-    for (i = 0; i < desc->vertex_count; ++i) {
+    for (i = 0; i < nused; ++i) {
         float p[3];
-        memcpy(p, base + (size_t)i * stride, sizeof p);
+        memcpy(p, base + (size_t)used[i] * stride, sizeof p);
         for (c = 0; c < 3; ++c) {
-            if (p[c] < m->bmin[c]) m->bmin[c] = p[c];
-            if (p[c] > m->bmax[c]) m->bmax[c] = p[c];
+            if (i == 0 || p[c] < m->bmin[c]) m->bmin[c] = p[c];
+            if (i == 0 || p[c] > m->bmax[c]) m->bmax[c] = p[c];
         }
     }
 }
@@ -7766,11 +8042,11 @@ static fogvol_result fogvol__upload_mesh(fogvol_context *ctx, const fogvol_mesh_
     md.positions = desc->positions;
     md.vertex_count = desc->vertex_count;
     md.indices = idx ? idx : desc->indices;
-    md.index_count = desc->index_count;
+    md.index_count = fogvol__index_count(desc);
     if (ctx->be.caps & FOGVOL_CAP_MESH_LAYOUT) {
         md.stride = stride;
         md.offset = desc->offset;
-        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->weld_distance <= 0) { /* 16-bit as given */
+        if (desc->index_type == FOGVOL_INDEX_UINT16 && desc->indices16 && desc->weld_distance <= 0) { /* as given */
             md.index_type = FOGVOL_INDEX_UINT16;
             md.indices16 = desc->indices16;
             md.indices = NULL;
@@ -7797,16 +8073,18 @@ static void fogvol__vertex(const fogvol_mesh_desc *desc, uint32_t i, double p[3]
     p[2] = f[2];
 }
 
-/* fogvol_mesh_report.convex of a valid hull: every vertex on the inner side of every face plane
-   (outward normals: counter-clockwise seen from outside), within 1e-5 of the box diagonal. */
-static int fogvol__convexity(const fogvol_mesh_desc *desc)
+/* fogvol_mesh_report.convex of a valid hull: every used vertex on the inner side of every face plane
+   (outward normals: counter-clockwise seen from outside), within 1e-5 of the used vertices' box
+   diagonal; decided on the triangles as validated (idx: welded), where the slivers that a weld closes
+   (repeated corners) have no plane. */
+static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused)
 {
-    int t, v, k, tris = desc->index_count / 3;
+    int t, v, k, tris = fogvol__index_count(desc) / 3;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0.0, tol;
-    if ((double)tris * (double)desc->vertex_count > 67108864.0) return -1;
-    for (v = 0; v < desc->vertex_count; ++v) {
+    if ((double)tris * (double)nused > 67108864.0) return -1;
+    for (v = 0; v < nused; ++v) {
         double p[3];
-        fogvol__vertex(desc, (uint32_t)v, p);
+        fogvol__vertex(desc, used[v], p);
         for (k = 0; k < 3; ++k) {
             if (p[k] < lo[k]) lo[k] = p[k];
             if (p[k] > hi[k]) hi[k] = p[k];
@@ -7817,12 +8095,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
     tol = 1e-5 * diag;
     for (t = 0; t < tris; ++t) {
         double a[3], b[3], c[3], n[3], len;
-        uint32_t ix[3];
-        for (k = 0; k < 3; ++k)
-            ix[k] = desc->index_type == FOGVOL_INDEX_UINT16 ? desc->indices16[3 * t + k] : desc->indices[3 * t + k];
-        fogvol__vertex(desc, ix[0], a);
-        fogvol__vertex(desc, ix[1], b);
-        fogvol__vertex(desc, ix[2], c);
+        fogvol__vertex(desc, idx[3 * t], a);
+        fogvol__vertex(desc, idx[3 * t + 1], b);
+        fogvol__vertex(desc, idx[3 * t + 2], c);
         for (k = 0; k < 3; ++k) {
             b[k] -= a[k];
             c[k] -= a[k];
@@ -7832,9 +8107,9 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc)
         n[2] = b[0] * c[1] - b[1] * c[0];
         len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
-        for (v = 0; v < desc->vertex_count; ++v) {
+        for (v = 0; v < nused; ++v) {
             double p[3];
-            fogvol__vertex(desc, (uint32_t)v, p);
+            fogvol__vertex(desc, used[v], p);
             if ((n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]) + n[2] * (p[2] - a[2])) / len > tol) return 0;
         }
     }
@@ -7846,11 +8121,13 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
 {
     fogvol_mesh_report rep;
     fogvol_mesh *m;
-    uint32_t *idx = NULL;
+    uint32_t *idx = NULL, *used;
     fogvol_result r;
     const char *problem;
+    int nused;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_mesh: desc or out is NULL");
     problem = fogvol__mesh_problem(desc);
     r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
     if (report) *report = rep;
@@ -7880,25 +8157,31 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
                     desc->vertex_count);
     m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    if (!m) {
+    used = m ? fogvol__referenced(ctx, desc, idx ? idx : desc->indices, &nused) : NULL;
+    if (!m || !used) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: out of memory");
+        fogvol__free(&ctx->alloc, m);
         fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_OUT_OF_MEMORY;
     }
     memset(m, 0, sizeof *m);
-    fogvol__mesh_box(m, desc);
-    r = fogvol__upload_mesh(ctx, desc, idx, &m->handle);
+    fogvol__mesh_box(m, desc, used, nused);
+    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused) : -1;
+    fogvol__free(&ctx->alloc, used);
+    r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
+        if (m->handle) ctx->be.destroy_mesh(ctx->be.user_data, m->handle);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, m);
         return r;
     }
     m->vertex_count = desc->vertex_count;
-    m->index_count = desc->index_count;
+    m->index_count = fogvol__index_count(desc);
     m->volume = rep.valid;
-    m->convex = rep.valid ? fogvol__convexity(desc) : -1;
     if (report) report->convex = m->convex;
-    ctx->live_meshes++;
+    fogvol__live_add(&ctx->meshes, &m->live, &ctx->live_meshes);
     *out = m;
     return FOGVOL_SUCCESS;
 }
@@ -7929,7 +8212,8 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     fogvol__forget(ctx, mesh, NULL);
     fogvol__forget_lights(ctx, mesh);
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
-    ctx->live_meshes--;
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
+    fogvol__live_remove(&mesh->live, &ctx->live_meshes);
     fogvol__free(&ctx->alloc, mesh);
 }
 
@@ -7961,7 +8245,8 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     float tmax;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_ramp: desc or out is NULL");
     r = fogvol_make_color_ramp(desc, NULL, 0, &info, &tmax);
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: invalid ramp description");
@@ -7972,7 +8257,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     if (!px || !rp) {
         fogvol__free(&ctx->alloc, px);
         fogvol__free(&ctx->alloc, rp);
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_ramp: out of memory");
     }
     memset(rp, 0, sizeof *rp);
     fogvol_make_color_ramp(desc, px, info.size, &info, &tmax);
@@ -7983,11 +8268,13 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     td.filter = FOGVOL_FILTER_LINEAR;
     td.wrap = FOGVOL_WRAP_CLAMP;
     td.label = "fogvol colour ramp";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &rp->texture));
     fogvol__free(&ctx->alloc, px);
     if (r != FOGVOL_SUCCESS) {
+        if (rp->texture) ctx->be.destroy_texture(ctx->be.user_data, rp->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, rp);
-        return r;
+        return fogvol__refuse(ctx, r, "create_ramp: the backend could not make its texture");
     }
     rp->width = info.width;
     rp->max_thickness = tmax;
@@ -8001,7 +8288,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
         rp->exp_rgba[2] = fogvol__unorm8(desc->color[2]) / 255.0f;
         rp->exp_rgba[3] = desc->density;
     }
-    ctx->live_ramps++;
+    fogvol__live_add(&ctx->ramps, &rp->live, &ctx->live_ramps);
     *out = rp;
     return FOGVOL_SUCCESS;
 }
@@ -8011,7 +8298,8 @@ FOGVOL_API void fogvol_destroy_ramp(fogvol_context *ctx, fogvol_ramp *ramp)
     if (!ctx || !ramp) return;
     fogvol__forget(ctx, NULL, ramp);
     ctx->be.destroy_texture(ctx->be.user_data, ramp->texture);
-    ctx->live_ramps--;
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
+    fogvol__live_remove(&ramp->live, &ctx->live_ramps);
     fogvol__free(&ctx->alloc, ramp);
 }
 
@@ -8022,22 +8310,33 @@ FOGVOL_API fogvol_result fogvol_create_volume_texture(fogvol_context *ctx, const
     fogvol_texture_desc td;
     fogvol_result r;
     if (out) *out = NULL;
-    if (!ctx || !desc || !out) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_volume_texture: desc or out is NULL");
     if (!desc->pixels || desc->width < 1 || desc->height < 1 || desc->width > 4096 || desc->height > 4096) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture needs pixels and 1..4096 texels a side "
                     "(got %dx%d)", desc->width, desc->height);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
+    if ((desc->filter != FOGVOL_FILTER_NEAREST && desc->filter != FOGVOL_FILTER_LINEAR) ||
+        (desc->wrap != FOGVOL_WRAP_REPEAT && desc->wrap != FOGVOL_WRAP_CLAMP)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture filter %d or wrap %d unknown (FOGVOL_FILTER_*, "
+                    "FOGVOL_WRAP_*)", (int)desc->filter, (int)desc->wrap);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     t = (fogvol_volume_texture *)fogvol__alloc(&ctx->alloc, sizeof *t);
-    if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
+    if (!t) return fogvol__refuse(ctx, FOGVOL_ERROR_OUT_OF_MEMORY, "create_volume_texture: out of memory");
     td = *desc;
     if (!td.label) td.label = "fogvol volume texture";
-    r = ctx->be.create_texture(ctx->be.user_data, &td, &t->texture);
+    r = fogvol__be_result(ctx, ctx->be.create_texture(ctx->be.user_data, &td, &t->texture));
     if (r != FOGVOL_SUCCESS) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume texture: %s", fogvol_result_string(r));
+        if (t->texture) ctx->be.destroy_texture(ctx->be.user_data, t->texture);
+        (void)fogvol__be_result(ctx, r);
         fogvol__free(&ctx->alloc, t);
         return r;
     }
+    fogvol__live_add(&ctx->textures, &t->live, &ctx->live_textures);
     *out = t;
     return FOGVOL_SUCCESS;
 }
@@ -8054,6 +8353,8 @@ FOGVOL_API void fogvol_destroy_volume_texture(fogvol_context *ctx, fogvol_volume
         ctx->cur.nvol = n;
     }
     ctx->be.destroy_texture(ctx->be.user_data, texture->texture);
+    (void)fogvol__be_result(ctx, FOGVOL_SUCCESS);
+    fogvol__live_remove(&texture->live, &ctx->live_textures);
     fogvol__free(&ctx->alloc, texture);
 }
 
@@ -8069,13 +8370,50 @@ static float fogvol__dither_offset(const fogvol_context *ctx)
     return (float)(r * (unsigned)ctx->cfg.enc.dither_steps / 8u);
 }
 
+/* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
+   next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
 FOGVOL_API fogvol_result fogvol_cancel_frame(fogvol_context *ctx)
 {
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
     ctx->cur.in_frame = 0;
-    ctx->cur.nvol = ctx->cur.nocc = 0;
+    ctx->cur.nvol = ctx->cur.nocc = ctx->cur.nlight = 0;
     ctx->cur.engine_occluders = 0;
+    ctx->cur.mrt_ready = 0;
     return FOGVOL_SUCCESS;
+}
+
+/* Matrices as fogvol reads them (column-major: m[column * 4 + row]). */
+static void fogvol__transpose(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* An affine transform: bottom row (m[3], m[7], m[11], m[15]) = (0, 0, 0, 1) within 1e-6 (of the
+   largest coefficient of the 3x3 part for the first three). A row-major matrix copied as it is has
+   its translation there. */
+static int fogvol__affine(const float m[16])
+{
+    double big = 0.0, tol;
+    int c, k;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 3; ++k)
+            if (FOGVOL_FABS(m[c * 4 + k]) > big) big = FOGVOL_FABS(m[c * 4 + k]);
+    tol = 1e-6 * big;
+    return FOGVOL_FABS(m[3]) <= tol && FOGVOL_FABS(m[7]) <= tol && FOGVOL_FABS(m[11]) <= tol &&
+           FOGVOL_FABS(m[15] - 1.0) <= 1e-6;
+}
+
+/* A perspective projection transposed: the w row (0, 0, -1, 0) (or +1, w = z) stands in column 3, so
+   m[14] is exactly +-1 and m[11] (the near/far term) is not, m[12] = m[13] = m[15] = 0 and the w row
+   read where it belongs, (m[3], m[7], m[11], m[15]), has the same (0, 0, c, 0) form. A projection as
+   written by glFrustum, gluPerspective, glm or D3D has m[11] = +-1 (reversed and infinite ones too),
+   so it is never taken for this. */
+static int fogvol__w_at_14(const float p[16])
+{
+    return FOGVOL_FABS(p[14]) == 1.0f && FOGVOL_FABS(p[11]) != 1.0f && p[11] != 0.0f && p[12] == 0.0f &&
+           p[13] == 0.0f && p[15] == 0.0f && p[3] == 0.0f && p[7] == 0.0f;
 }
 
 /* Camera axes in world space from the frame's input: eye, right X, up Y, forward F (view
@@ -8111,6 +8449,9 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
     if (d->camera != FOGVOL_CAMERA_VIEW_AND_PROJECTION) return "unknown camera input";
     if (!fogvol__finite_n(d->view, 16) || !fogvol__finite_n(d->projection, 16))
         return "non-finite view or projection matrix";
+    if (!fogvol__affine(d->view)) return "the view matrix's bottom row (m[3], m[7], m[11], m[15]) is not (0, 0, 0, 1)";
+    if (fogvol__w_at_14(d->projection))
+        return "the projection's clip w takes the view depth from m[14] (the z row), not m[11] (the w row)";
     fogvol__tod(v, d->view);
     fogvol__tod(p, d->projection);
     fogvol__mul4(ctx->cur.viewproj, p, v);
@@ -8129,8 +8470,8 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
 /* The frame's camera: how clip w relates to view depth (perspective: w = s e, s > 0;
    orthographic: w constant > 0), whether the projection mirrors the screen (orientation
    of a camera-facing triangle, counter-clockwise as seen from the eye, after projection),
-   and the inverse view-projection. Logs and refuses what it cannot interpret. */
-static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+   and the inverse view-projection. Returns why it cannot interpret the camera, or NULL. */
+static const char *fogvol__camera_why(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     double ax[4][3], q[3][3], wr[4], sc, rr = 0.0, wn = 0.0, e = d->znear, det;
     const char *why = fogvol__camera_axes(ctx, d, ax);
@@ -8166,11 +8507,33 @@ static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc
         if (!(det != 0.0) || det - det != 0.0) why = "the projection collapses the screen (zero area)";
         else ctx->cur.mirrored = det < 0.0;
     }
-    if (why) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    return why;
+}
+
+/* The camera (fogvol__camera_why); a refusal is logged, and says which matrices transposed would be
+   accepted: row-major engine matrices (raylib's Matrix, DirectXMath) copied as they are. */
+static fogvol_result fogvol__camera(fogvol_context *ctx, const fogvol_frame_desc *d)
+{
+    static const char *const which[4] = {"", "the view matrix", "the projection", "the view and projection matrices"};
+    const char *why = fogvol__camera_why(ctx, d);
+    fogvol_frame_desc t;
+    int k, hint = 0;
+    if (!why) return FOGVOL_SUCCESS;
+    for (k = d->camera == FOGVOL_CAMERA_VIEW_PROJECTION ? 3 : 1; k <= 3 && !hint; ++k) {
+        t = *d;
+        if (d->camera == FOGVOL_CAMERA_VIEW_PROJECTION) fogvol__transpose(t.view_projection, d->view_projection);
+        if (k & 1) fogvol__transpose(t.view, d->view);
+        if (k & 2) fogvol__transpose(t.projection, d->projection);
+        if (!fogvol__camera_why(ctx, &t)) hint = k;
     }
-    return FOGVOL_SUCCESS;
+    if (hint && d->camera == FOGVOL_CAMERA_VIEW_PROJECTION)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? view_projection "
+                    "transposed would be accepted: a row-major matrix copied as it is)", why);
+    else if (hint)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s (transposed? %s transposed would be "
+                    "accepted: a row-major matrix copied as it is)", why, which[hint]);
+    else fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: camera refused: %s", why);
+    return FOGVOL_ERROR_INVALID_ARGUMENT;
 }
 
 FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], int zero_to_one,
@@ -8210,6 +8573,16 @@ FOGVOL_API fogvol_result fogvol_projection_planes(const float projection[16], in
     return FOGVOL_SUCCESS;
 }
 
+/* A viewport fogvol takes: its origin within -32768..32767 (the least viewport bounds range GL 4.1 /
+   ARB_viewport_array reports) and its size 1..16384, so that every sum of them is an int; else a
+   reason. */
+static const char *fogvol__viewport_problem(const int vp[4])
+{
+    if (vp[2] <= 0 || vp[3] <= 0 || vp[2] > 16384 || vp[3] > 16384) return "size outside 1..16384";
+    if (vp[0] < -32768 || vp[0] > 32767 || vp[1] < -32768 || vp[1] > 32767) return "origin outside -32768..32767";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_frame_desc *d)
 {
     fogvol_result r;
@@ -8219,19 +8592,19 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
                     "fogvol: begin_frame without end_frame: the open frame is discarded");
         fogvol_cancel_frame(ctx);
     }
-    if (!d) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!d) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: desc is NULL");
     if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: need 0 < znear < zfar (got %g, %g)", (double)d->znear,
                     (double)d->zfar);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if (d->viewport[2] <= 0 || d->viewport[3] <= 0 || d->viewport[2] > 16384 || d->viewport[3] > 16384) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport %dx%d outside 1..16384", d->viewport[2],
-                    d->viewport[3]);
+    if (fogvol__viewport_problem(d->viewport)) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: viewport (%d, %d) %dx%d: %s", d->viewport[0], d->viewport[1],
+                    d->viewport[2], d->viewport[3], fogvol__viewport_problem(d->viewport));
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if (d->composite != FOGVOL_COMPOSITE_FULLSCREEN && d->composite != FOGVOL_COMPOSITE_GEOMETRY)
-        return FOGVOL_ERROR_INVALID_ARGUMENT;
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "begin_frame: unknown composite");
     if (d->downsample < 0 || d->downsample > 2) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample %d is not 0, 1 or 2", d->downsample);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
@@ -8257,7 +8630,9 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.frame = *d;
     ctx->cur.nvol = ctx->cur.nocc = 0;
     ctx->cur.in_frame = 1;
+    ctx->cur.serial++;
     ctx->cur.nlight = 0;
+    ctx->cur.mrt_ready = ctx->cur.engine_occluders = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -8280,20 +8655,49 @@ static fogvol_result fogvol__grow(fogvol_context *ctx, void **arr, int *cap, int
     return FOGVOL_SUCCESS;
 }
 
+/* What makes a model matrix unusable, or NULL: non-finite, all zero, not affine (a row-major matrix
+   copied as it is: transposed, told apart by its transpose being affine), and for a volume or a
+   light, singular (|det| of the 3x3 part at most 1e-7 of the product of its column lengths: a zero
+   scale, or two axes along each other, flattens the mesh to no volume). */
+static const char *fogvol__model_problem(const float m[16], int volume)
+{
+    double d[16], c[3];
+    float t[16];
+    int i, k, zero = 1;
+    if (!fogvol__finite_n(m, 16)) return "is not finite";
+    for (i = 0; i < 16; ++i) zero &= m[i] == 0.0f;
+    if (zero) return "is all zero";
+    if (!fogvol__affine(m)) {
+        fogvol__transpose(t, m);
+        return fogvol__affine(t) ? "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1) but its "
+                                   "right column is (transposed? a row-major matrix copied as it is)"
+                                 : "has its bottom row (m[3], m[7], m[11], m[15]) not (0, 0, 0, 1)";
+    }
+    if (!volume) return NULL;
+    fogvol__tod(d, m);
+    for (k = 0; k < 3; ++k) c[k] = FOGVOL_SQRT(d[4 * k] * d[4 * k] + d[4 * k + 1] * d[4 * k + 1] + d[4 * k + 2] * d[4 * k + 2]);
+    if (FOGVOL_FABS(fogvol__det3(d)) <= 1e-7 * c[0] * c[1] * c[2])
+        return "is singular (a zero scale or two axes along each other flatten the mesh: no volume)";
+    return NULL;
+}
+
 FOGVOL_API fogvol_result fogvol_add_occluder(fogvol_context *ctx, const fogvol_mesh *mesh, const float model[16])
 {
+    const char *why;
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !mesh || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!mesh || !model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder: mesh or model is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_occluder outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
         return FOGVOL_ERROR_INVALID_STATE;
     }
-    if (!fogvol__finite_n(model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite occluder model matrix");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the occluder's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.occ;
@@ -8312,8 +8716,11 @@ FOGVOL_API fogvol_result fogvol_add_occluder_callback(fogvol_context *ctx, fogvo
     fogvol__occluder *o;
     void *arr;
     fogvol_result r;
-    if (!ctx || !fn) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fn) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_occluder_callback: fn is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "add_occluder_callback outside a frame (after begin_frame only)");
     if (ctx->cur.engine_occluders) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the engine draws this frame's occluders "
                                                  "(fogvol_occluder_prepare): add_occluder refused");
@@ -8383,17 +8790,21 @@ static void fogvol__set_textures(fogvol__volume *v, const fogvol_volume_desc *de
 
 FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_volume_desc *desc)
 {
+    const char *why;
     fogvol__volume *v;
     void *arr;
     fogvol_result r;
-    if (!ctx || !desc || !desc->mesh || !desc->ramp) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh || !desc->ramp)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_volume: desc, its mesh or its ramp is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_volume outside a frame (after begin_frame only)");
     if (!desc->mesh->volume) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: an open (occluder-only) mesh cannot be a volume");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite volume model matrix");
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the volume's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     r = fogvol__check_textures(ctx, desc);
@@ -8408,6 +8819,8 @@ FOGVOL_API fogvol_result fogvol_add_volume(fogvol_context *ctx, const fogvol_vol
     memcpy(v->model, desc->model, sizeof v->model);
     v->negative = desc->negative != 0;
     fogvol__set_textures(v, desc);
+    if (desc->density || desc->color) /* (a ramp of this context: its own object) */
+        ((fogvol_ramp *)(uintptr_t)desc->ramp)->textured = ctx->cur.serial;
     return FOGVOL_SUCCESS;
 }
 
@@ -8434,10 +8847,17 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
 
 FOGVOL_API fogvol_result fogvol_occluder_transform(fogvol_context *ctx, const float model[16])
 {
+    const char *why;
     fogvol_draw dr;
-    if (!ctx || !model) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_occluder_pass) return FOGVOL_ERROR_INVALID_STATE;
-    if (!fogvol__finite_n(model, 16)) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!model) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_transform: model is NULL");
+    if (!ctx->cur.in_occluder_pass)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "occluder_transform outside an occluder callback (fogvol_add_occluder_callback)");
+    if ((why = fogvol__model_problem(model, 0)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: occluder_transform: the model matrix %s", why);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
     fogvol__draw_for(ctx, model, &dr);
     ctx->be.set_draw(ctx->be.user_data, &dr);
     return FOGVOL_SUCCESS;
@@ -8464,7 +8884,7 @@ static fogvol_result fogvol__frame_samples(fogvol_context *ctx, const fogvol_fra
             why = "the backend has no multisample targets with per-sample shading (GL 4.0 or ARB_sample_shading)";
         else if (fogvol_msaa_supported(ctx->cfg.tier, ctx->cfg.variants, ctx->be.dialect) != FOGVOL_SUCCESS)
             why = "no per-sample path for this tier, variants and GLSL dialect (needs GLSL 150/330; not MRT, WIDE "
-                  "or ENGINE_DEPTH)";
+                  "or COLORS)";
         else if (ctx->cur.frame.debug_thickness)
             why = "debug_thickness cannot read multisampled targets";
         if (why) {
@@ -8486,8 +8906,10 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
     memset(info, 0, sizeof *info);
     info->draw_buffer = ctx->cur.frame.draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, info);
-    if (r != FOGVOL_SUCCESS)
+    if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
+    }
     return r;
 }
 
@@ -8500,9 +8922,11 @@ static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k,
     if (r != FOGVOL_SUCCESS) return r;
     r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     if (r != FOGVOL_SUCCESS) return r;
     fogvol_compute_constants(&ctx->cfg.enc, ctx->cur.frame.znear, ctx->cur.frame.zfar, 0.0f, k);
     *texture = ctx->be.native_texture(ctx->be.user_data, ctx->gpu.tgt_o);
+    ctx->gpu.o_far = 0; /* the engine writes O from here, whether or not this frame is ended */
     return FOGVOL_SUCCESS;
 }
 
@@ -8510,7 +8934,8 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
 {
     fogvol_constants k;
     fogvol_result r;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "mrt_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     if (ctx->cfg.tier != FOGVOL_TIER_MRT || !ctx->cur.in_frame || !ctx->be.native_texture) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mrt_prepare needs the MRT tier, an open frame and a "
@@ -8611,7 +9036,8 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     fogvol_constants k;
     fogvol_result r;
     int fl;
-    if (!ctx || !info) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!info) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "occluder_prepare: info is NULL");
     memset(info, 0, sizeof *info);
     fl = ctx->cfg.tier == FOGVOL_TIER_FLOAT;
     if (!ctx->cur.in_frame || ctx->cur.nocc > 0 || !ctx->be.native_texture) {
@@ -8731,15 +9157,51 @@ static void fogvol__end_pass(fogvol_context *ctx)
     if (ctx->be.end_pass) ctx->be.end_pass(ctx->be.user_data);
 }
 
+static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp);
+
+/* The frame's colour-ramp groups as lists, once per end_frame, so that each group's passes visit its
+   own volumes only: each ramp's first and last volume (stamped with this end_frame), each volume's
+   next of the same ramp, in the frame's order; the one-pass colour group's first volume. (The ramps
+   belong to the context; the const of the volume desc is the caller's promise, not theirs.) */
+static void fogvol__link_groups(fogvol_context *ctx)
+{
+    int i;
+    ctx->cur.group_stamp++;
+    ctx->cur.color_first = -1;
+    ctx->cur.color_pos = 0;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        fogvol__volume *v = &ctx->cur.vols[i];
+        fogvol_ramp *rp = (fogvol_ramp *)(uintptr_t)v->ramp;
+        v->next = -1;
+        if (rp->stamp != ctx->cur.group_stamp) {
+            rp->stamp = ctx->cur.group_stamp;
+            rp->head = i;
+        } else {
+            ctx->cur.vols[rp->tail].next = i;
+        }
+        rp->tail = i;
+        if (fogvol__color_member(ctx, rp)) {
+            if (ctx->cur.color_first < 0) ctx->cur.color_first = i;
+            ctx->cur.color_pos |= !v->negative;
+        }
+    }
+}
+
+/* The first volume of a ramp's group in this frame (then vols[i].next), -1: none. */
+static int fogvol__first(const fogvol_context *ctx, const fogvol_ramp *ramp)
+{
+    return ramp->stamp == ctx->cur.group_stamp ? ramp->head : -1;
+}
+
 /* Draw the volumes of one ramp group into the current pass: negative = 0
    positives, 1 negatives, -1 both (FLOAT: the sign goes to the shader). */
 static int fogvol__draw_group(fogvol_context *ctx, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
     fogvol_draw dr;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || v->density) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
@@ -8801,11 +9263,11 @@ static unsigned fogvol__origin_bit(const fogvol_context *ctx)
 static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, const fogvol_ramp *ramp, int negative)
 {
     int i, n = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
         fogvol_pass ps;
         fogvol_draw dr;
-        if (v->ramp != ramp || (negative >= 0 && v->negative != negative) || !v->density) continue;
+        if ((negative >= 0 && v->negative != negative) || !v->density) continue;
         ps = *base;
         ps.clear = 0;
         if (ps.read_target) { /* (the general program samples O) */
@@ -8833,9 +9295,9 @@ static int fogvol__draw_textured(fogvol_context *ctx, const fogvol_pass *base, c
 static void fogvol__group_color(const fogvol_context *ctx, const fogvol_ramp *ramp, fogvol_pass *ps)
 {
     int i;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
         const fogvol__volume *v = &ctx->cur.vols[i];
-        if (v->ramp != ramp || !v->color) continue;
+        if (!v->color) continue;
         ps->textures[FOGVOL__UNIT_CTEX] = v->color->texture;
         memcpy(ps->uniforms[FOGVOL_U_COLOR_U], v->color_map, 3 * sizeof(float));
         memcpy(ps->uniforms[FOGVOL_U_COLOR_V], v->color_map + 3, 3 * sizeof(float));
@@ -9006,41 +9468,55 @@ static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp
     return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
 }
 
-/* The window rectangle (x, y, w, h) that holds every pixel the volumes of a
-   ramp group can cover: the 8 corners of each mesh's box projected, rounded
-   out by a pixel, within the viewport. A corner nearer than the near plane
-   (perspective; NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole
-   viewport. An empty rectangle is 1x1 in the corner (nothing is drawn). */
-static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+/* After the groups: a debug read-back that no group made (the frame draws no volume of debug_ramp,
+   or no volume at all) is the thickness the frame draws for it, 0. */
+static void fogvol__debug_empty(fogvol_context *ctx, const fogvol__run *run)
+{
+    size_t n = (size_t)ctx->cur.frame.viewport[2] * (size_t)ctx->cur.frame.viewport[3], i;
+    if (!ctx->cur.frame.debug_thickness || run->captured) return;
+    for (i = 0; i < n; ++i) ctx->cur.frame.debug_thickness[i] = 0.0f;
+}
+
+/* Window rectangles (x, y, w, h) that hold every pixel some volumes can cover:
+   the 8 corners of each mesh's box projected (fogvol__rect_add, into the window
+   extent lo, hi), rounded out by a pixel, within the viewport
+   (fogvol__rect_finish). A corner nearer than the near plane (perspective;
+   NEAR_CLAMP moves such vertices) or at w <= 0 gives the whole viewport
+   (rect_add returns 0). An empty rectangle is 1x1 in the corner (nothing is
+   drawn). */
+static int fogvol__rect_add(const fogvol_context *ctx, const fogvol__volume *v, double lo[2], double hi[2])
 {
     const int *vp = ctx->cur.frame.viewport;
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300}, wmin;
-    int i, k, c;
+    double m[16], mvp[16], wmin;
+    int k, c;
     wmin = ctx->cur.frame.projection[15] == 0.0f ? (double)ctx->cur.frame.znear * (1.0 - 1e-6) : 1e-12;
-    memcpy(rect, vp, 4 * sizeof(int));
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        const fogvol__volume *v = &ctx->cur.vols[i];
-        double m[16], mvp[16];
-        if (v->ramp != ramp) continue;
-        fogvol__tod(m, v->model);
-        fogvol__mul4(mvp, ctx->cur.viewproj, m);
-        for (k = 0; k < 8; ++k) {
-            double p[3], clip[4];
-            for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
-            for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
-            if (!(clip[3] >= wmin)) return; /* behind the near plane (or NaN): whole viewport */
-            for (c = 0; c < 2; ++c) {
-                double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
-                if (win < lo[c]) lo[c] = win;
-                if (win > hi[c]) hi[c] = win;
-            }
+    fogvol__tod(m, v->model);
+    fogvol__mul4(mvp, ctx->cur.viewproj, m);
+    for (k = 0; k < 8; ++k) {
+        double p[3], clip[4];
+        for (c = 0; c < 3; ++c) p[c] = (k >> c & 1) ? v->mesh->bmax[c] : v->mesh->bmin[c];
+        for (c = 0; c < 4; ++c) clip[c] = mvp[c] * p[0] + mvp[4 + c] * p[1] + mvp[8 + c] * p[2] + mvp[12 + c];
+        if (!(clip[3] >= wmin)) return 0; /* behind the near plane (or NaN): whole viewport */
+        for (c = 0; c < 2; ++c) {
+            double win = vp[c] + (clip[c] / clip[3] * 0.5 + 0.5) * vp[c + 2];
+            if (win < lo[c]) lo[c] = win;
+            if (win > hi[c]) hi[c] = win;
         }
     }
+    return 1;
+}
+
+/* The extent rounded out and clamped to the viewport in floating point before it becomes integers (a
+   volume far off screen projects to any double: 1e9 pixels and more, or infinite). */
+static void fogvol__rect_finish(const fogvol_context *ctx, const double lo[2], const double hi[2], int rect[4])
+{
+    const int *vp = ctx->cur.frame.viewport;
+    int c;
     for (c = 0; c < 2; ++c) { /* downsample 2: the bilinear read spreads a texel over 2 more pixels */
-        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0;
+        double m = ctx->cur.frame.downsample == 2 ? 2.0 : 0.0, v0 = vp[c], v1 = (double)vp[c] + vp[c + 2];
         double a = FOGVOL_FLOOR(lo[c]) - 1.0 - m, b = FOGVOL_FLOOR(hi[c]) + 2.0 + m;
-        if (a < vp[c]) a = vp[c];
-        if (b > (double)vp[c] + vp[c + 2]) b = (double)vp[c] + vp[c + 2];
+        a = !(a >= v0) ? v0 : a > v1 ? v1 : a;
+        b = !(b >= v0) ? v0 : b > v1 ? v1 : b;
         rect[c] = (int)a;
         rect[c + 2] = b > a ? (int)(b - a) : 0;
     }
@@ -9049,6 +9525,17 @@ static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ram
         rect[1] = vp[1];
         rect[2] = rect[3] = 1;
     }
+}
+
+/* The rectangle of the volumes of a ramp group. */
+static void fogvol__group_rect(const fogvol_context *ctx, const fogvol_ramp *ramp, int rect[4])
+{
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next)
+        if (!fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi)) return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 static void fogvol__target_space(fogvol_context *ctx, fogvol_pass *ps)
@@ -9665,12 +10152,15 @@ static fogvol_result fogvol__frame_overflow(fogvol_context *ctx, fogvol__run *ru
 
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc)
 {
+    const char *why;
     fogvol__light *l;
     void *arr;
     fogvol_result r;
     float k;
-    if (!ctx || !desc || !desc->mesh) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !desc->mesh) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "add_light: desc or its mesh is NULL");
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE, "add_light outside a frame (after begin_frame only)");
     if (!fogvol__tier_has(ctx->cfg.tier, ctx->cfg.variants, FOGVOL__F_LIGHT)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: volume lights need tier FLOAT, PS20 or MRT without WIDE "
                     "(tier %s, variants 0x%x)", fogvol_tier_name(ctx->cfg.tier), ctx->cfg.variants);
@@ -9683,12 +10173,15 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
                                               : "the mesh is too large for the convexity check");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->model, 16) || !fogvol__finite_n(desc->color, 3) ||
-        !fogvol__finite_n(&desc->intensity, 1) || !fogvol__finite_n(desc->position, 3) ||
-        !fogvol__finite(desc->falloff_radius) || desc->falloff_radius < 0.0f ||
-        !fogvol__finite(desc->edge_softness) || desc->edge_softness < 0.0f) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light model, colour, intensity or position, "
+    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1) ||
+        !fogvol__finite_n(desc->position, 3) || !fogvol__finite(desc->falloff_radius) ||
+        desc->falloff_radius < 0.0f || !fogvol__finite(desc->edge_softness) || desc->edge_softness < 0.0f) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour, intensity or position, "
                     "or a negative falloff_radius or edge_softness");
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the light's model matrix %s", why);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     arr = ctx->cur.lights;
@@ -9845,9 +10338,12 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 /* >>colour groups ========================================================= */
 /* One-pass colours (FOGVOL_VARIANT_COLORS): the group's optical depth and emission sums. */
 
+/* A ramp in the colour group this frame: a colour ramp none of whose volumes has a density or colour
+   texture this frame (the colour group's programs draw neither: such a ramp is a group of its own,
+   drawn as without COLORS). */
 static int fogvol__color_member(const fogvol_context *ctx, const fogvol_ramp *ramp)
 {
-    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors;
+    return fogvol__has(ctx, FOGVOL_VARIANT_COLORS) && ramp->colors && ramp->textured != ctx->cur.serial;
 }
 
 /* The sum pass of the colour group: every member's faces, signed, into the two RGBA32F sums
@@ -9884,24 +10380,16 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
     return grey;
 }
 
-/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY): the union of their
-   ramps' rectangles. */
+/* The window rectangle of every member's volumes (FOGVOL_COMPOSITE_GEOMETRY), each projected once. */
 static void fogvol__color_rect(const fogvol_context *ctx, int rect[4])
 {
-    int i, k, r[4], lo[2] = {0, 0}, hi[2] = {0, 0}, any = 0;
-    for (i = 0; i < ctx->cur.nvol; ++i) {
-        if (!fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) continue;
-        fogvol__group_rect(ctx, ctx->cur.vols[i].ramp, r);
-        for (k = 0; k < 2; ++k) {
-            if (!any || r[k] < lo[k]) lo[k] = r[k];
-            if (!any || r[k] + r[k + 2] > hi[k]) hi[k] = r[k] + r[k + 2];
-        }
-        any = 1;
-    }
-    rect[0] = lo[0];
-    rect[1] = lo[1];
-    rect[2] = hi[0] - lo[0];
-    rect[3] = hi[1] - lo[1];
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    int i;
+    memcpy(rect, ctx->cur.frame.viewport, 4 * sizeof(int));
+    for (i = ctx->cur.color_first; i >= 0 && i < ctx->cur.nvol; ++i)
+        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !fogvol__rect_add(ctx, &ctx->cur.vols[i], lo, hi))
+            return;
+    fogvol__rect_finish(ctx, lo, hi, rect);
 }
 
 /* The composite of the colour group into the engine framebuffer: one FOG-blended draw when every
@@ -9931,17 +10419,32 @@ static void fogvol__color_composite(fogvol_context *ctx, fogvol__run *run, int g
     }
 }
 
+/* The debug read-back of a colour group (its sums are optical depths of all its ramps): one more
+   pass sums the faces of the debug ramp's volumes (debug_ramp NULL: the ramp of the group's first
+   volume, g) into B as the FLOAT tier's groups do, and reads that back. */
+static void fogvol__color_debug(fogvol_context *ctx, fogvol__run *run, int g)
+{
+    const fogvol_ramp *ramp = ctx->cur.frame.debug_ramp ? ctx->cur.frame.debug_ramp : ctx->cur.vols[g].ramp;
+    int i, has_pos = 0, has_neg = 0;
+    if (!fogvol__want_debug(ctx, ramp, run->captured) || !fogvol__color_member(ctx, ramp)) return;
+    for (i = g; i < ctx->cur.nvol; ++i)
+        if (ctx->cur.vols[i].ramp == ramp) {
+            has_neg |= ctx->cur.vols[i].negative;
+            has_pos |= !ctx->cur.vols[i].negative;
+        }
+    if (!has_pos) return; /* (no thickness: the frame's end writes 0) */
+    run->xsum = 0;
+    fogvol__sum_passes(ctx, run, ramp, has_neg);
+}
+
 /* The colour group, drawn where its first member volume g comes in the frame's order (once), if it
    holds a positive volume. */
 static void fogvol__color_group(fogvol_context *ctx, fogvol__run *run, int g)
 {
-    int i, has_pos = 0;
-    for (i = 0; i < g; ++i)
-        if (fogvol__color_member(ctx, ctx->cur.vols[i].ramp)) return;
-    for (i = g; i < ctx->cur.nvol; ++i) has_pos |= fogvol__color_member(ctx, ctx->cur.vols[i].ramp) && !ctx->cur.vols[i].negative;
-    if (!has_pos) return;
+    if (g != ctx->cur.color_first || !ctx->cur.color_pos) return;
     run->st.groups++;
     fogvol__color_composite(ctx, run, fogvol__color_sums(ctx, run));
+    fogvol__color_debug(ctx, run, g);
 }
 
 /* >>end frame ============================================================= */
@@ -9986,7 +10489,7 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
     if (fogvol__has(ctx, FOGVOL_VARIANT_ENGINE_DEPTH) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
         r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
                                fd->engine_depth_source == FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER, fd->viewport,
-                               &run->engine_depth);
+                               ctx->cur.samples > 1 ? ctx->cur.samples : 0, &run->engine_depth);
         if (r != FOGVOL_SUCCESS) {
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot copy the engine's depth buffer: %s",
                         fogvol_result_string(r));
@@ -10018,16 +10521,14 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
         fogvol__color_group(ctx, run, g);
         return;
     }
-    for (i = 0; i < g; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) return;
-    for (i = g; i < ctx->cur.nvol; ++i)
-        if (ctx->cur.vols[i].ramp == ramp) {
-            if (ctx->cur.vols[i].negative) has_neg = 1;
-            else has_pos = 1;
-            convex &= ctx->cur.vols[i].mesh->convex == 1;
-            density |= ctx->cur.vols[i].density != NULL;
-            ++n;
-        }
+    if (fogvol__first(ctx, ramp) != g) return;
+    for (i = g; i >= 0; i = ctx->cur.vols[i].next) {
+        if (ctx->cur.vols[i].negative) has_neg = 1;
+        else has_pos = 1;
+        convex &= ctx->cur.vols[i].mesh->convex == 1;
+        density |= ctx->cur.vols[i].density != NULL;
+        ++n;
+    }
     if (!has_pos) return;
     /* FOGVOL_SPEEDUP_EXACT_SUM: a signed 32-bit sum holds 127 layers as deep as the range (2^24 each) */
     run->xsum = ctx->cfg.exact_sum && !run->count && ctx->cur.samples <= 1 && !density && n < 128;
@@ -10044,11 +10545,38 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     fogvol__composite_pass(ctx, run, &ps, ramp);
 }
 
+/* fogvol_frame_stats.depth_lsb, and its warning: the step of the digit sums against the view-depth
+   extent (within znear..zfar) of the bounds of the frame's smallest positive volume. */
+static void fogvol__frame_precision(fogvol_context *ctx, fogvol__run *run)
+{
+    int bits = ctx->gpu.tgt_b2 ? 2 * ctx->cfg.enc.precision_bits : ctx->cfg.enc.precision_bits, i, coarse;
+    double n = ctx->cur.frame.znear, f = ctx->cur.frame.zfar, lsb = (f - n) / (double)(1L << bits), small = 0.0;
+    if (!run->rgba8 || run->st.exact_sum >= run->st.groups) return;
+    run->st.depth_lsb = (float)lsb;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        double lo = 0.0, hi = 0.0;
+        if (ctx->cur.vols[i].negative) continue;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &lo, &hi);
+        lo = lo < n ? n : lo > f ? f : lo;
+        hi = hi < n ? n : hi > f ? f : hi;
+        if (hi > lo && (small == 0.0 || hi - lo < small)) small = hi - lo;
+    }
+    coarse = small > 0.0 && lsb > small / 16.0;
+    if (coarse && !ctx->ovf.coarse)
+        fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
+                    "fogvol: the %d-bit depth sums step by %g (one LSB: (zfar - znear) / 2^%d), more than 1/16 of "
+                    "the smallest volume's depth extent %g: its thickness is quantised that coarsely (move znear "
+                    "out or zfar in, or use fewer faces per target, or the FLOAT tier)",
+                    bits, lsb, bits, small);
+    ctx->ovf.coarse = coarse;
+}
+
 /* Restore the engine's state, report, react to the overflow count and reset the frame's lists. */
 static fogvol_result fogvol__frame_finish(fogvol_context *ctx, fogvol__run *run, fogvol_result r,
                                          fogvol_frame_stats *stats)
 {
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
+    r = fogvol__be_result(ctx, r);
     run->st.frame = ctx->ovf.frame_no;
     run->st.overflow_pixels_late = ctx->ovf.overflow_late;
     run->st.overflow_frame = ctx->ovf.overflow_frame;
@@ -10072,7 +10600,9 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.overflow_frame = -1;
     if (stats) *stats = run.st;
     if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!ctx->cur.in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (!ctx->cur.in_frame)
+        return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_STATE,
+                              "end_frame without begin_frame (or after the frame was ended or cancelled)");
     r = fogvol__frame_refusal(ctx);
     if (r == FOGVOL_SUCCESS) r = fogvol__begin_backend_frame(ctx, &run.info);
     if (r != FOGVOL_SUCCESS) {
@@ -10087,12 +10617,15 @@ FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stat
     run.st.depth_tested = run.count;
     run.st.inline_resolved = ctx->cfg.inline_resolve;
     run.rgba8 = ctx->cfg.tier != FOGVOL_TIER_FLOAT;
+    fogvol__link_groups(ctx);
     r = fogvol__frame_setup(ctx, &run);
     if (r == FOGVOL_SUCCESS) {
         fogvol__frame_uniforms(ctx, &run);
         fogvol__opaque_pass(ctx, &run);
         fogvol__light_passes(ctx, &run);
         for (g = 0; g < ctx->cur.nvol; ++g) fogvol__group(ctx, &run, g);
+        fogvol__debug_empty(ctx, &run);
+        fogvol__frame_precision(ctx, &run);
         r = fogvol__frame_overflow(ctx, &run);
     }
     return fogvol__frame_finish(ctx, &run, r, stats);
@@ -10251,6 +10784,7 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
         (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout);
         if (r == FOGVOL_SUCCESS) r = ctx->be.create_program(ctx->be.user_data, &pd, &ctx->gpu.post_prog[slot]);
         if (r != FOGVOL_SUCCESS) {
+            (void)fogvol__be_result(ctx, r);
             fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot build the %s program (GLSL %s): %s",
                         labels[effect], fogvol_dialect_name(ctx->be.dialect), fogvol_result_string(r));
             ctx->gpu.post_prog[slot] = 0;
@@ -10283,9 +10817,8 @@ static fogvol_result fogvol__post_check(fogvol_context *ctx, const fogvol_frame_
         why = "no depth texture (frame->engine_depth_texture)";
     else if (!fogvol__finite(d->znear) || !fogvol__finite(d->zfar) || !(d->znear > 0) || !(d->zfar > d->znear))
         why = "need 0 < znear < zfar";
-    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || d->viewport[2] <= 0 || d->viewport[3] <= 0 ||
-             d->viewport[2] > 16384 || d->viewport[3] > 16384)
-        why = "viewport outside the framebuffer's 0..16384";
+    else if (d->viewport[0] < 0 || d->viewport[1] < 0 || fogvol__viewport_problem(d->viewport))
+        why = "viewport origin outside 0..32767 or size outside 1..16384";
     else if (size[0] < 0 || size[1] < 0 || (size[0] && size[0] < d->viewport[0] + d->viewport[2]) ||
              (size[1] && size[1] < d->viewport[1] + d->viewport[3]))
         why = "texture_size smaller than the viewport's extent";
@@ -10314,6 +10847,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     info.draw_buffer = fd->draw_buffer;
     if (ctx->be.begin_frame) r = ctx->be.begin_frame(ctx->be.user_data, &info);
     if (r != FOGVOL_SUCCESS) {
+        (void)fogvol__be_result(ctx, r);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: backend begin_frame failed: %s", fogvol_result_string(r));
         return r;
     }
@@ -10337,7 +10871,7 @@ static fogvol_result fogvol__post_run(fogvol_context *ctx, const fogvol_frame_de
     ctx->be.draw_fullscreen(ctx->be.user_data);
     fogvol__end_pass(ctx);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
-    return FOGVOL_SUCCESS;
+    return fogvol__be_result(ctx, FOGVOL_SUCCESS);
 }
 
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc)
@@ -10522,7 +11056,7 @@ enum {
     FOGVOL__GL_COLOR_ATTACHMENT0 = 0x8CE0, FOGVOL__GL_DEPTH_ATTACHMENT = 0x8D00,
     FOGVOL__GL_STENCIL_ATTACHMENT = 0x8D20, FOGVOL__GL_FRAMEBUFFER = 0x8D40, FOGVOL__GL_RENDERBUFFER = 0x8D41,
     FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE = 0x8CD0, FOGVOL__GL_FRAMEBUFFER_ATTACHMENT_STENCIL_SIZE = 0x8217,
-    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126,
+    FOGVOL__GL_FRAMEBUFFER_DEFAULT = 0x8218, FOGVOL__GL_CONTEXT_PROFILE_MASK = 0x9126, FOGVOL__GL_DEBUG_OUTPUT = 0x92E0,
     FOGVOL__GL_COLOR_BUFFER_BIT = 0x4000, FOGVOL__GL_DEPTH_BUFFER_BIT = 0x0100,
     FOGVOL__GL_STENCIL_BUFFER_BIT = 0x0400, FOGVOL__GL_FUNC_REVERSE_SUBTRACT = 0x800B, FOGVOL__GL_RED = 0x1903,
     FOGVOL__GL_R32F = 0x822E, FOGVOL__GL_NUM_EXTENSIONS = 0x821D, FOGVOL__GL_HIGH_FLOAT = 0x8DF2,
@@ -10564,6 +11098,7 @@ enum {
     X(void, Enable, (fogvol__GLenum)) \
     X(void, Disable, (fogvol__GLenum)) \
     X(fogvol__GLboolean, IsEnabled, (fogvol__GLenum)) \
+    X(fogvol__GLboolean, IsTexture, (fogvol__GLuint)) \
     X(void, Viewport, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, Scissor, (fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, ClearColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
@@ -10625,6 +11160,7 @@ enum {
 /* Framebuffer objects: GL 3.0, ARB_framebuffer_object, GLES 2.0; EXT_framebuffer_object names as fallback. */
 #define FOGVOL__GL_FBO(X) \
     X(void, GenFramebuffers, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsFramebuffer, (fogvol__GLuint)) \
     X(void, DeleteFramebuffers, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindFramebuffer, (fogvol__GLenum, fogvol__GLuint)) \
     X(void, FramebufferTexture2D, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLuint, fogvol__GLint)) \
@@ -10639,6 +11175,7 @@ enum {
 /* Vertex array objects: GL 3.0, GLES 3.0 (required in core profiles). */
 #define FOGVOL__GL_VAO(X) \
     X(void, GenVertexArrays, (fogvol__GLsizei, fogvol__GLuint *)) \
+    X(fogvol__GLboolean, IsVertexArray, (fogvol__GLuint)) \
     X(void, DeleteVertexArrays, (fogvol__GLsizei, const fogvol__GLuint *)) \
     X(void, BindVertexArray, (fogvol__GLuint))
 
@@ -10880,7 +11417,13 @@ typedef struct fogvol__gl {
     int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
     int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
     fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
-    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error */
+    fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error (err_fbo:
+                                                           made at creation without VAOs, the context's mark) */
+    int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
+    int skip_draws;                                     /* this pass has an engine texture that is none */
+    fogvol_result own;                                  /* fogvol's own first error since take_error */
+    void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
+    void *user_data, *context_id;                       /* and what it returned at creation */
     unsigned caps;
     fogvol_dialect dialect;
     fogvol__gl_state saved;
@@ -10889,7 +11432,7 @@ typedef struct fogvol__gl {
     fogvol__gl_mesh fullscreen;
     fogvol__GLuint native_sampler; /* engine textures (ENGINE_DEPTH): nearest, clamp, no depth compare */
     fogvol__GLuint depth_tex, depth_fbo; /* the engine's depth copied by copy_depth */
-    int depth_w, depth_h;
+    int depth_w, depth_h, depth_samples; /* depth_samples > 1: a multisample texture */
     fogvol__GLenum depth_format;
     int has_query; /* occlusion queries loaded (GL 1.5+, GLES 3.0+) */
     int webgl;     /* a WebGL context behind GLES (GL_VERSION names WebGL, as emscripten reports it) */
@@ -11110,18 +11653,23 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
     gl->MinSampleShading(s->min_sample_shading);
 }
 
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex); /* (with the pass's program) */
+
 /* A pass on multisampled targets: their textures on the multisample binding
    points, multisampling on and every sample shaded (per_sample); other passes
-   shade once per pixel. */
+   shade once per pixel. An engine texture of a per-sample pass (its depth) is
+   a multisample texture as well. */
 static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
     if (!gl->has_msaa) return;
     for (i = 0; i < FOGVOL_MAX_TEXTURE_UNITS; ++i) {
         const fogvol__gl_texture *t = (const fogvol__gl_texture *)p->textures[i];
+        fogvol__GLuint tex = t && t->samples > 1 ? t->tex : 0;
+        if (p->native_textures[i])
+            tex = p->per_sample ? fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]) : 0;
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
-        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE,
-                        t && !p->native_textures[i] && t->samples > 1 ? t->tex : 0);
+        gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
     }
     fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, p->per_sample);
     if (p->per_sample) {
@@ -11222,6 +11770,7 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
         gl->GetProgramiv(gl->err_shader, FOGVOL__GL_LINK_STATUS, &v);
         break;
     case FOGVOL__GL_INVALID_FRAMEBUFFER_OPERATION: /* clearing nothing through an FBO with no attachment */
+        if (!gl->BindFramebuffer) break; /* (a context creation that failed before loading them) */
         gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &v);
         if (!gl->err_fbo) gl->GenFramebuffers(1, &gl->err_fbo);
         gl->BindFramebuffer(fb, gl->err_fbo);
@@ -11235,14 +11784,62 @@ static void fogvol__gl_raise(fogvol__gl *gl, fogvol__GLenum e)
     }
 }
 
+/* fogvol's own GL errors, read while the engine's are held: the first becomes the public call's result
+   (FOGVOL_ERROR_BACKEND, through the backend's take_error), logged. */
+static void fogvol__gl_drain(fogvol__gl *gl)
+{
+    fogvol__GLenum first = gl->GetError();
+    int more = 0;
+    if (first == FOGVOL__GL_NO_ERROR) return;
+    while (more < 8 && gl->GetError() != FOGVOL__GL_NO_ERROR) ++more; /* (a lost context repeats its code) */
+    if (gl->own != FOGVOL_SUCCESS) return;
+    gl->own = FOGVOL_ERROR_BACKEND;
+    fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: GL error 0x%04x raised by fogvol's own GL calls (%d more after it)",
+                first, more);
+}
+
+/* The last exit: fogvol's errors read, then the engine's raised again with GL_DEBUG_OUTPUT off where
+   KHR_debug lets it be switched (the raising calls then reach no debug callback nor the message log;
+   the enable is put back). */
 static void fogvol__gl_host_leave(fogvol__gl *gl)
 {
-    int i;
+    int i, dbg;
     if (gl->host_depth <= 0 || --gl->host_depth > 0) return;
     if (gl->tf_paused) gl->ResumeTransformFeedback();
     gl->tf_paused = 0;
+    fogvol__gl_drain(gl);
+    dbg = gl->host_n > 0 && gl->has_debug_output && gl->IsEnabled(FOGVOL__GL_DEBUG_OUTPUT);
+    if (dbg) gl->Disable(FOGVOL__GL_DEBUG_OUTPUT);
     for (i = 0; i < gl->host_n; ++i) fogvol__gl_raise(gl, gl->host_errors[i]);
+    if (dbg) gl->Enable(FOGVOL__GL_DEBUG_OUTPUT);
     gl->host_n = 0;
+}
+
+/* Another GL context current than fogvol's: fogvol_gl_desc.current_context says so, or fogvol's own
+   per-context object is not there (its full-screen vertex array object; without VAOs a framebuffer
+   object made at creation; neither is shared between contexts). The first refusal of a call is
+   logged and is its result (INVALID_STATE, through take_error); the entry then touches nothing. */
+static int fogvol__gl_foreign(fogvol__gl *gl)
+{
+    int other = gl->current_context && gl->current_context(gl->user_data) != gl->context_id;
+    if (!other && gl->has_vao) other = gl->fullscreen.vao && !gl->IsVertexArray(gl->fullscreen.vao);
+    else if (!other) other = gl->err_fbo && !gl->IsFramebuffer(gl->err_fbo);
+    if (other && gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_STATE;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: another GL context is current than the one fogvol was "
+                                                "created in (its objects are not in it): nothing done; make "
+                                                "fogvol's context current");
+    }
+    return other;
+}
+
+/* fogvol_backend.take_error */
+static fogvol_result fogvol__gl_take_error(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    fogvol_result r = gl->own;
+    gl->own = FOGVOL_SUCCESS;
+    return r;
 }
 
 /* Vertex attribute 0 where there is no vertex array object to keep it. */
@@ -11421,6 +12018,7 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_result r;
     if (gl->in_frame) return FOGVOL_ERROR_INVALID_STATE;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     fogvol__gl_host_enter(gl);
     fogvol__gl_save(gl, &gl->saved);
     r = fogvol__gl_check_draw_buffer(gl, info->draw_buffer);
@@ -11512,10 +12110,11 @@ static fogvol_result fogvol__gl_create_texture(void *u, const fogvol_texture_des
     fogvol__gl_texture *t;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     t = (fogvol__gl_texture *)fogvol__alloc(&gl->alloc, sizeof *t);
     if (!t) return FOGVOL_ERROR_OUT_OF_MEMORY;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     tex = fogvol__gl_new_texture(gl, d->width, d->height, FOGVOL_FORMAT_RGBA8, filt, wrap, d->pixels);
     r = fogvol__gl_check(gl, d->label ? d->label : "create_texture");
@@ -11537,7 +12136,7 @@ static void fogvol__gl_destroy_texture(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_texture *t = (fogvol__gl_texture *)h;
     if (!t) return;
-    gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteTextures(1, &t->tex); /* deleting unbinds; touches no other state */
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11545,9 +12144,11 @@ static void fogvol__gl_free_target(fogvol__gl *gl, fogvol__gl_target *t)
 {
     if (!t) return;
     if (t->second) fogvol__gl_free_target(gl, t->second);
-    gl->DeleteFramebuffers(1, &t->fbo);
-    gl->DeleteTextures(1, &t->base.tex);
-    if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    if (!fogvol__gl_foreign(gl)) {
+        gl->DeleteFramebuffers(1, &t->fbo);
+        gl->DeleteTextures(1, &t->base.tex);
+        if (t->owns_depth) gl->DeleteRenderbuffers(1, &t->depth);
+    }
     fogvol__free(&gl->alloc, t);
 }
 
@@ -11620,7 +12221,7 @@ static fogvol_result fogvol__gl_create_target(void *u, const fogvol_target_desc 
     t->height = d->height;
     t->format = d->format;
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
     if (d->samples > 1)
         t->base.tex = fogvol__gl_new_texture_ms(gl, d);
@@ -11713,10 +12314,12 @@ static fogvol_result fogvol__gl_create_program(void *u, const fogvol_program_des
     const char *label = d->label ? d->label : "program";
     int i;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     p = (fogvol__gl_program *)fogvol__alloc(&gl->alloc, sizeof *p);
     if (!p) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(p, 0, sizeof *p);
     fogvol__gl_enter(gl, &s);
+    fogvol__gl_drain(gl); /* (earlier calls' errors are theirs, not this program's) */
     vs = fogvol__gl_shader(gl, FOGVOL__GL_VERTEX_SHADER, d->vs, d->vs_count, label, &r);
     fs = r == FOGVOL_SUCCESS ? fogvol__gl_shader(gl, FOGVOL__GL_FRAGMENT_SHADER, d->fs, d->fs_count, label, &r) : 0;
     if (r == FOGVOL_SUCCESS) {
@@ -11768,7 +12371,7 @@ static void fogvol__gl_destroy_program(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_program *p = (fogvol__gl_program *)h;
     if (!p) return;
-    gl->DeleteProgram(p->id); /* deferred by GL while the engine's program is current: no state change */
+    if (!fogvol__gl_foreign(gl)) gl->DeleteProgram(p->id); /* deferred while current: no state change */
     if (gl->program == p) gl->program = NULL;
     fogvol__free(&gl->alloc, p);
 }
@@ -11819,7 +12422,7 @@ static fogvol_result fogvol__gl_upload(fogvol__gl *gl, fogvol__gl_mesh *m, const
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     if (gl->has_vao) {
         gl->GenVertexArrays(1, &m->vao);
         gl->BindVertexArray(m->vao);
@@ -11866,6 +12469,7 @@ static fogvol_result fogvol__gl_create_mesh(void *u, const fogvol_mesh_data *d, 
     fogvol__gl_mesh *m;
     fogvol_result r;
     *out = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     m = (fogvol__gl_mesh *)fogvol__alloc(&gl->alloc, sizeof *m);
     if (!m) return FOGVOL_ERROR_OUT_OF_MEMORY;
     r = fogvol__gl_upload(gl, m, d);
@@ -11882,7 +12486,7 @@ static void fogvol__gl_destroy_mesh(void *u, fogvol_handle h)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_mesh *m = (fogvol__gl_mesh *)h;
     if (!m) return;
-    fogvol__gl_free_mesh(gl, m);
+    if (!fogvol__gl_foreign(gl)) fogvol__gl_free_mesh(gl, m);
     fogvol__free(&gl->alloc, m);
 }
 
@@ -11924,6 +12528,21 @@ static void fogvol__gl_pass_blend(fogvol__gl *gl, const fogvol_pass *p)
 }
 
 /* The program of a pass with its uniforms, and its textures on fogvol's units. */
+/* An engine texture of a pass (engine depth, post effect inputs): a name that is no texture of the
+   current context is not bound (in a compatibility profile binding it would make an empty one) and
+   the pass draws nothing; the call's result is INVALID_ARGUMENT, logged. */
+static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex)
+{
+    if (gl->IsTexture(tex)) return tex;
+    gl->skip_draws = 1;
+    if (gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: texture %u handed to fogvol (an engine depth, colour or "
+                    "normal texture) is not a texture of the current GL context: its passes draw nothing", tex);
+    }
+    return 0;
+}
+
 static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
 {
     int i;
@@ -11936,7 +12555,8 @@ static void fogvol__gl_pass_program(fogvol__gl *gl, const fogvol_pass *p)
         /* texture and target handles both start with the texture name */
         fogvol__GLuint tex = p->textures[i] ? ((const fogvol__gl_texture *)p->textures[i])->tex : 0;
         if (p->textures[i] && ((const fogvol__gl_texture *)p->textures[i])->samples > 1) tex = 0; /* below */
-        if (p->native_textures[i]) tex = (fogvol__GLuint)p->native_textures[i];
+        if (p->native_textures[i]) /* (per-sample passes: on the multisample binding, below) */
+            tex = p->per_sample ? 0 : fogvol__gl_native(gl, (fogvol__GLuint)p->native_textures[i]);
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D, tex);
         if (gl->has_sampler) gl->BindSampler((fogvol__GLuint)i, p->native_textures[i] ? gl->native_sampler : 0);
@@ -11959,6 +12579,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__gl_target *t = (fogvol__gl_target *)p->target;
+    gl->skip_draws = 0;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
@@ -12018,7 +12639,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     const fogvol__gl_mesh *m = (const fogvol__gl_mesh *)h;
-    if (!m) return;
+    if (!m || gl->skip_draws) return;
     fogvol__gl_set_draw(u, d);
     fogvol__gl_bind_mesh(gl, m);
     gl->DrawElements(FOGVOL__GL_TRIANGLES, m->count, m->index_type, NULL);
@@ -12027,6 +12648,7 @@ static void fogvol__gl_draw_mesh(void *u, fogvol_handle h, const fogvol_draw *d)
 static void fogvol__gl_draw_fullscreen(void *u)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
+    if (gl->skip_draws) return;
     fogvol__gl_bind_mesh(gl, &gl->fullscreen);
     gl->DrawArrays(FOGVOL__GL_TRIANGLES, 0, 3);
 }
@@ -12067,46 +12689,85 @@ static fogvol__GLenum fogvol__gl_depth_format(fogvol__gl *gl, int default_fb)
     return bits == 32 && !gl->gles ? FOGVOL__GL_DEPTH_COMPONENT32 : 0;
 }
 
-/* (Re)creates the copy texture and its framebuffer for a format and size. */
-static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h)
+/* The copy texture and its framebuffer for a format, size and sample count (0: single-sample),
+   recreated only when the format or samples differ or it is too small (it keeps the engine's
+   texel coordinates, so the views of a split screen share one); leaves the draw framebuffer alone. */
+static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w, int h, int samples)
 {
     static const fogvol__GLenum none = FOGVOL__GL_NONE;
     int packed = format == FOGVOL__GL_DEPTH24_STENCIL8 || format == FOGVOL__GL_DEPTH32F_STENCIL8;
+    fogvol__GLenum target = samples ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
+                                    : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D;
     fogvol__GLenum type = format == FOGVOL__GL_DEPTH_COMPONENT16 ? FOGVOL__GL_UNSIGNED_SHORT
                           : format == FOGVOL__GL_DEPTH24_STENCIL8 ? FOGVOL__GL_UNSIGNED_INT_24_8
                           : format == FOGVOL__GL_DEPTH32F_STENCIL8 ? FOGVOL__GL_FLOAT_32_UNSIGNED_INT_24_8_REV
                           : format == FOGVOL__GL_DEPTH_COMPONENT32F ? FOGVOL__GL_FLOAT
                                                                     : FOGVOL__GL_UNSIGNED_INT;
-    if (gl->depth_tex && gl->depth_format == format && gl->depth_w == w && gl->depth_h == h) return;
+    fogvol__GLuint fbo = 0;
+    if (gl->depth_tex && gl->depth_format == format && gl->depth_samples == samples) {
+        if (gl->depth_w >= w && gl->depth_h >= h) return;
+        w = w > gl->depth_w ? w : gl->depth_w; /* grow only: views of other sizes keep fitting */
+        h = h > gl->depth_h ? h : gl->depth_h;
+    }
     if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
     if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, (fogvol__GLint *)&fbo);
     gl->GenTextures(1, &gl->depth_tex);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, gl->depth_tex);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexParameteri(FOGVOL__GL_TEXTURE_2D, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
-    gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, (fogvol__GLint)format, w, h, 0,
-                   packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D, 0);
+    gl->BindTexture(target, gl->depth_tex);
+    if (samples) {
+        gl->TexImage2DMultisample(target, samples, format, w, h, 1);
+    } else {
+        gl->TexParameteri(target, FOGVOL__GL_TEXTURE_MIN_FILTER, FOGVOL__GL_NEAREST);
+        gl->TexParameteri(target, FOGVOL__GL_TEXTURE_MAG_FILTER, FOGVOL__GL_NEAREST);
+        gl->TexImage2D(target, 0, (fogvol__GLint)format, w, h, 0,
+                       packed ? FOGVOL__GL_DEPTH_STENCIL : FOGVOL__GL_DEPTH_COMPONENT, type, NULL);
+    }
+    gl->BindTexture(target, 0);
     gl->GenFramebuffers(1, &gl->depth_fbo);
     gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo);
     gl->FramebufferTexture2D(FOGVOL__GL_DRAW_FRAMEBUFFER,
-                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT,
-                             FOGVOL__GL_TEXTURE_2D, gl->depth_tex, 0);
+                             packed ? FOGVOL__GL_DEPTH_STENCIL_ATTACHMENT : FOGVOL__GL_DEPTH_ATTACHMENT, target,
+                             gl->depth_tex, 0);
     gl->DrawBuffers(1, &none); /* depth only (framebuffer state of our own FBO) */
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, fbo);
     gl->depth_format = format;
+    gl->depth_samples = samples;
     gl->depth_w = w;
     gl->depth_h = h;
 }
 
-static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+/* The samples per pixel of framebuffer fb (0: single-sample); leaves fb bound for drawing. */
+static int fogvol__gl_fb_samples(fogvol__gl *gl, fogvol__GLuint fb)
+{
+    fogvol__GLint buffers = 0, samples = 0;
+    if (!gl->has_msaa) return 0;
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, fb);
+    gl->GetIntegerv(FOGVOL__GL_SAMPLE_BUFFERS, &buffers);
+    gl->GetIntegerv(FOGVOL__GL_SAMPLES, &samples);
+    return buffers ? samples : 0;
+}
+
+/* Why the depth of a framebuffer of src samples cannot be copied with samples samples, or NULL. */
+static const char *fogvol__gl_copy_refusal(const fogvol__gl *gl, int src, int samples)
+{
+    if (samples && !gl->has_msaa) return "a per-sample copy needs multisample textures (GL 3.2)";
+    if (samples && src > 1 && src != samples)
+        return "its sample count differs from the engine framebuffer's drawn per sample (GL cannot blit it)";
+    if (samples && src <= 1 && gl->gles)
+        return "OpenGL ES cannot blit a single-sample depth buffer into a multisampled one";
+    return NULL;
+}
+
+static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                            fogvol_native *texture)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint src = bound ? (fogvol__GLuint)gl->saved.draw_fbo : (fogvol__GLuint)framebuffer;
     fogvol__GLenum format;
     fogvol_result r;
-    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3];
+    const char *why;
+    int x1 = rect[0] + rect[2], y1 = rect[1] + rect[3], src_samples;
     *texture = 0;
     if (!gl->in_frame || !gl->BlitFramebuffer || !gl->has_split_fbo || !gl->DrawBuffers) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copying a depth buffer needs glBlitFramebuffer "
@@ -12118,7 +12779,18 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
                     rect[1]);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    gl->GetError();
+    if (src && !gl->IsFramebuffer(src)) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine_depth_framebuffer %u is not a framebuffer of the "
+                                                "current GL context", src);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    fogvol__gl_drain(gl);
+    src_samples = fogvol__gl_fb_samples(gl, src);
+    if ((why = fogvol__gl_copy_refusal(gl, src_samples, samples > 1 ? samples : 0)) != NULL) {
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: copy_depth of framebuffer %u (%d samples): %s", src,
+                    src_samples, why);
+        return src_samples > 1 && samples > 1 ? FOGVOL_ERROR_INVALID_ARGUMENT : FOGVOL_ERROR_UNSUPPORTED;
+    }
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, src);
     format = fogvol__gl_depth_format(gl, src == 0);
     if (!format) {
@@ -12126,13 +12798,15 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
                     "fogvol: framebuffer %u has no depth buffer, or one whose format no depth texture matches", src);
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    fogvol__gl_depth_target(gl, format, x1, y1);
+    fogvol__gl_depth_target(gl, format, x1, y1, samples > 1 ? samples : 0);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo); /* every copy names its destination */
     gl->Disable(FOGVOL__GL_SCISSOR_TEST);
     if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
     /* the same rectangle on both sides: required to resolve a multisampled source */
     gl->BlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, FOGVOL__GL_DEPTH_BUFFER_BIT,
                         FOGVOL__GL_NEAREST);
     gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)gl->saved.read_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)gl->saved.draw_fbo);
     r = fogvol__gl_check(gl, "copy_depth (glBlitFramebuffer of the engine's depth)");
     if (r == FOGVOL_SUCCESS) *texture = gl->depth_tex;
     return r;
@@ -12148,7 +12822,7 @@ static fogvol_result fogvol__gl_read_target(void *u, fogvol_handle h, unsigned c
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (t->base.samples) return FOGVOL_ERROR_UNSUPPORTED; /* a multisample texture has no single value per pixel */
     fogvol__gl_enter(gl, &s);
-    gl->GetError();
+    fogvol__gl_drain(gl);
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t->fbo);
     if (t->format == FOGVOL_FORMAT_R32F)
         gl->ReadPixels(0, 0, t->width, t->height, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, rgba);
@@ -12166,6 +12840,7 @@ static fogvol_result fogvol__gl_create_query(void *u, fogvol_handle *out)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = 0;
+    if (fogvol__gl_foreign(gl)) return FOGVOL_ERROR_INVALID_STATE;
     gl->GenQueries(1, &id); /* names only: no state */
     *out = (fogvol_handle)id;
     return id ? FOGVOL_SUCCESS : FOGVOL_ERROR_BACKEND;
@@ -12175,7 +12850,7 @@ static void fogvol__gl_destroy_query(void *u, fogvol_handle q)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol__GLuint id = (fogvol__GLuint)q;
-    gl->DeleteQueries(1, &id);
+    if (!fogvol__gl_foreign(gl)) gl->DeleteQueries(1, &id);
 }
 
 /* Not while the engine has an occlusion query running: BeginQuery would fail (and add its error to
@@ -12221,12 +12896,14 @@ static void fogvol__gl_destroy(void *u)
     fogvol__gl *gl = (fogvol__gl *)u;
     fogvol_allocator a;
     if (!gl) return;
-    fogvol__gl_free_mesh(gl, &gl->fullscreen);
-    if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
-    if (gl->err_shader) gl->DeleteShader(gl->err_shader);
-    if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
-    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    if (!fogvol__gl_foreign(gl)) {
+        fogvol__gl_free_mesh(gl, &gl->fullscreen);
+        if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader);
+        if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
+        if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+        if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    }
     a = gl->alloc;
     fogvol__free(&a, gl);
 }
@@ -12351,7 +13028,13 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
         gl->major = desc->version_major;
         gl->minor = desc->version_minor;
         gl->gles = desc->gles != 0;
-        if (gl->gles || gl->major < 3 || (gl->major == 3 && gl->minor < 2)) gl->core = 0;
+        if (gl->core && gl->major < 3) { /* (GL 3.x stays the core profile it is; GLES 3 has VAOs too) */
+            fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: a core-profile context cannot be treated as %s %d.%d "
+                        "(drawn without vertex array objects, one GL_EXTENSIONS string): use a compatibility "
+                        "profile for that override", gl->gles ? "OpenGL ES" : "GL", gl->major, gl->minor);
+            return FOGVOL_ERROR_UNSUPPORTED;
+        }
+        if (gl->gles) gl->core = 0;
     }
     if ((!gl->gles && gl->major < 2) || (gl->gles && gl->major < 2)) {
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: %s %d.%d has no GLSL; need GL 2.0 or GLES 2.0",
@@ -12535,6 +13218,19 @@ static void fogvol__gl_load_clip_control(fogvol__gl *gl, const fogvol_gl_desc *d
 }
 
 /* The dialect, capabilities, the sampler for engine textures and the full-screen triangle. */
+/* Without VAOs, the context's mark (fogvol__gl_foreign): a framebuffer object, which exists once bound
+   (also the one fogvol__gl_raise clears through); the bindings are put back. */
+static void fogvol__gl_mark(fogvol__gl *gl)
+{
+    fogvol__GLint draw = 0, read = 0;
+    gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+    if (gl->has_split_fbo) gl->GetIntegerv(FOGVOL__GL_READ_FRAMEBUFFER_BINDING, &read);
+    gl->GenFramebuffers(1, &gl->err_fbo);
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->err_fbo);
+    gl->BindFramebuffer(gl->has_split_fbo ? FOGVOL__GL_DRAW_FRAMEBUFFER : FOGVOL__GL_FRAMEBUFFER, (fogvol__GLuint)draw);
+    if (gl->has_split_fbo) gl->BindFramebuffer(FOGVOL__GL_READ_FRAMEBUFFER, (fogvol__GLuint)read);
+}
+
 static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc, const char *ext)
 {
     static const float tri[9] = {-1, -1, 0, 3, -1, 0, -1, 3, 0};
@@ -12560,10 +13256,15 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_WRAP_T, FOGVOL__GL_CLAMP_TO_EDGE);
         gl->SamplerParameteri(gl->native_sampler, FOGVOL__GL_TEXTURE_COMPARE_MODE, FOGVOL__GL_NONE);
     }
+    gl->has_debug_output = gl->gles ? gl->major > 3 || (gl->major == 3 && gl->minor >= 2)
+                                    : gl->major > 4 || (gl->major == 4 && gl->minor >= 3);
+    if (!gl->has_debug_output)
+        gl->has_debug_output = gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_KHR_debug") : fogvol__has_ext(ext, "GL_KHR_debug");
     memset(&tri_data, 0, sizeof tri_data);
     tri_data.positions = tri;
     tri_data.vertex_count = 3;
     r = fogvol__gl_upload(gl, &gl->fullscreen, &tri_data);
+    if (r == FOGVOL_SUCCESS && !gl->has_vao) fogvol__gl_mark(gl);
     if (r != FOGVOL_SUCCESS && gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
     return r;
 }
@@ -12592,6 +13293,7 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->draw_fullscreen = fogvol__gl_draw_fullscreen;
     out->read_target = fogvol__gl_read_target;
     out->destroy = fogvol__gl_destroy;
+    out->take_error = fogvol__gl_take_error;
     if (gl->has_query) {
         out->create_query = fogvol__gl_create_query;
         out->destroy_query = fogvol__gl_destroy_query;
@@ -12637,18 +13339,39 @@ FOGVOL_API fogvol_result fogvol_gl_backend_create(const fogvol_gl_desc *in, cons
                     "fogvol: the GL backend needs a loader (get_proc_address, get_proc or get_proc_pointer)");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
-    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (desc->dialect == FOGVOL_GLSL_VULKAN) return FOGVOL_ERROR_UNSUPPORTED; /* SPIR-V, not GL */
+    if ((int)desc->dialect < 0 || (int)desc->dialect >= FOGVOL_GLSL_COUNT) {
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: unknown GLSL dialect %d in fogvol_gl_desc (FOGVOL_GLSL_*)",
+                    (int)desc->dialect);
+        return FOGVOL_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->dialect == FOGVOL_GLSL_VULKAN) { /* SPIR-V, not GL */
+        fogvol__log(logger, FOGVOL_LOG_ERROR, "fogvol: the GL backend cannot take FOGVOL_GLSL_VULKAN (a dialect for "
+                    "SPIR-V backends)");
+        return FOGVOL_ERROR_UNSUPPORTED;
+    }
     gl = (fogvol__gl *)fogvol__alloc(alloc, sizeof *gl);
     if (!gl) return FOGVOL_ERROR_OUT_OF_MEMORY;
     memset(gl, 0, sizeof *gl);
     if (alloc) gl->alloc = *alloc;
     gl->log = *logger;
+    gl->current_context = in->current_context;
+    gl->user_data = in->user_data; /* (the caller's, also with a plain loader) */
+    if (gl->current_context) gl->context_id = gl->current_context(gl->user_data);
     r = fogvol__gl_version(gl, desc, &ver);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_features(gl, desc, &ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
-    if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+    if (r == FOGVOL_SUCCESS) { /* (the engine's pending errors held: fogvol's own are this call's) */
+        fogvol__gl_host_enter(gl);
+        r = fogvol__gl_features(gl, desc, &ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_load_versioned(gl, desc, ext);
+        if (r == FOGVOL_SUCCESS) r = fogvol__gl_setup(gl, desc, ext);
+        fogvol__gl_host_leave(gl);
+        if (r == FOGVOL_SUCCESS && fogvol__gl_take_error(gl) != FOGVOL_SUCCESS) {
+            fogvol__gl_destroy(gl);
+            return FOGVOL_ERROR_BACKEND;
+        }
+    }
     if (r != FOGVOL_SUCCESS) {
+        if (gl->err_shader) gl->DeleteShader(gl->err_shader); /* (made to raise the engine's error) */
+        if (gl->err_fbo && gl->DeleteFramebuffers) gl->DeleteFramebuffers(1, &gl->err_fbo);
         fogvol__free(alloc, gl);
         return r;
     }

@@ -27,7 +27,9 @@
    GPU driver through EGL) it is GPU timestamps taken at the same points.
 
    usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
-                               prints only; --scene I: scene I alone, prints only)
+                               prints only; --scene I: scene I alone, prints only;
+                               --cpu: the scale and lifetime figures of the CPU section
+                               alone, on the null backend, no GL, prints only)
    full run: prints the tables, writes bench/RESULTS.md and bench/plot.png
    (GLU_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
 #define FOGVOL_IMPLEMENTATION
@@ -1234,6 +1236,256 @@ static void cpu_measure(cpu_figs *c, int quick)
     shp_free(&big);
 }
 
+/* ---- scale and lifetime: fogvol's CPU work at large counts, on the recording null backend ------ */
+typedef struct scale_figs {
+    int ramps;                 /* end_frame of a frame with one volume per ramp */
+    double ramps_ms;
+    int ramps_passes;
+    int colors;                /* end_frame, FOGVOL_VARIANT_COLORS + the GEOMETRY composite, one ramp */
+    double colors_ms;
+    int weld_n, weld_v, weld_kept; /* per-face subdivided cube: n x n quads a face, 6 (n+1)^2 vertices */
+    double weld_ms, weld_total_ms; /* the weld alone (fogvol__weld); fogvol_validate_mesh with the weld */
+    int life_n;                /* live meshes, ramps and volume textures each at fogvol_destroy_context */
+    long life_host;            /* allocations of the context's allocator still live after it */
+    int life_gpu;              /* backend objects created and never destroyed */
+    double life_ms;
+} scale_figs;
+
+typedef struct scale_alloc {
+    long live;
+} scale_alloc;
+
+static void *scale_alloc_fn(size_t size, void *u)
+{
+    void *p = malloc(size);
+    if (p) ((scale_alloc *)u)->live++;
+    return p;
+}
+
+static void scale_free_fn(void *p, void *u)
+{
+    ((scale_alloc *)u)->live--;
+    free(p);
+}
+
+static fogvol_context *scale_context(fogvol_null_backend *nb, fogvol_tier tier, unsigned variants, scale_alloc *a)
+{
+    fogvol_context_desc cd;
+    fogvol_context *c = NULL;
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(nb, &cd.backend);
+    cd.backend.caps |= FOGVOL_CAP_FLOAT_BLEND;
+    cd.tier = tier;
+    cd.variants = variants;
+    if (a) {
+        cd.allocator.alloc = scale_alloc_fn;
+        cd.allocator.free = scale_free_fn;
+        cd.allocator.user_data = a;
+    }
+    if (fogvol_create_context(&cd, &c) != FOGVOL_SUCCESS) die("fogvol_create_context (null backend)");
+    return c;
+}
+
+static void scale_frame_desc(fogvol_frame_desc *fd, int composite)
+{
+    double eye[3] = {0, 0, 30}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    memset(fd, 0, sizeof *fd);
+    glu_look_at(fd->view, eye, at, up);
+    glu_perspective(fd->projection, 60.0, 16.0 / 9.0, 0.5, 100.0);
+    fd->znear = 0.5f;
+    fd->zfar = 100.0f;
+    fd->viewport[2] = 1280;
+    fd->viewport[3] = 720;
+    fd->composite = (fogvol_composite)composite;
+}
+
+/* n volumes (boxes on a grid in front of the camera), each with its own ramp (per_ramp) or all
+   with one; the time of fogvol_end_frame alone, median of reps */
+static double scale_end_frame(fogvol_context *c, fogvol_mesh *mesh, fogvol_ramp **ramps, int n, int per_ramp,
+                              int composite, int reps, int *passes)
+{
+    double v[9];
+    int r, i, side = (int)ceil(sqrt((double)n));
+    for (r = 0; r < reps; ++r) {
+        fogvol_frame_desc fd;
+        fogvol_frame_stats st;
+        double t0;
+        scale_frame_desc(&fd, composite);
+        if (fogvol_begin_frame(c, &fd) != FOGVOL_SUCCESS) die("begin_frame (scale)");
+        for (i = 0; i < n; ++i) {
+            fogvol_volume_desc vd;
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = mesh;
+            vd.ramp = ramps[per_ramp ? i : 0];
+            trs(vd.model, 20.0f * ((float)(i % side) / side - 0.5f), 12.0f * ((float)(i / side) / side - 0.5f), 0.0f,
+                0, 0, 1, 0, 0.02f, 0.02f, 0.02f);
+            if (fogvol_add_volume(c, &vd) != FOGVOL_SUCCESS) die("add_volume (scale)");
+        }
+        t0 = now_ms();
+        if (fogvol_end_frame(c, &st) != FOGVOL_SUCCESS) die("end_frame (scale)");
+        v[r] = now_ms() - t0;
+        *passes = st.passes;
+    }
+    return median(v, reps);
+}
+
+static void scale_ramp_desc(fogvol_ramp_desc *rd, int i)
+{
+    memset(rd, 0, sizeof *rd);
+    rd->color[0] = (float)(i % 7) / 6.0f;
+    rd->color[1] = 0.5f;
+    rd->color[2] = 0.8f;
+    rd->density = 0.5f + 0.001f * (float)(i % 1000);
+    rd->width = 16;
+}
+
+static void scale_frames(scale_figs *s, int quick)
+{
+    fogvol_null_backend nb;
+    fogvol_context *c;
+    fogvol_mesh *mesh;
+    fogvol_ramp **ramps;
+    fogvol_mesh_desc md;
+    shp_mesh box = shp_box(1.0f, 1.0f, 1.0f);
+    int i, p;
+    s->ramps = quick ? 2000 : 20000;
+    s->colors = quick ? 1000 : 10000;
+    ramps = (fogvol_ramp **)malloc(sizeof *ramps * (size_t)s->ramps);
+    if (!ramps) die("out of memory");
+    memset(&md, 0, sizeof md);
+    md.positions = box.pos;
+    md.vertex_count = box.vcount;
+    md.indices = box.idx;
+    md.index_count = box.icount;
+    c = scale_context(&nb, FOGVOL_TIER_PS20, 0, NULL);
+    if (fogvol_create_mesh(c, &md, &mesh, NULL) != FOGVOL_SUCCESS) die("mesh (scale)");
+    for (i = 0; i < s->ramps; ++i) {
+        fogvol_ramp_desc rd;
+        scale_ramp_desc(&rd, i);
+        if (fogvol_create_ramp(c, &rd, &ramps[i]) != FOGVOL_SUCCESS) die("ramp (scale)");
+    }
+    s->ramps_ms = scale_end_frame(c, mesh, ramps, s->ramps, 1, FOGVOL_COMPOSITE_FULLSCREEN, quick ? 1 : 3,
+                                  &s->ramps_passes);
+    for (i = 0; i < s->ramps; ++i) fogvol_destroy_ramp(c, ramps[i]);
+    fogvol_destroy_mesh(c, mesh);
+    fogvol_destroy_context(c);
+    c = scale_context(&nb, FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_COLORS, NULL);
+    if (fogvol_create_mesh(c, &md, &mesh, NULL) != FOGVOL_SUCCESS) die("mesh (scale, colours)");
+    {
+        fogvol_ramp_desc rd;
+        scale_ramp_desc(&rd, 0);
+        if (fogvol_create_ramp(c, &rd, &ramps[0]) != FOGVOL_SUCCESS) die("ramp (scale, colours)");
+    }
+    s->colors_ms = scale_end_frame(c, mesh, ramps, s->colors, 0, FOGVOL_COMPOSITE_GEOMETRY, quick ? 1 : 3, &p);
+    fogvol_destroy_ramp(c, ramps[0]);
+    fogvol_destroy_mesh(c, mesh);
+    fogvol_destroy_context(c);
+    free(ramps);
+    shp_free(&box);
+}
+
+/* the weld of a per-face subdivided cube (6 x 257^2 vertices at 1e-5): alone (fogvol__weld, the
+   implementation is in this file), and inside
+   fogvol_validate_mesh (weld + the checks of the welded mesh) */
+static void scale_weld(scale_figs *s, int quick)
+{
+    shp_mesh m;
+    fogvol_mesh_desc md;
+    fogvol_mesh_report rep;
+    uint32_t *rep_idx;
+    double t0;
+    s->weld_n = quick ? 64 : 256;
+    m = shp_cube_faces(1.0f, s->weld_n);
+    s->weld_v = m.vcount;
+    rep_idx = (uint32_t *)malloc(sizeof *rep_idx * (size_t)m.vcount);
+    if (!m.pos || !rep_idx) die("out of memory");
+    t0 = now_ms();
+    s->weld_kept = m.vcount - fogvol__weld((const unsigned char *)m.pos, 12, m.vcount, 1e-5f, NULL, rep_idx);
+    s->weld_ms = now_ms() - t0;
+    memset(&md, 0, sizeof md);
+    md.positions = m.pos;
+    md.vertex_count = m.vcount;
+    md.indices = m.idx;
+    md.index_count = m.icount;
+    md.weld_distance = 1e-5f;
+    t0 = now_ms();
+    if (fogvol_validate_mesh(&md, NULL, &rep) != FOGVOL_SUCCESS) die("validate (weld)");
+    s->weld_total_ms = now_ms() - t0;
+    if (rep.vertices != s->weld_kept) die("weld: the validation welded another count");
+    free(rep_idx);
+    shp_free(&m);
+}
+
+/* fogvol_destroy_context with n live meshes, ramps and volume textures the caller forgot */
+static void scale_lifetime(scale_figs *s, int quick)
+{
+    fogvol_null_backend nb;
+    scale_alloc a;
+    fogvol_context *c;
+    fogvol_mesh_desc md;
+    fogvol_texture_desc td;
+    shp_mesh box = shp_box(1.0f, 1.0f, 1.0f);
+    unsigned char px[4] = {255, 255, 255, 255};
+    int i;
+    double t0;
+    s->life_n = quick ? 100 : 1000;
+    memset(&a, 0, sizeof a);
+    c = scale_context(&nb, FOGVOL_TIER_PS20, 0, &a);
+    memset(&md, 0, sizeof md);
+    md.positions = box.pos;
+    md.vertex_count = box.vcount;
+    md.indices = box.idx;
+    md.index_count = box.icount;
+    memset(&td, 0, sizeof td);
+    td.width = td.height = 1;
+    td.pixels = px;
+    for (i = 0; i < s->life_n; ++i) {
+        fogvol_mesh *m;
+        fogvol_ramp *r;
+        fogvol_volume_texture *t;
+        fogvol_ramp_desc rd;
+        scale_ramp_desc(&rd, i);
+        if (fogvol_create_mesh(c, &md, &m, NULL) != FOGVOL_SUCCESS || fogvol_create_ramp(c, &rd, &r) != FOGVOL_SUCCESS ||
+            fogvol_create_volume_texture(c, &td, &t) != FOGVOL_SUCCESS)
+            die("lifetime objects");
+    }
+    t0 = now_ms();
+    fogvol_destroy_context(c);
+    s->life_ms = now_ms() - t0;
+    s->life_host = a.live;
+    s->life_gpu = nb.creates - nb.destroys;
+    shp_free(&box);
+}
+
+static void scale_measure(scale_figs *s, int quick)
+{
+    scale_frames(s, quick);
+    scale_weld(s, quick);
+    scale_lifetime(s, quick);
+}
+
+static void print_scale(const scale_figs *s)
+{
+    out("| fogvol_end_frame, %d volumes of %d ramps, PS20, null backend (%d passes) | %.1f ms |\n", s->ramps,
+        s->ramps, s->ramps_passes, s->ramps_ms);
+    out("| fogvol_end_frame, %d volumes of one ramp, FLOAT + COLORS + GEOMETRY composite, null backend | %.1f ms |\n",
+        s->colors, s->colors_ms);
+    out("| weld of a per-face subdivided cube, %d vertices (6 x %d^2) at 1e-5 -> %d | %.1f ms |\n", s->weld_v,
+        s->weld_n + 1, s->weld_kept, s->weld_ms);
+    out("| fogvol_validate_mesh of that cube with weld_distance 1e-5 (weld + checks) | %.1f ms |\n", s->weld_total_ms);
+    out("| fogvol_destroy_context with %d meshes, %d ramps and %d volume textures alive | %.1f ms, %ld allocations "
+        "and %d backend objects left |\n",
+        s->life_n, s->life_n, s->life_n, s->life_ms, s->life_host, s->life_gpu);
+}
+
+/* the scale figures for the summary line */
+static void scale_summary(const scale_figs *s, char *buf, size_t size)
+{
+    snprintf(buf, size, "end_frame %d ramps %.1f ms, colours %d volumes %.1f ms, weld %dk vertices %.1f ms, "
+             "destroy_context leaves %ld allocations %d objects",
+             s->ramps, s->ramps_ms, s->colors, s->colors_ms, s->weld_v / 1000, s->weld_ms, s->life_host, s->life_gpu);
+}
+
 /* the GL backend (wrapped by the pass timer) + fogvol_create_context, timed together */
 static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
 {
@@ -1638,15 +1890,16 @@ static void analytic_figures(char *buf, size_t size)
 }
 
 /* the last line of the output: the figures to compare between runs */
-static void print_summary_line(const result *rs, int n)
+static void print_summary_line(const result *rs, int n, const scale_figs *sc)
 {
     const char *w;
-    char an[256];
+    char an[256], sf[256];
     analytic_figures(an, sizeof an);
+    scale_summary(sc, sf, sizeof sf);
     out("\nsummary: FLOAT worst %.2fx floor, FLOAT occluders %.2fx occluder floor, PS20 worst %.2fx, MRT worst %.2fx, "
-        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, %s\n",
+        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, %s, %s\n",
         worst_ratio(rs, n, 3, 0, &w), worst_ratio(rs, n, 3, 1, &w), worst_ratio(rs, n, 1, -1, &w),
-        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n), an);
+        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n), an, sf);
 }
 
 /* ---- 16 coloured volumes: per-ramp groups against one pass (FOGVOL_VARIANT_COLORS) ------ */
@@ -1769,16 +2022,27 @@ int main(int argc, char **argv)
     static const int sizes[2][2] = {{1280, 720}, {640, 360}};
     int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
     int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
+    int cpu_only = argc > 1 && strcmp(argv[1], "--cpu") == 0; /* the scale figures alone, no GL */
     double t_start = now_ms(), v[5];
     glu_ctx g;
     fogs F;
     cpu_figs cpu;
+    scale_figs scale;
     struct utsname un;
-    char cpu_model[256], load0[64], load1[64];
+    char cpu_model[256], load0[64], load1[64], line[256];
     int ncpu;
-    if (argc > 1 && !quick && (only < 0 || only >= NSCENES)) {
-        fprintf(stderr, "usage: %s [--quick | --scene 0..%d]\n", argv[0], NSCENES - 1);
+    if (argc > 1 && !quick && !cpu_only && (only < 0 || only >= NSCENES)) {
+        fprintf(stderr, "usage: %s [--quick | --cpu | --scene 0..%d]\n", argv[0], NSCENES - 1);
         return 2;
+    }
+    memset(&scale, 0, sizeof scale);
+    if (cpu_only) {
+        scale_measure(&scale, 0);
+        out("| what | figure |\n|---|---:|\n");
+        print_scale(&scale);
+        scale_summary(&scale, line, sizeof line);
+        out("\nsummary: %s\n", line);
+        return 0;
     }
     /* cold shader compiles for the startup figures (no Mesa disk cache) */
     setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
@@ -1803,6 +2067,7 @@ int main(int argc, char **argv)
         if (fogvol_create_ramp(F.ctx[t], &rd, &F.ramp[t]) != FOGVOL_SUCCESS) die("ramp");
     }
     cpu_measure(&cpu, quick);
+    scale_measure(&scale, quick);
     if (!quick && only < 0) {
         g_md = fopen(BENCH_MD, "w");
         if (!g_md) die("cannot write " BENCH_MD " (run from the repository root)");
@@ -1863,6 +2128,7 @@ int main(int argc, char **argv)
     out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
     out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
         cpu.validate_ms, cpu.validate_mtris);
+    print_scale(&scale);
     for (t = 0; t < NTIER; ++t)
         out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
             g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
@@ -1873,7 +2139,7 @@ int main(int argc, char **argv)
     out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
         "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
         (now_ms() - t_start) / 1e3, load0, load1, ncpu);
-    print_summary_line(g_res, g_nres);
+    print_summary_line(g_res, g_nres, &scale);
     if (g_md) {
         fclose(g_md);
         plot(BENCH_PNG, g_res, g_nres, 1280, 720);

@@ -41,12 +41,13 @@
 enum {
     E_BEGIN_FRAME, E_END_FRAME, E_CREATE_TEXTURE, E_DESTROY_TEXTURE, E_CREATE_TARGET, E_DESTROY_TARGET,
     E_CREATE_PROGRAM, E_DESTROY_PROGRAM, E_CREATE_MESH, E_DESTROY_MESH, E_BEGIN_PASS, E_SET_DRAW, E_DRAW_MESH,
-    E_DRAW_FULLSCREEN, E_END_PASS, E_READ_TARGET, E_DESTROY, E_NATIVE_TEXTURE, E_TARGET_ATTACHMENT, E_COUNT
+    E_DRAW_FULLSCREEN, E_END_PASS, E_READ_TARGET, E_DESTROY, E_NATIVE_TEXTURE, E_TARGET_ATTACHMENT, E_TAKE_ERROR,
+    E_COUNT
 };
 static const char *const k_entry[E_COUNT] = {
     "begin_frame", "end_frame", "create_texture", "destroy_texture", "create_target", "destroy_target",
     "create_program", "destroy_program", "create_mesh", "destroy_mesh", "begin_pass", "set_draw", "draw_mesh",
-    "draw_fullscreen", "end_pass", "read_target", "destroy", "native_texture", "target_attachment"};
+    "draw_fullscreen", "end_pass", "read_target", "destroy", "native_texture", "target_attachment", "take_error"};
 
 typedef struct rec_pass {
     fogvol_pass pass; /* a copy of what begin_pass received */
@@ -311,6 +312,19 @@ static fogvol_handle rec_target_attachment(void *u, fogvol_handle h, int index)
     return r->inner.target_attachment ? r->inner.target_attachment(r->inner.user_data, h, index) : 0;
 }
 
+/* take_error (optional). The first failure of the backend's own calls since the last
+   take_error (GL: a GL error fogvol's own calls raised, read before the engine's pending
+   errors are raised again; an engine texture name that is no texture; another context
+   current), logged by the backend, and forgotten; FOGVOL_SUCCESS when none. fogvol calls it
+   after the backend calls of each public call and returns it when the call had no error
+   of its own. Without it, failures the void entries meet cannot reach the result. */
+static fogvol_result rec_take_error(void *u)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_TAKE_ERROR]++;
+    return r->inner.take_error ? r->inner.take_error(r->inner.user_data) : FOGVOL_SUCCESS;
+}
+
 /* The table: the recorder's entries, the wrapped backend's dialect and capabilities. */
 static fogvol_backend recorder_table(recorder *r)
 {
@@ -338,6 +352,7 @@ static fogvol_backend recorder_table(recorder *r)
     t.destroy = rec_destroy;
     t.native_texture = rec_native_texture;
     t.target_attachment = rec_target_attachment;
+    t.take_error = rec_take_error;
     return t;
 }
 

@@ -5,7 +5,8 @@
      fogvk_desc d = {instance, physical device, device, frames in flight, logger};
      fogvol_backend be;  fogvk_create(&d, &be);          // before fogvol_create_context
      cd.backend = be;  fogvol_create_context(&cd, &fv);   // dialect FOGVOL_GLSL_VULKAN, caps below
-     every frame, after recording its opaque scene into cmd (outside any render pass):
+     every frame, once, before the first fogvol call that records into cmd (fogvol_end_frame; for the
+     MRT tier fogvol_mrt_prepare, before the engine's pass), outside any render pass:
        fogvk_frame f = {cmd, slot, colour image, depth image, size, flush};
        fogvk_set_frame(&be, &f);
        fogvol_begin_frame ... fogvol_end_frame            // records fogvol's passes into f.cmd
@@ -44,7 +45,12 @@
    coordinates). The engine's own projection may flip y and map depth to [0, 1] as Vulkan engines
    do: fogvol sees the mirroring in the matrix, and begin_frame reports depth_zero_to_one.
    Lifetimes: objects fogvol destroys are freed when their frame slot comes round again (the engine
-   promises, by fogvk_frame.slot, that the slot's previous command buffer has completed).
+   promises, by fogvk_frame.slot, that the slot's previous command buffer has completed), and so are
+   the staging buffers of textures, once their copies are recorded. fogvk_set_frame is that "comes
+   round again": called a second time inside one frame, it would free what the frame's own commands
+   still read (the MRT tier's fogvol_mrt_prepare has recorded uploads by then) and rewind the uniforms
+   of passes already recorded; the frame's description is given once, with the layouts the engine's
+   images are in when fogvol_end_frame records.
 
    In exactly one file: #define FOGVOL_VULKAN_IMPLEMENTATION before #include "fogvol_vulkan.h"
    (after fogvol.h and <vulkan/vulkan.h>); link -lvulkan -lshaderc. */
@@ -68,10 +74,10 @@ typedef struct fogvk_frame {
     VkImage color_image;      /* the engine's colour target (fogvol_pass.target 0), single-sample */
     VkImageView color_view;
     VkFormat color_format;
-    VkImageLayout color_layout; /* its layout now; fogvol leaves it in this layout */
+    VkImageLayout color_layout; /* its layout when fogvol_end_frame records; fogvol leaves it in this layout */
     VkImage depth_image;      /* the engine's depth buffer (copy_depth, FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER) */
     VkFormat depth_format;
-    VkImageLayout depth_layout;
+    VkImageLayout depth_layout; /* the same: when fogvol_end_frame records, and after */
     int width, height;
     /* debug read-back only: end and submit cmd, wait until it has run, and return a new command
        buffer in the recording state (NULL: read_target fails with FOGVOL_ERROR_UNSUPPORTED) */
@@ -85,6 +91,8 @@ void fogvk_enable_features(VkPhysicalDeviceFeatures2 *f2, VkPhysicalDeviceVulkan
                            VkPhysicalDeviceVulkan13Features *f13);
 
 fogvol_result fogvk_create(const fogvk_desc *desc, fogvol_backend *out);
+/* Starts a frame in frame->slot, once per frame: frees what was let go of in the slot's previous
+   frame and rewinds its uniform ring (see Lifetimes above). */
 void fogvk_set_frame(fogvol_backend *backend, const fogvk_frame *frame);
 /* the command buffer the frame's commands are in now (a read-back's flush replaces it) */
 VkCommandBuffer fogvk_frame_command(const fogvol_backend *backend);
@@ -1160,15 +1168,15 @@ static void fogvk__end_pass(void *u)
 
 /* ---- the engine's depth, read-back, queries ---- */
 
-static fogvol_result fogvk__copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4],
+static fogvol_result fogvk__copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
                                        fogvol_native *texture)
 {
     fogvk *vk = (fogvk *)u;
     VkCommandBuffer cmd = vk->frame.cmd;
     VkImageCopy c;
     (void)framebuffer;
-    if (!bound || !vk->engine_depth.image) {
-        fogvk__log(vk, "fogvk: copy_depth copies the depth image of fogvk_frame only");
+    if (!bound || !vk->engine_depth.image || samples > 1) { /* (no FOGVOL_CAP_MULTISAMPLE: samples is 0) */
+        fogvk__log(vk, "fogvk: copy_depth copies the single-sample depth image of fogvk_frame only");
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     fogvk__end_rendering(vk);

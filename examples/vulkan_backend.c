@@ -14,7 +14,9 @@
      vulkan_backend --bench              milliseconds per frame, this backend beside the GL one
 
    The validation layers (VK_LAYER_KHRONOS_validation) are on when installed; every message they
-   send is printed and counted, and --check fails on any.
+   send is printed and counted, from vkCreateInstance to the end of the program: the count is reported
+   after the last Vulkan object is gone, the run fails on any (the picture and --check alike), and a
+   message after the count was reported fails it too (report_validation_count).
    Build: cc -std=c99 -I. examples/vulkan_backend.c -lvulkan -l:libshaderc_combined.a -lstdc++ -lOSMesa -lm */
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
@@ -62,20 +64,42 @@ typedef struct engine {
     VkPipeline pipeline_o;        /* the same, and fogvol's O as a second output (the MRT tier) */
     VkFormat o_format;
     int validation;               /* the layers are on */
-    int messages;                 /* validation messages received */
 } engine;
+
+/* The validation messages of the whole program (not of one engine: a message may come while an
+   engine is being destroyed, or from vkDestroyInstance after its messenger is gone), and the count
+   reported (-1: none yet). */
+static int g_validation_messages;
+static int g_validation_reported = -1;
 
 static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                     VkDebugUtilsMessageTypeFlagsEXT types,
                                                     const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
 {
-    engine *e = (engine *)user;
     (void)types;
+    (void)user;
     if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
-        e->messages++;
+        g_validation_messages++;
         fprintf(stderr, "validation: %s\n", data->pMessage);
     }
     return VK_FALSE;
+}
+
+/* The count, once every engine is destroyed (the last message can only come before that); at exit,
+   any message after it fails the program (atexit, set in main). */
+static int report_validation_count(void)
+{
+    g_validation_reported = g_validation_messages;
+    return g_validation_reported;
+}
+
+static void fail_on_late_validation(void)
+{
+    if (g_validation_reported < 0 || g_validation_messages == g_validation_reported) return;
+    fprintf(stderr, "vulkan_backend: %d validation messages after the count (%d) was reported\n",
+            g_validation_messages - g_validation_reported, g_validation_reported);
+    fflush(stdout);
+    _Exit(1);
 }
 
 static void on_fogvol_log(void *user, fogvol_log_level level, const char *msg)
@@ -123,7 +147,6 @@ static void create_instance(engine *e)
     mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     mi.pfnUserCallback = on_validation;
-    mi.pUserData = e;
     memset(&ii, 0, sizeof ii);
     ii.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     ii.pApplicationInfo = &app;
@@ -744,6 +767,8 @@ int main(int argc, char **argv)
     const char *out = "vulkan.png";
     fogvol_tier tier = FOGVOL_TIER_FLOAT;
     int i, check = 0, bench = 0, rc;
+    setvbuf(stdout, NULL, _IOLBF, 0); /* in order with the validation messages on stderr, in a log too */
+    atexit(fail_on_late_validation);
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--check")) check = 1;
         else if (!strcmp(argv[i], "--bench")) bench = 1;

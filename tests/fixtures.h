@@ -1,6 +1,7 @@
 /* fixtures.h - GL helpers the cmocka test programs share: the engine's shaders and
  * program, its colour + depth framebuffer, a mesh desc of a generated shape, a frame
- * looking through a test camera.
+ * looking through a test camera, and the sequence runner (tests/sequence.h: a test as
+ * frames in which the camera, occluders, viewport and views change, each checked).
  * Include after <cmocka.h>, fogvol.h and tests/gl_util.h. A failure
  * fails the running cmocka test (fail_msg / assert_*). The GL helpers are there when
  * the program has the GL 3 prototypes (GL_GLEXT_PROTOTYPES and <GL/glext.h>); the shader
@@ -11,6 +12,7 @@
 #include <string.h>
 #include "tests/raycast.h"
 #include "tests/shapes.h"
+#include "tests/sequence.h"
 
 #if (defined(GL_GLEXT_PROTOTYPES) && defined(GL_GLEXT_VERSION)) || defined(GL_ES_VERSION_2_0)
 /* one shader stage from n strings; the test fails with the info log when it does not compile */

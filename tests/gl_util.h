@@ -113,6 +113,15 @@ static inline void (*glu_proc(const char *name, void *user))(void)
     return (void (*)(void))eglGetProcAddress(name);
 }
 
+/* Makes c current (several contexts in one test); the current context as an opaque id
+   (fogvol_gl_desc.current_context). */
+static inline int glu_make_current(glu_ctx *c) { return eglMakeCurrent(c->dpy, c->surf, c->surf, c->ctx) != 0; }
+static inline void *glu_current_context(void *user)
+{
+    (void)user;
+    return (void *)eglGetCurrentContext();
+}
+
 /* Framebuffer 0's pixels after glFinish: read back into c->pixels with the GL state the read
    touches (read framebuffer, pack buffer, pack alignment and row length) put back as it was. */
 static inline unsigned char *glu_pixels(glu_ctx *c)
@@ -166,6 +175,18 @@ static inline void (*glu_proc(const char *name, void *user))(void)
 {
     (void)user;
     return (void (*)(void))OSMesaGetProcAddress(name);
+}
+
+/* Makes c current (several contexts in one test); the current context as an opaque id
+   (fogvol_gl_desc.current_context). */
+static inline int glu_make_current(glu_ctx *c)
+{
+    return OSMesaMakeCurrent(c->ctx, c->pixels, GL_UNSIGNED_BYTE, c->width, c->height) != 0;
+}
+static inline void *glu_current_context(void *user)
+{
+    (void)user;
+    return (void *)OSMesaGetCurrentContext();
 }
 
 /* Framebuffer 0's pixels after glFinish (OSMesa renders into c->pixels) */

@@ -250,7 +250,7 @@ static void free_scenes(void)
 /* The ray caster's scene of s (with_occluders 0: without its occluders); free with rc_scene_free. */
 static void scene_raycaster(const tscene *s, int with_occluders, rc_scene *rs)
 {
-    rc_object ro[MAX_OBJ];
+    rc_object ro[MAX_OBJ] = {{0}};
     unsigned *reversed[MAX_OBJ] = {0};
     int i, n = 0;
     /* a mirrored instance is the same solid, so its triangles are reversed for the ray caster, which

@@ -334,6 +334,39 @@ SHP__FN shp_mesh shp_grid_plane(float hx, float hy, int n) {
   return m;
 }
 
+/* Cube [-h,h]^3 whose six faces are n x n quad grids with vertices of their own, (n+1)^2 a face
+   (edges and corners repeated, as per-face normals or UVs make engines export cubes): closed only
+   after welding (fogvol_mesh_desc.weld_distance). The repeated vertices are bit-identical.
+   vcount = 6 (n+1)^2, triangles = 12 n^2, counter-clockwise seen from outside. */
+SHP__FN shp_mesh shp_cube_faces(float h, int n) {
+  shp_mesh m;
+  unsigned *p;
+  int f, i, j, k = n + 1;
+  if (n < 1 || !(h > 0)) return shp__zero();
+  m = shp__alloc(6.0 * k * k, 36.0 * n * n);
+  if (!m.pos) return m;
+  p = m.idx;
+  for (f = 0; f < 6; f++) { /* normal axis a = f / 2, sign + for even f; in-plane axes u, v with u x v = a */
+    int a = f / 2, u = (a + 1) % 3, v = (a + 2) % 3, base = f * k * k;
+    double s = (f & 1) ? -1.0 : 1.0;
+    for (j = 0; j <= n; j++)
+      for (i = 0; i <= n; i++) {
+        double c[3];
+        c[a] = s * h;
+        c[u] = -h + 2.0 * h * i / n;
+        c[v] = -h + 2.0 * h * j / n;
+        shp__setv(&m, base + j * k + i, c[0], c[1], c[2]);
+      }
+    for (j = 0; j < n; j++)
+      for (i = 0; i < n; i++) {
+        int q = base + j * k + i;
+        if (s > 0) shp__quad(&p, q, q + 1, q + k + 1, q + k);
+        else shp__quad(&p, q, q + k, q + k + 1, q + 1);
+      }
+  }
+  return m;
+}
+
 /* Apply a column-major 4x4 matrix to every position (with a homogeneous divide when the
    bottom row is not (0,0,0,1)). A mirroring matrix (negative determinant) flips the
    orientation; the caller must then flip the triangles (shp_flip). */

@@ -1811,6 +1811,209 @@ static void test_a4_bad_input(void **state)
     shp_free(&plane);
 }
 
+static void transposed(float out[16], const float m[16])
+{
+    int c, k;
+    for (c = 0; c < 4; ++c)
+        for (k = 0; k < 4; ++k) out[c * 4 + k] = m[k * 4 + c];
+}
+
+/* Issue 31 3e and 3f: row-major engine matrices copied as they are (raylib's Matrix, DirectXMath)
+   and degenerate model matrices were accepted and drew nothing (or the wrong thing). What can be
+   told is refused with INVALID_ARGUMENT and a log that says "transposed?": a view or model matrix
+   whose bottom row is not (0, 0, 0, 1) (its translation went there), a projection whose w row is
+   in the wrong place (the -1 that makes clip w from view depth at m[14], not m[11]), a
+   view-projection whose transpose is the camera that was meant. A volume or light model matrix
+   that is singular (all zero, a zero scale) has no volume: refused; an occluder flattened to a
+   plane still hides, an all-zero one does not. */
+static void test_a4_transposed_and_degenerate(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd, t;
+    fogvol_volume_desc vd;
+    fogvol_light_desc ld;
+    fogvol_mesh *closed, *open_mesh;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh box = box_mesh(), plane = shp_grid_plane(1, 1, 2);
+    float m[16], zero[16], tr[16];
+    (void)state;
+    log_reset(&lc);
+    rec_init(&r);
+    memset(&cd, 0, sizeof cd);
+    cd.backend = r.table;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.logger = cap_logger(&lc);
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &box, 0, 0, &closed), FOGVOL_SUCCESS);
+    assert_int_equal(make_mesh(fv, &plane, 1, 0, &open_mesh), FOGVOL_SUCCESS);
+    assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+    memset(zero, 0, sizeof zero);
+
+    /* ---- camera ---- */
+    a_frame_desc(&fd);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    t = fd; /* the view transposed: its translation (0, 0, -5) in the bottom row */
+    transposed(t.view, fd.view);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    assert_true(log_error_has(&lc, "bottom row"));
+    t = fd; /* the projection transposed */
+    transposed(t.projection, fd.projection);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    transposed(t.view, fd.view); /* both (a raylib Matrix copied with memcpy) */
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    t = fd; /* a view whose bottom row is (0, 0, 0, 2): view depth would be off by 2 */
+    t.view[15] = 2.0f;
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "bottom row"));
+    /* the view-projection camera: P V with the eye and forward of a_frame_desc's view (the camera at
+       (5, 0, 0) looking down -x), then transposed */
+    t = fd;
+    t.camera = FOGVOL_CAMERA_VIEW_PROJECTION;
+    shp_mat_mul(t.view_projection, fd.projection, fd.view);
+    t.eye[0] = 5.0f;
+    t.forward[0] = -1.0f;
+    assert_int_equal(fogvol_begin_frame(fv, &t), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    memcpy(m, t.view_projection, sizeof m);
+    transposed(t.view_projection, m);
+    EXPECT_LOGGED(fogvol_begin_frame(fv, &t), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+
+    /* ---- model matrices ---- */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = closed;
+    vd.ramp = ramp;
+    memcpy(vd.model, zero, sizeof zero);
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "all zero"));
+    mat_ts(m, 0.5f, 0.25f, -0.5f, 1.0f, 1.0f, 1.0f); /* a translation, transposed */
+    transposed(vd.model, m);
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f); /* y scaled to 0: flat, no volume */
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "singular"));
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f); /* y along x: rank 2 */
+    vd.model[4] = 1.0f;
+    vd.model[5] = 0.0f;
+    EXPECT_LOGGED(fogvol_add_volume(fv, &vd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    /* occluders: all zero and transposed refused, flattened to a plane accepted */
+    EXPECT_LOGGED(fogvol_add_occluder(fv, closed, zero), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "all zero"));
+    mat_ts(m, 0.5f, 0.25f, -0.5f, 1.0f, 1.0f, 1.0f);
+    transposed(tr, m);
+    EXPECT_LOGGED(fogvol_add_occluder(fv, closed, tr), FOGVOL_ERROR_INVALID_ARGUMENT);
+    assert_true(log_error_has(&lc, "transposed?"));
+    mat_ts(m, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f);
+    assert_int_equal(fogvol_add_occluder(fv, closed, m), FOGVOL_SUCCESS);
+    /* lights: a singular model refused */
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = closed;
+    ld.color[0] = 1.0f;
+    memcpy(ld.model, zero, sizeof zero);
+    EXPECT_LOGGED(fogvol_add_light(fv, &ld), FOGVOL_ERROR_INVALID_ARGUMENT);
+    mat_ts(ld.model, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f);
+    EXPECT_LOGGED(fogvol_add_light(fv, &ld), FOGVOL_ERROR_INVALID_ARGUMENT);
+    /* what is fine: a small uniform scale, a mirror, a translation */
+    mat_ts(vd.model, 0.5f, 0.25f, -0.5f, 1e-3f, 1e-3f, 1e-3f);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    mat_ts(vd.model, 0.0f, 0.0f, 0.0f, -1.0f, 1.0f, 1.0f);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+    assert_int_equal(st.volumes, 2);
+    assert_int_equal(st.occluders, 1);
+    assert_int_equal(st.lights, 0);
+    fogvol_destroy_mesh(fv, closed);
+    fogvol_destroy_mesh(fv, open_mesh);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    assert_int_equal(r.nb.creates, r.nb.destroys);
+    shp_free(&box);
+    shp_free(&plane);
+}
+
+/* a warning-level message containing needle */
+static int log_warning_has(const logcap *c, const char *needle)
+{
+    int i;
+    for (i = 0; i < c->count && i < LOG_MAX; ++i)
+        if (c->level[i] == FOGVOL_LOG_WARNING && strstr(c->msg[i], needle)) return 1;
+    return 0;
+}
+
+/* Issue 31 3h: RGBA8 digits over near 1e-4 / far 1e5 quantise the thickness in steps of
+   1e5 / 2^12 = 24.4 units, ten times a 2-unit box (PS20 + COUNT drew fog in 30 of its 484
+   pixels), and nothing said so. Now: fogvol_frame_stats.depth_lsb is the step (hand-computed:
+   (far - near) / 2^(3L)) and a warning is logged when it is coarser than 1/16 of the depth extent
+   of the frame's smallest volume, once until a frame is fine again. */
+static void test_a4_coarse_lsb(void **state)
+{
+    rec r;
+    logcap lc;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_mesh *box;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh b = shp_box(1.0f, 1.0f, 1.0f); /* 2 units across */
+    int frame, tier;
+    (void)state;
+    for (tier = 0; tier < 2; ++tier) {
+        log_reset(&lc);
+        rec_init(&r);
+        memset(&cd, 0, sizeof cd);
+        cd.backend = r.table;
+        if (tier) cd.backend.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_FLOAT_TARGET;
+        cd.tier = tier ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_PS20;
+        cd.variants = tier ? 0u : (unsigned)FOGVOL_VARIANT_COUNT;
+        cd.logger = cap_logger(&lc);
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        assert_int_equal(make_mesh(fv, &b, 0, 0, &box), FOGVOL_SUCCESS);
+        assert_int_equal(make_ramp(fv, FOGVOL_BLEND_FOG, &ramp), FOGVOL_SUCCESS);
+        for (frame = 0; frame < 4; ++frame) {
+            int coarse = frame != 2; /* frame 2: near 0.5, far 10.5: a step of 10 / 4096 */
+            a_frame_desc(&fd);
+            if (coarse) {
+                glu_perspective(fd.projection, 60.0, (double)A_W / A_H, 1e-4, 1e5);
+                fd.znear = 1e-4f;
+                fd.zfar = 1e5f;
+            }
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = box;
+            vd.ramp = ramp;
+            mat_identity(vd.model); /* 5 units in front of the camera */
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            lc.count = lc.warnings = 0;
+            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            if (tier) { /* float sums: no step, no warning */
+                assert_true(st.depth_lsb == 0.0f);
+                assert_false(log_warning_has(&lc, "LSB"));
+                continue;
+            }
+            assert_close(st.depth_lsb, ((double)fd.zfar - fd.znear) / 4096.0, 1e-6, "depth_lsb");
+            /* warned on frames 0 and 3 (the first coarse frame, and again after a fine one) */
+            if (frame == 0 || frame == 3) assert_true(log_warning_has(&lc, "LSB"));
+            else assert_false(log_warning_has(&lc, "LSB"));
+        }
+        fogvol_destroy_mesh(fv, box);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+    }
+    shp_free(&b);
+}
+
 /* ---- A5: fault injection ---- */
 
 /* n-th backend create call failing during context creation: PS20 encodes by arithmetic by default
@@ -3090,6 +3293,8 @@ int main(void)
         cmocka_unit_test(test_a4_encoding_combinations),
         cmocka_unit_test(test_a4_tier_choice),
         cmocka_unit_test(test_a4_bad_input),
+        cmocka_unit_test(test_a4_transposed_and_degenerate),
+        cmocka_unit_test(test_a4_coarse_lsb),
         cmocka_unit_test(test_a5_backend_create_faults),
         cmocka_unit_test(test_a5_alloc_faults_context),
         cmocka_unit_test(test_a5_alloc_faults_mesh_ramp),

@@ -369,6 +369,153 @@ static void test_coloured_extinction(void **state)
     run_scene(&s, FOGVOL_COMPOSITE_GEOMETRY);
 }
 
+/* The thickness of volume i of the scene per pixel, ray-cast (rows bottom to top). */
+static void trace_volume(const cscene *s, int i, double *t)
+{
+    shp_mesh m = shp_sphere(0.42f, 48, 24);
+    rc_scene sc;
+    rc_object o;
+    int px, py;
+    memset(&o, 0, sizeof o);
+    o.pos = m.pos;
+    o.vcount = m.vcount;
+    o.idx = m.idx;
+    o.icount = m.icount;
+    memcpy(o.model, s->model[i], sizeof o.model);
+    o.sign = 1;
+    assert_true(rc_scene_init(&sc, &o, 1));
+    for (py = 0; py < CH; ++py)
+        for (px = 0; px < CW; ++px) t[py * CW + px] = rc_trace(&sc, &s->cam, px + 0.5, py + 0.5).thickness;
+    rc_scene_free(&sc);
+    shp_free(&m);
+}
+
+/* max |dbg - t| over the interior pixels */
+static double max_thickness_diff(const float *dbg, const double *t, const unsigned char *interior)
+{
+    double mx = 0;
+    int k;
+    for (k = 0; k < CW * CH; ++k)
+        if (interior[k] && fabs(dbg[k] - t[k]) > mx) mx = fabs(dbg[k] - t[k]);
+    return mx;
+}
+
+/* A frame of the scene's 16 volumes in volume order; volumes below 'dens_below' get the density
+   texture, those from 'col_from' on the colour texture; debug read-back of debug_ramp. */
+static fogvol_result textured_frame(cgpu *c, const cscene *s, const fogvol_volume_texture *dens, int dens_below,
+                                    const fogvol_volume_texture *col, int col_from, int nvol, float *dbg,
+                                    const fogvol_ramp *debug_ramp, unsigned char *out)
+{
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_result r;
+    int i;
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&s->cam, fd.view, fd.projection);
+    fd.znear = (float)s->cam.znear;
+    fd.zfar = (float)s->cam.zfar;
+    fd.viewport[2] = CW;
+    fd.viewport[3] = CH;
+    fd.debug_thickness = dbg;
+    fd.debug_ramp = debug_ramp;
+    glClearColor(g_scene_rgb[0], g_scene_rgb[1], g_scene_rgb[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    assert_int_equal(fogvol_begin_frame(c->fv, &fd), FOGVOL_SUCCESS);
+    for (i = 0; i < nvol; ++i) {
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = c->mesh;
+        vd.ramp = c->ramp[i];
+        memcpy(vd.model, s->model[i], sizeof vd.model);
+        if (i < dens_below) vd.density = dens;
+        if (i >= col_from) vd.color = col;
+        assert_int_equal(fogvol_add_volume(c->fv, &vd), FOGVOL_SUCCESS);
+    }
+    r = fogvol_end_frame(c->fv, NULL);
+    memcpy(out, glu_pixels(&c->g), (size_t)CW * CH * 4);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    return r;
+}
+
+/* Issue 31 3b and 3g: FOGVOL_VARIANT_COLORS drew textured volumes as if untextured (a density
+   texture of 0 gave full fog, a colour texture was ignored) and never wrote the debug read-back;
+   a debug_ramp with no volume in the frame left the buffer untouched. Ground truth: density 0
+   draws nothing, the colour texture (1, 128/255, 0) multiplies the ramp colours (the Beer-Lambert
+   model of reference() with those colours and densities), the ray-cast thickness of one volume,
+   and 0 where the frame has no volume of the ramp. */
+static void test_textures_and_debug(void **state)
+{
+    static const unsigned char zero[4] = {0, 0, 0, 255}, orange[4] = {255, 128, 0, 255};
+    unsigned char *img = (unsigned char *)malloc((size_t)CW * CH * 4), *interior = (unsigned char *)malloc(CW * CH);
+    double *ref = (double *)malloc(sizeof(double) * 3 * CW * CH), *exact = (double *)malloc(sizeof(double) * 3 * CW * CH);
+    double *t = (double *)malloc(sizeof(double) * CW * CH), d;
+    float *dbg = (float *)malloc(sizeof(float) * CW * CH);
+    int *nhit = (int *)malloc(sizeof(int) * CW * CH), i, k, untouched;
+    fogvol_texture_desc td;
+    fogvol_volume_texture *dens, *col;
+    cscene s, m;
+    cgpu c;
+    (void)state;
+    assert_true(img && interior && ref && exact && t && dbg && nhit);
+    build_scene(&s, "textured_16", 0, 0);
+    m = s; /* the model: volumes 0-7 without density, 8-15 coloured by the texture */
+    for (i = 0; i < NV; ++i) {
+        if (i < 8) m.density[i] = 0.0f;
+        else {
+            m.color[i][1] = (float)(m.color[i][1] * 128.0 / 255.0);
+            m.color[i][2] = 0.0f;
+        }
+    }
+    reference(&m, ref, exact, nhit, interior);
+    gpu_setup(&c, &s, FOGVOL_VARIANT_COLORS);
+    memset(&td, 0, sizeof td);
+    td.width = td.height = 1;
+    td.pixels = zero;
+    assert_int_equal(fogvol_create_volume_texture(c.fv, &td, &dens), FOGVOL_SUCCESS);
+    td.pixels = orange;
+    assert_int_equal(fogvol_create_volume_texture(c.fv, &td, &col), FOGVOL_SUCCESS);
+    /* the textures drawn, the thickness of volume 9 (a coloured-texture ramp) read back */
+    for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+    assert_int_equal(textured_frame(&c, &s, dens, 8, col, 8, NV, dbg, c.ramp[9], img), FOGVOL_SUCCESS);
+    write_png("textured_16", img, img);
+    d = max_diff(img, NULL, ref, interior);
+    print_message("# COLORS with textures: max |picture - model| %.2f/255 over interior pixels\n", d);
+    assert_true(d <= 2.0);
+    trace_volume(&s, 9, t);
+    d = max_thickness_diff(dbg, t, interior);
+    print_message("# COLORS, debug_ramp of volume 9: max |read-back - ray cast| %.3g (range %.1f)\n", d,
+                  s.cam.zfar - s.cam.znear);
+    assert_true(d <= 3e-5 * (s.cam.zfar - s.cam.znear));
+    /* no texture: the one-pass colour group; debug_ramp NULL: its first volume's ramp (volume 0) */
+    for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+    assert_int_equal(textured_frame(&c, &s, NULL, 0, NULL, NV, NV, dbg, NULL, img), FOGVOL_SUCCESS);
+    trace_volume(&s, 0, t);
+    d = max_thickness_diff(dbg, t, interior);
+    print_message("# COLORS, debug_ramp NULL: max |read-back - ray cast of volume 0| %.3g\n", d);
+    assert_true(d <= 3e-5 * (s.cam.zfar - s.cam.znear));
+    /* debug_ramp with no volume in the frame (volume 15 left out): thickness 0 everywhere */
+    for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+    assert_int_equal(textured_frame(&c, &s, NULL, 0, NULL, NV, NV - 1, dbg, c.ramp[NV - 1], img), FOGVOL_SUCCESS);
+    for (untouched = 0, k = 0; k < CW * CH; ++k) untouched += dbg[k] != 0.0f;
+    assert_int_equal(untouched, 0);
+    fogvol_destroy_volume_texture(c.fv, dens);
+    fogvol_destroy_volume_texture(c.fv, col);
+    gpu_teardown(&c);
+    /* the same without COLORS: the empty debug ramp is 0 too */
+    gpu_setup(&c, &s, 0);
+    for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+    assert_int_equal(textured_frame(&c, &s, NULL, 0, NULL, NV, NV - 1, dbg, c.ramp[NV - 1], img), FOGVOL_SUCCESS);
+    for (untouched = 0, k = 0; k < CW * CH; ++k) untouched += dbg[k] != 0.0f;
+    assert_int_equal(untouched, 0);
+    gpu_teardown(&c);
+    free(img);
+    free(interior);
+    free(ref);
+    free(exact);
+    free(t);
+    free(dbg);
+    free(nhit);
+}
+
 /* Null backend: pass counts, groups kept apart, refusals. */
 static void null_context(fogvol_null_backend *nb, unsigned caps, fogvol_tier tier, unsigned variants,
                          fogvol_context **fv, fogvol_result expect)
@@ -499,6 +646,7 @@ int main(void)
         cmocka_unit_test(test_separate),
         cmocka_unit_test(test_overlapping),
         cmocka_unit_test(test_coloured_extinction),
+        cmocka_unit_test(test_textures_and_debug),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

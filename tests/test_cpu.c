@@ -1612,6 +1612,144 @@ static void test_mesh_winding(void **state)
     shp_free(&good);
 }
 
+/* A box [lo, hi] whose faces are grids of n[axis] quads along each axis (per-face vertices, so
+   the caller welds them with weld_distance), outward, or inward with inward = 1. */
+static shp_mesh grid_box(const double lo[3], const double hi[3], const int n[3], int inward)
+{
+    int a, s, i, j, nv = 0, ni = 0;
+    shp_mesh m;
+    for (a = 0; a < 3; ++a) {
+        int u = (a + 1) % 3, v = (a + 2) % 3;
+        nv += 2 * (n[u] + 1) * (n[v] + 1);
+        ni += 2 * 6 * n[u] * n[v];
+    }
+    m = shp__alloc(nv, ni);
+    if (!m.pos) return m;
+    nv = ni = 0;
+    for (a = 0; a < 3; ++a)
+        for (s = 0; s < 2; ++s) {
+            int u = (a + 1) % 3, v = (a + 2) % 3, base = nv;
+            for (j = 0; j <= n[v]; ++j)
+                for (i = 0; i <= n[u]; ++i, ++nv) {
+                    double c[3];
+                    c[a] = s ? hi[a] : lo[a];
+                    c[u] = lo[u] + (hi[u] - lo[u]) * i / n[u];
+                    c[v] = lo[v] + (hi[v] - lo[v]) * j / n[v];
+                    shp__setv(&m, nv, c[0], c[1], c[2]);
+                }
+            for (j = 0; j < n[v]; ++j)
+                for (i = 0; i < n[u]; ++i) {
+                    unsigned q[4], *p = m.idx + ni;
+                    q[0] = (unsigned)(base + j * (n[u] + 1) + i); /* u x v = +axis: counter-clockwise */
+                    q[1] = q[0] + 1;                              /* seen from +axis */
+                    q[2] = q[1] + (unsigned)(n[u] + 1);
+                    q[3] = q[0] + (unsigned)(n[u] + 1);
+                    if (s == inward) shp__quad(&p, (int)q[0], (int)q[3], (int)q[2], (int)q[1]);
+                    else shp__quad(&p, (int)q[0], (int)q[1], (int)q[2], (int)q[3]);
+                    ni += 6;
+                }
+        }
+    return m;
+}
+
+static fogvol_result validate_welded(const shp_mesh *m, fogvol_mesh_report *rep)
+{
+    fogvol_mesh_desc d = mesh_desc(m->pos, m->vcount, (const uint32_t *)m->idx, m->icount);
+    d.weld_distance = 1e-6f;
+    return fogvol_validate_mesh(&d, NULL, rep);
+}
+
+/* Issue 31 3a: parts built from quads exactly one probe-grid step wide. The probe grid divides
+   the mesh's bounds in FOGVOL__WIND_GRID (32) steps per axis; with an outward box [-1,1]^3
+   beside it, the inward box [2,3]x[-.5,.5]^2 of 8x16x16 quads has quads one step wide, so every
+   probe ray that lands at the same offset in both of a quad's axes lies on its diagonal. */
+static void test_mesh_winding_grid(void **state)
+{
+    static const double olo[3] = {-1, -1, -1}, ohi[3] = {1, 1, 1}, ilo[3] = {2, -.5, -.5}, ihi[3] = {3, .5, .5};
+    static const int on[3] = {16, 32, 32}, in[3] = {8, 16, 16}, cube_n[3] = {32, 32, 32}, one[3] = {1, 1, 1};
+    fogvol_mesh_report rep;
+    shp_mesh outer = grid_box(olo, ohi, on, 0), inner = grid_box(ilo, ihi, in, 1), both = shp__zero();
+    shp_mesh cube = grid_box(olo, ohi, cube_n, 0), plain = grid_box(ilo, ihi, one, 1), both1 = shp__zero();
+    (void)state;
+    assert_non_null(outer.pos);
+    assert_non_null(inner.pos);
+    assert_true(shp_append(&both, &outer));
+    assert_true(shp_append(&both, &inner));
+    assert_true(shp_append(&both1, &outer));
+    assert_true(shp_append(&both1, &plain));
+    /* each box alone: the outward one is valid, the inward one exposed (winding -1 inside) */
+    assert_int_equal(validate_welded(&outer, &rep), FOGVOL_SUCCESS);
+    CHECK_NEAR(rep.volume, 8.0, 1e-9);
+    assert_int_equal(validate_welded(&inner, &rep), FOGVOL_ERROR_INVALID_MESH);
+    /* the inward box as 12 triangles beside the grid box: refused (the probes are not all on diagonals) */
+    assert_int_equal(validate_welded(&both1, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_int_equal(rep.inward_components, 1);
+    /* the grid-aligned inward box beside the outward one: refused too, the bad triangle named */
+    assert_int_equal(validate_welded(&both, &rep), FOGVOL_ERROR_INVALID_MESH);
+    assert_true(rep.closed && rep.consistent);
+    assert_int_equal(rep.components, 2);
+    assert_int_equal(rep.inward_components, 1);
+    CHECK_NEAR(rep.volume, 8.0 - 1.0, 1e-9);
+    assert_true(rep.negative_winding > 0);
+    assert_true(rep.negative_triangle >= outer.icount / 3);
+    assert_false(rep.valid);
+    /* a welded cube of 32x32 quads per face: valid (its probe rays all lie on quad diagonals) */
+    assert_int_equal(validate_welded(&cube, &rep), FOGVOL_SUCCESS);
+    assert_int_equal(rep.vertices, 6 * 32 * 32 + 2);
+    CHECK_NEAR(rep.volume, 8.0, 1e-9);
+    assert_int_equal(rep.negative_winding, 0);
+    /* the same cube inward: refused */
+    shp_flip(&cube);
+    assert_int_equal(validate_welded(&cube, &rep), FOGVOL_ERROR_INVALID_MESH);
+    /* an inward box [.5,3]x[-.5,.5]^2 of 20x16x16 quads (one probe-grid step each: the bounds are
+       [-1,3]x[-1,1]^2) half inside the outward box [-1,1]^3: winding 0 where they overlap, -1 in
+       [1,3]x[-.5,.5]^2; the probe just inside the inward part lands where they overlap, so the
+       probe rays must see it */
+    {
+        static const double plo[3] = {.5, -.5, -.5}, phi[3] = {3, .5, .5};
+        static const int pn[3] = {20, 16, 16};
+        shp_mesh part = grid_box(plo, phi, pn, 1), box = grid_box(olo, ohi, one, 0);
+        assert_true(shp_append(&box, &part));
+        assert_int_equal(validate_welded(&box, &rep), FOGVOL_ERROR_INVALID_MESH);
+        assert_int_equal(rep.inward_components, 1);
+        assert_true(rep.negative_winding > 0);
+        assert_true(rep.negative_triangle >= 0); /* the outward box's face x = 1 bounds the region too */
+        shp_free(&part);
+        shp_free(&box);
+    }
+    /* outward boxes [-1,1]^3 and [2,4]x[-1,1]^2 (bounds: steps 5/32 in x, 2/32 in y and z) and between
+       them an inward box from 0.05 to 0.15 of a probe-grid cell in each axis: no probe ray (at 0.47
+       to 0.52 of a cell) meets it, the probe just inside the inward part alone must see it */
+    {
+        static const double blo[3] = {2, -1, -1}, bhi[3] = {4, 1, 1};
+        double tlo[3], thi[3];
+        shp_mesh two = grid_box(olo, ohi, one, 0), b = grid_box(blo, bhi, one, 0), tiny;
+        int c;
+        for (c = 0; c < 3; ++c) {
+            double lo = -1.0, step = c ? 2.0 / 32 : 5.0 / 32, i = c ? 10 : 16;
+            tlo[c] = lo + (i + 0.05) * step;
+            thi[c] = lo + (i + 0.15) * step;
+        }
+        tiny = grid_box(tlo, thi, one, 1);
+        assert_true(shp_append(&two, &b));
+        assert_int_equal(validate_welded(&two, &rep), FOGVOL_SUCCESS);
+        assert_true(shp_append(&two, &tiny));
+        assert_int_equal(validate_welded(&two, &rep), FOGVOL_ERROR_INVALID_MESH);
+        assert_int_equal(rep.inward_components, 1);
+        assert_int_equal(rep.negative_winding, 1);
+        assert_true(rep.negative_triangle >= 24);
+        shp_free(&two);
+        shp_free(&b);
+        shp_free(&tiny);
+    }
+    shp_free(&outer);
+    shp_free(&inner);
+    shp_free(&both);
+    shp_free(&cube);
+    shp_free(&plain);
+    shp_free(&both1);
+}
+
 static void test_mesh_alloc_and_stride(void **state)
 {
     fogvol_mesh_report rep;
@@ -1892,6 +2030,7 @@ int main(void)
         cmocka_unit_test(test_mesh_nonmanifold),
         cmocka_unit_test(test_mesh_torus),
         cmocka_unit_test(test_mesh_winding),
+        cmocka_unit_test(test_mesh_winding_grid),
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
         cmocka_unit_test(test_vulkan_layout),

@@ -95,11 +95,48 @@ static GLenum APIENTRY fake_get_error(void)
     g_fake_error = GL_NO_ERROR;
     return e != GL_NO_ERROR ? e : glGetError();
 }
+/* glDrawArrays that raises a GL error the test queues after drawing (fogvol's own call failing). */
+static GLenum g_draw_error;
+static void APIENTRY fake_draw_arrays(GLenum mode, GLint first, GLsizei count)
+{
+    glDrawArrays(mode, first, count);
+    if (g_draw_error == GL_INVALID_ENUM) glBindTexture(0x1234, 0);
+    g_draw_error = GL_NO_ERROR;
+}
 static void (*fake_proc(const char *name, void *user))(void)
 {
     if (strcmp(name, "glGetError") == 0) return (void (*)(void))fake_get_error;
+    if (strcmp(name, "glDrawArrays") == 0) return (void (*)(void))fake_draw_arrays;
     return glu_proc(name, user);
 }
+
+/* The engine's KHR_debug callback: GL_DEBUG_TYPE_ERROR messages counted (the last kept). */
+static int g_dbg_errors;
+static char g_dbg_last[256];
+static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
+                              const GLchar *message, const void *user)
+{
+    (void)source;
+    (void)id;
+    (void)severity;
+    (void)length;
+    (void)user;
+    if (type != GL_DEBUG_TYPE_ERROR) return;
+    g_dbg_errors++;
+    snprintf(g_dbg_last, sizeof g_dbg_last, "%s", message);
+}
+static void debug_on(void)
+{
+    glEnable(GL_DEBUG_OUTPUT);
+    glDebugMessageCallback(debug_cb, NULL);
+    g_dbg_errors = 0;
+}
+static void no_debug_errors(const char *after)
+{
+    if (g_dbg_errors) fail_msg("%s: %d KHR_debug error messages reached the engine's callback, the last: %s", after,
+                               g_dbg_errors, g_dbg_last);
+}
+static unsigned g_variants; /* fogvol_context_desc.variants of make_fogvol */
 
 static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
 {
@@ -109,6 +146,7 @@ static fogvol_result make_fogvol(eng *e, fogvol_tier tier)
     cd.logger.func = logger;
     cd.logger.user_data = &e->lc;
     cd.tier = tier;
+    cd.variants = g_variants;
     cd.disable_dither = 1;
     if (e->v21) {
         cd.gl.version_major = 2;
@@ -729,6 +767,156 @@ static void test_geometry_21(void **st)
     geometry_scenes(PROF_21);
 }
 
+/* ---- sequences (tests/sequence.h) -------------------------------------------------------------
+   The engine framebuffer over the default script: a 4-attachment FBO with a stencil pattern, the
+   draw buffer fogvol composites into changing every frame (frame % 4), the camera walking into the
+   big sphere and out, the second ramp's sphere coming and going (the "occluders" of this scene),
+   the viewport shrinking and splitting, a cancelled frame in between; full-screen and geometry
+   composites. Each view: thickness against its own ray cast (1 LSB per pair of faces, interior
+   pixels), the other attachments and the named one outside the viewport byte-identical, the
+   stencil untouched, the engine state snapshot unchanged. */
+typedef struct fbseq {
+    eng e;
+    efbo f;
+    fogvol_composite composite;
+    unsigned char *pre[4], *post, st0[NPIX], st1[NPIX];
+    float *thick;
+    double *gt;
+    unsigned char *in;
+} fbseq;
+
+static void fbseq_camera(eng *e, double walk, const int vp[4])
+{
+    e->cam.eye[0] = 0.5 * walk;
+    e->cam.eye[1] = 0.3 * walk;
+    e->cam.eye[2] = 6.0 - 5.5 * walk; /* 0.5 at the end: inside the radius-2 sphere */
+    e->cam.target[0] = e->cam.eye[0] - 0.2;
+    e->cam.target[1] = e->cam.eye[1] - 0.1;
+    e->cam.target[2] = e->cam.eye[2] - 6.0;
+    e->cam.aspect = (double)vp[2] / vp[3];
+    e->cam.width = vp[2];
+    e->cam.height = vp[3];
+}
+
+/* begin a frame of the view's objects (the second sphere with occluders) into viewport vp */
+static void fbseq_begin(fbseq *q, const sq_view *v, double walk, float *thick)
+{
+    fogvol_frame_desc fd;
+    int i;
+    fbseq_camera(&q->e, walk, v->viewport);
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&q->e.cam, fd.view, fd.projection);
+    fd.znear = (float)ZN;
+    fd.zfar = (float)ZF;
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    fd.draw_buffer = v->frame % 4;
+    fd.composite = q->composite;
+    fd.debug_thickness = thick;
+    fd.debug_ramp = q->e.ramp[0];
+    assert_int_equal(fogvol_begin_frame(q->e.fv, &fd), FOGVOL_SUCCESS);
+    for (i = 0; i < q->e.n - !v->occluders; ++i) {
+        fogvol_volume_desc vd;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = q->e.o[i].m;
+        vd.ramp = q->e.ramp[q->e.o[i].ramp];
+        memcpy(vd.model, q->e.o[i].model, sizeof vd.model);
+        assert_int_equal(fogvol_add_volume(q->e.fv, &vd), FOGVOL_SUCCESS);
+    }
+}
+
+static void fbseq_cancel(void *user, const sq_view *v)
+{
+    fbseq *q = (fbseq *)user;
+    fbseq_begin(q, v, 1.0 - v->walk, NULL);
+    assert_int_equal(fogvol_cancel_frame(q->e.fv), FOGVOL_SUCCESS);
+}
+
+static void fbseq_view(void *user, const sq_view *v, sq_check *out)
+{
+    fbseq *q = (fbseq *)user;
+    const int *vp = v->viewport;
+    snap before, after;
+    rc_object ro[MAXOBJ];
+    rc_scene rs;
+    int i, x, y, named = v->frame % 4;
+    glBindFramebuffer(GL_FRAMEBUFFER, q->f.fbo);
+    for (i = 0; i < 4; ++i) {
+        tex_fill(q->f.tex[i], 11u * (unsigned)v->frame + (unsigned)i);
+        tex_read(q->f.tex[i], q->pre[i]);
+    }
+    stencil_pattern();
+    read_stencil(q->st0);
+    take_snap(&q->e, &before);
+    fbseq_begin(q, v, v->walk, q->thick);
+    assert_int_equal(fogvol_end_frame(q->e.fv, NULL), FOGVOL_SUCCESS);
+    take_snap(&q->e, &after);
+    out->wrong += memcmp(&before, &after, sizeof before) != 0;
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    read_stencil(q->st1);
+    for (i = 0; i < NPIX; ++i) out->wrong += q->st0[i] != q->st1[i];
+    for (i = 0; i < 4; ++i) { /* only the named attachment, only inside the viewport */
+        tex_read(q->f.tex[i], q->post);
+        for (y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                int inside = i == named && x >= vp[0] && x < vp[0] + vp[2] && y >= vp[1] && y < vp[1] + vp[3];
+                out->wrong += !inside && memcmp(q->pre[i] + 4 * (y * W + x), q->post + 4 * (y * W + x), 4) != 0;
+            }
+    }
+    for (i = 0; i < q->e.n - !v->occluders; ++i) { /* ramp 0's volumes (the read-back's group) */
+        ro[i].pos = q->e.o[i].mesh.pos;
+        ro[i].vcount = q->e.o[i].mesh.vcount;
+        ro[i].idx = q->e.o[i].mesh.idx;
+        ro[i].icount = q->e.o[i].mesh.icount;
+        memcpy(ro[i].model, q->e.o[i].model, sizeof ro[i].model);
+        ro[i].sign = q->e.o[i].ramp == 0 ? q->e.o[i].sign : 0; /* (the other ramp occludes nothing: sign 0 */
+        if (q->e.o[i].ramp != 0) ro[i].icount = 0;            /*  and no triangles) */
+    }
+    assert_true(rc_scene_init(&rs, ro, q->e.n - !v->occluders));
+    out->bound = LSB;
+    for (y = 0; y < vp[3]; ++y)
+        for (x = 0; x < vp[2]; ++x) {
+            rc_result r;
+            double err;
+            int pairs;
+            if (!rc_interior(&rs, &q->e.cam, x, y)) continue;
+            r = rc_trace(&rs, &q->e.cam, x + 0.5, y + 0.5);
+            pairs = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            err = fabs(q->thick[y * vp[2] + x] - r.thickness) / (pairs > 1 ? pairs : 1);
+            out->pixels++;
+            out->wrong += err > LSB;
+            if (err > out->max_err) out->max_err = err;
+        }
+    rc_scene_free(&rs);
+}
+
+static void test_fb_sequence(void **st)
+{
+    int c;
+    (void)st;
+    for (c = 0; c < 2; ++c) {
+        fbseq q;
+        int i;
+        memset(&q, 0, sizeof q);
+        q.composite = c ? FOGVOL_COMPOSITE_GEOMETRY : FOGVOL_COMPOSITE_FULLSCREEN;
+        eng_open(&q.e, PROF_CORE, FOGVOL_TIER_PS20);
+        add_obj(&q.e, shp_sphere(2.0f, 48, 24), 0, 0, 0, 1, 1, 0);
+        add_obj(&q.e, shp_sphere(1.0f, 32, 16), 1.5f, 1.0f, -2.0f, 1, 1, 1); /* the one that comes and goes */
+        efbo_make(&q.f, 4, GL_RGBA8);
+        glDrawBuffers(4, g_list4);
+        engine_blend_state();
+        for (i = 0; i < 4; ++i) q.pre[i] = (unsigned char *)malloc(NPIX * 4);
+        q.post = (unsigned char *)malloc(NPIX * 4);
+        q.thick = (float *)calloc(NPIX, sizeof(float));
+        sq_run(c ? "engine FBO, 4 draw buffers, geometry composite" : "engine FBO, 4 draw buffers", W, H,
+               sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, fbseq_view, fbseq_cancel, &q);
+        for (i = 0; i < 4; ++i) free(q.pre[i]);
+        free(q.post);
+        free(q.thick);
+        efbo_free(&q.f);
+        eng_close(&q.e);
+    }
+}
+
 /* ---- 3. engine state left set --------------------------------------------- */
 typedef struct state_item {
     const char *name;
@@ -892,6 +1080,13 @@ static void raise_engine_error(GLenum code)
     }
 }
 
+/* the engine's error, its own KHR_debug message not counted */
+static void engine_error(GLenum code)
+{
+    raise_engine_error(code);
+    g_dbg_errors = 0;
+}
+
 static void errors_case(int prof)
 {
     static const GLenum codes[4] = {GL_INVALID_ENUM, GL_INVALID_VALUE, GL_INVALID_OPERATION,
@@ -902,13 +1097,15 @@ static void errors_case(int prof)
     int c, f;
     eng_open(&e, prof, FOGVOL_TIER_PS20);
     add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on(); /* raising the engine's errors again reaches no KHR_debug callback (issue 31 3c) */
     for (c = 0; c < 4; ++c) {
         snap before, after;
         for (f = 0; f < 3; ++f) { /* every frame, with and without the debug read-back */
             take_snap(&e, &before);
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             frame_desc(&e, &fd);
             assert_int_equal(run(&e, &fd, f == 1 ? thick : NULL), FOGVOL_SUCCESS);
+            no_debug_errors("end_frame");
             assert_int_equal(glGetError(), codes[c]);
             assert_int_equal(glGetError(), GL_NO_ERROR);
             take_snap(&e, &after);
@@ -927,22 +1124,31 @@ static void errors_case(int prof)
             md.vertex_count = s.vcount;
             md.indices = (const uint32_t *)s.idx;
             md.index_count = s.icount;
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(fogvol_create_mesh(e.fv, &md, &m, NULL), FOGVOL_SUCCESS);
+            no_debug_errors("create_mesh");
             assert_int_equal(glGetError(), codes[c]);
             memset(&rd, 0, sizeof rd);
             rd.density = 1.0f;
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(fogvol_create_ramp(e.fv, &rd, &r), FOGVOL_SUCCESS);
+            no_debug_errors("create_ramp");
             assert_int_equal(glGetError(), codes[c]);
+            engine_error(codes[c]);
             fogvol_destroy_ramp(e.fv, r);
             fogvol_destroy_mesh(e.fv, m);
+            no_debug_errors("destroy_ramp, destroy_mesh");
+            assert_int_equal(glGetError(), codes[c]);
             shp_free(&s);
-            raise_engine_error(codes[c]);
+            engine_error(codes[c]);
             assert_int_equal(make_fogvol(&e, FOGVOL_TIER_PS20), FOGVOL_SUCCESS); /* a second context */
+            no_debug_errors("create_context");
             assert_int_equal(glGetError(), codes[c]);
             assert_int_equal(glGetError(), GL_NO_ERROR);
+            engine_error(codes[c]);
             fogvol_destroy_context(e.fv);
+            no_debug_errors("destroy_context");
+            assert_int_equal(glGetError(), codes[c]);
             e.fv = fv2;
         }
         print_message("# %s: engine error 0x%04x still pending after end_frame (3 frames), create_mesh, "
@@ -962,6 +1168,266 @@ static void test_errors_21(void **st)
 {
     (void)st;
     errors_case(PROF_21);
+}
+
+/* Issue 31 3c: fogvol's own GL errors. Each public call that touches GL reports the errors its own GL
+   calls raised (a result code and a log line) and leaves exactly the engine's pending errors:
+   - fogvol's own draw failing (glDrawArrays made to raise GL_INVALID_ENUM): BACKEND, the code
+     logged, the engine's GL_INVALID_VALUE still pending and nothing else (before: fogvol's code was
+     left pending as if the engine's);
+   - an engine depth texture name that is no texture: INVALID_ARGUMENT, logged, no GL call on it
+     (before: success, no fog, the error swallowed; in a compatibility context binding the name
+     made an empty texture);
+   - post_dof given a colour texture that does not exist: INVALID_ARGUMENT (before: success,
+     GL_INVALID_OPERATION left pending);
+   - engine_depth_framebuffer 999: INVALID_ARGUMENT with nothing left pending (before:
+     GL_INVALID_OPERATION left pending). */
+static void test_own_errors(void **st)
+{
+    eng e;
+    fogvol_frame_desc fd;
+    fogvol_dof_desc dd;
+    float *thick = (float *)calloc(NPIX, sizeof(float));
+    GLuint color = 0, depth = 0, fbo = 0;
+    (void)st;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on();
+    glLineWidth(-1.0f); /* the engine's GL_INVALID_VALUE */
+    g_dbg_errors = 0;
+    g_draw_error = GL_INVALID_ENUM;
+    frame_desc(&e, &fd);
+    e.lc.errors = 0;
+    e.lc.last[0] = 0;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_BACKEND);
+    print_message("# fogvol's draw failing: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "0x0500"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_int_equal(g_dbg_errors, 1); /* fogvol's own failing call, and no re-raise */
+    g_dbg_errors = 0;
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS); /* the next frame is clean */
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("the next frame");
+    eng_close(&e);
+
+    g_variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_FLOAT);
+    g_variants = 0;
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    debug_on();
+    fx_color_depth_fbo(W, H, GL_DEPTH_COMPONENT24, GL_UNSIGNED_INT, &color, &depth, &fbo);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    frame_desc(&e, &fd);
+    fd.engine_depth_texture = depth;
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    /* a depth texture name that is no texture */
+    glLineWidth(-1.0f);
+    g_dbg_errors = 0;
+    e.lc.last[0] = 0;
+    fd.engine_depth_texture = 4242;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# engine depth texture 4242: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "4242"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("a bad engine depth texture");
+    /* post_dof: the colour texture 4243 does not exist */
+    fd.engine_depth_texture = depth;
+    memset(&dd, 0, sizeof dd);
+    dd.frame = &fd;
+    dd.color_texture = color;
+    dd.focus_distance = 6.0f;
+    dd.focus_range = 2.0f;
+    assert_int_equal(fogvol_post_dof(e.fv, &dd), FOGVOL_SUCCESS);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    dd.color_texture = 4243;
+    glLineWidth(-1.0f);
+    g_dbg_errors = 0;
+    e.lc.last[0] = 0;
+    assert_int_equal(fogvol_post_dof(e.fv, &dd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# post_dof colour texture 4243: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "4243"));
+    assert_int_equal(glGetError(), GL_INVALID_VALUE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("post_dof with a bad texture");
+    /* engine_depth_framebuffer 999 */
+    fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT;
+    fd.engine_depth_framebuffer = 999;
+    e.lc.last[0] = 0;
+    assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_ARGUMENT);
+    print_message("# engine_depth_framebuffer 999: %s\n", e.lc.last);
+    assert_non_null(strstr(e.lc.last, "999"));
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    no_debug_errors("engine_depth_framebuffer 999");
+    fd.engine_depth_framebuffer = fbo; /* the same through the framebuffer: fine */
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &color);
+    glDeleteTextures(1, &depth);
+    eng_close(&e);
+    free(thick);
+}
+
+/* Issue 31 3c: version overrides that a core-profile context cannot honour. OpenGL ES 2.0 and GL 2.1
+   draw without vertex array objects and read one GL_EXTENSIONS string, which a core profile has not:
+   refused (UNSUPPORTED, logged) with nothing left pending (before: ES 2.0 was accepted and left
+   GL_INVALID_OPERATION, 2.1 refused but left GL_INVALID_ENUM). GL 3.0 is drawn as the core profile
+   it is (before: refused as a backend error leaving GL_INVALID_ENUM: fogvol touched the
+   compatibility profile's alpha test and polygon stipple). */
+static void test_override_core(void **st)
+{
+    static const struct {
+        int major, minor, gles;
+        fogvol_result want;
+    } cases[] = {{2, 0, 1, FOGVOL_ERROR_UNSUPPORTED}, {2, 1, 0, FOGVOL_ERROR_UNSUPPORTED},
+                 {3, 0, 0, FOGVOL_SUCCESS},           {3, 1, 0, FOGVOL_SUCCESS},
+                 {3, 0, 1, FOGVOL_SUCCESS}};
+    eng e;
+    int i;
+    (void)st;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    debug_on();
+    for (i = 0; i < (int)(sizeof cases / sizeof cases[0]); ++i) {
+        fogvol_context_desc cd;
+        fogvol_context *fv = NULL;
+        fogvol_result r;
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.logger.func = logger;
+        cd.logger.user_data = &e.lc;
+        cd.gl.version_major = cases[i].major;
+        cd.gl.version_minor = cases[i].minor;
+        cd.gl.gles = cases[i].gles;
+        e.lc.last[0] = 0;
+        g_dbg_errors = 0;
+        r = fogvol_create_context(&cd, &fv);
+        print_message("# core profile treated as %s %d.%d: %s%s%s\n", cases[i].gles ? "OpenGL ES" : "GL",
+                      cases[i].major, cases[i].minor, fogvol_result_string(r), e.lc.last[0] ? ": " : "", e.lc.last);
+        assert_int_equal(r, cases[i].want);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        no_debug_errors("create_context");
+        if (r == FOGVOL_SUCCESS) { /* and it draws: the sphere's chord through its centre */
+            fogvol_context *own = e.fv;
+            fogvol_ramp *own_ramp = e.ramp[0];
+            fogvol_frame_desc fd;
+            float *thick = (float *)calloc(NPIX, sizeof(float));
+            e.fv = fv;
+            make_ramp(&e, 0, NULL);
+            add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+            frame_desc(&e, &fd);
+            assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+            assert_true(fabs(thick[(H / 2) * W + W / 2] - 4.0) < 0.05);
+            assert_int_equal(glGetError(), GL_NO_ERROR);
+            no_debug_errors("a frame");
+            fogvol_destroy_mesh(fv, e.o[0].m);
+            shp_free(&e.o[0].mesh);
+            e.n = 0;
+            fogvol_destroy_ramp(fv, e.ramp[0]);
+            fogvol_destroy_context(fv);
+            e.fv = own;
+            e.ramp[0] = own_ramp;
+            free(thick);
+        } else {
+            assert_non_null(strstr(e.lc.last, "core"));
+        }
+    }
+    eng_close(&e);
+}
+
+/* Issue 31 3i: fogvol called with another GL context current (one that does not share objects with
+   fogvol's). Before: end_frame returned success and deleted two of that context's textures whose
+   names were those of fogvol's targets. Now every entry that would touch GL refuses
+   (INVALID_STATE, logged: "another GL context is current?") and touches nothing: the other
+   context's textures and buffers all exist afterwards and no GL error is left there; fogvol works
+   again once its context is current. Told by a per-context object of fogvol's own (its vertex
+   array object, or on GL 2 a framebuffer object) and, when the desc has one, by
+   fogvol_gl_desc.current_context. */
+static void other_context_case(int with_callback)
+{
+    eng e;
+    glu_ctx other;
+    fogvol_frame_desc fd;
+    fogvol_mesh_desc md;
+    fogvol_mesh *m = NULL;
+    GLuint tex[8], buf[8];
+    float *thick = (float *)calloc(NPIX, sizeof(float));
+    shp_mesh s = shp_sphere(1.0f, 16, 8);
+    int k, size;
+    eng_open(&e, PROF_CORE, FOGVOL_TIER_PS20);
+    if (with_callback) { /* the same, told by the callback */
+        fogvol_context_desc cd;
+        fogvol_destroy_ramp(e.fv, e.ramp[0]);
+        fogvol_destroy_ramp(e.fv, e.ramp[1]);
+        fogvol_destroy_context(e.fv);
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.gl.current_context = glu_current_context;
+        cd.logger.func = logger;
+        cd.logger.user_data = &e.lc;
+        cd.tier = FOGVOL_TIER_PS20;
+        assert_int_equal(fogvol_create_context(&cd, &e.fv), FOGVOL_SUCCESS);
+        make_ramp(&e, 0, NULL);
+        make_ramp(&e, 1, NULL);
+    }
+    add_obj(&e, shp_sphere(2.0f, 32, 16), 0, 0, 0, 1, 1, 0);
+    frame_desc(&e, &fd);
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS);
+    assert_true(thick[(H / 2) * W + W / 2] > 3.9f);
+    assert_true(glu_create(&other, W, H, 1)); /* now current */
+    glGenTextures(8, tex);
+    glGenBuffers(8, buf);
+    for (k = 0; k < 8; ++k) {
+        static const unsigned char px[16] = {0};
+        glBindTexture(GL_TEXTURE_2D, tex[k]);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 2, 2, 0, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        glBindBuffer(GL_ARRAY_BUFFER, buf[k]);
+        glBufferData(GL_ARRAY_BUFFER, 16, px, GL_STATIC_DRAW);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    for (size = 0; size < 2; ++size) { /* the same viewport, and one that would make new targets */
+        frame_desc(&e, &fd);
+        fd.viewport[2] = size ? W / 2 : W;
+        e.lc.last[0] = 0;
+        assert_int_equal(run(&e, &fd, NULL), FOGVOL_ERROR_INVALID_STATE);
+        assert_non_null(strstr(e.lc.last, "context"));
+    }
+    print_message("# %s: %s\n", with_callback ? "with current_context" : "fingerprint", e.lc.last);
+    fx_mesh_desc(&md, &s, 0);
+    assert_int_equal(fogvol_create_mesh(e.fv, &md, &m, NULL), FOGVOL_ERROR_INVALID_STATE);
+    fogvol_destroy_mesh(e.fv, e.o[0].m); /* forgotten, its GL objects not deleted here */
+    e.o[0].m = NULL;
+    for (k = 0; k < 8; ++k) {
+        assert_true(glIsTexture(tex[k]));
+        assert_true(glIsBuffer(buf[k]));
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_true(glu_make_current(&e.g));
+    glu_destroy(&other);
+    assert_true(glu_make_current(&e.g));
+    e.o[0].m = NULL;
+    assert_int_equal(fogvol_create_mesh(e.fv, &md, &e.o[0].m, NULL), FOGVOL_SUCCESS);
+    frame_desc(&e, &fd);
+    memset(thick, 0, NPIX * sizeof(float));
+    assert_int_equal(run(&e, &fd, thick), FOGVOL_SUCCESS); /* back in its own context: a sphere of radius 1 */
+    assert_true(fabs(thick[(H / 2) * W + W / 2] - 2.0) < 0.05);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    shp_free(&s);
+    free(thick);
+    eng_close(&e);
+}
+
+static void test_other_context(void **st)
+{
+    (void)st;
+    other_context_case(0);
+    other_context_case(1);
 }
 
 /* Codes GL cannot raise again on demand (out of memory, stack over/underflow, context loss) are logged. */
@@ -1102,12 +1568,16 @@ int main(void)
         cmocka_unit_test(test_drawbuffers_21),    cmocka_unit_test(test_drawbuffers_es30),
         cmocka_unit_test(test_drawbuffers_swizzled),
         cmocka_unit_test(test_drawbuffers_refused), cmocka_unit_test(test_geometry_core),
-        cmocka_unit_test(test_geometry_21),       cmocka_unit_test(test_state_core),
+        cmocka_unit_test(test_geometry_21),       cmocka_unit_test(test_fb_sequence),
+        cmocka_unit_test(test_state_core),
         cmocka_unit_test(test_state_compat),      cmocka_unit_test(test_transform_feedback),
         cmocka_unit_test(test_errors_core),       cmocka_unit_test(test_errors_21),
         cmocka_unit_test(test_errors_unraisable),
+        cmocka_unit_test(test_own_errors),        cmocka_unit_test(test_override_core),
+        cmocka_unit_test(test_other_context),
         cmocka_unit_test(test_alpha),             cmocka_unit_test(test_srgb),
         cmocka_unit_test(test_srgb_own_targets),
     };
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -574,6 +574,354 @@ static void test_engine_depth_refusals(void **state)
     free_objs(o, n);
 }
 
+/* ==== 1b. the engine's depth over a camera walk, frame after frame (issue 31) ==
+   Each source of the engine's depth through a 60-frame walk (tests/sequence.h's walk script:
+   into the fog box and out again, the occluders leaving and coming back, split-screen frames
+   whose two views have their own cameras and depth, frames after a cancelled one, a smaller
+   viewport now and then). The engine clears and draws its occluders into the view's viewport
+   of its framebuffer every frame; fogvol must read that depth as it is at each end_frame. Each
+   view's thickness (debug read-back) is compared with the ray cast of that view's camera and
+   occluders; a wrong pixel is an interior pixel off by more than the bound of
+   test_engine_depth_buffers. The engine's other depth buffers must come back unchanged. */
+
+#define SW 64 /* the walk's framebuffer */
+#define SH 64
+#define WALK_FRAMES 60
+
+typedef struct walk_src {
+    const char *name;
+    GLenum format;              /* 0: the default framebuffer */
+    int samples, texture, bits; /* texture: the depth is a texture attachment; bits: depth quantum 2^-bits */
+    fogvol_depth_source source; /* FRAMEBUFFER_OBJECT: the engine's FBO by name, the default framebuffer bound */
+} walk_src;
+
+static const walk_src g_walk_srcs[] = {
+    {"default framebuffer", 0, 0, 0, 24, FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER},
+    {"bound FBO, D24S8 renderbuffer", GL_DEPTH24_STENCIL8, 0, 0, 24, FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER},
+    {"FBO by name, DEPTH32F renderbuffer", GL_DEPTH_COMPONENT32F, 0, 0, 0, FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT},
+    {"FBO by name, DEPTH24 texture", GL_DEPTH_COMPONENT24, 0, 1, 24, FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT},
+    {"FBO by name, 4x MSAA D24S8", GL_DEPTH24_STENCIL8, 4, 0, 24, FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT},
+    {"depth texture (no copy)", GL_DEPTH_COMPONENT24, 0, 1, 24, FOGVOL_DEPTH_SOURCE_TEXTURE},
+};
+#define NWALK ((int)(sizeof g_walk_srcs / sizeof g_walk_srcs[0]))
+
+typedef struct walk {
+    const walk_src *src;
+    fogvol_tier tier;
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    engine e;
+    GLuint fbo, rb[2], dtex; /* the engine's framebuffer (fbo 0: the default one) */
+    tobj o[3];               /* the fog box, a column and a wall */
+    float *thick, *zb, *za;
+    double *gt, *spread;
+    unsigned char *interior;
+    long depth_changed;      /* depth values of the engine's buffers fogvol changed */
+    int failed, gl_errors;   /* views whose end_frame failed, that left a GL error */
+    unsigned char *sheet;    /* 10 frames x (rendered, truth), RGB */
+} walk;
+
+/* the camera of a walk position: from outside the box (w = 0) to inside it (w = 1), turning a little */
+static rc_camera walk_camera(double w, const int vp[4])
+{
+    rc_camera c;
+    static const double e0[3] = {1.6, 1.1, 9.0}, e1[3] = {0.3, 0.2, 0.6};
+    int i;
+    memset(&c, 0, sizeof c);
+    for (i = 0; i < 3; ++i) c.eye[i] = e0[i] + (e1[i] - e0[i]) * w;
+    c.target[0] = c.eye[0] - 0.25 + 0.2 * w;
+    c.target[1] = c.eye[1] - 0.15;
+    c.target[2] = c.eye[2] - 1.0;
+    c.up[1] = 1.0;
+    c.fovy_deg = 60.0;
+    c.aspect = (double)vp[2] / vp[3];
+    c.znear = 0.25;
+    c.zfar = 30.0;
+    c.width = vp[2];
+    c.height = vp[3];
+    return c;
+}
+
+static void walk_scene(tobj *o)
+{
+    o[0].m = shp_box(2.0f, 1.2f, 2.0f); /* the fog, around the walk's end */
+    shp_mat_identity(o[0].model);
+    o[0].sign = 1;
+    o[1].m = shp_box(0.25f, 1.5f, 0.25f); /* a column inside the fog */
+    shp_mat_translate(o[1].model, 0.9f, -0.2f, -0.6f);
+    o[1].sign = 0;
+    o[2].m = shp_box(1.5f, 2.0f, 0.15f); /* a wall cutting the fog's far part */
+    shp_mat_translate(o[2].model, -1.3f, 0.0f, -1.5f);
+    o[2].sign = 0;
+}
+
+/* The ray casts of the walk's views, made once for all sources and tiers (slot frame * 2 + view). */
+static struct {
+    int have[WALK_FRAMES * 2];
+    double *gt, *spread;
+    unsigned char *interior;
+} g_walk_truth;
+
+/* the ray cast of view v: thickness, interior pixels, and how far the nearest occluder's depth moves
+   across each pixel (a multisampled source's resolve keeps one sample) */
+static void walk_truth(walk *wk, const rc_camera *c, const sq_view *v)
+{
+    rc_object ro[3];
+    rc_scene rs;
+    int i, x, y, n = v->occluders ? 3 : 1, slot = v->frame * 2 + v->view;
+    size_t off = (size_t)slot * SW * SH, np = (size_t)c->width * c->height;
+    if (!g_walk_truth.gt) {
+        g_walk_truth.gt = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
+        g_walk_truth.spread = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
+        g_walk_truth.interior = (unsigned char *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, 1);
+    }
+    if (g_walk_truth.have[slot]) {
+        memcpy(wk->gt, g_walk_truth.gt + off, np * sizeof(double));
+        memcpy(wk->spread, g_walk_truth.spread + off, np * sizeof(double));
+        memcpy(wk->interior, g_walk_truth.interior + off, np);
+        return;
+    }
+    for (i = 0; i < n; ++i) {
+        ro[i].pos = wk->o[i].m.pos;
+        ro[i].vcount = wk->o[i].m.vcount;
+        ro[i].idx = wk->o[i].m.idx;
+        ro[i].icount = wk->o[i].m.icount;
+        memcpy(ro[i].model, wk->o[i].model, sizeof ro[i].model);
+        ro[i].sign = wk->o[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, n));
+    for (y = 0; y < c->height; ++y)
+        for (x = 0; x < c->width; ++x) {
+            int p = y * c->width + x, k;
+            double ctr;
+            rc_result r = rc_trace(&rs, c, x + 0.5, y + 0.5);
+            wk->gt[p] = r.thickness;
+            wk->interior[p] = (unsigned char)rc_interior(&rs, c, x, y);
+            wk->spread[p] = 0.0;
+            if (!wk->interior[p]) continue;
+            ctr = r.opaque_w;
+            for (k = 0; k < 4; ++k) {
+                double o = rc_trace(&rs, c, x + (k & 1), y + (k >> 1)).opaque_w;
+                double d = isinf(o) && isinf(ctr) ? 0.0 : fabs(o - ctr);
+                if (!(d <= wk->spread[p])) wk->spread[p] = d;
+            }
+        }
+    rc_scene_free(&rs);
+    memcpy(g_walk_truth.gt + off, wk->gt, np * sizeof(double));
+    memcpy(g_walk_truth.spread + off, wk->spread, np * sizeof(double));
+    memcpy(g_walk_truth.interior + off, wk->interior, np);
+    g_walk_truth.have[slot] = 1;
+}
+
+/* the engine's depth buffer that fogvol must leave alone: the draw framebuffer's at end_frame */
+static void walk_read_depth(float *z)
+{
+    glReadPixels(0, 0, SW, SH, GL_DEPTH_COMPONENT, GL_FLOAT, z);
+}
+
+/* the engine's frame for view v: clear the viewport, draw the occluders into it */
+static void walk_engine(walk *wk, const sq_view *v, const fogvol_frame_desc *fd)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, wk->fbo);
+    glViewport(v->viewport[0], v->viewport[1], v->viewport[2], v->viewport[3]);
+    glScissor(v->viewport[0], v->viewport[1], v->viewport[2], v->viewport[3]);
+    glEnable(GL_SCISSOR_TEST);
+    glClearColor(0.2f, 0.3f, 0.4f, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+    if (v->occluders) engine_draw(&wk->e, wk->o + 1, 2, fd->view, fd->projection, NULL);
+    glDisable(GL_DEPTH_TEST);
+}
+
+static void walk_desc(walk *wk, const sq_view *v, const rc_camera *c, fogvol_frame_desc *fd)
+{
+    fx_frame_desc(fd, c, v->viewport[2], v->viewport[3]);
+    fd->viewport[0] = v->viewport[0];
+    fd->viewport[1] = v->viewport[1];
+    fd->debug_thickness = wk->thick;
+    fd->engine_depth_source = wk->src->source;
+    if (wk->src->source == FOGVOL_DEPTH_SOURCE_TEXTURE) fd->engine_depth_texture = wk->dtex;
+    if (wk->src->source == FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT) fd->engine_depth_framebuffer = wk->fbo;
+}
+
+/* a frame begun with this view's input (a volume, the whole fog) and cancelled */
+static void walk_cancel(void *user, const sq_view *v)
+{
+    walk *wk = (walk *)user;
+    rc_camera c = walk_camera(1.0 - v->walk, v->viewport);
+    fogvol_frame_desc fd;
+    walk_desc(wk, v, &c, &fd);
+    assert_int_equal(fogvol_begin_frame(wk->fv, &fd), FOGVOL_SUCCESS);
+    add_volume(wk->fv, wk->vol, wk->o[0].model, wk->ramp);
+    assert_int_equal(fogvol_cancel_frame(wk->fv), FOGVOL_SUCCESS);
+}
+
+/* every 6th frame of the walk (one view, full viewport) into the contact sheet: rendered thickness
+   above, the ray cast below, 0..4 units black to white */
+static void walk_sheet(walk *wk, const sq_view *v)
+{
+    int col = v->frame / 6, x, y, k;
+    if (v->frame % 6 || v->views != 1 || v->viewport[2] != SW || v->viewport[3] != SH || col >= 10) return;
+    for (y = 0; y < SH; ++y)
+        for (x = 0; x < SW; ++x)
+            for (k = 0; k < 2; ++k) {
+                double t = k ? wk->gt[y * SW + x] : wk->thick[y * SW + x];
+                unsigned char *o = wk->sheet + (((size_t)(SH - 1 - y + k * SH) * SW * 10) + col * SW + x) * 3;
+                o[0] = o[1] = o[2] = (unsigned char)(t <= 0 ? 0 : t >= 4 ? 255 : t * 63.75);
+                if (k == 0 && wk->interior[y * SW + x] && fabs(wk->thick[y * SW + x] - wk->gt[y * SW + x]) > 0.05)
+                    o[1] = o[2] = 0; /* wrong: red */
+            }
+}
+
+static void walk_view(void *user, const sq_view *v, sq_check *out)
+{
+    walk *wk = (walk *)user;
+    rc_camera c = walk_camera(v->walk, v->viewport);
+    fogvol_frame_desc fd;
+    double range = c.zfar - c.znear, wmax = 12.0;
+    int i, npx = v->viewport[2] * v->viewport[3];
+    fogvol_result r;
+    walk_desc(wk, v, &c, &fd);
+    walk_engine(wk, v, &fd);
+    if (wk->src->source == FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT) glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    walk_read_depth(wk->zb); /* (the draw framebuffer is single-sample) */
+    for (i = 0; i < npx; ++i) wk->thick[i] = -1.0f;
+    assert_int_equal(fogvol_begin_frame(wk->fv, &fd), FOGVOL_SUCCESS);
+    add_volume(wk->fv, wk->vol, wk->o[0].model, wk->ramp);
+    r = fogvol_end_frame(wk->fv, NULL);
+    if (r != FOGVOL_SUCCESS && !wk->failed++) print_message("#   end_frame: %s\n", fogvol_result_string(r));
+    wk->gl_errors += glGetError() != GL_NO_ERROR;
+    walk_read_depth(wk->za); /* the depth buffer bound for drawing: the engine's, untouched */
+    for (i = 0; i < SW * SH; ++i) wk->depth_changed += wk->za[i] != wk->zb[i];
+    walk_truth(wk, &c, v);
+    /* as test_engine_depth_buffers: FLOAT 1e-4 of the range, PS20 1 LSB of the 12-bit encoding
+       (one pair of faces), + the depth quantum at the farthest occluder; a multisampled source's
+       resolve keeps one of the pixel's samples: + the occluder's depth spread over the pixel */
+    out->bound = (wk->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0) +
+                 (wk->src->bits ? ldexp(1.0, -wk->src->bits) * wmax * wmax * range / (c.zfar * c.znear) : 0.0);
+    for (i = 0; i < npx; ++i) {
+        double err;
+        if (!wk->interior[i]) continue;
+        err = fabs(wk->thick[i] - wk->gt[i]) - (wk->src->samples ? wk->spread[i] : 0.0);
+        out->pixels++;
+        if (r != FOGVOL_SUCCESS) { /* no fog drawn: the whole view is wrong */
+            out->wrong++;
+            continue;
+        }
+        if (err > out->max_err) out->max_err = err;
+        out->wrong += err > out->bound;
+    }
+    walk_sheet(wk, v);
+}
+
+static void walk_setup(walk *wk, const walk_src *src, fogvol_tier tier)
+{
+    GLenum att;
+    memset(wk, 0, sizeof *wk);
+    wk->src = src;
+    wk->tier = tier;
+    walk_scene(wk->o);
+    wk->fv = make_ctx(tier, FOGVOL_VARIANT_ENGINE_DEPTH);
+    wk->vol = mesh_of(wk->fv, &wk->o[0].m, 0);
+    wk->ramp = ramp_of(wk->fv);
+    engine_init(&wk->e);
+    wk->thick = (float *)calloc((size_t)SW * SH, sizeof(float));
+    wk->zb = (float *)calloc((size_t)SW * SH, sizeof(float));
+    wk->za = (float *)calloc((size_t)SW * SH, sizeof(float));
+    wk->gt = (double *)calloc((size_t)SW * SH, sizeof(double));
+    wk->spread = (double *)calloc((size_t)SW * SH, sizeof(double));
+    wk->interior = (unsigned char *)calloc((size_t)SW * SH, 1);
+    wk->sheet = (unsigned char *)calloc((size_t)SW * 10 * SH * 2, 3);
+    if (!src->format) return;
+    att = src->format == GL_DEPTH24_STENCIL8 ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT;
+    glGenFramebuffers(1, &wk->fbo);
+    glGenRenderbuffers(2, wk->rb);
+    glBindFramebuffer(GL_FRAMEBUFFER, wk->fbo);
+    glBindRenderbuffer(GL_RENDERBUFFER, wk->rb[0]);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, src->samples, GL_RGBA8, SW, SH);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, wk->rb[0]);
+    if (src->texture) {
+        glGenTextures(1, &wk->dtex);
+        glBindTexture(GL_TEXTURE_2D, wk->dtex);
+        glTexImage2D(GL_TEXTURE_2D, 0, (GLint)src->format, SW, SH, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, att, GL_TEXTURE_2D, wk->dtex, 0);
+    } else {
+        glBindRenderbuffer(GL_RENDERBUFFER, wk->rb[1]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, src->samples, src->format, SW, SH);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, att, GL_RENDERBUFFER, wk->rb[1]);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+}
+
+static void walk_teardown(walk *wk)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (wk->fbo) glDeleteFramebuffers(1, &wk->fbo);
+    glDeleteRenderbuffers(2, wk->rb);
+    if (wk->dtex) glDeleteTextures(1, &wk->dtex);
+    glDeleteProgram(wk->e.prog);
+    fogvol_destroy_mesh(wk->fv, wk->vol);
+    fogvol_destroy_ramp(wk->fv, wk->ramp);
+    fogvol_destroy_context(wk->fv);
+    free_objs(wk->o, 3);
+    free(wk->thick);
+    free(wk->zb);
+    free(wk->za);
+    free(wk->gt);
+    free(wk->spread);
+    free(wk->interior);
+    free(wk->sheet);
+}
+
+static void test_engine_depth_walk(void **state)
+{
+    static const fogvol_tier tiers[2] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20};
+    sq_step steps[WALK_FRAMES];
+    glu_ctx g;
+    long wrong = 0, changed = 0;
+    int s, t, failed = 0;
+    (void)state;
+    assert_true(glu_create(&g, SW, SH, 1));
+    sq_walk_script(steps, WALK_FRAMES);
+    for (t = 0; t < 2; ++t)
+        for (s = 0; s < NWALK; ++s) {
+            walk wk;
+            char name[96], where[200], png[128];
+            sq_totals tot;
+            walk_setup(&wk, &g_walk_srcs[s], tiers[t]);
+            snprintf(name, sizeof name, "%s %s", fogvol_tier_name(tiers[t]), g_walk_srcs[s].name);
+            tot = sq_play(name, SW, SH, steps, WALK_FRAMES, SQ_ALL, walk_view, walk_cancel, &wk, where);
+            if (tot.wrong) print_message("#   first wrong pixel: %s\n", where);
+            if (wk.depth_changed || wk.failed || wk.gl_errors)
+                print_message("#   %ld depth values of the engine's buffers changed; %d views failed, %d left a GL "
+                              "error\n", wk.depth_changed, wk.failed, wk.gl_errors);
+            mkdir("build", 0777);
+            mkdir("build/engine_input", 0777);
+            snprintf(png, sizeof png, "build/engine_input/walk_%s_%d.png", fogvol_tier_name(tiers[t]), s);
+            stbi_flip_vertically_on_write(0);
+            stbi_write_png(png, SW * 10, SH * 2, 3, wk.sheet, SW * 10 * 3);
+            wrong += tot.wrong;
+            changed += wk.depth_changed;
+            failed += wk.failed + wk.gl_errors;
+            walk_teardown(&wk);
+        }
+    glu_destroy(&g);
+    free(g_walk_truth.gt);
+    free(g_walk_truth.spread);
+    free(g_walk_truth.interior);
+    memset(&g_walk_truth, 0, sizeof g_walk_truth);
+    print_message("# walk: %ld wrong pixels, %ld engine depth values changed, %d failed views\n", wrong, changed,
+                  failed);
+    assert_int_equal(wrong, 0);
+    assert_int_equal(changed, 0);
+    assert_int_equal(failed, 0);
+}
+
 /* ==== 2. occluders drawn by the engine's own program ========================= */
 
 static void render_occluders(fogvol_tier tier, int by_engine, const tobj *o, int n, float *thick)
@@ -671,6 +1019,154 @@ static void test_engine_occluders(void **state)
     free(tf);
 }
 
+/* The engine-drawn occluders as a sequence (tests/sequence.h's default script): the camera walks
+   into the sphere and out, the engine draws its occluders into fogvol's O in the frames that have
+   them and does not call fogvol_occluder_prepare in the others (fogvol's own O, the far plane, must
+   take over), the viewport shrinks and splits (O has the viewport's size), a cancelled frame in
+   which the engine drew its occluders comes in between. Each view against the ray cast of its own
+   camera and occluders, 1 LSB per pair of faces (FLOAT 1e-4 of the range) on interior pixels. */
+typedef struct occseq {
+    fogvol_tier tier;
+    engine e;
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    tobj *o;
+    float *thick;
+    GLuint fbo, depth;
+} occseq;
+
+/* The camera of walk position w: up to 0.5 it circles the sphere (60 degrees about y, looking at its
+   centre), so an O left from another frame would cut the sphere somewhere else; then it moves into
+   the sphere (radius 1.5 at the origin), looking the same way. */
+static rc_camera occseq_camera(double w, const int vp[4])
+{
+    rc_camera c = camera();
+    static const double in[3] = {0.3, 0.2, 0.5};
+    double a = (w < 0.5 ? w : 0.5) * 2.0 * 1.0471975511965976, e[3], u = w > 0.5 ? (w - 0.5) * 2.0 : 0.0;
+    int i;
+    e[0] = c.eye[0] * cos(a) + c.eye[2] * sin(a);
+    e[1] = c.eye[1];
+    e[2] = -c.eye[0] * sin(a) + c.eye[2] * cos(a);
+    for (i = 0; i < 3; ++i) {
+        c.eye[i] = e[i] + (in[i] - e[i]) * u;
+        c.target[i] = c.eye[i] - e[i]; /* towards the centre from the orbit point */
+    }
+    c.aspect = (double)vp[2] / vp[3];
+    c.width = vp[2];
+    c.height = vp[3];
+    return c;
+}
+
+static void occseq_engine_o(occseq *q, const fogvol_frame_desc *fd)
+{
+    fogvol_occluder_info oi;
+    assert_int_equal(fogvol_occluder_prepare(q->fv, &oi), FOGVOL_SUCCESS);
+    assert_int_equal(oi.width, fd->viewport[2]);
+    assert_int_equal(oi.height, fd->viewport[3]);
+    glBindRenderbuffer(GL_RENDERBUFFER, q->depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, oi.width, oi.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, q->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, q->depth);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glViewport(0, 0, oi.width, oi.height);
+    glClearBufferfv(GL_COLOR, 0, oi.clear_color);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    engine_draw(&q->e, q->o, 2, fd->view, fd->projection, oi.uniforms);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static void occseq_cancel(void *user, const sq_view *v)
+{
+    occseq *q = (occseq *)user;
+    rc_camera c = occseq_camera(0.5 - v->walk * 0.5, v->viewport); /* (another view than the next frame's) */
+    fogvol_frame_desc fd;
+    frame_of(&fd, &c, NULL);
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    occseq_engine_o(q, &fd); /* the engine's occluders of a frame that is given up */
+    add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
+    assert_int_equal(fogvol_cancel_frame(q->fv), FOGVOL_SUCCESS);
+}
+
+static void occseq_view(void *user, const sq_view *v, sq_check *out)
+{
+    occseq *q = (occseq *)user;
+    rc_camera c = occseq_camera(v->walk, v->viewport);
+    fogvol_frame_desc fd;
+    rc_object ro[2];
+    rc_scene rs;
+    int i, x, y, n = v->occluders ? 2 : 1;
+    double range = c.zfar - c.znear;
+    frame_of(&fd, &c, q->thick);
+    memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    if (v->occluders) occseq_engine_o(q, &fd); /* the engine's pass into fogvol's O, its own depth buffer */
+    add_volume(q->fv, q->vol, q->o[0].model, q->ramp);
+    assert_int_equal(fogvol_end_frame(q->fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    for (i = 0; i < n; ++i) {
+        ro[i].pos = q->o[i].m.pos;
+        ro[i].vcount = q->o[i].m.vcount;
+        ro[i].idx = q->o[i].m.idx;
+        ro[i].icount = q->o[i].m.icount;
+        memcpy(ro[i].model, q->o[i].model, sizeof ro[i].model);
+        ro[i].sign = q->o[i].sign;
+    }
+    assert_true(rc_scene_init(&rs, ro, n));
+    out->bound = q->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0;
+    for (y = 0; y < c.height; ++y)
+        for (x = 0; x < c.width; ++x) {
+            double err;
+            if (!rc_interior(&rs, &c, x, y)) continue;
+            err = fabs(q->thick[y * c.width + x] - rc_trace(&rs, &c, x + 0.5, y + 0.5).thickness);
+            out->pixels++;
+            out->wrong += err > out->bound;
+            if (err > out->max_err) out->max_err = err;
+        }
+    rc_scene_free(&rs);
+}
+
+static void test_engine_occluders_sequence(void **state)
+{
+    static const fogvol_tier tiers[3] = {FOGVOL_TIER_PS20, FOGVOL_TIER_PS20, FOGVOL_TIER_FLOAT};
+    tobj o[2];
+    int t;
+    glu_ctx g;
+    (void)state;
+    scene(o);
+    assert_true(glu_create(&g, W, H, 1));
+    for (t = 0; t < 3; ++t) {
+        occseq q;
+        char name[64];
+        memset(&q, 0, sizeof q);
+        q.tier = tiers[t];
+        q.o = o;
+        g_speedups_off = t == 1 ? FOGVOL_SPEEDUP_FLOAT_O : 0u; /* PS20 with an R32F O, then an RGBA8 one */
+        q.fv = make_ctx(q.tier, 0);
+        q.vol = mesh_of(q.fv, &o[0].m, 0);
+        q.ramp = ramp_of(q.fv);
+        q.thick = (float *)calloc((size_t)W * H, sizeof(float));
+        engine_init(&q.e);
+        glGenFramebuffers(1, &q.fbo);
+        glGenRenderbuffers(1, &q.depth);
+        snprintf(name, sizeof name, "engine occluders %s%s", fogvol_tier_name(q.tier), t == 1 ? " (RGBA8 O)" : "");
+        sq_run(name, W, H, sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, occseq_view, occseq_cancel, &q);
+        glDeleteFramebuffers(1, &q.fbo);
+        glDeleteRenderbuffers(1, &q.depth);
+        glDeleteProgram(q.e.prog);
+        fogvol_destroy_mesh(q.fv, q.vol);
+        fogvol_destroy_ramp(q.fv, q.ramp);
+        fogvol_destroy_context(q.fv);
+        free(q.thick);
+    }
+    g_speedups_off = 0;
+    glu_destroy(&g);
+    free_objs(o, 2);
+}
+
 static void test_engine_occluder_refusals(void **state)
 {
     static const struct {
@@ -713,6 +1209,116 @@ static void test_engine_occluder_refusals(void **state)
     assert_int_equal(glGetError(), GL_NO_ERROR);
     glu_destroy(&g);
     free_objs(o, n);
+}
+
+/* Issue 31 3d: what a cancelled frame leaves behind. fogvol_occluder_prepare hands O to the engine;
+   the engine writes it (here: cleared to the near plane, which hides every volume), and the frame
+   is cancelled. The next frame has no occluders: O must be the far plane again, so the sphere's
+   thickness is its ray-cast chord (before: the previous frame without occluders had left "O holds
+   the far plane" set, the cleared O was reused and the thickness was 0). MRT: after mrt_prepare
+   and cancel_frame, the next frame without mrt_prepare is refused (before: drawn with the
+   cancelled frame's O). */
+static void cancelled_frame(fogvol_tier tier, unsigned speedups_off, const tobj *o, const double *gt,
+                            const unsigned char *interior, float *thick)
+{
+    static const float near_plane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    rc_camera c = camera();
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_occluder_info oi;
+    GLuint fbo = 0;
+    double lsb = tier == FOGVOL_TIER_FLOAT ? 1e-4 * (c.zfar - c.znear) : (c.zfar - c.znear) / 4096.0, e;
+    int frame, pixels;
+    g_speedups_off = speedups_off;
+    fv = make_ctx(tier, 0);
+    g_speedups_off = 0;
+    vol = mesh_of(fv, &o[0].m, 0);
+    ramp = ramp_of(fv);
+    frame_of(&fd, &c, thick);
+    glGenFramebuffers(1, &fbo);
+    for (frame = 0; frame < 3; ++frame) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        if (frame == 1) { /* the engine draws O (cleared to the near plane), then the frame is cancelled */
+            assert_int_equal(fogvol_occluder_prepare(fv, &oi), FOGVOL_SUCCESS);
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)oi.texture, 0);
+            assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+            glClearBufferfv(GL_COLOR, 0, near_plane);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+            continue;
+        }
+        add_volume(fv, vol, o[0].model, ramp);
+        assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+        e = max_err(thick, gt, interior, &pixels);
+        print_message("  %s, speed-ups off 0x%x, frame %d%s: max |thickness - ray cast| %.3f LSB (%d fogged pixels)\n",
+                      fogvol_tier_name(tier), speedups_off, frame, frame == 2 ? " (after the cancelled frame)" : "",
+                      e / lsb, pixels);
+        assert_true(pixels > 1000);
+        assert_true(e <= lsb);
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    glDeleteFramebuffers(1, &fbo);
+    fogvol_destroy_mesh(fv, vol);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+}
+
+static void test_cancelled_frames(void **state)
+{
+    rc_camera c = camera();
+    tobj o[2];
+    int n = scene(o);
+    double *gt = (double *)malloc(sizeof(double) * W * H);
+    unsigned char *interior = (unsigned char *)malloc((size_t)W * H);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_mrt_info mi;
+    glu_ctx g;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    truth(&c, o, 1, gt, interior); /* the sphere alone */
+    cancelled_frame(FOGVOL_TIER_PS20, FOGVOL_SPEEDUP_SPECIALIZE, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_PS20, FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_FLOAT_O, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_FLOAT, FOGVOL_SPEEDUP_SPECIALIZE, o, gt, interior, thick);
+    cancelled_frame(FOGVOL_TIER_PS20, 0, o, gt, interior, thick);
+    /* MRT: the engine's O of a cancelled frame is not this frame's */
+    fv = make_ctx(FOGVOL_TIER_MRT, 0);
+    vol = mesh_of(fv, &o[0].m, 0);
+    ramp = ramp_of(fv);
+    frame_of(&fd, &c, NULL);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_mrt_prepare(fv, &mi), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_cancel_frame(fv), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_volume(fv, vol, o[0].model, ramp);
+    g_log[0] = 0;
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_ERROR_INVALID_STATE);
+    assert_non_null(strstr(g_log, "mrt_prepare"));
+    /* ... nor is an ended frame's */
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_mrt_prepare(fv, &mi), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_volume(fv, vol, o[0].model, ramp);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_ERROR_INVALID_STATE);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    fogvol_destroy_mesh(fv, vol);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free_objs(o, n);
+    free(gt);
+    free(interior);
+    free(thick);
 }
 
 /* ==== 3. meshes as engines store them ======================================== */
@@ -1108,10 +1714,13 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_engine_depth_buffers),     cmocka_unit_test(test_engine_depth_refusals),
-        cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluder_refusals),
+        cmocka_unit_test(test_engine_depth_walk),
+        cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluders_sequence),
+        cmocka_unit_test(test_engine_occluder_refusals), cmocka_unit_test(test_cancelled_frames),
         cmocka_unit_test(test_weld_seam_sphere),         cmocka_unit_test(test_weld_face_cube),
         cmocka_unit_test(test_interleaved_16bit),        cmocka_unit_test(test_mesh_bad_layouts),
     };
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests_name("engine input (depth buffers, engine occluders, engine meshes)", tests, NULL,
                                        NULL);
 }

@@ -641,6 +641,342 @@ static void test_gles3_any_samples(void **state)
     }
 }
 
+/* ---- sequences (tests/sequence.h) ------------------------------------------------------------
+   The overflow counts over frames that change: the camera walks from the far shells' view to the
+   near one, "occluders" are here the shells beyond the two-target limit (the frames that have them
+   overflow, the others fit), the viewport shrinks and splits, a cancelled frame comes in between.
+   Every view is drawn with show_overflow and the debug read-back; the GPU count of fogvol frame f,
+   when it arrives in a later frame, must be frame f's own read-back count (a count that belongs to
+   another frame, a query read twice or a count kept across frames fail); every wrong pixel is
+   magenta and none is where the faces fit, against the ray cast of that view's camera. */
+typedef struct vtruth {
+    int k, near, w, h;
+    rc_camera cam;
+    rc_scene rs;     /* kept for what is found per pixel when asked (vtruth_interior) */
+    double *gt, *slope;
+    int *pairs, max_faces;
+    signed char *interior; /* -1: not known yet */
+} vtruth;
+#define NVTRUTH 16
+static vtruth g_vtruth[NVTRUTH]; /* made on first use, shared by the sequences */
+
+/* Whether pixel p of the view is interior (rc_interior) and, if so, its depth slope: found when first
+   asked (only pixels that would fail a check need it), then kept. */
+static int vtruth_interior(vtruth *t, int p)
+{
+    if (t->interior[p] < 0) {
+        int x = p % t->w, y = p / t->w;
+        t->interior[p] = (signed char)rc_interior(&t->rs, &t->cam, x, y);
+        t->slope[p] = t->interior[p] ? rc_depth_slope(&t->rs, &t->cam, x, y) : 0.0;
+    }
+    return t->interior[p];
+}
+
+/* The truth of the shells (k, near) through a vw x vh viewport (the scene's camera, its aspect):
+   thickness and pairs of faces per pixel now, interior and slope when asked. */
+static vtruth *view_truth(int k, int near, int vw, int vh)
+{
+    vtruth *t;
+    int i, x, y;
+    for (i = 0; i < NVTRUTH && g_vtruth[i].k; ++i)
+        if (g_vtruth[i].k == k && g_vtruth[i].near == near && g_vtruth[i].w == vw && g_vtruth[i].h == vh)
+            return &g_vtruth[i];
+    assert_true(i < NVTRUTH);
+    t = &g_vtruth[i];
+    t->k = k;
+    t->near = near;
+    t->w = vw;
+    t->h = vh;
+    t->gt = (double *)malloc(sizeof(double) * vw * vh);
+    t->slope = (double *)malloc(sizeof(double) * vw * vh);
+    t->pairs = (int *)malloc(sizeof(int) * vw * vh);
+    t->interior = (signed char *)malloc((size_t)vw * vh);
+    memset(t->interior, -1, (size_t)vw * vh);
+    t->cam = get_truth(k, near)->s->cam;
+    t->cam.width = vw;
+    t->cam.height = vh;
+    t->cam.aspect = (double)vw / vh;
+    scene_raycaster(get_truth(k, near)->s, 1, &t->rs);
+    for (y = 0; y < vh; ++y)
+        for (x = 0; x < vw; ++x) {
+            rc_result r = rc_trace(&t->rs, &t->cam, x + 0.5, y + 0.5);
+            int p = y * vw + x;
+            t->gt[p] = r.thickness;
+            t->pairs[p] = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
+            if (t->pairs[p] < 1) t->pairs[p] = 1;
+            if (t->pairs[p] > t->max_faces) t->max_faces = t->pairs[p];
+        }
+    return t;
+}
+
+static void free_view_truths(void)
+{
+    int i;
+    for (i = 0; i < NVTRUTH; ++i) {
+        if (g_vtruth[i].k) rc_scene_free(&g_vtruth[i].rs);
+        free(g_vtruth[i].gt);
+        free(g_vtruth[i].slope);
+        free(g_vtruth[i].pairs);
+        free(g_vtruth[i].interior);
+    }
+    memset(g_vtruth, 0, sizeof g_vtruth);
+}
+
+typedef struct ovseq {
+    const combo *c;
+    glu_ctx *g;
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ]; /* the most shells' scene: a frame adds the first k */
+    fogvol_ramp *ramp;
+    float *thick;
+    unsigned char *px;
+    int readback[64]; /* the read-back's saturated pixels per fogvol frame number */
+    int checked, mismatched, lowered_at, show, bits_at[64];
+    logcap lc;
+} ovseq;
+
+/* a frame of the first k shells, camera near or far, into viewport vp (MRT: the engine's O cleared) */
+static fogvol_result ovseq_frame(ovseq *q, int k, int near, const int vp[4], float *thick, fogvol_frame_stats *st,
+                                 int cancel)
+{
+    const tscene *s = get_truth(k, near)->s;
+    rc_camera cam = s->cam;
+    fogvol_frame_desc fd;
+    int i;
+    cam.width = vp[2];
+    cam.height = vp[3];
+    cam.aspect = (double)vp[2] / vp[3];
+    fx_frame_desc(&fd, &cam, vp[2], vp[3]);
+    fd.viewport[0] = vp[0];
+    fd.viewport[1] = vp[1];
+    fd.show_overflow = q->show;
+    fd.debug_thickness = thick;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    assert_int_equal(fogvol_begin_frame(q->fv, &fd), FOGVOL_SUCCESS);
+    if (q->c->tier == FOGVOL_TIER_MRT) {
+        fogvol_mrt_info mrt;
+        GLuint fbo;
+        assert_int_equal(fogvol_mrt_prepare(q->fv, &mrt), FOGVOL_SUCCESS);
+        glGenFramebuffers(1, &fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, (GLuint)mrt.texture, 0);
+        glClearBufferfv(GL_COLOR, 0, mrt.clear_color);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glDeleteFramebuffers(1, &fbo);
+    }
+    for (i = 0; i < k && i < MAX_OBJ; ++i) {
+        fogvol_volume_desc vd;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = q->meshes[i];
+        vd.ramp = q->ramp;
+        memcpy(vd.model, s->obj[i].model, sizeof vd.model);
+        assert_int_equal(fogvol_add_volume(q->fv, &vd), FOGVOL_SUCCESS);
+    }
+    if (cancel) return fogvol_cancel_frame(q->fv);
+    return fogvol_end_frame(q->fv, st);
+}
+
+static void ovseq_cancel(void *user, const sq_view *v)
+{
+    ovseq *q = (ovseq *)user;
+    assert_int_equal(ovseq_frame(q, q->c->k[1], v->walk < 0.5, v->viewport, NULL, NULL, 1), FOGVOL_SUCCESS);
+}
+
+static void ovseq_view(void *user, const sq_view *v, sq_check *out)
+{
+    ovseq *q = (ovseq *)user;
+    int k = q->c->k[v->occluders], near = v->walk >= 0.5, single = (q->c->variants & FOGVOL_VARIANT_SINGLE_TARGET) != 0;
+    vtruth *t = view_truth(k, near, v->viewport[2], v->viewport[3]);
+    const fogvol_encoding *enc = fogvol_context_encoding(q->fv);
+    int bits = enc->bits, limit = single ? enc->max_faces_single : enc->max_faces, x, y;
+    double range = get_truth(k, near)->s->cam.zfar - get_truth(k, near)->s->cam.znear, snap = snap_pixels();
+    double lsb = range / pow(2.0, ((q->c->variants & FOGVOL_VARIANT_WIDE) ? 6.0 : 3.0) * bits);
+    fogvol_frame_stats st;
+    fogvol_result r;
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    r = ovseq_frame(q, k, near, v->viewport, q->thick, &st, 0);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, q->px); /* (what an engine's swap would do) */
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_true(st.frame < 64);
+    q->readback[st.frame] = st.overflow_pixels;
+    q->bits_at[st.frame] = bits;
+    out->wrong += r != (st.overflow_pixels > 0 ? FOGVOL_ERROR_DEPTH_OVERFLOW : FOGVOL_SUCCESS);
+    if (st.overflow_frame >= 0) { /* a count arrived: it is the read-back of the frame it names */
+        q->checked++;
+        if (st.overflow_pixels_late != q->readback[st.overflow_frame]) {
+            q->mismatched++;
+            out->wrong++;
+            print_message("#   frame %lld: GPU count %d, its read-back %d\n", (long long)st.overflow_frame,
+                          st.overflow_pixels_late, q->readback[st.overflow_frame]);
+        }
+    }
+    if (q->lowered_at < 0 && fogvol_context_encoding(q->fv)->bits != bits) q->lowered_at = (int)st.frame;
+    out->bound = 1.0; /* in LSBs per pair of faces */
+    for (y = 0; y < v->viewport[3]; ++y)
+        for (x = 0; x < v->viewport[2]; ++x) {
+            int p = y * v->viewport[2] + x, mag = is_magenta(q->px + 4 * ((v->viewport[1] + y) * W + v->viewport[0] + x));
+            double err = fabs(q->thick[p] - t->gt[p]) / lsb, allowed = t->pairs[p] + 1e-6 * range / lsb;
+            /* the interior test and the slope only where a pixel would fail without them */
+            if (((err > allowed && !mag) || (mag && t->pairs[p] <= limit)) && !vtruth_interior(t, p)) continue;
+            if (t->interior[p] > 0) allowed += t->slope[p] * snap / lsb;
+            out->pixels++;
+            if (!mag && err / allowed > out->max_err) out->max_err = err / allowed;
+            out->wrong += (err > allowed && !mag) || (mag && t->pairs[p] <= limit);
+        }
+}
+
+static void ovseq_open(ovseq *q, const combo *c, unsigned policy, glu_ctx *g, unsigned speedups_off)
+{
+    fogvol_context_desc cd;
+    fogvol_ramp_desc rd;
+    memset(q, 0, sizeof *q);
+    q->c = c;
+    q->g = g;
+    q->lowered_at = -1;
+    q->show = 1;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = watch_proc;
+    cd.logger.func = logger;
+    cd.logger.user_data = &q->lc;
+    cd.tier = c->tier;
+    cd.variants = c->variants;
+    cd.encoding_bits = c->bits;
+    cd.disable_dither = 1;
+    cd.disable_speedups = FOGVOL_SPEEDUP_EXACT_SUM | speedups_off; /* the digits */
+    cd.overflow_policy = (fogvol_overflow_policy)policy;
+    assert_int_equal(fogvol_create_context(&cd, &q->fv), FOGVOL_SUCCESS);
+    upload_meshes(q->fv, get_truth(c->k[1], 0)->s, q->meshes);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 0.2f;
+    rd.color[1] = 0.8f;
+    rd.color[2] = 0.3f;
+    rd.density = 0.4f;
+    assert_int_equal(fogvol_create_ramp(q->fv, &rd, &q->ramp), FOGVOL_SUCCESS);
+    q->thick = (float *)calloc((size_t)W * H, sizeof(float));
+    q->px = (unsigned char *)malloc((size_t)W * H * 4);
+}
+
+static void ovseq_close(ovseq *q)
+{
+    int i;
+    for (i = 0; i < get_truth(q->c->k[1], 0)->s->n; ++i) fogvol_destroy_mesh(q->fv, q->meshes[i]);
+    fogvol_destroy_ramp(q->fv, q->ramp);
+    fogvol_destroy_context(q->fv);
+    free(q->thick);
+    free(q->px);
+}
+
+static void test_overflow_sequence(void **state)
+{
+    static const int picks[] = {0, 1, 3, 5, 7}; /* PS20, +single, +count, PS13, MRT */
+    glu_ctx g;
+    int i;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    for (i = 0; i < (int)(sizeof picks / sizeof picks[0]); ++i) {
+        ovseq q;
+        char name[64];
+        ovseq_open(&q, &g_combos[picks[i]], FOGVOL_OVERFLOW_COUNT_ONLY, &g, 0);
+        g_blocking_reads = 0;
+        snprintf(name, sizeof name, "overflow counts %s", q.c->name);
+        sq_run(name, W, H, sq_default_script, SQ_DEFAULT_FRAMES,
+               q.c->tier == FOGVOL_TIER_MRT ? SQ_CAMERA | SQ_OCCLUDER | SQ_CANCEL : SQ_ALL, ovseq_view, ovseq_cancel,
+               &q);
+        print_message("#   %d GPU counts checked against their frames' read-backs, %d differed\n", q.checked,
+                      q.mismatched);
+        assert_true(q.checked >= 4);
+        assert_int_equal(g_blocking_reads, 0);
+        ovseq_close(&q);
+    }
+    glu_destroy(&g);
+}
+
+/* LOWER_BITS over a sequence whose first two frames overflow (then as the default script: fitting
+   frames, a split and a cancelled frame, overflowing ones): the first count lowers L once, from then
+   on every frame (any camera, viewport, shells) is within the new encoding's bound, and the second
+   frame's count, arriving after the change, does not lower it again. The lookup textures (ALU
+   encode off) must follow L. */
+static const sq_step g_lb_script[6] = {
+    {{0.0, 0.0}, 1, 1, 0, 0},  {{0.5, 0.0}, 1, 1, 0, 0}, {{1.0, 0.0}, 0, 1, 1, 0},
+    {{0.25, 0.75}, 1, 2, 0, 1}, {{0.0, 0.0}, 0, 1, 0, 1}, {{0.0, 0.0}, 1, 1, 0, 0},
+};
+
+static void test_lower_bits_sequence(void **state)
+{
+    glu_ctx g;
+    ovseq q;
+    int f;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_LOWER_BITS, &g, FOGVOL_SPEEDUP_ALU);
+    sq_run("LOWER_BITS PS20 (lookup textures)", W, H, g_lb_script, 6, SQ_ALL, ovseq_view, ovseq_cancel, &q);
+    print_message("#   L lowered after fogvol frame %d; L per frame:", q.lowered_at);
+    for (f = 0; f < 7; ++f) print_message(" %d", q.bits_at[f]);
+    print_message("\n");
+    assert_true(q.lowered_at >= 0 && q.lowered_at <= 2);
+    assert_int_equal(fogvol_context_encoding(q.fv)->bits, 3);
+    ovseq_close(&q);
+    glu_destroy(&g);
+}
+
+/* FOGVOL_SPEEDUP_OVERFLOW_BANDS over stills that change: the 20 shells, then 12 (no overflow), then
+   20 again through a smaller viewport after a cancelled frame, 12 frames each; no show_overflow (bands
+   on). Each band's count is replaced by its newest: after the 8 bands and the query latency, the
+   count is the new still's read-back count, whatever the bands held before; in between it never
+   exceeds the two stills' read-backs together (the bands partition the picture). Then with
+   LOWER_BITS: the bands counted at the old L are forgotten when it changes, so it changes once and
+   the count settles at 0 (20 shells fit at L = 3). */
+static void test_bands_sequence(void **state)
+{
+    static const struct {
+        int k, small;
+    } stills[3] = {{20, 0}, {12, 0}, {20, 1}};
+    glu_ctx g;
+    ovseq q;
+    int s, f, prev = 0, vp[4];
+    fogvol_frame_stats st;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_COUNT_ONLY, &g, 0);
+    q.show = 0;
+    for (s = 0; s < 3; ++s) {
+        int rb = -1, last = -1;
+        sq_viewport(W, H, stills[s].small, 1, 0, vp);
+        if (s == 2) assert_int_equal(ovseq_frame(&q, 20, 1, vp, NULL, NULL, 1), FOGVOL_SUCCESS);
+        for (f = 0; f < FOGVOL_OVERFLOW_BANDS + 4; ++f) {
+            unsigned char px[4];
+            ovseq_frame(&q, stills[s].k, 0, vp, f == 0 ? q.thick : NULL, &st, 0);
+            if (f == 0) rb = st.overflow_pixels;
+            glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+            assert_true(st.overflow_pixels_late <= rb + prev);
+            last = st.overflow_pixels_late;
+        }
+        prev = rb;
+        print_message("#   bands: still %d (%d shells%s): read-back %d saturated, the count after %d frames %d\n", s,
+                      stills[s].k, stills[s].small ? ", smaller viewport" : "", rb, f, last);
+        assert_int_equal(last, rb);
+        if (stills[s].k == 20) assert_true(rb > 0);
+        else assert_int_equal(rb, 0);
+    }
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    ovseq_close(&q);
+    ovseq_open(&q, &g_combos[0], FOGVOL_OVERFLOW_LOWER_BITS, &g, 0);
+    q.show = 0;
+    sq_viewport(W, H, 0, 1, 0, vp);
+    for (f = 0; f < 2 * FOGVOL_OVERFLOW_BANDS + 4; ++f) {
+        unsigned char px[4];
+        ovseq_frame(&q, 20, 0, vp, NULL, &st, 0);
+        glReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    }
+    print_message("#   bands with LOWER_BITS: L %d after %d frames, count %d (frame %lld)\n",
+                  fogvol_context_encoding(q.fv)->bits, f, st.overflow_pixels_late, (long long)st.overflow_frame);
+    assert_int_equal(fogvol_context_encoding(q.fv)->bits, 3);
+    assert_int_equal(st.overflow_pixels_late, 0);
+    ovseq_close(&q);
+    glu_destroy(&g);
+}
+
 /* ---- the null backend: the plumbing ------------------------------------- */
 typedef struct nullrig {
     fogvol_null_backend nb;
@@ -862,7 +1198,9 @@ static void test_null_plumbing(void **state)
     n.nb.query_samples = 5;
     for (f = 0; f < 12; ++f) null_frame(&n, 0, 1, &st);
     assert_int_equal(fogvol_context_encoding(n.fv)->bits, 1);
-    assert_int_equal(n.lc.warnings, 4); /* three lowerings, then "cannot" once */
+    /* three lowerings, then "cannot" once, and once that the digits step by more than 1/16 of the
+       volume's depth (fogvol_frame_stats.depth_lsb) */
+    assert_int_equal(n.lc.warnings, 5);
     null_close(&n);
 }
 
@@ -1091,7 +1429,7 @@ static void test_bad_policy(void **state)
 int main(void)
 {
     static int params[NCOMBO * 3][2];
-    static struct CMUnitTest tests[NCOMBO * 3 + 10]; /* zeroed: the unused entries are skipped */
+    static struct CMUnitTest tests[NCOMBO * 3 + 16]; /* zeroed: the unused entries are skipped */
     int n = 0, i, j, fails;
     char *names[NCOMBO * 3];
     build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
@@ -1115,6 +1453,8 @@ int main(void)
             cmocka_unit_test(test_skip_check),
             cmocka_unit_test(test_lower_bits), cmocka_unit_test(test_exact_sum), cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
+            cmocka_unit_test(test_overflow_sequence), cmocka_unit_test(test_lower_bits_sequence),
+            cmocka_unit_test(test_bands_sequence),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {
             if (n >= (int)(sizeof tests / sizeof tests[0])) {
@@ -1124,6 +1464,7 @@ int main(void)
             tests[n++] = more[i];
         }
     }
+    if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     fails = cmocka_run_group_tests_name("overflow", tests, NULL, NULL);
     for (i = 0; i < NCOMBO * 3; ++i) free(names[i]);
     for (i = 0; i < NTRUTH; ++i) {
@@ -1132,6 +1473,7 @@ int main(void)
         free(g_truth[i].interior);
         free(g_truth[i].covered);
     }
+    free_view_truths();
     free_scenes();
     return fails;
 }
