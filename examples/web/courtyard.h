@@ -17,8 +17,8 @@ enum { CY_KEY_W, CY_KEY_A, CY_KEY_S, CY_KEY_D, CY_KEY_UP, CY_KEY_DOWN, CY_KEY_FA
 typedef struct court {
     int version, width, height;
     ds_scene scene;
-    GLuint prog, sky, sky_vbo, vbo[DS_MAX_OBJECTS];
-    GLint u_vp, u_model, u_color, u_material, u_eye, u_sky_inv;
+    GLuint prog, sky, sky_vbo, vbo[DS_MAX_OBJECTS], flat;
+    GLint u_vp, u_model, u_color, u_material, u_eye, u_sky_inv, u_flat_vp, u_flat_model;
     /* fogvol */
     fogvol_context *fv;
     fogvol_mesh *fm[DS_MAX_MESHES];
@@ -60,6 +60,10 @@ static const char *const cy_sky_vs = "attribute vec2 p; uniform mat4 inv_vp; var
                                      "}\n";
 static const char *const cy_sky_fs = "varying vec3 dir;\n"
                                      "void main() { gl_FragColor = vec4(sky_color(normalize(dir)), 1.0); }\n";
+/* the volumes' footprint (cy_footprint): the meshes in white */
+static const char *const cy_flat_vs = "attribute vec3 p; uniform mat4 vp, model;\n"
+                                      "void main() { gl_Position = vp * model * vec4(p, 1.0); }\n";
+static const char *const cy_flat_fs = "precision mediump float; void main() { gl_FragColor = vec4(1.0); }\n";
 
 static void cy_engine_init(court *c)
 {
@@ -71,6 +75,9 @@ static void cy_engine_init(court *c)
     c->prog = exm_program("courtyard", cy_vs, fs, 4, attribs);
     fs[0] = cy_fs_head, fs[2] = cy_sky_fs;
     c->sky = exm_program("courtyard sky", cy_sky_vs, fs, 3, sky_attribs);
+    c->flat = exm_program("courtyard footprint", cy_flat_vs, &cy_flat_fs, 1, attribs);
+    c->u_flat_vp = glGetUniformLocation(c->flat, "vp");
+    c->u_flat_model = glGetUniformLocation(c->flat, "model");
     c->u_vp = glGetUniformLocation(c->prog, "vp");
     c->u_model = glGetUniformLocation(c->prog, "model");
     c->u_color = glGetUniformLocation(c->prog, "color");
@@ -286,7 +293,7 @@ static void cy_step(court *c, double dt)
         i += snprintf(c->status + i, sizeof c->status - (size_t)i, "%d bits/ch | ", fogvol_context_encoding(c->fv)->bits);
     glFinish(); /* (the frame's GL work done: the time is the frame's) */
     c->frame_ms = c->frames == 1 ? emscripten_get_now() - t0 : c->frame_ms * 0.9 + (emscripten_get_now() - t0) * 0.1;
-    snprintf(c->status + i, sizeof c->status - (size_t)i, "%.1f ms a frame (CPU side)", c->frame_ms);
+    snprintf(c->status + i, sizeof c->status - (size_t)i, "%.1f ms a frame", c->frame_ms);
     { /* the page's status line (the status has no quote or backslash) */
         char js[320];
         snprintf(js, sizeof js, "var e = document.getElementById('stats'); if (e) e.textContent = '%s';", c->status);
@@ -348,6 +355,42 @@ EMSCRIPTEN_KEEPALIVE double cy_camera_value(int i)
     return i < 3 ? g_cy.pos[i] : i == 3 ? g_cy.yaw : g_cy.pitch;
 }
 
+/* The page's own check (?drive): the volumes' footprint, every fog, mist, hole and light mesh drawn in
+   white on black by the courtyard's camera with no depth test (the opaque objects do not hide them), read
+   back like cy_snapshot: where it is black no volume can change the picture. The next frame draws as
+   usual. */
+EMSCRIPTEN_KEEPALIVE unsigned char *cy_footprint(void)
+{
+    court *c = &g_cy;
+    float view[16], proj[16], eye[3], vp[16];
+    GLuint vbo;
+    int i, n;
+    cy_camera(c, view, proj, eye);
+    shp_mat_mul(vp, proj, view);
+    glViewport(0, 0, c->width, c->height);
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glUseProgram(c->flat);
+    glUniformMatrix4fv(c->u_flat_vp, 1, GL_FALSE, vp);
+    glGenBuffers(1, &vbo);
+    glEnableVertexAttribArray(0);
+    for (i = 0; i < c->scene.count; ++i) {
+        const ds_object *o = &c->scene.obj[i];
+        if (o->kind == DS_OPAQUE) continue;
+        n = exm_upload_flat(vbo, &c->scene.mesh[o->mesh], o->model, GL_STREAM_DRAW);
+        glUniformMatrix4fv(c->u_flat_model, 1, GL_FALSE, o->model);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 24, (void *)0);
+        glDrawArrays(GL_TRIANGLES, 0, n);
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glDeleteBuffers(1, &vbo);
+    glUseProgram(0);
+    return cy_snapshot();
+}
+
 /* the interactive page: the canvas's context is made; drive: the page's script runs the frames */
 static int cy_main(int version, int width, int height, int drive)
 {
@@ -362,7 +405,7 @@ static int cy_main(int version, int width, int height, int drive)
     c->t = 0.7;
     cy_engine_init(c);
     cy_fog_build(c);
-    if (!c->fv || !c->prog || !c->sky) {
+    if (!c->fv || !c->prog || !c->sky || !c->flat) {
         printf("not ok - the courtyard could not start (see above)\n");
         return 0;
     }
