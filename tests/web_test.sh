@@ -9,7 +9,9 @@
 #   ?drive&webgl1, ?drive&webgl2 the interactive courtyard (examples/web/courtyard.h) driven by the
 #                                page's script with synthetic input (controls changed through the DOM,
 #                                key events W and S, mouse and touch pointer drags), checking that the
-#                                picture changes as each control says; its pictures:
+#                                picture changes as each control says (fog on/off, the gradient ramp and
+#                                dithering change nothing outside the volumes' footprint: their meshes
+#                                rasterised flat, dilated by a pixel); its pictures:
 #                                build/web/webgl1_demo_<step>.png (webgl2 likewise)
 #   ?webgl1, ?webgl2             the interactive page, a screenshot: build/web/webgl1_page.png (webgl2)
 # usage: tests/web_test.sh [page]     (CHROMIUM=... picks the browser binary)
