@@ -7,7 +7,7 @@
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
 #   make docs   rewrite the figures in README.md and docs/*.md (tests/doc_figures.sh checks them)
 #   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
-#   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
+#   make web    the browser demo (emscripten, WebGL1 + WebGL2: the courtyard to fly through) into build/web/demo_web.html
 #   make vulkan the Vulkan example (examples/vulkan_backend.c, lavapipe) into build/vulkan/*.png
 # Adding a test program: one name in TESTS (see "test programs" below). JOBS=n sets how many
 # compilers and tests run at once (default: the number of cores).
@@ -58,7 +58,7 @@ $(BUILD):
 #   assignments on one line each).
 # tests/run.sh runs everything $(JOBS) at a time and prints the logs in list order, then the one
 # summary line "N passed, M failed". Slow entries first: they start first.
-TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post limits cpu
+TESTS     = tiers render analytic gles texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks limits cpu
 CXX_TESTS = cpu
 JOBS     ?= $(shell nproc 2> /dev/null || echo 2)
 
@@ -257,7 +257,7 @@ $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
 # driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with
 # test_gles (EGL's surfaceless platform, OpenGL ES) and the headless demo
-EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post limits
+EGL_TESTS = tiers render analytic texlight speedups backend engine_fb glstate engine_input overflow engine_msaa engine_depth colors post looks limits
 $(BUILD)/egl/test_%: tests/test_%.c $(TEST_DEPS)
 	@mkdir -p $(BUILD)/egl
 	$(CC) -std=c99 -DGLU_EGL $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ -lcmocka -lEGL -lOpenGL -lm
@@ -329,19 +329,21 @@ images: demo
 	cp $(BUILD)/demo/tiers.png $(BUILD)/demo/dither.png $(BUILD)/demo/ramps.png $(BUILD)/demo/thickness.png docs/
 	cp $(BUILD)/demo/textured_fog.png $(BUILD)/demo/light_compare.png $(BUILD)/demo/dof.png \
 	   $(BUILD)/demo/outlines.png $(BUILD)/demo/distance_fog.png docs/
+	cp $(BUILD)/demo/soft_edges.png $(BUILD)/demo/before_after.png docs/
 
 # --- browser build: emscripten (Debian's emcc ships its system libraries prebuilt), one page for
 # WebGL1 (?webgl1) and WebGL2 (?webgl2, the default), the wasm embedded so it loads from file://.
 # NODE_PATH: Debian's emscripten finds its node modules (acorn) there even under a node from elsewhere
 WEB_FLAGS = -std=c99 -O2 $(WARN) $(INC) -I/usr/include/stb -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 \
             -sSINGLE_FILE=1 -sWASM_ASYNC_COMPILATION=0 -sALLOW_MEMORY_GROWTH=1 -sMINIFY_HTML=0
-$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/shell.html fogvol.h examples/example_gl.h tests/raycast.h tests/shapes.h
+$(BUILD)/web/demo_web.html: examples/web/demo_web.c examples/web/courtyard.h examples/web/shell.html fogvol.h \
+	  examples/example_gl.h examples/demo_scene.h tests/raycast.h tests/shapes.h
 	@mkdir -p $(BUILD)/web
 	NODE_PATH=/usr/share/nodejs $(EMCC) $(WEB_FLAGS) $< --shell-file examples/web/shell.html -o $@
 
 web: deps-web
 	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html
-	@echo "open $(BUILD)/web/demo_web.html?webgl1 or ?webgl2 in a browser"
+	@echo "open $(BUILD)/web/demo_web.html (WebGL2) or demo_web.html?webgl1 in a browser; ?test&webgl1 / ?test&webgl2: its self-test"
 
 test-web: deps-web
 	@$(MAKE) --no-print-directory $(BUILD)/web/demo_web.html

@@ -717,6 +717,25 @@ typedef struct fogvol_ramp_desc {
        grey: the colour ramp texture (and so every other path) has one alpha per pixel and uses
        density alone (create_ramp logs a warning for a non-grey colour without the variant). */
     float extinction_color[3];
+    /* Soft edges (0 = off: uniform density up to the boundary, the old behaviour; else finite, > 0;
+       in the units of thickness: view depth, world units for a view matrix without scale). The
+       density rises linearly from 0 over a distance s = softness from both ends of every chord of
+       the fog along a ray (entry and exit: the volume's faces, the opaque surface that cuts it, the
+       near plane), so silhouettes and the places where fog meets opaque geometry fade:
+           density(x) = density * min(1, (x - a) / s, (b - x) / s)   on a chord [a, b]
+       whose optical thickness is f(b - a), f(t) = t^2 / (4 s) for t < 2 s, t - s for t >= 2 s.
+       The composite applies f to the group's summed thickness t and looks the ramp up at f(t)
+       (every model: the gradient's keys are at the softened thickness). Exact where a ray
+       crosses one chord of the group's volumes (one convex volume, or volumes apart on screen).
+       Where it crosses k > 1 chords (a concave volume, overlapping volumes of one ramp) f(sum)
+       >= sum f (f is convex, f(0) = 0): the fog is denser than the model by at most (k - 1) s
+       of thickness (each inner end counts as inside); negative volumes subtract their chord
+       before f. A density-textured volume sums rho * chord (see fogvol_volume_desc.density):
+       f(rho t) = rho f_{s/rho}(t), its edge ramp is s / rho long where the density factor is rho.
+       Every tier and variant (the composite does it); a soft ramp does not join the one-pass
+       colour group of FOGVOL_VARIANT_COLORS (it keeps a group of its own). The debug read-back
+       (fogvol_frame_desc.debug_thickness) gives t, not f(t). README: "Soft edges". */
+    float softness;
 } fogvol_ramp_desc;
 
 FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ramp_desc *desc, fogvol_ramp **out);
@@ -895,6 +914,19 @@ typedef struct fogvol_frame_desc {
        otherwise end_frame returns FOGVOL_ERROR_UNSUPPORTED (logged). Other values:
        FOGVOL_ERROR_INVALID_ARGUMENT. */
     int downsample;
+    /* The dither pattern's frame (RGBA8 tiers with dithering on; engines that accumulate frames,
+       e.g. TAA): 0 = the fixed 8x8 ordered pattern, the same every frame. Any other value n rotates
+       every pixel's rounding threshold by bitrev3(n mod 8) / 8 of an LSB (n mod 8 = 0, 1, 2, ... ->
+       0, 1/2, 1/4, 3/4, 1/8, 5/8, 3/8, 7/8: period 8, each run of 2, 4, 8 frames stratified), so a
+       pixel's values over 8 consecutive frames average to within 1/8 LSB of the exact depth and the
+       block bias of the fixed pattern on depth gradients averages away: pass the engine's frame
+       counter. Measured (test_looks: linear depth gradients of slopes -2..2 LSB per pixel, any
+       offset and block position, L = 4): the worst 8x8 block mean of a pair of faces (B - F) over
+       1 / 4 (frames 4k..4k+3) / 8 frames is 0.44 / 0.068 / 0.042 LSB (a longer search: 0.50 / 0.088 /
+       0.045); on a rendered sphere and box against FLOAT 0.122 / 0.028 / 0.016 LSB. The MRT and
+       occluder snippets' uniforms carry it (fogvol_mrt_prepare, fogvol_occluder_prepare after
+       begin_frame). FLOAT: no effect. */
+    int dither_frame;
 } fogvol_frame_desc;
 
 /* Frames: begin_frame, any number of add_* calls, end_frame. Nothing touches
@@ -1002,6 +1034,19 @@ typedef struct fogvol_light_desc {
     float model[16];
     float color[3];           /* added to lit pixels */
     float intensity;          /* 0 = 1 */
+    /* Falloff with distance (falloff_radius 0 = none: the same colour on every lit pixel, the old
+       behaviour; else finite, > 0): each lit pixel gets colour * intensity * w(r), r the world
+       distance from its scene point to position (world space), w(r) = (1 - (r / R)^2)^2 for
+       r < R = falloff_radius and 0 beyond (a smooth window: 1 at the light, no slope at R). The
+       scene point is rebuilt from the pixel's ray and its opaque depth (any camera fogvol_frame_desc
+       accepts; RGBA8 tiers: the decoded depth, 12 bits by default). */
+    float position[3];
+    float falloff_radius;
+    /* Soft edge (0 = none; else finite, > 0, view depth units): the lit colour is also multiplied by
+       clamp(m / edge_softness, 0, 1), m the distance along the view axis from the scene point to the
+       nearer of the light volume's front and back faces on its ray (only the back face for a camera
+       inside the light), so the lit region fades where the scene surface meets the light's walls. */
+    float edge_softness;
 } fogvol_light_desc;
 FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_light_desc *desc);
 FOGVOL_API fogvol_result fogvol_end_frame(fogvol_context *ctx, fogvol_frame_stats *stats);
@@ -1093,14 +1138,22 @@ typedef enum fogvol_post_effect {
 } fogvol_post_effect;
 
 /* Depth of field with the edge-preserving moving kernel (Baker, "Image-Space
-   Rendering Techniques"). Out-of-focus amount c(e) = clamp(|e - focus_distance|
-   / focus_range, 0, 1); the centre pixel's radius r = c(e0) * max_radius; taps k
-   at offsets round(r * dir_k) pixels (3: a triangle, dirs at 90, 210, 330
-   degrees; 6: + the opposite triangle; 12: + a hexagon of half radius at 0,
-   60 ... 300 degrees); each tap enters as mix(C0, Ck, c(ek)), weighted by its
-   own out-of-focus amount so in-focus pixels never bleed into blurred ones,
-   and out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1) on RGBA, written
-   without blending (in-focus pixels keep their colour exactly). */
+   Rendering Techniques"), gathered over the whole circle of confusion.
+   Out-of-focus amount c(e) = clamp(|e - focus_distance| / focus_range, 0, 1);
+   the centre pixel's radius r = c(e0) * max_radius; taps k = 0 .. taps-1 on a
+   golden-angle spiral that covers the disc of radius r evenly: at offsets
+   round(r sqrt((k + u) / taps) (cos t_k, sin t_k)) pixels, t_k = 2.39996 k + a,
+   the spiral turned and its radii jittered per pixel by a = 2 pi IGN(p),
+   u = IGN(p.yx + (37, 91)), p = pixel + 5.588238 (dither_frame mod 64)
+   (interleaved gradient noise): neighbouring pixels' taps never line up, so
+   blurred regions show fine grain instead of copies of the taps or a pattern,
+   and an engine that accumulates frames (TAA) averages the grain away by passing
+   its frame counter in frame->dither_frame. Each tap enters as mix(C0, Ck, c(ek)),
+   weighted by its own out-of-focus amount so in-focus pixels never bleed into
+   blurred ones, and out = sum_k mix(C0, Ck, c(ek)) / taps on RGBA, written without
+   blending (in-focus pixels keep their colour exactly). Against a continuous disc
+   blur (README "Depth of field": measured by test_post): the grain's RMS and the
+   error of 4x4 block means, one frame and 8 frames. */
 typedef struct fogvol_dof_desc {
     const fogvol_frame_desc *frame;
     fogvol_native color_texture; /* the scene's colour (GL texture name), required */
@@ -1108,7 +1161,7 @@ typedef struct fogvol_dof_desc {
     float focus_distance;    /* view depth in focus (> 0) */
     float focus_range;       /* distance from focus_distance at which the blur is full (> 0) */
     float max_radius;        /* pixels, 0 = 4, at most 64 */
-    int taps;                /* 0 = 6; 3, 6 or 12 */
+    int taps;                /* 0 = 24; 3, 6, 12, 24 or 48 (more taps: less grain, more time) */
 } fogvol_dof_desc;
 FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_desc *desc);
 
@@ -1171,7 +1224,7 @@ typedef uintptr_t fogvol_handle;
    the order of their fogvol_uniform values (0, 1, ...); add new ones at the
    end. fogvol_uniform_name gives the name.
    ENC      fv_enc:     (N, N^2, depth_offset, depth_max)
-   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, 0)
+   DITHER   fv_dith:    (255 or 0 = dither off, 1/D, D, row offset of the frame: fogvol__dither_offset)
    SCREEN   fv_screen:  (1/w, 1/h, -x0, -y0): gl_FragCoord + zw = pixel of fogvol's targets,
                         (gl_FragCoord + zw) * xy in [0,1]
    DECODE   fv_dec:     decode weights (world units)
@@ -1197,7 +1250,13 @@ typedef uintptr_t fogvol_handle;
    LIGHT     fv_light:  (light rgb, 0 = front-depth pass, 1 = compare pass)
    SPEEDUP   fv_speed:  FACE (FLOAT): x = 1: no opaque depth (O is the far plane, not read);
                         COMPOSITE: (ramp rgb, density): density > 0: c = (rgb, 1 - exp(-density t)),
-                        not the ramp texture */
+                        not the ramp texture
+   SOFT      fv_soft:   COMPOSITE: (s, 1/(4s), 2s, 0), s the ramp's softness (0: off): the thickness t
+                        looked up is t^2/(4s) below 2s, t - s above (fogvol_ramp_desc.softness)
+   LIGHT_Q0..5 fv_lq0..5: LIGHT compare pass: the lit point relative to the light's falloff sphere,
+                        q = (P - position) / radius = lq0 + lq1 s + lq2 t + o (lq3 + lq4 s + lq5 t),
+                        (s, t) = fv_st(), o the normalised opaque depth; lq0.w = 1: falloff on;
+                        lq1.w = (far - near) / edge_softness (0: no soft edge) */
 #define FOGVOL_UNIFORMS(X) \
     X(ENC, fv_enc) \
     X(DITHER, fv_dith) \
@@ -1218,7 +1277,14 @@ typedef uintptr_t fogvol_handle;
     X(COLOR_U, fv_ctex_u) \
     X(COLOR_V, fv_ctex_v) \
     X(LIGHT, fv_light) \
-    X(SPEEDUP, fv_speed)
+    X(SPEEDUP, fv_speed) \
+    X(SOFT, fv_soft) \
+    X(LIGHT_Q0, fv_lq0) \
+    X(LIGHT_Q1, fv_lq1) \
+    X(LIGHT_Q2, fv_lq2) \
+    X(LIGHT_Q3, fv_lq3) \
+    X(LIGHT_Q4, fv_lq4) \
+    X(LIGHT_Q5, fv_lq5)
 
 typedef enum fogvol_uniform {
 #define FOGVOL__UNIFORM_ENUM(id, name) FOGVOL_U_##id,
@@ -2539,6 +2605,7 @@ static fogvol_result fogvol__ramp_check(const fogvol_ramp_desc *d)
     if (d->width != 0 && (d->width < 2 || d->width > 4096)) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (!fogvol__finite(d->max_thickness) || d->max_thickness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
     if (d->blend != FOGVOL_BLEND_FOG && d->blend != FOGVOL_BLEND_LIGHT) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!fogvol__finite(d->softness) || d->softness < 0) return FOGVOL_ERROR_INVALID_ARGUMENT;
     switch (d->model) {
     case FOGVOL_RAMP_EXTINCTION:
     case FOGVOL_RAMP_LINEAR:
@@ -5992,7 +6059,7 @@ static const char fogvol__vs_fullscreen[] =
 static const char fogvol__fs_common[] =
     "#ifndef FV_TARGET_SAMPLER\n#define FV_TARGET_SAMPLER sampler2D\n#endif\n"
     "FV_UNIFORM(vec4, fv_enc)\n"    /* (N, N^2, depth offset, depth max) */
-    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, 0) */
+    "FV_UNIFORM(vec4, fv_dith)\n"   /* (255 or 0, 1/D, D, the frame's row offset) */
     "FV_UNIFORM(vec4, fv_screen)\n"
     "FV_UNIFORM(vec4, fv_dec)\n"
     /* FV_PIXEL: the pixel of fogvol's targets; FV_ENGINE_TEXEL: the texel of the engine's depth
@@ -6070,14 +6137,14 @@ static const char fogvol__fs_encode_common[] =
     FOGVOL__IALU_TEXT
     "float fv_dither_row() {\n"
     "    highp int dd = FV_DD_I;\n"
-    "    return fv_dith.x > 0.5 ? float((fogvol_dither_scaled(dd) + (dd >> 1)) & (dd - 1)) : 0.0;\n"
+    "    return fv_dith.x > 0.5 ? float((fogvol_dither_scaled(dd) + (dd >> 1) + int(fv_dith.w)) & (dd - 1)) : 0.0;\n"
     "}\n"
-    /* the encode's offset (row + D/2) mod D = (v D) >> 6 (the dither off: D/2) */
+    /* the encode's offset (row + D/2) mod D = ((v D) >> 6) + the frame's offset (the dither off: D/2) */
     "highp int fv_dither_offset_i() {\n"
     "#ifdef FV_DITHER_ON\n"                       /* SPECIALIZE_DITHER: fv_dith.x = 255 */
-    "    return fogvol_dither_scaled(FV_DD_I);\n"
+    "    return (fogvol_dither_scaled(FV_DD_I) + int(fv_dith.w)) & (FV_DD_I - 1);\n"
     "#else\n"
-    "    return fv_dith.x > 0.5 ? fogvol_dither_scaled(FV_DD_I) : FV_DD_I >> 1;\n"
+    "    return fv_dith.x > 0.5 ? (fogvol_dither_scaled(FV_DD_I) + int(fv_dith.w)) & (FV_DD_I - 1) : FV_DD_I >> 1;\n"
     "#endif\n"
     "}\n"
     "#elif defined(FV_ALU)\n"                 /* the row of fogvol_make_dither_index, by arithmetic */
@@ -6087,10 +6154,12 @@ static const char fogvol__fs_encode_common[] =
     "    float v = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n"
     "              abs(b2.x - b2.y) * 2.0 + b2.y;\n"    /* 8x8 Bayer index by bit interleaving */
     "    float dd = FV_DD;\n"
-    "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5), dd) : 0.0;\n"
+    "    return fv_dith.x > 0.5 ? mod(floor(v * dd / 64.0) + floor(dd * 0.5) + fv_dith.w, dd) : 0.0;\n"
     "}\n"
     "#else\n"
-    "float fv_dither_row() { return floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5); }\n"
+    "float fv_dither_row() {\n"
+    "    return mod(floor(FV_TEXTURE(fv_dither, gl_FragCoord.xy * 0.125).r * fv_dith.x + 0.5) + fv_dith.w, FV_DD);\n"
+    "}\n"
     "#endif\n"
     "vec4 fv_encode(float d) {\n"
     "    float u = clamp(d, 0.0, fv_enc.w) + fv_enc.z;\n"
@@ -6333,6 +6402,12 @@ static const char fogvol__fs_composite[] =
     "FV_UNIFORM(vec4, fv_speed)\n"
     "FV_UNIFORM(vec4, fv_ctex_u)\n"
     "FV_UNIFORM(vec4, fv_ctex_v)\n"
+    /* soft edges (fogvol_ramp_desc.softness): the optical thickness of a chord t whose density rises
+       over s from both ends, fv_soft = (s, 1/(4s), 2s, 0); s = 0: t */
+    "FV_UNIFORM(vec4, fv_soft)\n"
+    "float fv_soften(float t) {\n"
+    "    return fv_soft.x <= 0.0 || t <= 0.0 ? t : t < fv_soft.z ? t * t * fv_soft.y : t - fv_soft.x;\n"
+    "}\n"
     "#ifdef FV_WIDE\n"
     "FV_BINDING(4) uniform sampler2D fv_back2;\n"
     "FV_BINDING(5) uniform sampler2D fv_front2;\n"
@@ -6424,6 +6499,7 @@ static const char fogvol__fs_composite_main[] =
     "    FV_FRAGCOLOR = vec4(1.0);\n"
     "#else\n"
     "    vec4 c;\n"
+    "    t = fv_soften(t);\n"
     "#if defined(FV_EXP) && defined(FV_BLEND_COLOR)\n" /* the colour: fogvol_pass.blend_color */
     "    c = vec4(1.0 - fv_transmit(fv_speed.w * max(t, 0.0)));\n"
     "#elif defined(FV_EXP)\n"
@@ -6470,6 +6546,26 @@ static const char fogvol__fs_light[] =
     "    return fv_light_depth(FV_O_DIGITS(fv_opaque));\n"
     "#endif\n"
     "}\n"
+    /* falloff with distance and the soft edge (fogvol_light_desc): q the scene point relative to the
+       falloff sphere (fv_lq0..5), f and d the light's front and back depths on the ray */
+    "FV_UNIFORM(vec4, fv_lq0)\n"
+    "FV_UNIFORM(vec4, fv_lq1)\n"
+    "FV_UNIFORM(vec4, fv_lq2)\n"
+    "FV_UNIFORM(vec4, fv_lq3)\n"
+    "FV_UNIFORM(vec4, fv_lq4)\n"
+    "FV_UNIFORM(vec4, fv_lq5)\n"
+    "float fv_light_weight(float o, float f, float d) {\n"
+    "    float w = 1.0;\n"
+    "    if (fv_lq0.w > 0.5) {\n"
+    "        vec2 st = fv_st();\n"
+    "        vec3 q = fv_lq0.xyz + fv_lq1.xyz * st.x + fv_lq2.xyz * st.y +\n"
+    "                 o * (fv_lq3.xyz + fv_lq4.xyz * st.x + fv_lq5.xyz * st.y);\n"
+    "        float r2 = min(dot(q, q), 1.0);\n"
+    "        w = (1.0 - r2) * (1.0 - r2);\n"
+    "    }\n"
+    "    if (fv_lq1.w > 0.0) w *= clamp((f > 0.0 ? min(o - f, d - o) : d - o) * fv_lq1.w, 0.0, 1.0);\n"
+    "    return w;\n"
+    "}\n"
     "void main() {\n"
     "    float d = max(fv_d, 0.0);\n"
     "    if (fv_light.w < 0.5) {\n"
@@ -6481,9 +6577,9 @@ static const char fogvol__fs_light[] =
     "        FV_FRAGCOLOR = fv_encode(d);\n"
     "#endif\n"
     "    } else {\n"
-    "        float o = fv_light_opaque();\n"
-    "        if (o < fv_light_depth(FV_SCREEN(fv_lfront)) || o > d) discard;\n"
-    "        FV_FRAGCOLOR = vec4(fv_light.rgb, 1.0);\n"
+    "        float o = fv_light_opaque(), f = fv_light_depth(FV_SCREEN(fv_lfront));\n"
+    "        if (o < f || o > d) discard;\n"
+    "        FV_FRAGCOLOR = vec4(fv_light.rgb * fv_light_weight(o, f, d), 1.0);\n"
     "    }\n"
     "}\n";
 
@@ -6749,7 +6845,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "vec4 fogvol_encode_view_depth(float view_depth) {\n" \
     "    if (fogvol_mrt[0].z == 0.0) return fogvol_view_depth_r32f(view_depth);\n" \
     "    highp int ln = fogvol_log2i(fogvol_mrt[0].z), ld = fogvol_log2i(fogvol_mrt[1].z), dd = 1 << ld;\n" \
-    "    highp int k = fogvol_mrt[1].w > 0.5 ? fogvol_dither_scaled(dd) : dd >> 1;\n" \
+    "    highp int k = fogvol_mrt[1].w > 0.5 ? (fogvol_dither_scaled(dd) + int(fogvol_mrt[1].w) - 1) & (dd - 1) : dd >> 1;\n" \
     "    float u = clamp(view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
     "    return fogvol_encode_int(int(u * (fogvol_mrt[0].w * fogvol_mrt[0].z * fogvol_mrt[1].z)), ln, ld, k);\n" \
     "}\n" \
@@ -6761,7 +6857,7 @@ FOGVOL_API fogvol_result fogvol_shader_source(fogvol_tier tier, fogvol_program p
     "    float bayer = abs(b0.x - b0.y) * 32.0 + b0.y * 16.0 + abs(b1.x - b1.y) * 8.0 + b1.y * 4.0 +\n" \
     "                  abs(b2.x - b2.y) * 2.0 + b2.y;\n" \
     "    float n = fogvol_mrt[0].z, dd = fogvol_mrt[1].z;\n" \
-    "    float k = fogvol_mrt[1].w > 0.5 ? floor(bayer * dd / 64.0) : dd * 0.5;\n" \
+    "    float k = fogvol_mrt[1].w > 0.5 ? mod(floor(bayer * dd / 64.0) + fogvol_mrt[1].w - 1.0, dd) : dd * 0.5;\n" \
     "    float d = view_depth * fogvol_mrt[0].x + fogvol_mrt[0].y;\n" \
     "    float u = clamp(d, 0.0, fogvol_mrt[1].y) + fogvol_mrt[1].x;\n" \
     "    float t = u * fogvol_mrt[0].w * n;\n" \
@@ -7016,6 +7112,7 @@ struct fogvol_ramp {
     float sigma[3];      /* extinction per world unit and channel: density * extinction_color */
     float emit[3];       /* the colour, clamped to [0, 1] as the ramp texture holds it */
     float exp_rgba[4]; /* EXTINCTION over its whole range: the ramp's rgb (8-bit) and density, else 0 */
+    float softness;    /* fogvol_ramp_desc.softness (0: hard edges) */
     /* its colour-ramp group in the frame being ended (fogvol__link_groups): valid while stamp is the
        frame's group_stamp; head and tail: its first and last volume in the frame's order */
     int64_t stamp;
@@ -7043,6 +7140,7 @@ typedef struct fogvol__light {
     const fogvol_mesh *mesh;
     float model[16];
     float rgb[3];
+    float position[3], radius, edge; /* fogvol_light_desc.position, falloff_radius, edge_softness */
 } fogvol__light;
 
 typedef struct fogvol__occluder {
@@ -7052,9 +7150,10 @@ typedef struct fogvol__occluder {
     float model[16];
 } fogvol__occluder;
 
-/* image-space effect programs: depth of field with 3, 6, 12 taps; outlines from depth, from depth and
-   normals; distance fog */
-#define FOGVOL__POST_PROGRAMS 6
+/* image-space effect programs: depth of field with 3, 6, 12, 24, 48 taps; outlines from depth, from
+   depth and normals; distance fog */
+#define FOGVOL__DOF_TAPSETS 5
+#define FOGVOL__POST_PROGRAMS (FOGVOL__DOF_TAPSETS + 3)
 
 /* Overflow counting: the occlusion queries of one frame (one per check pass), read when all are done. */
 #define FOGVOL__QFRAMES 4
@@ -8104,7 +8203,7 @@ static void fogvol__ramp_colors(fogvol_context *ctx, const fogvol_ramp_desc *des
 {
     const float *ec = desc->extinction_color;
     int c, unset = ec[0] == 0.0f && ec[1] == 0.0f && ec[2] == 0.0f;
-    rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG;
+    rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG && desc->softness == 0.0f;
     for (c = 0; c < 3; ++c) {
         rp->sigma[c] = desc->density * (unset ? 1.0f : ec[c]);
         rp->emit[c] = desc->color[c] < 0.0f ? 0.0f : desc->color[c] > 1.0f ? 1.0f : desc->color[c];
@@ -8160,6 +8259,7 @@ FOGVOL_API fogvol_result fogvol_create_ramp(fogvol_context *ctx, const fogvol_ra
     rp->width = info.width;
     rp->max_thickness = tmax;
     rp->blend = desc->blend;
+    rp->softness = desc->softness;
     fogvol__ramp_colors(ctx, desc, rp);
     if (desc->model == FOGVOL_RAMP_EXTINCTION && (double)tmax * desc->density >= 7.0 * (1.0 - 1e-6))
     {
@@ -8334,6 +8434,15 @@ static void fogvol__draw_for(const fogvol_context *ctx, const float model[16], f
     dr->front_cw = (fogvol__det3(m) < 0) != (ctx->cur.mirrored != 0);
 }
 
+
+/* The dither rows' offset of the open frame (fogvol_frame_desc.dither_frame): bitrev3(n mod 8) * D / 8
+   (a threshold rotation by bitrev3(n mod 8) / 8 of an LSB; D, a power of two >= 8, divides evenly) */
+static float fogvol__dither_offset(const fogvol_context *ctx)
+{
+    unsigned n = (unsigned)ctx->cur.frame.dither_frame & 7u;
+    unsigned r = ((n & 1u) << 2) | (n & 2u) | (n >> 2);
+    return (float)(r * (unsigned)ctx->cfg.enc.dither_steps / 8u);
+}
 
 /* Nothing of a cancelled frame reaches the next: its lists, the engine's O (MRT, occluder_prepare: the
    next frame prepares it again; what O holds is forgotten in fogvol__prepare_o). */
@@ -8901,7 +9010,7 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     info->uniforms[4] = k.depth_offset;
     info->uniforms[5] = k.depth_max;
     info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
-    info->uniforms[7] = ctx->cfg.dither ? 1.0f : 0.0f;
+    info->uniforms[7] = ctx->cfg.dither ? 1.0f + fogvol__dither_offset(ctx) : 0.0f; /* (+ the frame's offset) */
     ctx->cur.mrt_ready = 1;
     return FOGVOL_SUCCESS;
 }
@@ -9017,7 +9126,7 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     info->uniforms[4] = fl ? 0.0f : k.depth_offset;
     info->uniforms[5] = fl ? 1.0f : k.depth_max;
     info->uniforms[6] = (float)ctx->cfg.enc.dither_steps;
-    info->uniforms[7] = ctx->cfg.dither && !fl ? 1.0f : 0.0f;
+    info->uniforms[7] = ctx->cfg.dither && !fl ? 1.0f + fogvol__dither_offset(ctx) : 0.0f;
     ctx->cur.engine_occluders = 1;
     return FOGVOL_SUCCESS;
 }
@@ -9520,6 +9629,7 @@ static void fogvol__frame_uniforms(fogvol_context *ctx, fogvol__run *run)
     ps->uniforms[FOGVOL_U_DITHER][0] = ctx->cfg.dither ? 255.0f : 0.0f;
     ps->uniforms[FOGVOL_U_DITHER][1] = 1.0f / (float)ctx->cfg.enc.dither_steps;
     ps->uniforms[FOGVOL_U_DITHER][2] = (float)ctx->cfg.enc.dither_steps;
+    ps->uniforms[FOGVOL_U_DITHER][3] = ctx->cfg.dither ? fogvol__dither_offset(ctx) : 0.0f;
     ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.target_w; /* target space (downsample: half) */
     ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.target_h;
     if (!run->p.float_sums) {
@@ -9705,6 +9815,16 @@ static void fogvol__sum_sources(fogvol_context *ctx, fogvol__run *run, const fog
     ps->textures[FOGVOL__UNIT_FRONT] = 0;
 }
 
+/* fv_soft of a ramp's composite: (s, 1/(4s), 2s, 0), zeros for hard edges (fogvol_ramp_desc.softness) */
+static void fogvol__soft_uniforms(const fogvol_ramp *ramp, fogvol_pass *ps)
+{
+    float s = ramp->softness;
+    ps->uniforms[FOGVOL_U_SOFT][0] = s;
+    ps->uniforms[FOGVOL_U_SOFT][1] = s > 0.0f ? 0.25f / s : 0.0f;
+    ps->uniforms[FOGVOL_U_SOFT][2] = 2.0f * s;
+    ps->uniforms[FOGVOL_U_SOFT][3] = 0.0f;
+}
+
 /* FOGVOL_SPEEDUP_BLEND_COLOR: a composite of one colour (spec: EXP, no colour texture, no
    overflow test) takes it from the blend unit where the backend can. */
 static void fogvol__blend_color(const fogvol__run *run, fogvol_pass *ps, unsigned *spec)
@@ -9738,6 +9858,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     ps->uniforms[FOGVOL_U_RAMP][0] = (float)((double)(ramp->width - 1) / ((double)ramp->width * ramp->max_thickness));
     ps->uniforms[FOGVOL_U_RAMP][1] = 0.5f / (float)ramp->width;
     ps->uniforms[FOGVOL_U_RAMP][2] = fd->show_overflow ? 1.0f : 0.0f;
+    fogvol__soft_uniforms(ramp, ps);
     fogvol__group_color(ctx, ramp, ps);
     spec = ps->uniforms[FOGVOL_U_SPEEDUP][3] > 0.0f ? FOGVOL_SPECIALIZE_EXP : FOGVOL_SPECIALIZE_RAMP;
     if (spec == FOGVOL_SPECIALIZE_EXP && run->p.fast_exp) spec |= FOGVOL_SPECIALIZE_FAST_EXP;
@@ -10102,8 +10223,11 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
                                               : "the mesh is too large for the convexity check");
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour or intensity");
+    if (!fogvol__finite_n(desc->color, 3) || !fogvol__finite_n(&desc->intensity, 1) ||
+        !fogvol__finite_n(desc->position, 3) || !fogvol__finite(desc->falloff_radius) ||
+        desc->falloff_radius < 0.0f || !fogvol__finite(desc->edge_softness) || desc->edge_softness < 0.0f) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: non-finite light colour, intensity or position, "
+                    "or a negative falloff_radius or edge_softness");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
     if ((why = fogvol__model_problem(desc->model, 1)) != NULL) {
@@ -10121,6 +10245,9 @@ FOGVOL_API fogvol_result fogvol_add_light(fogvol_context *ctx, const fogvol_ligh
     l->rgb[0] = desc->color[0] * k;
     l->rgb[1] = desc->color[1] * k;
     l->rgb[2] = desc->color[2] * k;
+    memcpy(l->position, desc->position, sizeof l->position);
+    l->radius = desc->falloff_radius;
+    l->edge = desc->edge_softness;
     return FOGVOL_SUCCESS;
 }
 
@@ -10145,6 +10272,66 @@ static fogvol_result fogvol__light_setup(fogvol_context *ctx, const fogvol__run 
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: cannot set up the light passes: %s",
                     fogvol_result_string(r));
     return r;
+}
+
+/* The world point on the ray of viewport position (s, t) in [0,1]^2 at view depth e: clip x = (2s - 1) w,
+   clip y = sy (2t - 1) w and eyerow . (P, 1) = e, three linear equations in P (Cramer's rule).
+   0 where they are singular. */
+static int fogvol__ray_point(const fogvol_context *ctx, double s, double t, double sy, double e, double out[3])
+{
+    const double *m = ctx->cur.viewproj;
+    double x = 2.0 * s - 1.0, y = sy * (2.0 * t - 1.0), a[3][3], b[3], det;
+    int j, k;
+    for (j = 0; j < 3; ++j) {
+        a[0][j] = m[j * 4] - x * m[j * 4 + 3];
+        a[1][j] = m[j * 4 + 1] - y * m[j * 4 + 3];
+        a[2][j] = ctx->cur.eyerow[j];
+    }
+    b[0] = x * m[15] - m[12];
+    b[1] = y * m[15] - m[13];
+    b[2] = e - ctx->cur.eyerow[3];
+    det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+          a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(det != 0.0) || det - det != 0.0) return 0;
+    for (k = 0; k < 3; ++k) { /* column k replaced by b */
+        double c[3][3];
+        memcpy(c, a, sizeof c);
+        for (j = 0; j < 3; ++j) c[j][k] = b[j];
+        out[k] = (c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+                  c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])) / det;
+    }
+    return 1;
+}
+
+/* fv_lq0..5 of a light's compare pass: the scene point P(s, t, o) = A + B s + C t + o (D + E s + F t)
+   (P is affine in the screen position at a given view depth and affine in the depth along a ray, for
+   perspective and orthographic cameras alike), taken from the ray points at the near and far planes
+   of three screen corners, as (P - position) / falloff_radius; the soft edge's scale in lq1.w. */
+static void fogvol__light_uniforms(const fogvol_context *ctx, const fogvol__run *run, const fogvol__light *l,
+                                   fogvol_pass *ps)
+{
+    static const double corner[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
+    double p[3][2][3], sy = run->info.clip_upper_left ? -1.0 : 1.0, q[6][3];
+    int c, k, j, ok = 1;
+    for (k = FOGVOL_U_LIGHT_Q0; k <= FOGVOL_U_LIGHT_Q5; ++k) memset(ps->uniforms[k], 0, sizeof ps->uniforms[k]);
+    if (l->edge > 0.0f) ps->uniforms[FOGVOL_U_LIGHT_Q1][3] = (fd->zfar - fd->znear) / l->edge;
+    if (!(l->radius > 0.0f)) return;
+    for (c = 0; c < 3; ++c)
+        for (k = 0; k < 2; ++k)
+            ok &= fogvol__ray_point(ctx, corner[c][0], corner[c][1], sy, k ? fd->zfar : fd->znear, p[c][k]);
+    if (!ok) return; /* (the camera was validated: not reached) */
+    for (j = 0; j < 3; ++j) {
+        q[0][j] = p[0][0][j] - l->position[j];
+        q[1][j] = p[1][0][j] - p[0][0][j];
+        q[2][j] = p[2][0][j] - p[0][0][j];
+        q[3][j] = p[0][1][j] - p[0][0][j];
+        q[4][j] = p[1][1][j] - p[1][0][j] - q[3][j];
+        q[5][j] = p[2][1][j] - p[2][0][j] - q[3][j];
+    }
+    for (k = 0; k < 6; ++k)
+        for (j = 0; j < 3; ++j) ps->uniforms[FOGVOL_U_LIGHT_Q0 + k][j] = (float)(q[k][j] / l->radius);
+    ps->uniforms[FOGVOL_U_LIGHT_Q0][3] = 1.0f;
 }
 
 /* Per light: its front faces' depth into L (cleared to 0: the near plane, for a camera inside),
@@ -10187,6 +10374,7 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
         ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
         fogvol__end_pass(ctx);
         memcpy(bp.uniforms[FOGVOL_U_LIGHT], l->rgb, sizeof l->rgb);
+        fogvol__light_uniforms(ctx, run, l, &bp);
         ctx->be.begin_pass(ctx->be.user_data, &bp);
         ctx->be.draw_mesh(ctx->be.user_data, l->mesh->handle, &dr);
         fogvol__end_pass(ctx);
@@ -10541,35 +10729,28 @@ static const char fogvol__fs_post_common[] =
     "    return dot(fv_lin, q) / dot(fv_lin2, q);\n"
     "}\n";
 
-/* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, 0). */
+/* Depth of field: fv_pparams = (focus distance, 1 / focus range, max radius in pixels, frame phase).
+   FV_TAPS taps on a golden-angle (Vogel) spiral covering the disc of radius r evenly, tap i at radius
+   r sqrt((i + u) / FV_TAPS), angle i 2.39996 + a, the spiral turned per pixel by a = 2 pi
+   IGN(p) and its radii jittered by u = IGN(p.yx + (37, 91)), p = pixel + 5.588238 phase (interleaved
+   gradient noise, Jimenez 2014): no pixel's taps line up with its neighbours', so the blur shows no
+   copies of its taps and no pattern, the taps' expectation is the disc itself (stratified in angle and
+   in r^2), and the phase (fogvol_frame_desc.dither_frame) turns it again every frame. */
 static const char fogvol__fs_post_dof[] =
     "FV_BINDING(0) uniform sampler2D fv_pscene;\n"
     "float fv_coc(float e) { return clamp(abs(e - fv_pparams.x) * fv_pparams.y, 0.0, 1.0); }\n"
-    "vec4 fv_dof_tap(vec2 dir, float r, vec4 c0) {\n"
-    "    vec2 o = floor(dir * r + 0.5);\n"
-    "    return mix(c0, fv_ptex(fv_pscene, o), fv_coc(fv_view_depth(o)));\n"
-    "}\n"
+    "float fv_ign(vec2 p) { return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715)))); }\n"
     "void main() {\n"
-    "    vec4 c0 = fv_ptex(fv_pscene, vec2(0.0));\n"
+    "    vec4 c0 = fv_ptex(fv_pscene, vec2(0.0)), sum = vec4(0.0);\n"
     "    float r = fv_coc(fv_view_depth(vec2(0.0))) * fv_pparams.z;\n"
-    "    vec4 sum = c0;\n"
-    "    sum += fv_dof_tap(vec2(0.0, 1.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.8660254, -0.5), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.8660254, -0.5), r, c0);\n"
-    "#if FV_TAPS >= 6\n"
-    "    sum += fv_dof_tap(vec2(0.0, -1.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.8660254, 0.5), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.8660254, 0.5), r, c0);\n"
-    "#endif\n"
-    "#if FV_TAPS >= 12\n"
-    "    sum += fv_dof_tap(vec2(0.5, 0.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.25, 0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.25, 0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.5, 0.0), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(-0.25, -0.4330127), r, c0);\n"
-    "    sum += fv_dof_tap(vec2(0.25, -0.4330127), r, c0);\n"
-    "#endif\n"
-    "    FV_FRAGCOLOR = sum / float(FV_TAPS + 1);\n"
+    "    vec2 p = floor(gl_FragCoord.xy) + 5.588238 * fv_pparams.w;\n"
+    "    float a = 6.2831853 * fv_ign(p), u = fv_ign(p.yx + vec2(37.0, 91.0));\n"
+    "    for (int i = 0; i < FV_TAPS; ++i) {\n"
+    "        float fi = float(i), t = a + 2.3999632 * fi;\n"
+    "        vec2 o = floor(vec2(cos(t), sin(t)) * (r * sqrt((fi + u) / float(FV_TAPS))) + 0.5);\n"
+    "        sum += mix(c0, fv_ptex(fv_pscene, o), fv_coc(fv_view_depth(o)));\n"
+    "    }\n"
+    "    FV_FRAGCOLOR = sum / float(FV_TAPS);\n"
     "}\n";
 
 /* Outlines: fv_pparams = (depth threshold, normal threshold, 0, 0), fv_pcolor the colour. */
@@ -10610,17 +10791,25 @@ static const char fogvol__fs_post_fog[] =
     "    FV_FRAGCOLOR = FV_TEXTURE(fv_colors, vec2(clamp(t * fv_rampmap.x + fv_rampmap.y, 0.0, 1.0), 0.5));\n"
     "}\n";
 
+/* The depth of field's program slot of a tap count (3, 6, 12, 24, 48), -1 for other counts. */
+static int fogvol__dof_slot(int taps)
+{
+    return taps == 3 ? 0 : taps == 6 ? 1 : taps == 12 ? 2 : taps == 24 ? 3 : taps == 48 ? 4 : -1;
+}
+
 FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, int variant, fogvol_dialect dialect,
                                                     fogvol_stage stage, const char **strings, int *count)
 {
-    static const char *const taps[3] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n", "#define FV_TAPS 12\n"};
+    static const char *const taps[FOGVOL__DOF_TAPSETS] = {"#define FV_TAPS 3\n", "#define FV_TAPS 6\n",
+                                                          "#define FV_TAPS 12\n", "#define FV_TAPS 24\n",
+                                                          "#define FV_TAPS 48\n"};
     const fogvol__dialect_info *di;
     int n = 0;
     if (!strings || !count) return FOGVOL_ERROR_INVALID_ARGUMENT;
     *count = 0;
     if ((int)dialect <= FOGVOL_GLSL_AUTO || (int)dialect >= FOGVOL_GLSL_COUNT) return FOGVOL_ERROR_UNSUPPORTED;
     if (stage != FOGVOL_STAGE_VERTEX && stage != FOGVOL_STAGE_FRAGMENT) return FOGVOL_ERROR_UNSUPPORTED;
-    if (!(effect == FOGVOL_POST_DOF && (variant == 3 || variant == 6 || variant == 12)) &&
+    if (!(effect == FOGVOL_POST_DOF && fogvol__dof_slot(variant) >= 0) &&
         !(effect == FOGVOL_POST_OUTLINES && (variant == 0 || variant == 1)) &&
         !(effect == FOGVOL_POST_DISTANCE_FOG && variant == 0))
         return FOGVOL_ERROR_UNSUPPORTED;
@@ -10634,7 +10823,7 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
         strings[n++] = di->fs;
         strings[n++] = di->decl;
         strings[n++] = fogvol__fs_post_common;
-        if (effect == FOGVOL_POST_DOF) strings[n++] = taps[variant == 3 ? 0 : variant == 6 ? 1 : 2];
+        if (effect == FOGVOL_POST_DOF) strings[n++] = taps[fogvol__dof_slot(variant)];
         if (effect == FOGVOL_POST_OUTLINES && variant) strings[n++] = "#define FV_NORMALS\n";
         strings[n++] = effect == FOGVOL_POST_DOF        ? fogvol__fs_post_dof
                        : effect == FOGVOL_POST_OUTLINES ? fogvol__fs_post_outlines
@@ -10650,9 +10839,9 @@ static fogvol_result fogvol__post_program(fogvol_context *ctx, fogvol_post_effec
 {
     static const char *const labels[FOGVOL_POST_EFFECT_COUNT] = {"fogvol depth of field", "fogvol outlines",
                                                                   "fogvol distance fog"};
-    int slot = effect == FOGVOL_POST_DOF ? (variant == 3 ? 0 : variant == 6 ? 1 : 2)
-               : effect == FOGVOL_POST_OUTLINES ? 3 + variant
-                                                : 5;
+    int slot = effect == FOGVOL_POST_DOF        ? fogvol__dof_slot(variant)
+               : effect == FOGVOL_POST_OUTLINES ? FOGVOL__DOF_TAPSETS + variant
+                                                : FOGVOL__DOF_TAPSETS + 2;
     fogvol_program_desc pd;
     fogvol_result r;
     if (!ctx->gpu.post_prog[slot]) {
@@ -10774,12 +10963,12 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
     }
     r = fogvol__post_check(ctx, desc->frame, desc->texture_size, "post_dof");
     if (r != FOGVOL_SUCCESS) return r;
-    taps = desc->taps ? desc->taps : 6;
+    taps = desc->taps ? desc->taps : 24;
     radius = desc->max_radius != 0.0f ? desc->max_radius : 4.0f;
-    if (!desc->color_texture || (taps != 3 && taps != 6 && taps != 12) || !fogvol__finite(desc->focus_distance) ||
+    if (!desc->color_texture || fogvol__dof_slot(taps) < 0 || !fogvol__finite(desc->focus_distance) ||
         !(desc->focus_distance > 0.0f) || !fogvol__finite(desc->focus_range) || !(desc->focus_range > 0.0f) ||
         !(radius > 0.0f && radius <= 64.0f)) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: need color_texture, taps 3, 6 or 12, "
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: post_dof: need color_texture, taps 3, 6, 12, 24 or 48, "
                     "focus_distance > 0, focus_range > 0, 0 < max_radius <= 64");
         return FOGVOL_ERROR_INVALID_ARGUMENT;
     }
@@ -10792,6 +10981,7 @@ FOGVOL_API fogvol_result fogvol_post_dof(fogvol_context *ctx, const fogvol_dof_d
     ps.uniforms[FOGVOL_U_POST_PARAMS][0] = desc->focus_distance;
     ps.uniforms[FOGVOL_U_POST_PARAMS][1] = 1.0f / desc->focus_range;
     ps.uniforms[FOGVOL_U_POST_PARAMS][2] = radius;
+    ps.uniforms[FOGVOL_U_POST_PARAMS][3] = (float)((unsigned)desc->frame->dither_frame & 63u);
     return fogvol__post_run(ctx, desc->frame, desc->texture_size, &ps);
 }
 

@@ -61,8 +61,9 @@ typedef struct app {
     fogvol_context *fv;
     fogvol_mesh *vol[DS_MAX_MESHES]; /* one per scene mesh */
     fogvol_ramp *ramp[R_COUNT];
+    fogvol_volume_texture *fade; /* the lights' fade along their length (NULL on PS13) */
     /* settings */
-    int tier_i, bits_i, dither, ramp_model, main_light, paused, show_overflow;
+    int tier_i, bits_i, dither, ramp_model, main_light, paused, show_overflow, soft;
     /* camera and time */
     float cam[3], yaw, pitch;
     double anim_t, last_x, last_y;
@@ -92,7 +93,27 @@ static void make_main_ramp(app *a)
     rd.keys = keys;
     rd.key_count = 4;
     rd.blend = a->main_light ? FOGVOL_BLEND_LIGHT : FOGVOL_BLEND_FOG;
+    rd.softness = a->soft ? 0.6f : 0.0f; /* soft edges: the density rises over 0.6 units from each end */
+    if (a->soft && a->ramp_model == FOGVOL_RAMP_EXTINCTION) rd.density = 1.4f;
     if (fogvol_create_ramp(a->fv, &rd, &a->ramp[R_MAIN]) != FOGVOL_SUCCESS) fprintf(stderr, "fogvol: ramp refused\n");
+}
+
+/* a 1-texel-high density texture fading the lights along their length (demo_scene.h) */
+static fogvol_volume_texture *make_fade(fogvol_context *fv)
+{
+    unsigned char px[DS_FADE_TEXELS * 4];
+    fogvol_texture_desc td;
+    fogvol_volume_texture *t = NULL;
+    if (fogvol_context_tier(fv, NULL) == FOGVOL_TIER_PS13) return NULL; /* (no density textures) */
+    ds_fade_texels(px);
+    memset(&td, 0, sizeof td);
+    td.width = DS_FADE_TEXELS;
+    td.height = 1;
+    td.pixels = px;
+    td.filter = FOGVOL_FILTER_LINEAR;
+    td.wrap = FOGVOL_WRAP_CLAMP;
+    if (fogvol_create_volume_texture(fv, &td, &t) != FOGVOL_SUCCESS) t = NULL;
+    return t;
 }
 
 static void destroy_fog(app *a)
@@ -101,6 +122,8 @@ static void destroy_fog(app *a)
     if (!a->fv) return;
     for (i = 0; i < DS_MAX_MESHES; ++i) fogvol_destroy_mesh(a->fv, a->vol[i]), a->vol[i] = NULL;
     for (i = 0; i < R_COUNT; ++i) fogvol_destroy_ramp(a->fv, a->ramp[i]), a->ramp[i] = NULL;
+    fogvol_destroy_volume_texture(a->fv, a->fade);
+    a->fade = NULL;
     fogvol_destroy_context(a->fv);
     a->fv = NULL;
 }
@@ -130,9 +153,12 @@ static int build_fog(app *a, fogvol_tier tier, int bits)
     make_main_ramp(a);
     memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.74f, rd.color[1] = 0.80f, rd.color[2] = 0.86f, rd.density = 0.35f;
+    rd.softness = a->soft ? 0.5f : 0.0f;
     fogvol_create_ramp(fv, &rd, &a->ramp[R_BANK]);
     rd.color[0] = 1.0f, rd.color[1] = 0.78f, rd.color[2] = 0.42f, rd.density = 0.30f, rd.blend = FOGVOL_BLEND_LIGHT;
+    if (a->soft) rd.density = 0.8f, rd.softness = 0.2f; /* (the fade thins it) */
     fogvol_create_ramp(fv, &rd, &a->ramp[R_LIGHT]);
+    a->fade = a->soft ? make_fade(fv) : NULL;
     return 1;
 }
 
@@ -172,6 +198,10 @@ static void press(app *a, int key)
     case GLFW_KEY_L:
         a->main_light = !a->main_light;
         make_main_ramp(a);
+        break;
+    case GLFW_KEY_K:
+        a->soft = !a->soft;
+        build_fog(a, k_tiers[a->tier_i], k_bits[a->bits_i]);
         break;
     case GLFW_KEY_O: a->show_overflow = !a->show_overflow; break;
     case GLFW_KEY_P: a->paused = !a->paused; break;
@@ -304,6 +334,10 @@ static fogvol_frame_stats render(app *a, int w, int h)
         vd.ramp = a->ramp[ds_group(o->kind)]; /* main group, mist bank, light */
         vd.negative = o->kind == DS_HOLE;     /* the clearing in the mist */
         memcpy(vd.model, o->model, sizeof vd.model);
+        if (o->fade && a->fade) { /* the sunbeam and the lamp's cone fade along their length */
+            vd.density = a->fade;
+            memcpy(vd.density_map, o->fade_map, sizeof vd.density_map);
+        }
         fogvol_add_volume(a->fv, &vd);
     }
     fogvol_end_frame(a->fv, &st); /* renders, composites, restores the GL state */
@@ -317,11 +351,11 @@ static const char *set_title(app *a, double ms)
     fogvol_tier tier = fogvol_context_tier(a->fv, NULL);
     snprintf(title, sizeof title,
              "fogvol demo | %.1f ms | [T] %s | [B] %d bits/ch (%d-bit, %d faces%s) | [G] dither %s | [R] %s | "
-             "[L] %s%s%s",
+             "[L] %s | [K] soft edges %s%s%s",
              ms, fogvol_tier_name(tier), e->bits, e->precision_bits, e->max_faces,
              tier == FOGVOL_TIER_FLOAT ? ", unused by FLOAT" : "", /* R32F sums: no RGB encoding */
              a->dither ? "on" : "off", k_ramp_names[a->ramp_model], a->main_light ? "light" : "fog",
-             a->paused ? " | [P] paused" : "", a->show_overflow ? " | [O] overflow" : "");
+             a->soft ? "on" : "off", a->paused ? " | [P] paused" : "", a->show_overflow ? " | [O] overflow" : "");
     glfwSetWindowTitle(a->win, title);
     return title;
 }
@@ -395,6 +429,7 @@ int main(int argc, char **argv)
     ds_gl_init(&a.gl, &a.scene);
 
     a.dither = 1;
+    a.soft = 1;
     a.cam[0] = 1.0f, a.cam[1] = 5.2f, a.cam[2] = 13.5f, a.yaw = -3.5f, a.pitch = -14.5f;
     if (cam_n == 5) a.cam[0] = cam[0], a.cam[1] = cam[1], a.cam[2] = cam[2], a.yaw = cam[3], a.pitch = cam[4];
     if (!build_fog(&a, tier, bits)) {

@@ -7,15 +7,23 @@
    placed in it: a fog sphere around the rocks, a ring standing in the arch, a
    drifting cloud, a low mist bank the camera can stand in with a clearing
    carved by a negative sphere, a sunbeam and the lamp's cone of light. The
-   opaque objects cut the volumes. It writes PNGs:
+   opaque objects cut the volumes. The fog has soft edges (fogvol_ramp_desc.softness),
+   the lights fade along their length (a density texture) and, by compare, with
+   distance (fogvol_light_desc.falloff_radius, edge_softness). It writes PNGs:
      scene_overview.png, scene_low.png, scene_inside_fog_bank.png  three viewpoints
      tiers.png        the same frame per tier: PS13 | PS20 | FLOAT (the RGBA8 tiers on their
                       classic digit path: FOGVOL_SPEEDUP_EXACT_SUM off)
      dither.png       L = 2 bits per channel (6-bit depth precision), close to the fog sphere,
-                      dithering off | on (the banding and its cure; the digit path too)
+                      dithering off | on | on, the mean of 8 frames with dither_frame 1..8
+                      (the banding, its cure, and the pattern averaged away as TAA would; the
+                      digit path too)
+     soft_edges.png   close to the fog sphere: softness 0 | the demo's softness
      ramps.png        colour ramps: extinction | linear | artist gradient
      thickness.png    the raw thickness of the fog group as false colour
      dof.png, outlines.png, distance_fog.png  the overview with the image-space effects
+     textured_fog.png, light_compare.png  density and colour textures; lights by compare
+     before_after.png hard edges and flat lights (softness 0, no fades, no falloff) | this
+                      version: the fog sphere, the sunbeam, the lights by compare
    and prints where they went, the tier, the pass count and the frame time.
 
    usage: demo_headless [output-dir] [--check]    (default dir: build/demo)
@@ -70,6 +78,8 @@ typedef struct settings {
     int w, h, view;
     float fog_scale;         /* density multiplier of the fog group */
     unsigned speedups_off;   /* fogvol_context_desc.disable_speedups */
+    int before;              /* 1: as fogvol 0.2 drew it: hard edges, lights that do not fade */
+    int frames;              /* > 1: the mean of that many frames, dither_frame 1 .. frames (TAA) */
 } settings;
 
 typedef struct shot {
@@ -90,13 +100,17 @@ static void camera(int view, int w, int h, float v[16], float p[16])
     glu_perspective(p, 55.0, (double)w / h, 0.1, 40.0);
 }
 
+/* soft edges of the three groups (fogvol_ramp_desc.softness, world units): fog, mist bank, light */
+static const float g_soft[3] = {0.6f, 0.5f, 0.2f};
+
 /* the three colour ramps: the fog group (model and density from the settings), the mist bank, the light */
 static void make_ramps(fogvol_context *fv, const settings *s, fogvol_ramp *ramp[3])
 {
     fogvol_ramp_desc rd;
     fogvol_color_key keys[4];
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.70f, rd.color[1] = 0.78f, rd.color[2] = 0.90f, rd.density = 1.1f * s->fog_scale;
+    rd.softness = s->before ? 0.0f : g_soft[0];
+    rd.color[0] = 0.70f, rd.color[1] = 0.78f, rd.color[2] = 0.90f, rd.density = (s->before ? 1.1f : 1.4f) * s->fog_scale;
     rd.model = s->ramp == 1 ? FOGVOL_RAMP_LINEAR : s->ramp == 2 ? FOGVOL_RAMP_GRADIENT : FOGVOL_RAMP_EXTINCTION;
     if (s->ramp == 1) rd.density = 0.45f * s->fog_scale;
     keys[0].thickness = 0.0f, keys[0].rgba[0] = 0.2f, keys[0].rgba[1] = 0.9f, keys[0].rgba[2] = 0.7f, keys[0].rgba[3] = 0.0f;
@@ -108,13 +122,35 @@ static void make_ramps(fogvol_context *fv, const settings *s, fogvol_ramp *ramp[
     fogvol_create_ramp(fv, &rd, &ramp[0]);
     memset(&rd, 0, sizeof rd);
     rd.color[0] = 0.74f, rd.color[1] = 0.80f, rd.color[2] = 0.86f, rd.density = 0.35f;
+    rd.softness = s->before ? 0.0f : g_soft[1];
     fogvol_create_ramp(fv, &rd, &ramp[1]);
     rd.color[0] = 1.0f, rd.color[1] = 0.78f, rd.color[2] = 0.42f, rd.density = 0.30f, rd.blend = FOGVOL_BLEND_LIGHT;
+    rd.softness = s->before ? 0.0f : g_soft[2];
+    if (!s->before) rd.density = 0.8f; /* (the fade thins it) */
     fogvol_create_ramp(fv, &rd, &ramp[2]);
 }
 
-/* fogvol's part of a frame: the opaque objects as occluders, the volumes by group */
-static void add_scene(fogvol_context *fv, const ds_scene *sc, fogvol_mesh *const *fm, fogvol_ramp *const *ramp)
+/* the lights' fade along their axis (demo_scene.h: ds_fade_texels) */
+static fogvol_volume_texture *fade_texture(fogvol_context *fv)
+{
+    unsigned char px[DS_FADE_TEXELS * 4];
+    fogvol_texture_desc td;
+    fogvol_volume_texture *t = NULL;
+    ds_fade_texels(px);
+    memset(&td, 0, sizeof td);
+    td.width = DS_FADE_TEXELS;
+    td.height = 1;
+    td.pixels = px;
+    td.filter = FOGVOL_FILTER_LINEAR;
+    td.wrap = FOGVOL_WRAP_CLAMP;
+    if (fogvol_create_volume_texture(fv, &td, &t) != FOGVOL_SUCCESS) t = NULL;
+    return t;
+}
+
+/* fogvol's part of a frame: the opaque objects as occluders, the volumes by group (fade: the lights'
+   density texture, NULL: no fade) */
+static void add_scene(fogvol_context *fv, const ds_scene *sc, fogvol_mesh *const *fm, fogvol_ramp *const *ramp,
+                      const fogvol_volume_texture *fade)
 {
     int i;
     for (i = 0; i < sc->count; ++i) {
@@ -129,6 +165,10 @@ static void add_scene(fogvol_context *fv, const ds_scene *sc, fogvol_mesh *const
         vd.ramp = ramp[ds_group(o->kind)];
         vd.negative = o->kind == DS_HOLE;
         memcpy(vd.model, o->model, sizeof vd.model);
+        if (o->fade && fade) {
+            vd.density = fade;
+            memcpy(vd.density_map, o->fade_map, sizeof vd.density_map);
+        }
         fogvol_add_volume(fv, &vd);
     }
 }
@@ -141,8 +181,10 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
     fogvol_context *fv;
     fogvol_mesh *fm[DS_MAX_MESHES];
     fogvol_ramp *ramp[3];
+    fogvol_volume_texture *fade;
     float v[16], p[16];
-    int i, grp, captures;
+    unsigned *sum = NULL;
+    int i, grp, captures, f;
     if (!glu_create(&d->g, s->w, s->h, 1)) return 0;
     ds_gl_init(&d->gl, &d->scene);
     camera(s->view, s->w, s->h, v, p);
@@ -161,9 +203,13 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
     out->tier = fogvol_context_tier(fv, NULL);
     for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
     make_ramps(fv, s, ramp);
+    fade = s->before || out->tier == FOGVOL_TIER_PS13 ? NULL : fade_texture(fv); /* (PS13: no density textures) */
 
-    captures = with_fog ? 3 : 1; /* one frame per group whose thickness is read back, the first one timed */
-    for (grp = 0; grp < captures; ++grp) {
+    /* one frame per group whose thickness is read back, the first one timed; with s->frames > 1 the
+       frames 2 .. frames follow (dither_frame = frame), their mean the picture */
+    captures = with_fog ? 3 : 1;
+    if (with_fog && s->frames > 1) sum = (unsigned *)calloc((size_t)s->w * s->h * 4, sizeof(unsigned));
+    for (grp = 0, f = 1; grp < captures || (sum && f <= s->frames); ++grp) {
         fogvol_frame_desc fd;
         double t0;
         ds_draw(&d->gl, &d->scene, v, p, s->w, s->h);
@@ -175,18 +221,24 @@ static int render(demo *d, const settings *s, int with_fog, shot *out)
         fd.zfar = 40.0f;
         fd.viewport[2] = s->w;
         fd.viewport[3] = s->h;
-        fd.debug_thickness = out->thick[grp];
-        fd.debug_ramp = ramp[grp];
+        fd.debug_thickness = grp < captures ? out->thick[grp] : NULL;
+        fd.debug_ramp = grp < captures ? ramp[grp] : NULL;
+        fd.dither_frame = sum && grp >= captures - 1 ? f++ : sum ? 1 : 0;
         glFinish();
         t0 = now_ms();
         fogvol_begin_frame(fv, &fd);
-        add_scene(fv, &d->scene, fm, ramp);
+        add_scene(fv, &d->scene, fm, ramp, fade);
         fogvol_end_frame(fv, grp == 0 ? &out->st : NULL);
         glFinish();
         if (grp == 0) out->ms = now_ms() - t0;
         if (grp == 0) memcpy(out->rgba, glu_pixels(&d->g), (size_t)s->w * s->h * 4);
+        if (sum && grp >= captures - 1)
+            for (i = 0; i < s->w * s->h * 4; ++i) sum[i] += d->g.pixels[i];
     }
     if (!with_fog) memcpy(out->rgba, glu_pixels(&d->g), (size_t)s->w * s->h * 4);
+    for (i = 0; sum && i < s->w * s->h * 4; ++i) out->rgba[i] = (unsigned char)((sum[i] + s->frames / 2) / s->frames);
+    free(sum);
+    if (fade) fogvol_destroy_volume_texture(fv, fade);
     for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
     for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
     fogvol_destroy_context(fv);
@@ -283,6 +335,7 @@ static void scene_to_textures(demo *d, fogvol_context *fv, const float v[16], co
 {
     fogvol_mesh *fm[DS_MAX_MESHES];
     fogvol_ramp *ramp[3];
+    fogvol_volume_texture *fade;
     fogvol_frame_desc fd;
     settings s;
     int i;
@@ -299,9 +352,11 @@ static void scene_to_textures(demo *d, fogvol_context *fv, const float v[16], co
     fd.viewport[2] = DW;
     fd.viewport[3] = DH;
     for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
+    fade = fade_texture(fv);
     fogvol_begin_frame(fv, &fd);
-    add_scene(fv, &d->scene, fm, ramp);
+    add_scene(fv, &d->scene, fm, ramp, fade);
     fogvol_end_frame(fv, NULL);
+    if (fade) fogvol_destroy_volume_texture(fv, fade);
     for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
     for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -341,7 +396,7 @@ static int post_effect(demo *d, fogvol_context *fv, const fogvol_frame_desc *fd,
     dd.focus_distance = 9.0f; /* the pillars in the middle sharp, the front and the back blurred */
     dd.focus_range = 5.0f;
     dd.max_radius = 5.0f;
-    dd.taps = 12;
+    dd.taps = 24;
     od.color[0] = 0.05f, od.color[1] = 0.04f, od.color[2] = 0.08f, od.color[3] = 0.9f;
     gd.ramp = ramp;
     gd.start = 4.0f;
@@ -447,27 +502,50 @@ static shp_mesh demo_shaft(void)
     return m;
 }
 
-/* the scene's volumes with textures: noise density (scrolled), the shaft's gradient, a colour */
-static fogvol_mesh *demo_tl_lights(fogvol_context *fv)
+/* Two light shafts by compare, each falling off from its top (fogvol_light_desc.falloff_radius) and
+   fading where the ground meets its walls (edge_softness); unless before, each also glows as a soft
+   volume of its light ramp (ramp[k]; NULL = no glow) fading along its length. */
+static fogvol_mesh *demo_tl_lights(fogvol_context *fv, int before, fogvol_ramp *const *ramp,
+                                   const fogvol_volume_texture *fade)
 {
+    static const float rot[2][4] = {{15, 0, 0, 1}, {-25, 0, 1, 0}}, pos[2][3] = {{-5.2f, 1.6f, -0.8f}, {2.6f, 1.2f, -4.3f}};
+    static const float rgb[2][3] = {{1.0f, 0.72f, 0.38f}, {0.45f, 0.62f, 1.0f}}, old_rgb[2][3] = {{0.9f, 0.65f, 0.3f},
+                                                                                             {0.2f, 0.45f, 0.8f}};
     fogvol_mesh *shaft;
     fogvol_light_desc ld;
+    fogvol_volume_desc vd;
     float r[16], t[16];
     shp_mesh sm = demo_shaft();
+    int k;
     shaft = upload(fv, &sm);
     shp_free(&sm);
-    memset(&ld, 0, sizeof ld);
-    ld.mesh = shaft;
-    shp_mat_rotate(r, 15, 0, 0, 1); /* a warm shaft over the column at (-5.5, -0.8) */
-    shp_mat_translate(t, -5.2f, 1.6f, -0.8f);
-    shp_mat_mul(ld.model, t, r);
-    ld.color[0] = 0.9f, ld.color[1] = 0.65f, ld.color[2] = 0.3f;
-    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
-    shp_mat_rotate(r, -25, 0, 1, 0); /* a cold one through the arch gate, lighting its right pier */
-    shp_mat_translate(t, 2.6f, 1.2f, -4.3f);
-    shp_mat_mul(ld.model, t, r);
-    ld.color[0] = 0.2f, ld.color[1] = 0.45f, ld.color[2] = 0.8f;
-    if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+    for (k = 0; k < 2; ++k) { /* a warm shaft over the column at (-5.5, -0.8), a cold one through the arch gate */
+        memset(&ld, 0, sizeof ld);
+        ld.mesh = shaft;
+        shp_mat_rotate(r, rot[k][0], rot[k][1], rot[k][2], rot[k][3]);
+        shp_mat_translate(t, pos[k][0], pos[k][1], pos[k][2]);
+        shp_mat_mul(ld.model, t, r);
+        memcpy(ld.color, before ? old_rgb[k] : rgb[k], sizeof ld.color);
+        if (!before) { /* from the shaft's top (model y 2.6), reaching past its base */
+            ld.position[0] = ld.model[4] * 2.9f + ld.model[12];
+            ld.position[1] = ld.model[5] * 2.9f + ld.model[13];
+            ld.position[2] = ld.model[6] * 2.9f + ld.model[14];
+            ld.falloff_radius = 6.5f;
+            ld.edge_softness = 0.35f;
+            ld.intensity = 1.35f;
+        }
+        if (fogvol_add_light(fv, &ld) != FOGVOL_SUCCESS) fprintf(stderr, "demo: light refused\n");
+        if (before || !ramp[k]) continue;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = shaft;
+        vd.ramp = ramp[k];
+        memcpy(vd.model, ld.model, sizeof vd.model);
+        vd.density = fade;
+        vd.density_map[1] = 1.0f / 5.2f; /* s from the base (y -2.6) to the top (2.6) */
+        vd.density_map[3] = 0.5f;
+        vd.density_map[7] = 0.5f;
+        fogvol_add_volume(fv, &vd);
+    }
     return shaft;
 }
 
@@ -494,13 +572,9 @@ static void demo_tl_volumes(demo *d, fogvol_context *fv, fogvol_mesh **fm, fogvo
         vd.ramp = ramp[ds_group(o->kind)];
         vd.negative = o->kind == DS_HOLE;
         memcpy(vd.model, o->model, sizeof vd.model);
-        if (o->kind == DS_LIGHT) { /* s along the axis, thin at the base: the sunbeam's box spans model
-                                      y -1..1, the lamp's cone y 0..2.6 */
-            int cone = d->scene.mesh[o->mesh].vcount > 8;
+        if (o->fade) { /* s along the axis (demo_scene.h's fade_map), thin at the base */
             vd.density = grad;
-            vd.density_map[1] = cone ? 1.0f / 2.6f : 0.5f;
-            vd.density_map[3] = cone ? 0.0f : 0.5f;
-            vd.density_map[7] = 0.5f;
+            memcpy(vd.density_map, o->fade_map, sizeof vd.density_map);
         } else if (!vd.negative) { /* noise in the horizontal plane, scrolled (time 1.5 s, 0.2 units/s) */
             vd.density = noise;
             vd.density_map[0] = o->kind == DS_BANK ? 0.12f : 0.35f;
@@ -514,20 +588,21 @@ static void demo_tl_volumes(demo *d, fogvol_context *fv, fogvol_mesh **fm, fogvo
 
 /* textured: fog groups with density noise (the bank scrolled, the light shafts thinning towards
    their base), a colour texture on the fog group; lights: two convex light volumes lighting the
-   scene by compare, no fog. */
-static void demo_texlight(demo *d, const char *dir, int lights)
+   scene by compare, falling off and glowing (before: flat, as fogvol 0.2 drew them), no fog.
+   Writes name (NULL: none) and returns the picture (malloc'ed, rows bottom to top; NULL on failure). */
+static unsigned char *demo_texlight(demo *d, const char *dir, int lights, int before, const char *name)
 {
     fogvol_context_desc cd;
     fogvol_context *fv;
     fogvol_mesh *fm[DS_MAX_MESHES], *shaft = NULL;
-    fogvol_ramp *ramp[3];
+    fogvol_ramp *ramp[3], *glow[2] = {NULL, NULL};
     fogvol_ramp_desc rd;
-    fogvol_volume_texture *tex[3];
+    fogvol_volume_texture *tex[3], *fade;
     fogvol_frame_desc fd;
     float v[16], p[16];
-    unsigned char *imgs[1];
+    unsigned char *imgs[1], *out;
     int i;
-    if (!glu_create(&d->g, DW, DH, 1)) return;
+    if (!glu_create(&d->g, DW, DH, 1)) return NULL;
     ds_gl_init(&d->gl, &d->scene);
     camera(0, DW, DH, v, p);
     memset(&cd, 0, sizeof cd);
@@ -536,16 +611,24 @@ static void demo_texlight(demo *d, const char *dir, int lights)
     if (fogvol_create_context(&cd, &fv) != FOGVOL_SUCCESS) {
         ds_gl_free(&d->gl);
         glu_destroy(&d->g);
-        return;
+        return NULL;
     }
     for (i = 0; i < d->scene.mesh_count; ++i) fm[i] = upload(fv, &d->scene.mesh[i]);
     for (i = 0; i < 3; ++i) tex[i] = demo_volume_texture(fv, i, i == 1 ? 32 : 64);
+    fade = fade_texture(fv);
+    for (i = 0; i < 2 && lights && !before; ++i) { /* the shafts' glow: faint, soft, their own colours */
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = i ? 0.45f : 1.0f, rd.color[1] = i ? 0.62f : 0.72f, rd.color[2] = i ? 1.0f : 0.38f;
+        rd.density = 0.45f, rd.softness = 0.6f, rd.blend = FOGVOL_BLEND_LIGHT;
+        fogvol_create_ramp(fv, &rd, &glow[i]);
+    }
     memset(&rd, 0, sizeof rd);
-    rd.color[0] = 0.9f, rd.color[1] = 0.92f, rd.color[2] = 0.97f, rd.density = 0.9f;
+    rd.color[0] = 0.9f, rd.color[1] = 0.92f, rd.color[2] = 0.97f, rd.density = 1.1f, rd.softness = g_soft[0];
     fogvol_create_ramp(fv, &rd, &ramp[0]);
-    rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.45f;
+    rd.color[0] = 0.55f, rd.color[1] = 0.62f, rd.color[2] = 0.70f, rd.density = 0.45f, rd.softness = g_soft[1];
     fogvol_create_ramp(fv, &rd, &ramp[1]);
-    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.6f, rd.blend = FOGVOL_BLEND_LIGHT;
+    rd.color[0] = 1.0f, rd.color[1] = 0.75f, rd.color[2] = 0.35f, rd.density = 0.8f, rd.blend = FOGVOL_BLEND_LIGHT;
+    rd.softness = g_soft[2];
     fogvol_create_ramp(fv, &rd, &ramp[2]);
     ds_draw(&d->gl, &d->scene, v, p, DW, DH);
     memset(&fd, 0, sizeof fd);
@@ -557,19 +640,70 @@ static void demo_texlight(demo *d, const char *dir, int lights)
     fd.viewport[3] = DH;
     fogvol_begin_frame(fv, &fd);
     demo_tl_volumes(d, fv, fm, ramp, tex, lights);
-    if (lights) shaft = demo_tl_lights(fv);
+    if (lights) shaft = demo_tl_lights(fv, before, glow, fade);
     fogvol_end_frame(fv, NULL);
     imgs[0] = glu_pixels(&d->g);
-    save_row(dir, lights ? "light_compare.png" : "textured_fog.png", imgs, 1, DW, DH);
-    printf("  %-34s tier %s\n", lights ? "light_compare.png" : "textured_fog.png",
-           fogvol_tier_name(fogvol_context_tier(fv, NULL)));
+    if (name) {
+        save_row(dir, name, imgs, 1, DW, DH);
+        printf("  %-34s tier %s\n", name, fogvol_tier_name(fogvol_context_tier(fv, NULL)));
+    }
+    out = (unsigned char *)malloc((size_t)DW * DH * 4);
+    if (out) memcpy(out, imgs[0], (size_t)DW * DH * 4);
     for (i = 0; i < d->scene.mesh_count; ++i) fogvol_destroy_mesh(fv, fm[i]);
     if (shaft) fogvol_destroy_mesh(fv, shaft);
     for (i = 0; i < 3; ++i) fogvol_destroy_volume_texture(fv, tex[i]);
+    if (fade) fogvol_destroy_volume_texture(fv, fade);
     for (i = 0; i < 3; ++i) fogvol_destroy_ramp(fv, ramp[i]);
+    for (i = 0; i < 2; ++i) fogvol_destroy_ramp(fv, glow[i]);
     fogvol_destroy_context(fv);
     ds_gl_free(&d->gl);
     glu_destroy(&d->g);
+    return out;
+}
+
+/* A w x h crop at (x, y) (from the top left) of a DW x DH picture (rows bottom to top) into dst (rows top
+   to bottom, stride pixels a row) */
+static void crop_into(unsigned char *dst, int stride, const unsigned char *src, int x, int y, int w, int h)
+{
+    int r;
+    for (r = 0; r < h; ++r) memcpy(dst + (size_t)r * stride * 4, src + ((size_t)(DH - 1 - (y + r)) * DW + x) * 4, (size_t)w * 4);
+}
+
+/* before_after.png: fogvol 0.2's look (left) and this version's (right): the fog sphere, the sunbeam
+   (overview) and the lights by compare (light_compare) */
+static int before_after(demo *d, const char *dir, const settings *base)
+{
+    enum { CW = 230, CH = 150 };
+    static const int at[3][2] = {{375, 125}, {215, 50}, {150, 90}}; /* crops: sphere, sunbeam, lights */
+    unsigned char *pic[2][2], *out = (unsigned char *)calloc((size_t)2 * CW * 3 * CH, 4);
+    char path[512];
+    int k, i, ok = out != NULL;
+    for (k = 0; k < 2 && ok; ++k) {
+        settings s = *base;
+        shot sh = new_shot(DW, DH);
+        s.before = !k;
+        s.view = 0;
+        ok = render(d, &s, 1, &sh);
+        pic[k][0] = sh.rgba;
+        sh.rgba = NULL;
+        free_shot(&sh);
+        pic[k][1] = demo_texlight(d, dir, 1, !k, NULL);
+        ok = ok && pic[k][0] && pic[k][1];
+    }
+    for (i = 0; i < 3 && ok; ++i)
+        for (k = 0; k < 2; ++k)
+            crop_into(out + ((size_t)i * CH * 2 * CW + (size_t)k * CW) * 4, 2 * CW, pic[k][i == 2], at[i][0], at[i][1], CW, CH);
+    if (ok) {
+        snprintf(path, sizeof path, "%s/before_after.png", dir);
+        stbi_write_png(path, 2 * CW, 3 * CH, 4, out, 2 * CW * 4);
+        printf("%s\n", path);
+    }
+    for (k = 0; k < 2; ++k) {
+        free(pic[k][0]);
+        free(pic[k][1]);
+    }
+    free(out);
+    return ok;
 }
 
 static int g_tap;
@@ -669,15 +803,26 @@ int main(int argc, char **argv)
         differ = row(&d, dir, "tiers.png", v, 3, 1);
         printf("# tiers.png: the RGBA8 tiers' digits differ from FLOAT in at least %d pixels\n", differ);
         if (do_check) failures += !check(differ > 100, "tiers.png: the RGBA8 panels show their digits (differ from FLOAT)");
-        for (k = 0; k < 2; ++k) { /* banding at low precision (close to the fog sphere) and its cure */
+        for (k = 0; k < 3; ++k) { /* banding at low precision (close to the fog sphere) and its cure; the
+                                     mean of 8 frames of the rotating pattern (fogvol_frame_desc.dither_frame) */
             v[k].tier = FOGVOL_TIER_PS20;
             v[k].bits = 2;
             v[k].view = 3;
-            v[k].dither = k;
+            v[k].dither = k > 0;
+            v[k].frames = k == 2 ? 8 : 0;
         }
-        differ = row(&d, dir, "dither.png", v, 2, 0);
-        printf("# dither.png: %d pixels differ between dithering off and on\n", differ);
+        differ = row(&d, dir, "dither.png", v, 3, 0);
+        printf("# dither.png: %d pixels differ between dithering off or on and the mean of 8 dithered frames\n", differ);
         if (do_check) failures += !check(differ > 100, "dither.png: dithering changes the picture");
+        for (k = 0; k < 2; ++k) { /* soft edges: softness 0 | the demo's */
+            v[k] = s;
+            v[k].w = DW / 2;
+            v[k].h = DH / 2;
+            v[k].view = 3;
+            v[k].before = !k;
+        }
+        differ = row(&d, dir, "soft_edges.png", v, 2, 0);
+        if (do_check) failures += !check(differ > 1000, "soft_edges.png: soft edges change the fog");
         for (k = 0; k < 3; ++k) {
             v[k] = v[2];
             v[k].tier = FOGVOL_TIER_AUTO;
@@ -689,8 +834,11 @@ int main(int argc, char **argv)
     k = post_effects(&d, dir);
     if (do_check) failures += !check(k, "image-space effects: dof.png, outlines.png, distance_fog.png");
     else failures += !k;
-    demo_texlight(&d, dir, 0);
-    demo_texlight(&d, dir, 1);
+    free(demo_texlight(&d, dir, 0, 0, "textured_fog.png"));
+    free(demo_texlight(&d, dir, 1, 0, "light_compare.png"));
+    k = before_after(&d, dir, &s);
+    if (do_check) failures += !check(k, "before_after.png");
+    else failures += !k;
     ds_scene_free(&d.scene);
     if (do_check) printf("1..%d\n", g_tap);
     return failures ? 1 : 0;

@@ -14,7 +14,8 @@
      DS_BANK   a low mist bank over the back of the courtyard, with DS_HOLE, a
                negative sphere, carving a clearing into it;
      DS_LIGHT  a sunbeam slanting onto the path and the cone of the lamp post,
-               blended additively.
+               blended additively; each fades along its length (ds_object.fade:
+               a density texture of ds_fade_texels along its axis, fogvol_volume_desc.density).
 
    Use:  ds_scene s; ds_scene_build(&s); ds_scene_animate(&s, t);
          ds_gl g; ds_gl_init(&g, &s);        once per GL 3.3 context
@@ -42,6 +43,8 @@ typedef struct ds_object {
     int mesh, kind, material;
     float color[3];
     float model[16];
+    int fade;          /* 1: light that fades along its axis: density texture of ds_fade_texels with */
+    float fade_map[8]; /*    these texture-coordinate rows (fogvol_volume_desc.density_map) */
 } ds_object;
 
 typedef struct ds_scene {
@@ -219,12 +222,38 @@ static inline void ds__nature(ds_scene *s, int box, int trunk, int cone)
     ds__add(s, box, DS_OPAQUE, DS_WOOD, 0.22f, 0.20f, 0.18f, m);
 }
 
+/* The density of a light fading along its axis, 1 texel high (RGBA8, red): s in [0, 1] from its
+   base to its top; faint where it meets the ground, full in the middle, gone at the top end. */
+#define DS_FADE_TEXELS 64
+static inline void ds_fade_texels(unsigned char *rgba)
+{
+    int i;
+    for (i = 0; i < DS_FADE_TEXELS; ++i) {
+        double u = (i + 0.5) / DS_FADE_TEXELS, a = u > 0.4 ? 1 : u / 0.4;
+        double b = u < 0.72 ? 0 : u > 1.0 ? 1 : (u - 0.72) / 0.28;
+        double f = (0.4 + 0.6 * a * a * (3 - 2 * a)) * (1 - b * b * (3 - 2 * b));
+        rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = (unsigned char)(255.0 * f + 0.5);
+        rgba[4 * i + 3] = 255;
+    }
+}
+
+/* fade_map for a light whose model-space axis is y from y0 to y1, the texture's s from s0 to s1 */
+static inline void ds__fade(ds_object *o, float y0, float y1, float s0, float s1)
+{
+    memset(o->fade_map, 0, sizeof o->fade_map);
+    o->fade = 1;
+    o->fade_map[1] = (s1 - s0) / (y1 - y0);
+    o->fade_map[3] = s0 - o->fade_map[1] * y0;
+    o->fade_map[7] = 0.5f;
+}
+
 /* the fog volumes */
 static inline void ds__volumes(ds_scene *s)
 {
     float m[16];
-    int sphere = ds__mesh(s, shp_sphere(1.0f, 64, 32)), ring = ds__mesh(s, shp_torus(1.3f, 0.3f, 96, 32));
+    int sphere = ds__mesh(s, shp_sphere(1.0f, 64, 32)), ring = ds__mesh(s, shp_torus(1.25f, 0.42f, 96, 32));
     int box = ds__mesh(s, shp_box(1, 1, 1)), lamp = ds__mesh(s, ds_frustum(1.0f, 0.12f, 2.6f, 48));
+    int beam = ds__mesh(s, ds_frustum(1.0f, 1.0f, 2.0f, 48)), k;
     s->blob_mesh = ds__mesh(s, shp_sphere(0.9f, 48, 24));
     s->blob_base = (float *)malloc(sizeof(float) * 3 * (size_t)s->mesh[s->blob_mesh].vcount);
     memcpy(s->blob_base, s->mesh[s->blob_mesh].pos, sizeof(float) * 3 * (size_t)s->mesh[s->blob_mesh].vcount);
@@ -235,10 +264,11 @@ static inline void ds__volumes(ds_scene *s)
     ds_trs(m, 0, 0.25f, -7.0f, 0, 0, 1, 0, 12.0f, 0.55f, 6.0f); /* the mist bank: y -0.3 .. 0.8, z -13 .. -1 */
     ds__add(s, box, DS_BANK, 0, 0, 0, 0, m);
     s->hole_obj = ds__add(s, sphere, DS_HOLE, 0, 0, 0, 0, m);
+    for (k = 0; k < s->mesh[beam].vcount; ++k) s->mesh[beam].pos[3 * k + 1] -= 1.0f; /* a cylinder, y -1 .. 1 */
     ds_trs(m, -0.6f, 2.6f, -1.6f, -22, 0.3f, 0, 1, 0.45f, 3.6f, 0.45f); /* sunbeam */
-    ds__add(s, box, DS_LIGHT, 0, 0, 0, 0, m);
+    ds__fade(&s->obj[ds__add(s, beam, DS_LIGHT, 0, 0, 0, 0, m)], -1.0f, 1.0f, 0.0f, 1.0f);
     ds_trs(m, 1.6f, 0, 2.6f, 0, 0, 1, 0, 1, 1, 1); /* the lamp's cone, from the ground up to the lantern */
-    ds__add(s, lamp, DS_LIGHT, 0, 0, 0, 0, m);
+    ds__fade(&s->obj[ds__add(s, lamp, DS_LIGHT, 0, 0, 0, 0, m)], 0.0f, 2.6f, 0.08f, 0.5f);
 }
 
 /* Pose the animated volumes at time t (seconds): the ring turns in the gate, the
@@ -288,20 +318,10 @@ static inline void ds_scene_free(ds_scene *s)
     memset(s, 0, sizeof *s);
 }
 
-/* ---- the opaque renderer (GL 3.3 core) --------------------------------------------- */
-
-typedef struct ds_gl {
-    GLuint prog, sky, vao[DS_MAX_MESHES], vbo[DS_MAX_MESHES], ebo[DS_MAX_MESHES], empty_vao;
-    GLuint shadow_prog, shadow_fbo, shadow_tex; /* the sun's shadow map, rendered once */
-    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv, u_shadow_vp, u_shadow_map, u_shadow_mvp;
-    int count[DS_MAX_MESHES];
-    float shadow_vp[16];
-} ds_gl;
-
-#define DS_SHADOW_SIZE 2048
-
-#define DS_GLSL_COMMON                                                                                              \
-    "#version 330 core\n"                                                                                           \
+/* The shaders' shared functions (noise, the sky) and the surfaces' albedos, in the GLSL that GLSL 330
+   core and GLSL ES 1.00 share (the browser demo draws the place with them too); DS_GLSL_ALBEDO reads
+   wp (world position), color and material. */
+#define DS_GLSL_FUNCS                                                                                               \
     "const vec3 sun = normalize(" DS_SUN ");\n"                                                                     \
     "float hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }\n"                        \
     "float noise(vec2 p) { vec2 i = floor(p), f = fract(p); f = f * f * (3.0 - 2.0 * f);\n"                       \
@@ -317,43 +337,82 @@ typedef struct ds_gl {
     "  return c + vec3(1.0, 0.8, 0.5) * 0.5 * pow(max(dot(d, sun), 0.0), 24.0);\n"                                \
     "}\n"
 
+#define DS_GLSL_ALBEDO \
+    "vec3 ground() {\n" \
+    "  vec2 q = wp.xz; float g = fbm(q * 1.7);\n" \
+    "  vec3 c = mix(vec3(0.17, 0.30, 0.08), vec3(0.38, 0.48, 0.15), g);\n" \
+    "  c = mix(c, vec3(0.40, 0.33, 0.22), 0.8 * smoothstep(0.58, 0.72, fbm(q * 0.22 + 7.0)));\n" \
+    "  float px = abs(q.x - 1.0 - 1.2 * sin(q.y * 0.28)), plaza = length((q - vec2(-1.0, -3.2)) * vec2(0.55, 0.8));\n" \
+    "  float path = max(smoothstep(1.05, 0.9, px), smoothstep(3.1, 2.9, plaza));\n" \
+    "  vec2 b = q / vec2(0.5, 0.36); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b) - 0.5;\n" \
+    "  float e = smoothstep(0.5, 0.36, max(abs(f.x), abs(f.y)));\n" \
+    "  vec3 st = mix(vec3(0.40, 0.38, 0.35), vec3(0.62, 0.58, 0.52), hash(floor(b))) * (0.45 + 0.55 * e);\n" \
+    "  return mix(c, st * (0.85 + 0.3 * g), path * smoothstep(0.15, 0.4, fbm(q * 0.9 + 2.0) + 0.3));\n" \
+    "}\n" \
+    "vec2 face_uv(vec3 n) { return abs(n.x) > 0.7 ? wp.zy : abs(n.y) > 0.7 ? wp.xz : wp.xy; }\n" \
+    "vec3 albedo(vec3 n) {\n" \
+    "  vec2 uv = face_uv(n);\n" \
+    "  if (material == 0) return ground();\n" \
+    "  if (material == 1) { vec2 b = uv / vec2(0.7, 0.35); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b);\n" \
+    "    float m = smoothstep(0.0, 0.05, f.x) * smoothstep(1.0, 0.95, f.x) * smoothstep(0.0, 0.09, f.y)\n" \
+    "      * smoothstep(1.0, 0.91, f.y);\n" \
+    "    return color * (0.82 + 0.3 * hash(floor(b))) * mix(0.6, 1.0, m) * (0.85 + 0.3 * fbm(uv * 5.0)); }\n" \
+    "  if (material == 2) return color * (0.8 + 0.3 * fbm(uv * 3.0)) * (0.9 + 0.1 * smoothstep(0.3, 0.6, wp.y));\n" \
+    "  if (material == 3) { float r = fract(dot(wp, vec3(0.0, 4.0, 4.0))), c = fract(wp.x * 3.0 + 0.5 * floor(dot(wp, vec3(0.0, 4.0, 4.0))));\n" \
+    "    return color * (0.75 + 0.3 * hash(floor(vec2(wp.x * 3.0, dot(wp, vec3(0.0, 4.0, 4.0)))))) * mix(0.55, 1.0, smoothstep(0.0, 0.15, r))\n" \
+    "      * mix(0.8, 1.0, smoothstep(0.0, 0.06, c)); }\n" \
+    "  if (material == 4) return color * (0.6 + 0.6 * fbm(uv * 2.5 + wp.y)) * mix(vec3(1.0), vec3(0.75, 0.85, 0.6),\n" \
+    "    smoothstep(0.3, 0.9, n.y) * 0.8);\n" \
+    "  if (material == 5) return color * (0.7 + 0.4 * noise(vec2(atan(n.z, n.x) * 6.0, wp.y * 3.0)));\n" \
+    "  if (material == 6) return color * (0.65 + 0.6 * fbm(vec2(atan(n.z, n.x) * 3.0, wp.y * 6.0)));\n" \
+    "  if (material == 8) return color * (0.75 + 0.35 * noise(vec2(uv.x * 14.0, uv.y * 1.5)));\n" \
+    "  return color;\n" \
+    "}\n"
+
+/* general 4x4 inverse (column-major); returns 0 for a singular matrix */
+static inline int ds_invert(float out[16], const float m[16])
+{
+    double a[4][8], t;
+    int c, r, k, piv;
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 8; ++c) a[r][c] = c < 4 ? m[c * 4 + r] : (c - 4 == r);
+    for (c = 0; c < 4; ++c) {
+        for (piv = c, r = c + 1; r < 4; ++r)
+            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
+        if (fabs(a[piv][c]) < 1e-30) return 0;
+        for (k = 0; k < 8; ++k) t = a[c][k], a[c][k] = a[piv][k], a[piv][k] = t;
+        for (t = a[c][c], k = 0; k < 8; ++k) a[c][k] /= t;
+        for (r = 0; r < 4; ++r)
+            if (r != c)
+                for (t = a[r][c], k = 0; k < 8; ++k) a[r][k] -= t * a[c][k];
+    }
+    for (r = 0; r < 4; ++r)
+        for (c = 0; c < 4; ++c) out[c * 4 + r] = (float)a[r][c + 4];
+    return 1;
+}
+
+/* ---- the opaque renderer (GL 3.3 core; left out with DS_SCENE_ONLY) ----------------- */
+#ifndef DS_SCENE_ONLY
+
+typedef struct ds_gl {
+    GLuint prog, sky, vao[DS_MAX_MESHES], vbo[DS_MAX_MESHES], ebo[DS_MAX_MESHES], empty_vao;
+    GLuint shadow_prog, shadow_fbo, shadow_tex; /* the sun's shadow map, rendered once */
+    GLint u_mvp, u_model, u_color, u_material, u_eye, u_sky_inv, u_shadow_vp, u_shadow_map, u_shadow_mvp;
+    int count[DS_MAX_MESHES];
+    float shadow_vp[16];
+} ds_gl;
+
+#define DS_SHADOW_SIZE 2048
+
+#define DS_GLSL_COMMON "#version 330 core\n" DS_GLSL_FUNCS
+
 static const char *const ds__vs = "#version 330 core\n"
                             "layout(location = 0) in vec3 p;\n"
                             "uniform mat4 mvp, model; out vec3 wp;\n"
                             "void main() { wp = (model * vec4(p, 1.0)).xyz; gl_Position = mvp * vec4(p, 1.0); }\n";
 
 static const char *const ds__fs_albedo =
-    "in vec3 wp; uniform vec3 color, eye; uniform int material; out vec4 o;\n"
-    "vec3 ground() {\n"
-    "  vec2 q = wp.xz; float g = fbm(q * 1.7);\n"
-    "  vec3 c = mix(vec3(0.17, 0.30, 0.08), vec3(0.38, 0.48, 0.15), g);\n"
-    "  c = mix(c, vec3(0.40, 0.33, 0.22), 0.8 * smoothstep(0.58, 0.72, fbm(q * 0.22 + 7.0)));\n"
-    "  float px = abs(q.x - 1.0 - 1.2 * sin(q.y * 0.28)), plaza = length((q - vec2(-1.0, -3.2)) * vec2(0.55, 0.8));\n"
-    "  float path = max(smoothstep(1.05, 0.9, px), smoothstep(3.1, 2.9, plaza));\n"
-    "  vec2 b = q / vec2(0.5, 0.36); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b) - 0.5;\n"
-    "  float e = smoothstep(0.5, 0.36, max(abs(f.x), abs(f.y)));\n"
-    "  vec3 st = mix(vec3(0.40, 0.38, 0.35), vec3(0.62, 0.58, 0.52), hash(floor(b))) * (0.45 + 0.55 * e);\n"
-    "  return mix(c, st * (0.85 + 0.3 * g), path * smoothstep(0.15, 0.4, fbm(q * 0.9 + 2.0) + 0.3));\n"
-    "}\n"
-    "vec2 face_uv(vec3 n) { return abs(n.x) > 0.7 ? wp.zy : abs(n.y) > 0.7 ? wp.xz : wp.xy; }\n"
-    "vec3 albedo(vec3 n) {\n"
-    "  vec2 uv = face_uv(n);\n"
-    "  if (material == 0) return ground();\n"
-    "  if (material == 1) { vec2 b = uv / vec2(0.7, 0.35); b.x += 0.5 * mod(floor(b.y), 2.0); vec2 f = fract(b);\n"
-    "    float m = smoothstep(0.0, 0.05, f.x) * smoothstep(1.0, 0.95, f.x) * smoothstep(0.0, 0.09, f.y)\n"
-    "      * smoothstep(1.0, 0.91, f.y);\n"
-    "    return color * (0.82 + 0.3 * hash(floor(b))) * mix(0.6, 1.0, m) * (0.85 + 0.3 * fbm(uv * 5.0)); }\n"
-    "  if (material == 2) return color * (0.8 + 0.3 * fbm(uv * 3.0)) * (0.9 + 0.1 * smoothstep(0.3, 0.6, wp.y));\n"
-    "  if (material == 3) { float r = fract(dot(wp, vec3(0.0, 4.0, 4.0))), c = fract(wp.x * 3.0 + 0.5 * floor(dot(wp, vec3(0.0, 4.0, 4.0))));\n"
-    "    return color * (0.75 + 0.3 * hash(floor(vec2(wp.x * 3.0, dot(wp, vec3(0.0, 4.0, 4.0)))))) * mix(0.55, 1.0, smoothstep(0.0, 0.15, r))\n"
-    "      * mix(0.8, 1.0, smoothstep(0.0, 0.06, c)); }\n"
-    "  if (material == 4) return color * (0.6 + 0.6 * fbm(uv * 2.5 + wp.y)) * mix(vec3(1.0), vec3(0.75, 0.85, 0.6),\n"
-    "    smoothstep(0.3, 0.9, n.y) * 0.8);\n"
-    "  if (material == 5) return color * (0.7 + 0.4 * noise(vec2(atan(n.z, n.x) * 6.0, wp.y * 3.0)));\n"
-    "  if (material == 6) return color * (0.65 + 0.6 * fbm(vec2(atan(n.z, n.x) * 3.0, wp.y * 6.0)));\n"
-    "  if (material == 8) return color * (0.75 + 0.35 * noise(vec2(uv.x * 14.0, uv.y * 1.5)));\n"
-    "  return color;\n"
-    "}\n";
+    "in vec3 wp; uniform vec3 color, eye; uniform int material; out vec4 o;\n" DS_GLSL_ALBEDO;
 
 static const char *const ds__fs_main =
     "uniform mat4 shadow_vp; uniform sampler2DShadow shadow_map;\n"
@@ -522,28 +581,6 @@ static inline void ds_gl_free(ds_gl *g)
     memset(g, 0, sizeof *g);
 }
 
-/* general 4x4 inverse (column-major); returns 0 for a singular matrix */
-static inline int ds_invert(float out[16], const float m[16])
-{
-    double a[4][8], t;
-    int c, r, k, piv;
-    for (r = 0; r < 4; ++r)
-        for (c = 0; c < 8; ++c) a[r][c] = c < 4 ? m[c * 4 + r] : (c - 4 == r);
-    for (c = 0; c < 4; ++c) {
-        for (piv = c, r = c + 1; r < 4; ++r)
-            if (fabs(a[r][c]) > fabs(a[piv][c])) piv = r;
-        if (fabs(a[piv][c]) < 1e-30) return 0;
-        for (k = 0; k < 8; ++k) t = a[c][k], a[c][k] = a[piv][k], a[piv][k] = t;
-        for (t = a[c][c], k = 0; k < 8; ++k) a[c][k] /= t;
-        for (r = 0; r < 4; ++r)
-            if (r != c)
-                for (t = a[r][c], k = 0; k < 8; ++k) a[r][k] -= t * a[c][k];
-    }
-    for (r = 0; r < 4; ++r)
-        for (c = 0; c < 4; ++c) out[c * 4 + r] = (float)a[r][c + 4];
-    return 1;
-}
-
 /* The engine's opaque pass: clears the bound framebuffer's colour and depth to the
    viewport, draws the sky and the opaque objects (colour + depth). Leaves depth test,
    culling and blending disabled, program and vertex array 0. */
@@ -590,4 +627,5 @@ static inline void ds_draw(ds_gl *g, const ds_scene *s, const float view[16], co
     glBindVertexArray(0);
 }
 
+#endif /* DS_SCENE_ONLY */
 #endif /* DEMO_SCENE_H */

@@ -250,12 +250,13 @@ int main(int argc, char **argv)
                     }
     /* image-space effects: every effect variant in every dialect (post_<effect><variant>_<dialect>) */
     {
-        static const int eff[6] = {FOGVOL_POST_DOF, FOGVOL_POST_DOF, FOGVOL_POST_DOF, FOGVOL_POST_OUTLINES,
+        static const int eff[8] = {FOGVOL_POST_DOF,      FOGVOL_POST_DOF,      FOGVOL_POST_DOF,
+                                   FOGVOL_POST_DOF,      FOGVOL_POST_DOF,      FOGVOL_POST_OUTLINES,
                                    FOGVOL_POST_OUTLINES, FOGVOL_POST_DISTANCE_FOG};
-        static const int var[6] = {3, 6, 12, 0, 1, 0};
+        static const int var[8] = {3, 6, 12, 24, 48, 0, 1, 0};
         static const char *const ename[FOGVOL_POST_EFFECT_COUNT] = {"dof", "outlines", "fog"};
         int e;
-        for (e = 0; e < 6; ++e)
+        for (e = 0; e < 8; ++e)
             for (d = 1; d < FOGVOL_GLSL_COUNT; ++d)
                 for (st = 0; st < 2; ++st) {
                     const char *s[FOGVOL_MAX_SHADER_STRINGS];

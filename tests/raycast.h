@@ -692,6 +692,47 @@ RC__FN rc_result rc_trace(const rc_scene *sc, const rc_camera *cam, double sx, d
   return r;
 }
 
+/* The chords of sample (sx,sy): per volume object, each maximal interval of view depth w in
+   [znear, min(zfar, opaque_w)] where that object's winding count is positive, as pairs
+   (ab[2k], ab[2k+1]) with obj[k] the object's index (obj may be NULL). Returns the count
+   (<= cap; -1 on allocation failure). */
+RC__FN int rc_chords(const rc_scene *sc, const rc_camera *cam, double sx, double sy, double *ab, int *obj, int cap) {
+  rc__hitbuf buf;
+  rc__ray ray;
+  double o[3], d[3], zn = cam->znear, zf = cam->zfar, opaque, end;
+  int i, k, n = 0, oom = 0, nearest = -1;
+  rc_camera_ray(cam, sx, sy, o, d);
+  rc__ray_setup(&ray, o, d);
+  rc__hitbuf_init(&buf);
+  opaque = rc__occluders(sc, &ray, zn, zf, &buf, &nearest, NULL, &oom);
+  end = opaque < zf ? opaque : zf;
+  for (i = 0; i < sc->count; i++) {
+    int cnt = 0;
+    double start = 0.0;
+    if (sc->objs[i].sign == 0) continue;
+    buf.n = 0;
+    rc__object_hits(&sc->objs[i], &ray, -INFINITY, INFINITY, &buf);
+    oom |= buf.oom;
+    rc__sort(&buf);
+    for (k = 0; k < buf.n; k++) {
+      int was = cnt > 0;
+      cnt += buf.h[k].enter ? 1 : -1;
+      if (!was && cnt > 0) start = buf.h[k].t;
+      if (was && cnt <= 0) {
+        double a = start < zn ? zn : start, b = buf.h[k].t > end ? end : buf.h[k].t;
+        if (b > a && n < cap) {
+          ab[2 * n] = a;
+          ab[2 * n + 1] = b;
+          if (obj) obj[n] = i;
+          n++;
+        }
+      }
+    }
+  }
+  rc__hitbuf_free(&buf);
+  return oom ? -1 : n;
+}
+
 /* The view depths w of sample (sx,sy) that a rasteriser's faces produce: the nearest occluder
    crossing (if before zfar) and every volume crossing in [znear, min(zfar, opaque_w)], per
    volume in t order. Returns the count (<= cap; -1 on allocation failure). */

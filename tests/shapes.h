@@ -128,6 +128,33 @@ SHP__FN shp_mesh shp_box(float hx, float hy, float hz) {
   return m;
 }
 
+/* Capped cylinder around the y axis, radius r, from y = -hy to +hy, n >= 3 sides; 2n + 2 vertices:
+   bottom ring i = (r cos a, -hy, r sin a), top ring n + i, a = 2 pi i / n, then the caps' centres. */
+SHP__FN shp_mesh shp_cylinder(float r, float hy, int n) {
+  shp_mesh m;
+  unsigned *p;
+  int i, bc = 2 * n, tc = 2 * n + 1;
+  if (n < 3 || !(r > 0) || !(hy > 0)) return shp__zero();
+  m = shp__alloc(2.0 * n + 2, 12.0 * n);
+  if (!m.pos) return m;
+  for (i = 0; i < n; i++) {
+    double a = 2.0 * SHP__PI * i / n;
+    shp__setv(&m, i, r * cos(a), -hy, r * sin(a));
+    shp__setv(&m, n + i, r * cos(a), hy, r * sin(a));
+  }
+  shp__setv(&m, bc, 0, -hy, 0);
+  shp__setv(&m, tc, 0, hy, 0);
+  p = m.idx;
+  for (i = 0; i < n; i++) {
+    int j = (i + 1) % n;
+    shp__tri(&p, i, n + i, n + j);
+    shp__tri(&p, i, n + j, j);
+    shp__tri(&p, tc, n + j, n + i);
+    shp__tri(&p, bc, i, j);
+  }
+  return m;
+}
+
 /* Torus around the z axis (ring in the xy plane), major radius R, tube radius r (0 < r < R).
    nu >= 3 segments around the ring, nv >= 3 around the tube.
    Vertex (i,j) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v), u = 2 pi i/nu, v = 2 pi j/nv,

@@ -7,11 +7,14 @@
    OSMesa framebuffer. Each picture is compared pixel by pixel with a CPU
    reference of the same formula written here from the analytic view depths
    (not from fogvol's linearisation):
-   - depth of field: out = (C0 + sum_k mix(C0, Ck, c(ek))) / (taps + 1), c(e) =
-     clamp(|e - focus| / range, 0, 1), taps at round(c(e0) * R * dir_k), for
-     3, 6 and 12 taps; an in-focus square keeps its colour exactly and the
-     blurred background next to it takes none of it (an unweighted blur, also
-     computed, would halo);
+   - depth of field: taps on a golden-angle spiral turned and jittered per pixel and per frame
+     (fogvol_frame_desc.dither_frame), each tap entering as mix(C0, Ck, c(ek)), c(e) =
+     clamp(|e - focus| / range, 0, 1): against continuous disc blurs computed here by area (the
+     weighted one, and an unweighted one that halos), for 3 ... 48 taps: an in-focus square keeps its
+     colour exactly, the blurred background next to it takes none of it on average (the unweighted
+     blur brings in +24/255 of its red), and a fully blurred checkerboard stays within stated bounds of
+     the disc blur: one frame's 4x4 block means, and the mean of 64 frames per pixel (the kernel's
+     expectation, where fogvol 0.2's fixed kernel kept its copies: 67/255 and 32/255 off);
    - outlines: second differences of 1/e over lines of three pixels and
      normal deltas over the 3x3 neighbourhood, thresholded; outlines exactly
      where the depth jumps or the normals crease, none on a sloped plane;
@@ -168,6 +171,7 @@ static int teardown(void **state)
 #define FOCUS 6.0
 #define RANGE 4.0
 #define RADIUS 4.0
+#define RADIUS_DISC 6.0
 
 static int in_square(int px, int py) { return px >= 24 && px < 40 && py >= 14 && py < 30; }
 
@@ -188,8 +192,49 @@ static double coc(double e)
 
 static int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 
-/* the CPU reference; weighted = 0: every tap with weight 1 (the halo-prone blur) */
-static void dof_reference(const unsigned char *src, const double *e, int taps, int weighted, double *out)
+/* The continuous references. The GPU samples the image at whole-pixel offsets round(o) from a
+   pixel centre, i.e. the image as piecewise constant over pixel squares at the exact point p + o.
+   Over the rotations of its spiral a tap averages the image over a circle, and the taps' radii
+   sqrt((k + 0.5) / taps) R average the circles over the disc: in expectation the disc blur
+   (1/(pi r^2)) integral over |q| < r of mix(C0, C(p + q), c(e(p + q))) dq, computed here by the area
+   each pixel square shares with the disc (a 16 x 16 grid per square), image clamped at its edges.
+   weighted = 0: every point with weight 1 (the halo-prone blur of the in-focus square). */
+static void disc_blur(const unsigned char *src, const double *e, double radius_of_coc, int weighted, double *out)
+{
+    int px, py, c;
+    for (py = 0; py < H; ++py)
+        for (px = 0; px < W; ++px) {
+            int i = py * W + px, dx, dy, ext;
+            double r = coc(e[i]) * radius_of_coc, sum[4] = {0, 0, 0, 0}, wsum = 0;
+            if (r <= 0) {
+                for (c = 0; c < 4; ++c) out[4 * i + c] = src[4 * i + c];
+                continue;
+            }
+            ext = (int)ceil(r + 0.5);
+            for (dy = -ext; dy <= ext; ++dy)
+                for (dx = -ext; dx <= ext; ++dx) {
+                    int j = clampi(py + dy, 0, H - 1) * W + clampi(px + dx, 0, W - 1), su, sv, inside = 0;
+                    double w;
+                    for (sv = 0; sv < 16; ++sv)
+                        for (su = 0; su < 16; ++su) {
+                            double qx = dx - 0.5 + (su + 0.5) / 16.0, qy = dy - 0.5 + (sv + 0.5) / 16.0;
+                            inside += qx * qx + qy * qy < r * r;
+                        }
+                    if (!inside) continue;
+                    w = inside / 256.0;
+                    wsum += w;
+                    for (c = 0; c < 4; ++c) {
+                        double k = weighted ? coc(e[j]) : 1.0;
+                        sum[c] += w * (src[4 * i + c] + (src[4 * j + c] - src[4 * i + c]) * k);
+                    }
+                }
+            for (c = 0; c < 4; ++c) out[4 * i + c] = sum[c] / wsum;
+        }
+}
+
+/* fogvol 0.2's kernel, for the figures of what it did: fixed directions (3: a triangle, 6: + the
+   opposite one, 12: + a half-radius hexagon) at round(r dir_k), out = (C0 + sum_k ...) / (taps + 1) */
+static void old_kernel(const unsigned char *src, const double *e, int taps, double radius, double *out)
 {
     static const double dir[12][2] = {{0.0, 1.0},   {-0.8660254, -0.5}, {0.8660254, -0.5}, {0.0, -1.0},
                                       {0.8660254, 0.5}, {-0.8660254, 0.5}, {0.5, 0.0},     {0.25, 0.4330127},
@@ -198,16 +243,46 @@ static void dof_reference(const unsigned char *src, const double *e, int taps, i
     for (py = 0; py < H; ++py)
         for (px = 0; px < W; ++px) {
             int i = py * W + px;
-            double r = coc(e[i]) * RADIUS, sum[4];
+            double r = coc(e[i]) * radius, sum[4];
             for (c = 0; c < 4; ++c) sum[c] = src[4 * i + c];
             for (k = 0; k < taps; ++k) {
                 int qx = clampi(px + (int)floor(dir[k][0] * r + 0.5), 0, W - 1);
                 int qy = clampi(py + (int)floor(dir[k][1] * r + 0.5), 0, H - 1), j = qy * W + qx;
-                double w = weighted ? coc(e[j]) : 1.0;
-                for (c = 0; c < 4; ++c) sum[c] += src[4 * i + c] + (src[4 * j + c] - src[4 * i + c]) * w;
+                for (c = 0; c < 4; ++c) sum[c] += src[4 * i + c] + (src[4 * j + c] - src[4 * i + c]) * coc(e[j]);
             }
             for (c = 0; c < 4; ++c) out[4 * i + c] = sum[c] / (taps + 1);
         }
+}
+
+/* error figures of an RGBA picture against a reference over the pixels at least m from the edges:
+   per-pixel max and RMS, and the max of 4x4 block means (what the eye takes in at a glance) */
+typedef struct dof_err {
+    double max, rms, block;
+} dof_err;
+
+static dof_err dof_compare(const double *got, const double *ref, int m)
+{
+    dof_err r = {0, 0, 0};
+    int px, py, c, n = 0;
+    for (py = m; py < H - m; ++py)
+        for (px = m; px < W - m; ++px)
+            for (c = 0; c < 3; ++c) {
+                double d = got[4 * (py * W + px) + c] - ref[4 * (py * W + px) + c];
+                r.max = fmax(r.max, fabs(d));
+                r.rms += d * d;
+                ++n;
+            }
+    r.rms = sqrt(r.rms / n);
+    for (py = m; py + 4 <= H - m; py += 2)
+        for (px = m; px + 4 <= W - m; px += 2)
+            for (c = 0; c < 3; ++c) {
+                double sum = 0;
+                int u, v;
+                for (v = 0; v < 4; ++v)
+                    for (u = 0; u < 4; ++u) sum += got[4 * ((py + v) * W + px + u) + c] - ref[4 * ((py + v) * W + px + u) + c];
+                r.block = fmax(r.block, fabs(sum / 16.0));
+            }
+    return r;
 }
 
 static void dof_scene(unsigned char *src, double *e)
@@ -228,56 +303,86 @@ static void dof_scene(unsigned char *src, double *e)
         }
 }
 
+/* The GPU's picture of fogvol_post_dof: one frame (dither_frame = frame) into px (bytes as doubles);
+   with frames > 1 the mean of dither_frame 1 .. frames (what an engine accumulating frames sees) */
+static void dof_run(fx *x, fogvol_dof_desc *dd, fogvol_frame_desc *fd, int frames, double *px)
+{
+    int f, i;
+    for (i = 0; i < 4 * W * H; ++i) px[i] = 0.0;
+    for (f = frames > 1 ? 1 : 0; f <= (frames > 1 ? frames : 0); ++f) {
+        fd->dither_frame = f;
+        clear_fb(0, 0, 0);
+        assert_int_equal(fogvol_post_dof(x->fv, dd), FOGVOL_SUCCESS);
+        glu_pixels(&x->g);
+        for (i = 0; i < 4 * W * H; ++i) px[i] += x->g.pixels[i] / (double)(frames > 1 ? frames : 1);
+    }
+    fd->dither_frame = 0;
+}
+
+/* Edge preservation: an in-focus square keeps its colour exactly, and the blurred background next to it
+   takes none of it: the GPU (one frame; the mean of 8) follows the weighted disc blur, which an
+   unweighted blur misses by > 40/255 there (a halo of the square's red). */
 static void test_dof(void **state)
 {
     fx *x = (fx *)*state;
-    static const int tapset[3] = {3, 6, 12};
+    static const int tapset[5] = {3, 6, 12, 24, 48};
     unsigned char *src = (unsigned char *)malloc(4 * W * H);
     double *e = (double *)malloc(sizeof(double) * W * H), *ref = (double *)malloc(sizeof(double) * 4 * W * H),
-           *naive = (double *)malloc(sizeof(double) * 4 * W * H);
+           *naive = (double *)malloc(sizeof(double) * 4 * W * H), *px = (double *)malloc(sizeof(double) * 4 * W * H);
     fogvol_frame_desc fd;
     fogvol_dof_desc dd;
     GLuint tc, tdep;
-    int t, i, c;
+    int t, i, c, frames;
     dof_scene(src, e);
     camera(CONV_GL, &fd);
     tc = rgba_texture(src, 1); /* a filtered texture: the taps land on texel centres */
     tdep = depth_texture(&fd, e);
     fd.engine_depth_texture = tdep;
-    for (t = 0; t < 3; ++t) {
-        double maxerr = 0.0, halo_naive = 0.0;
-        int square_exact = 1, near_edge = 0;
-        memset(&dd, 0, sizeof dd);
-        dd.frame = &fd;
-        dd.color_texture = tc;
-        dd.focus_distance = (float)FOCUS;
-        dd.focus_range = (float)RANGE;
-        dd.max_radius = (float)RADIUS;
-        dd.taps = tapset[t];
-        clear_fb(0, 0, 0);
-        assert_int_equal(fogvol_post_dof(x->fv, &dd), FOGVOL_SUCCESS);
-        glu_pixels(&x->g);
-        dof_reference(src, e, tapset[t], 1, ref);
-        dof_reference(src, e, tapset[t], 0, naive);
-        for (i = 0; i < W * H; ++i) {
-            int px = i % W, py = i / W, bg_near = !in_square(px, py) && py >= 8 && px >= 20 && px < 44 && py >= 10 &&
-                                               py < 34;
-            for (c = 0; c < 4; ++c) {
-                double d = fabs(x->g.pixels[4 * i + c] - ref[4 * i + c]);
-                if (d > maxerr) maxerr = d;
-                if (bg_near && fabs(naive[4 * i + c] - ref[4 * i + c]) > halo_naive)
-                    halo_naive = fabs(naive[4 * i + c] - ref[4 * i + c]);
+    disc_blur(src, e, RADIUS, 1, ref);
+    disc_blur(src, e, RADIUS, 0, naive);
+    for (t = 0; t < 5; ++t)
+        for (frames = 1; frames <= 8; frames += 7) {
+            double halo_naive = 0.0, halo_gpu = 0.0, near_err = 0.0;
+            int square_exact = 1, near_edge = 0;
+            memset(&dd, 0, sizeof dd);
+            dd.frame = &fd;
+            dd.color_texture = tc;
+            dd.focus_distance = (float)FOCUS;
+            dd.focus_range = (float)RANGE;
+            dd.max_radius = (float)RADIUS;
+            dd.taps = tapset[t];
+            dof_run(x, &dd, &fd, frames, px);
+            for (i = 0; i < W * H; ++i) {
+                int pxl = i % W, py = i / W;
+                int bg_near = !in_square(pxl, py) && py >= 8 && pxl >= 20 && pxl < 44 && py >= 10 && py < 34;
+                for (c = 0; c < 4; ++c) {
+                    if (in_square(pxl, py) && px[4 * i + c] != src[4 * i + c]) square_exact = 0;
+                    if (!bg_near || c == 3) continue;
+                    /* the red channel: how much of the square's colour came in, on average */
+                    if (c == 0) {
+                        halo_naive += naive[4 * i] - ref[4 * i];
+                        halo_gpu += px[4 * i] - ref[4 * i];
+                    }
+                    near_err += fabs(px[4 * i + c] - ref[4 * i + c]);
+                }
+                near_edge += bg_near;
             }
-            if (in_square(px, py) && memcmp(x->g.pixels + 4 * i, src + 4 * i, 4) != 0) square_exact = 0;
-            near_edge += bg_near;
+            halo_naive /= near_edge;
+            halo_gpu /= near_edge;
+            print_message("# dof %2d taps, %d frame%s: in-focus square exact %d; next to it (%d pixels) red above the "
+                          "weighted disc blur, mean: GPU %+.1f/255, an unweighted blur %+.1f/255; mean |GPU - weighted| "
+                          "%.1f/255\n", tapset[t], frames, frames > 1 ? "s" : "", square_exact, near_edge,
+                          halo_gpu, halo_naive, near_err / (3.0 * near_edge));
+            assert_true(square_exact);                        /* in focus: untouched */
+            assert_true(near_edge > 100 && halo_naive > 20.0); /* the weighting is what keeps the edge clean */
+            assert_true(fabs(halo_gpu) < 3.0);
+            if (t == 2 && frames == 1) {
+                unsigned char *b = (unsigned char *)malloc(4 * W * H);
+                for (i = 0; i < 4 * W * H; ++i) b[i] = (unsigned char)(px[i] + 0.5);
+                save_png("dof.png", b);
+                free(b);
+            }
         }
-        printf("# dof %2d taps: max |GPU - CPU| = %.3f /255 over %d pixels; unweighted blur would differ by up to "
-               "%.1f /255 next to the in-focus square\n", tapset[t], maxerr, W * H, halo_naive);
-        assert_true(maxerr <= 1.0);
-        assert_true(square_exact);            /* in focus: untouched */
-        assert_true(near_edge > 100 && halo_naive > 40.0); /* the weighting is what keeps the edge clean */
-        if (t == 1) save_png("dof.png", x->g.pixels);
-    }
     save_png("dof_source.png", src);
     glDeleteTextures(1, &tc);
     glDeleteTextures(1, &tdep);
@@ -285,6 +390,97 @@ static void test_dof(void **state)
     free(e);
     free(ref);
     free(naive);
+    free(px);
+}
+
+/* Against a continuous disc blur: a fully blurred plane (c = 1, radius RADIUS_DISC) with a
+   high-contrast checkerboard and a diagonal edge. Per tap count: one frame's grain (RMS), the largest
+   4x4 block-mean error (copies of the taps or a pattern would show there), and the mean of 8 frames;
+   fogvol 0.2's fixed kernel (computed here) for comparison. */
+static void test_dof_disc(void **state)
+{
+    fx *x = (fx *)*state;
+    static const int tapset[4] = {6, 12, 24, 48};
+    /* bounds (/255): the mean of 64 frames (the kernel's expectation: copies of taps would stay there)
+       per pixel, and one frame's 4x4 block means (grain averaged as the eye does at a glance) */
+    static const double mean64_bound[4] = {12.0, 9.0, 5.0, 3.0}, block_bound[4] = {22.0, 14.0, 8.0, 5.0};
+    unsigned char *src = (unsigned char *)malloc(4 * W * H), *b = (unsigned char *)malloc(4 * W * H * 3);
+    double *e = (double *)malloc(sizeof(double) * W * H), *ref = (double *)malloc(sizeof(double) * 4 * W * H),
+           *px = (double *)malloc(sizeof(double) * 4 * W * H), *old = (double *)malloc(sizeof(double) * 4 * W * H);
+    fogvol_frame_desc fd;
+    fogvol_dof_desc dd;
+    GLuint tc, tdep;
+    int t, i, k, m = (int)RADIUS_DISC + 1;
+    dof_err e1, e8, e64, eo[2];
+    for (i = 0; i < W * H; ++i) {
+        int px_ = i % W, py = i / W, on = ((px_ / 6) + (py / 6)) % 2, edge = px_ + 2 * py > 80;
+        e[i] = 30.0;
+        src[4 * i + 0] = (unsigned char)(on ? 220 : 35);
+        src[4 * i + 1] = (unsigned char)(edge ? 200 : 60);
+        src[4 * i + 2] = (unsigned char)(on != edge ? 180 : 50);
+        src[4 * i + 3] = 255;
+    }
+    camera(CONV_GL, &fd);
+    tc = rgba_texture(src, 0);
+    tdep = depth_texture(&fd, e);
+    fd.engine_depth_texture = tdep;
+    disc_blur(src, e, RADIUS_DISC, 1, ref);
+    for (k = 0; k < 2; ++k) {
+        old_kernel(src, e, k ? 12 : 6, RADIUS_DISC, old);
+        eo[k] = dof_compare(old, ref, m);
+    }
+    print_message("# dof against a continuous disc blur (radius %.0f px, every pixel fully blurred): fogvol 0.2's "
+                  "fixed kernel: 6 taps max %.1f, RMS %.1f, 4x4 blocks %.1f; 12 taps max %.1f, RMS %.1f, 4x4 blocks "
+                  "%.1f (/255)\n", RADIUS_DISC, eo[0].max, eo[0].rms, eo[0].block, eo[1].max, eo[1].rms, eo[1].block);
+    for (t = 0; t < 4; ++t) {
+        memset(&dd, 0, sizeof dd);
+        dd.frame = &fd;
+        dd.color_texture = tc;
+        dd.focus_distance = (float)FOCUS;
+        dd.focus_range = (float)RANGE;
+        dd.max_radius = (float)RADIUS_DISC;
+        dd.taps = tapset[t];
+        dof_run(x, &dd, &fd, 1, px);
+        e1 = dof_compare(px, ref, m);
+        if (t == 1)
+            for (i = 0; i < 4 * W * H; ++i) b[i] = (unsigned char)(px[i] + 0.5);
+        dof_run(x, &dd, &fd, 8, px);
+        e8 = dof_compare(px, ref, m);
+        dof_run(x, &dd, &fd, 64, px);
+        e64 = dof_compare(px, ref, m);
+        print_message("# dof %2d taps: one frame: max %.1f, RMS %.1f (grain), 4x4 blocks %.1f; mean of 8 frames "
+                      "(dither_frame 1..8): max %.1f, RMS %.1f, 4x4 blocks %.1f; of 64: max %.1f, RMS %.1f, 4x4 "
+                      "blocks %.1f (/255; bounds: one frame's blocks %.0f, 64 frames' max %.0f)\n",
+                      tapset[t], e1.max, e1.rms, e1.block, e8.max, e8.rms, e8.block, e64.max, e64.rms, e64.block,
+                      block_bound[t], mean64_bound[t]);
+        assert_true(e1.block <= block_bound[t]);
+        assert_true(e64.max <= mean64_bound[t]);
+        if (t <= 1) assert_true(eo[t].max > mean64_bound[t]); /* the old kernel's copies never average away */
+    }
+    { /* source | reference | 12 taps, one frame */
+        unsigned char *row = (unsigned char *)malloc(4 * W * H * 3);
+        int y;
+        for (y = 0; y < H; ++y)
+            for (i = 0; i < W; ++i)
+                for (k = 0; k < 4; ++k) {
+                    row[4 * (y * 3 * W + i) + k] = src[4 * (y * W + i) + k];
+                    row[4 * (y * 3 * W + W + i) + k] = (unsigned char)(ref[4 * (y * W + i) + k] + 0.5);
+                    row[4 * (y * 3 * W + 2 * W + i) + k] = b[4 * (y * W + i) + k];
+                }
+        mkdir("build", 0777);
+        mkdir("build/post", 0777);
+        stbi_flip_vertically_on_write(1);
+        stbi_write_png("build/post/dof_disc.png", 3 * W, H, 4, row, 3 * W * 4);
+        free(row);
+    }
+    glDeleteTextures(1, &tc);
+    glDeleteTextures(1, &tdep);
+    free(src);
+    free(b);
+    free(e);
+    free(ref);
+    free(px);
+    free(old);
 }
 
 /* ---- outlines ----------------------------------------------------------------------------------- */
@@ -546,6 +742,8 @@ static void test_bad_input(void **state)
     assert_int_equal(fogvol_post_distance_fog(x->fv, &gd), FOGVOL_ERROR_INVALID_ARGUMENT); /* no ramp */
     dd.taps = 5;
     assert_int_equal(fogvol_post_dof(x->fv, &dd), FOGVOL_ERROR_INVALID_ARGUMENT);
+    dd.taps = 96;
+    assert_int_equal(fogvol_post_dof(x->fv, &dd), FOGVOL_ERROR_INVALID_ARGUMENT);
     dd.taps = 0;
     dd.focus_range = 0.0f;
     assert_int_equal(fogvol_post_dof(x->fv, &dd), FOGVOL_ERROR_INVALID_ARGUMENT);
@@ -756,6 +954,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_dof),
+        cmocka_unit_test(test_dof_disc),
         cmocka_unit_test(test_outlines_depth),
         cmocka_unit_test(test_outlines_normals),
         cmocka_unit_test(test_distance_fog),

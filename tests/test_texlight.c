@@ -20,6 +20,7 @@
 #include "tests/fogvol_test.h"
 #include "tests/gl_util.h"
 #include "tests/shapes.h"
+#include "tests/raycast.h"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -497,6 +498,162 @@ static void test_light_ps20(void **state)
                "light_ps20_single_alu_120");
 }
 
+/* ---- light falloff and soft edge ----------------------------------------------------------------- */
+static const double g_fpos[3] = {-0.3, 1.6, 0.0}, g_frad = 2.6, g_fedge = 0.4;
+
+/* the view ray of pixel (x, y): origin the eye, direction with view-axis component 1 (t = view depth) */
+static void pixel_ray(const float view[16], const float proj[16], int x, int y, double dir[3])
+{
+    double v[3] = {(2.0 * (x + 0.5) / TW - 1.0) / proj[0], (2.0 * (y + 0.5) / TH - 1.0) / proj[5], -1.0};
+    int k;
+    for (k = 0; k < 3; ++k) dir[k] = view[k * 4 + 0] * v[0] + view[k * 4 + 1] * v[1] + view[k * 4 + 2] * v[2];
+}
+
+/* the light box's entry and exit view depths on the ray (slabs in its own frame) */
+static void box_span(const double dir[3], double *t0, double *t1)
+{
+    double a = g_ang * 3.14159265358979 / 180.0, o[3], d[3], lo = -1e30, hi = 1e30;
+    int k;
+    for (k = 0; k < 3; ++k) o[k] = g_eye[k] - g_lpos[k];
+    { /* inverse rotation, as box_margin */
+        double ox = cos(a) * o[0] - sin(a) * o[2], oz = sin(a) * o[0] + cos(a) * o[2];
+        double dx = cos(a) * dir[0] - sin(a) * dir[2], dz = sin(a) * dir[0] + cos(a) * dir[2];
+        o[0] = ox, o[2] = oz, d[0] = dx, d[1] = dir[1], d[2] = dz;
+    }
+    for (k = 0; k < 3; ++k) {
+        double u = (-g_half[k] - o[k]) / d[k], v = (g_half[k] - o[k]) / d[k];
+        lo = fmax(lo, fmin(u, v));
+        hi = fmin(hi, fmax(u, v));
+    }
+    *t0 = lo;
+    *t1 = hi;
+}
+
+/* the lit colour's factor at scene depth t with the light's front and back depths tf, tb */
+static double falloff_weight(const double dir[3], double t, double tf, double tb)
+{
+    double p[3], r2 = 0.0, w, m;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        p[k] = g_eye[k] + t * dir[k];
+        r2 += (p[k] - g_fpos[k]) * (p[k] - g_fpos[k]);
+    }
+    r2 /= g_frad * g_frad;
+    w = r2 < 1.0 ? (1.0 - r2) * (1.0 - r2) : 0.0;
+    m = fmin(t - tf, tb - t) / g_fedge;
+    return w * (m < 0 ? 0 : m > 1 ? 1 : m);
+}
+
+/* The light with falloff and a soft edge against the reference: colour * w(|p - position|) *
+   clamp(m / edge, 0, 1) with p the ray-cast scene point and m its depth margin to the box's faces;
+   the GPU's depths may be off by depth_err (view units: the encoding's LSB on RGBA8), so each pixel
+   is checked against the reference's range over those perturbations, +-1/255. */
+static void light_falloff_case(fogvol_tier tier, unsigned variants, double depth_err, const char *name)
+{
+    static const float rgb[3] = {0.8f, 0.6f, 0.2f};
+    glu_ctx g;
+    fogvol_context *fv = make_ctx(&g, tier, variants, FOGVOL_GLSL_AUTO);
+    fogvol_mesh *ground = mesh_of(fv, shp_box(6, 0.5f, 6), NULL), *sphere = mesh_of(fv, shp_sphere(1, 48, 24), NULL);
+    fogvol_mesh *lbox = mesh_of(fv, shp_box((float)g_half[0], (float)g_half[1], (float)g_half[2]), NULL);
+    fogvol_frame_desc fd;
+    fogvol_light_desc ld;
+    float gm[16], sm[16];
+    double emax = 0.0, over = 0.0;
+    int x, y, k, checked = 0, faded = 0;
+    shp_mesh mg = shp_box(6, 0.5f, 6), ms = shp_sphere(1, 48, 24);
+    rc_object ro[2];
+    rc_scene sc;
+    rc_camera cam;
+    memset(&cam, 0, sizeof cam);
+    memcpy(cam.eye, g_eye, sizeof cam.eye);
+    memcpy(cam.target, g_at, sizeof cam.target);
+    cam.up[1] = 1.0;
+    cam.fovy_deg = 55.0;
+    cam.aspect = 1.0;
+    cam.znear = 0.5;
+    cam.zfar = 30.0;
+    cam.width = TW;
+    cam.height = TH;
+    memset(&fd, 0, sizeof fd);
+    rc_camera_matrices(&cam, fd.view, fd.projection);
+    fd.znear = 0.5f;
+    fd.zfar = 30.0f;
+    fd.viewport[2] = TW;
+    fd.viewport[3] = TH;
+    glu_translate_scale(gm, 0, -0.5f, 0, 1);
+    glu_translate_scale(sm, (float)g_sph[0], (float)g_sph[1], (float)g_sph[2], (float)g_sph[3]);
+    memset(ro, 0, sizeof ro);
+    ro[0].pos = mg.pos, ro[0].vcount = mg.vcount, ro[0].idx = mg.idx, ro[0].icount = mg.icount;
+    ro[1].pos = ms.pos, ro[1].vcount = ms.vcount, ro[1].idx = ms.idx, ro[1].icount = ms.icount;
+    memcpy(ro[0].model, gm, sizeof gm);
+    memcpy(ro[1].model, sm, sizeof sm);
+    assert_true(rc_scene_init(&sc, ro, 2));
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_occluder(fv, ground, gm), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_occluder(fv, sphere, sm), FOGVOL_SUCCESS);
+    memset(&ld, 0, sizeof ld);
+    ld.mesh = lbox;
+    light_model(ld.model);
+    memcpy(ld.color, rgb, sizeof rgb);
+    for (k = 0; k < 3; ++k) ld.position[k] = (float)g_fpos[k];
+    ld.falloff_radius = (float)g_frad;
+    ld.edge_softness = (float)g_fedge;
+    assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    png(name, glu_pixels(&g));
+    for (y = 0; y < TH; ++y)
+        for (x = 0; x < TW; ++x) {
+            int ref = light_reference(fd.view, fd.projection, x, y), c, sgn;
+            const unsigned char *p = g.pixels + 4 * (y * TW + x);
+            double dir[3], t = 0.0, tf, tb, lo = 1e30, hi = -1e30;
+            if (ref < 0) continue;
+            ++checked;
+            if (!ref) {
+                if (p[0] || p[1] || p[2]) over = fmax(over, 255.0);
+                continue;
+            }
+            pixel_ray(fd.view, fd.projection, x, y, dir);
+            t = rc_trace(&sc, &cam, x + 0.5, y + 0.5).opaque_w; /* the drawn triangles' depth */
+            box_span(dir, &tf, &tb);
+            for (sgn = 0; sgn < 8; ++sgn) {
+                double v = falloff_weight(dir, t + (sgn & 1 ? depth_err : -depth_err), tf + (sgn & 2 ? depth_err : -depth_err),
+                                          tb + (sgn & 4 ? depth_err : -depth_err));
+                lo = fmin(lo, v);
+                hi = fmax(hi, v);
+            }
+            faded += falloff_weight(dir, t, tf, tb) < 0.9;
+            for (c = 0; c < 3; ++c) {
+                double want = 255.0 * rgb[c] * falloff_weight(dir, t, tf, tb);
+                double a = 255.0 * rgb[c] * lo - 1.0, b = 255.0 * rgb[c] * hi + 1.0;
+                emax = fmax(emax, fabs(p[c] - want));
+                if (p[c] < a) over = fmax(over, a - p[c]);
+                if (p[c] > b) over = fmax(over, p[c] - b);
+            }
+        }
+    print_message("# light falloff and soft edge (%s): %d pixels classified, %d lit pixels faded below 0.9; max "
+                  "|GPU - reference| %.2f/255 (depths exact), beyond the depth-error range + 1/255 by %.2f/255\n",
+                  name, checked, faded, emax, over);
+    assert_true(faded > 300);
+    assert_true(over == 0.0);
+    rc_scene_free(&sc);
+    shp_free(&mg);
+    shp_free(&ms);
+    fogvol_destroy_mesh(fv, ground);
+    fogvol_destroy_mesh(fv, sphere);
+    fogvol_destroy_mesh(fv, lbox);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+}
+
+static void test_light_falloff(void **state)
+{
+    (void)state;
+    light_falloff_case(FOGVOL_TIER_FLOAT, 0, 1e-4, "light_falloff_float");
+    light_falloff_case(FOGVOL_TIER_PS20, 0, 1.5 * 29.5 / 4096.0, "light_falloff_ps20");
+}
+
 /* Concave light meshes and tiers without the features are refused, with a logged reason. */
 static void test_refusals(void **state)
 {
@@ -566,7 +723,7 @@ int main(void)
         cmocka_unit_test(test_density_exact_float), cmocka_unit_test(test_density_exact_ps20),
         cmocka_unit_test(test_density_along_ray),   cmocka_unit_test(test_color_texture),
         cmocka_unit_test(test_light_float),         cmocka_unit_test(test_light_ps20),
-        cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_light_falloff),       cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,4 +1,5 @@
-/* demo_web.c - fogvol.h in the browser (emscripten, WebGL1 or WebGL2), and its own check.
+/* demo_web.c - fogvol.h in the browser (emscripten, WebGL1 or WebGL2): the demos' courtyard to fly
+   through with the page's controls (examples/web/courtyard.h), and, with ?test, the page's own check:
 
    A ground and a pillar (opaque, drawn by this program's GLSL ES 1.00 shader) and four fog
    volumes: a sphere the pillar cuts through, a turned box, a torus and a flat slab lying on
@@ -16,8 +17,8 @@
    page (tests/web_test.sh reads them with chromium --dump-dom) and sets document.title to
    "fogvol-web: PASS" or "fogvol-web: FAIL".
 
-   Build: make web (build/web/demo_web.html). Open demo_web.html?webgl1 for WebGL1 (the
-   default is WebGL2). */
+   Build: make web (build/web/demo_web.html). Open demo_web.html (WebGL2) or demo_web.html?webgl1;
+   demo_web.html?test&webgl1 or ?test&webgl2 for the check. */
 #define FOGVOL_IMPLEMENTATION
 #include "fogvol.h"
 #include <GLES2/gl2.h>
@@ -498,12 +499,16 @@ static void print_error_map(web *w)
     free(m);
 }
 
-/* the canvas's WebGL context of the version asked for; checks it is that version */
-static int create_context(web *w)
+#include "examples/web/courtyard.h"
+
+/* the canvas's WebGL context of the version asked for; checks it is that version (quiet: only say so
+   when it is not) */
+static int create_context(web *w, int quiet)
 {
     EmscriptenWebGLContextAttributes a;
     const char *ver, *ren;
     char line[300];
+    int ok;
     emscripten_webgl_init_context_attributes(&a);
     a.alpha = 0;
     a.depth = 1;
@@ -513,46 +518,66 @@ static int create_context(web *w)
     a.majorVersion = w->version;
     emscripten_set_canvas_element_size("#canvas", WW, WH);
     w->ctx = emscripten_webgl_create_context("#canvas", &a);
-    if (!check(w, w->ctx > 0, "WebGL context created")) return 0;
+    if (!(w->ctx > 0)) return check(w, 0, "WebGL context created");
+    if (!quiet) check(w, 1, "WebGL context created");
     emscripten_webgl_make_context_current(w->ctx);
     emscripten_webgl_enable_extension(w->ctx, "WEBGL_debug_renderer_info");
     ver = (const char *)glGetString(GL_VERSION);
     ren = (const char *)glGetString(0x9246 /* UNMASKED_RENDERER_WEBGL */);
     printf("# renderer: %s\n", ren ? ren : (const char *)glGetString(GL_RENDERER));
     snprintf(line, sizeof line, "context is \"%s\"", ver ? ver : "(null)");
-    return check(w, ver && strncmp(ver, w->version == 2 ? "OpenGL ES 3.0" : "OpenGL ES 2.0", 13) == 0 &&
-                        strstr(ver, w->version == 2 ? "WebGL 2.0" : "WebGL 1.0"), line);
+    ok = ver && strncmp(ver, w->version == 2 ? "OpenGL ES 3.0" : "OpenGL ES 2.0", 13) == 0 &&
+         strstr(ver, w->version == 2 ? "WebGL 2.0" : "WebGL 1.0");
+    return quiet && ok ? 1 : check(w, ok, line);
 }
 
+/* The self-test (?test): the checks above, TAP lines and the title. */
+static void self_test(web *w)
+{
+    int i;
+    w->cam.eye[1] = 2.2, w->cam.eye[2] = 7.5, w->cam.target[1] = 0.2, w->cam.up[1] = 1;
+    w->cam.fovy_deg = 50, w->cam.aspect = (double)WW / WH, w->cam.znear = 0.1, w->cam.zfar = 40;
+    w->cam.width = WW, w->cam.height = WH;
+    rc_camera_matrices(&w->cam, w->view, w->proj);
+    w->plain = (unsigned char *)calloc(WW * WH, 4);
+    w->fogged = (unsigned char *)calloc(WW * WH, 4);
+    w->gt = (double *)malloc(sizeof(double) * WW * WH);
+    w->interior = (unsigned char *)malloc(WW * WH);
+    w->clear = (unsigned char *)malloc(WW * WH);
+    if (create_context(w, 0)) {
+        build(w);
+        engine_init(w);
+        for (i = 0; i < w->n; ++i)
+            if (!w->obj[i].sign) engine_upload(&w->obj[i]);
+        engine_draw(w);
+        glReadPixels(0, 0, WW, WH, GL_RGBA, GL_UNSIGNED_BYTE, w->plain);
+        render_fog(w);
+        ground_truth(w, w->gt, w->interior, w->clear);
+        check_picture(w);
+        check_closed_form(w);
+        print_png("canvas", w->fogged);
+        print_error_map(w);
+    }
+    printf("1..%d\n", w->tap);
+    emscripten_run_script(w->failed ? "document.title = 'fogvol-web: FAIL'" : "document.title = 'fogvol-web: PASS'");
+}
+
+/* The page's query (location.search without '?'): webgl1 or webgl2 (the default) picks the context;
+   test: the self-test; drive: the interactive page driven by its own script (tests/web_test.sh);
+   otherwise the interactive page. */
 int main(int argc, char **argv)
 {
     static web w;
-    int i;
-    w.version = argc > 1 && strstr(argv[1], "webgl1") ? 1 : 2;
-    w.cam.eye[1] = 2.2, w.cam.eye[2] = 7.5, w.cam.target[1] = 0.2, w.cam.up[1] = 1;
-    w.cam.fovy_deg = 50, w.cam.aspect = (double)WW / WH, w.cam.znear = 0.1, w.cam.zfar = 40;
-    w.cam.width = WW, w.cam.height = WH;
-    rc_camera_matrices(&w.cam, w.view, w.proj);
-    w.plain = (unsigned char *)calloc(WW * WH, 4);
-    w.fogged = (unsigned char *)calloc(WW * WH, 4);
-    w.gt = (double *)malloc(sizeof(double) * WW * WH);
-    w.interior = (unsigned char *)malloc(WW * WH);
-    w.clear = (unsigned char *)malloc(WW * WH);
-    if (create_context(&w)) {
-        build(&w);
-        engine_init(&w);
-        for (i = 0; i < w.n; ++i)
-            if (!w.obj[i].sign) engine_upload(&w.obj[i]);
-        engine_draw(&w);
-        glReadPixels(0, 0, WW, WH, GL_RGBA, GL_UNSIGNED_BYTE, w.plain);
-        render_fog(&w);
-        ground_truth(&w, w.gt, w.interior, w.clear);
-        check_picture(&w);
-        check_closed_form(&w);
-        print_png("canvas", w.fogged);
-        print_error_map(&w);
+    const char *q = argc > 1 ? argv[1] : "";
+    w.version = strstr(q, "webgl1") ? 1 : 2;
+    if (strstr(q, "test")) {
+        self_test(&w);
+        return 0;
     }
-    printf("1..%d\n", w.tap);
-    emscripten_run_script(w.failed ? "document.title = 'fogvol-web: FAIL'" : "document.title = 'fogvol-web: PASS'");
+    emscripten_run_script("document.body.className = 'demo'");
+    if (!create_context(&w, 1) || !cy_main(w.version, WW, WH, strstr(q, "drive") != NULL)) {
+        printf("1..%d\n", w.tap + 1);
+        emscripten_run_script("document.title = 'fogvol-web: FAIL'");
+    }
     return 0;
 }
