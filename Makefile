@@ -5,6 +5,7 @@
 #   make images refresh the README pictures in docs/ from the demo
 #   make run    the interactive GLFW demo (under Xvfb with a screenshot when there is no display)
 #   make bench  the benchmark (bench/RESULTS.md, bench/plot.png)
+#   make bench-large  the GPU-scale scenes on this machine (bench/RESULTS-large.md)
 #   on a machine with a GPU driver (EGL): make gpu-test, make gl-compile, make bench-egl
 #   make web    the browser demo (emscripten, WebGL1 + WebGL2) into build/web/demo_web.html
 #   make vulkan the Vulkan example (examples/vulkan_backend.c, lavapipe) into build/vulkan/*.png
@@ -25,7 +26,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test demo images fuzz run examples bench bench-egl gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test demo images fuzz run examples bench bench-egl bench-large gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web vulkan vulkan-bench
 
 all: test
@@ -259,6 +260,7 @@ bench-egl: deps-test
 	@$(MAKE) --no-print-directory $(BUILD)/bench_egl $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic | tee $(BUILD)/bench_analytic.txt
 	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench_egl
+	$(BUILD)/bench_egl --large
 
 # full run, 5-6 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run); the
 # analytic fog's figures (bench_analytic, run first) join its summary line
@@ -268,6 +270,12 @@ bench: deps-demo
 	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench
 
 # smoke test (smallest scene, a few frames), also part of make test
+# the GPU-scale scenes (64 volumes, shells k=16, floor + pillars at 2560x1440 and 3840x2160; on
+# llvmpipe about 10 minutes): writes bench/RESULTS-large.md
+bench-large: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/bench
+	$(BUILD)/bench --large
+
 bench-quick: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/bench
 	$(BUILD)/bench --quick

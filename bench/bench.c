@@ -29,7 +29,10 @@
    usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
                                prints only; --scene I: scene I alone, prints only;
                                --cpu: the scale and lifetime figures of the CPU section
-                               alone, on the null backend, no GL, prints only)
+                               alone, on the null backend, no GL, prints only;
+                               --large: the GPU-scale scenes, 64 volumes, shells k=16 and
+                               floor + pillars at 2560x1440 and 3840x2160, few frames,
+                               into bench/RESULTS-large.md (GLU_EGL: RESULTS-gpu-large.md))
    full run: prints the tables, writes bench/RESULTS.md and bench/plot.png
    (GLU_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
 #define FOGVOL_IMPLEMENTATION
@@ -57,7 +60,7 @@
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
      FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O | \
      FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_EXACT_SUM)
-#define MAXI 32 /* instances per scene */
+#define MAXI 72 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96
 #define MAXSCENE 12
@@ -98,11 +101,13 @@ static double now_ms(void)
    device, a GPU driver through glvnd */
 #ifdef GLU_EGL
 #define BENCH_MD "bench/RESULTS-gpu.md"
+#define BENCH_MD_LARGE "bench/RESULTS-gpu-large.md"
 #define BENCH_PNG "bench/plot-gpu.png"
 #define BENCH_FRAMES 41 /* GPU frames are short: more of them for the medians */
 #define BENCH_CONTEXT "EGL context (OpenGL 3.3 core on an EGL device)"
 #else
 #define BENCH_MD "bench/RESULTS.md"
+#define BENCH_MD_LARGE "bench/RESULTS-large.md"
 #define BENCH_PNG "bench/plot.png"
 #define BENCH_FRAMES 15
 #define BENCH_CONTEXT "OSMesa context"
@@ -392,7 +397,7 @@ static void set_cam(scene *s, double ex, double ey, double ez, double ax, double
 }
 
 /* which: 0 16 spheres, 1 concave tori, 2..5 shells k = 2, 4, 8, 16, 6 floor and
-   pillars cutting volumes, 7 camera inside a volume */
+   pillars cutting volumes, 7 camera inside a volume; 8 64 spheres (--large only) */
 #define NSCENES 8
 static void build_scene(scene *s, int which)
 {
@@ -457,6 +462,16 @@ static void build_scene(scene *s, int which)
         a = add_mesh(s, shp_box(0.7f, 3.0f, 0.7f)); /* light beam through the floor */
         trs(m, 0.3f, 1.0f, 2.0f, 15, 0, 0, 1, 1, 1, 1);
         add_inst(s, a, m, 0);
+    } else if (which == 8) { /* 4 x 4 x 4 spheres, each layer shifted: rays through up to 4 of them */
+        strcpy(s->name, "64 spheres");
+        set_cam(s, 0, 0.5, 10.0, 0, 0, 0, 0.5f, 30);
+        a = add_mesh(s, shp_sphere(0.75f, 32, 16));
+        for (i = 0; i < 64; ++i) {
+            int x = i % 4, y = (i / 4) % 4, z = i / 16;
+            shp_mat_translate(m, -2.7f + 1.6f * (float)x + 0.45f * (float)z, -2.2f + 1.3f * (float)y + 0.3f * (float)z,
+                              1.5f - 1.4f * (float)z);
+            add_inst(s, a, m, 0);
+        }
     } else {
         strcpy(s->name, "camera inside a volume");
         set_cam(s, 0, 0.3, 0, 0.4, 0.1, -5, 0.3f, 40);
@@ -2264,6 +2279,8 @@ int main(int argc, char **argv)
     int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
     int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
     int cpu_only = argc > 1 && strcmp(argv[1], "--cpu") == 0; /* the scale figures alone, no GL */
+    int large = argc > 1 && strcmp(argv[1], "--large") == 0; /* the GPU-scale scenes */
+    static const int large_sizes[2][2] = {{2560, 1440}, {3840, 2160}}, large_scenes[3] = {8, 5, 6};
     double t_start = now_ms(), v[5], msaa = 0;
     glu_ctx g;
     fogs F;
@@ -2272,8 +2289,8 @@ int main(int argc, char **argv)
     struct utsname un;
     char cpu_model[256], load0[64], load1[64], line[256];
     int ncpu;
-    if (argc > 1 && !quick && !cpu_only && (only < 0 || only >= NSCENES)) {
-        fprintf(stderr, "usage: %s [--quick | --cpu | --scene 0..%d]\n", argv[0], NSCENES - 1);
+    if (argc > 1 && !quick && !cpu_only && !large && (only < 0 || only >= NSCENES)) {
+        fprintf(stderr, "usage: %s [--quick | --cpu | --large | --scene 0..%d]\n", argv[0], NSCENES - 1);
         return 2;
     }
     memset(&scale, 0, sizeof scale);
@@ -2310,8 +2327,8 @@ int main(int argc, char **argv)
     cpu_measure(&cpu, quick);
     scale_measure(&scale, quick);
     if (!quick && only < 0) {
-        g_md = fopen(BENCH_MD, "w");
-        if (!g_md) die("cannot write " BENCH_MD " (run from the repository root)");
+        g_md = fopen(large ? BENCH_MD_LARGE : BENCH_MD, "w");
+        if (!g_md) die("cannot write the results file (run from the repository root)");
     }
     uname(&un);
     cpu_info(cpu_model, sizeof cpu_model, &ncpu);
@@ -2322,18 +2339,18 @@ int main(int argc, char **argv)
         (const char *)glGetString(GL_VERSION), un.sysname, un.machine, ncpu, cpu_model);
 
     for (si = quick ? 1 : 0; si < 2; ++si) {
-        int w = sizes[si][0], h = sizes[si][1];
-        for (sc = 0; sc < NSCENES; ++sc) {
+        int w = large ? large_sizes[si][0] : sizes[si][0], h = large ? large_sizes[si][1] : sizes[si][1];
+        for (sc = 0; sc < (large ? 3 : NSCENES); ++sc) {
             scene *s = (scene *)calloc(1, sizeof(scene));
-            int frames, warm = quick ? 1 : 3;
+            int frames, warm = quick || large ? 1 : 3;
             if ((quick && sc != 2) || (only >= 0 && sc != only)) {
                 free(s);
                 continue;
             }
-            build_scene(s, sc);
+            build_scene(s, large ? large_scenes[sc] : sc);
             scene_upload(s, &F);
-            frames = quick ? 3 : BENCH_FRAMES;
-            g_res[g_nres].bd = !quick && w > 640;
+            frames = quick || large ? 3 : BENCH_FRAMES;
+            g_res[g_nres].bd = !quick && !large && w > 640;
             run_scene(&F, s, w, h, warm, frames, &g_res[g_nres]);
             fprintf(stderr, "  %-24s %4dx%-4d %3d layers  %6.1f s\n", s->name, w, h, g_res[g_nres].layers,
                     (now_ms() - t_start) / 1e3);
@@ -2355,36 +2372,46 @@ int main(int argc, char **argv)
         "occluder floor in scenes with occluders), PS20 and MRT <= 2.0x, PS13 <= 2.5x (against the occluder floor "
         "in scenes with occluders), depth peeling >= 6x slower at >= 6 layers. The rows \"speed-ups off\" run with "
         "fogvol_context_desc.disable_speedups = every FOGVOL_SPEEDUP_* bit (the configuration before them).\n\n",
-        quick ? 3 : BENCH_FRAMES, quick ? 1 : 3,
+        quick || large ? 3 : BENCH_FRAMES, quick || large ? 1 : 3,
         g_gpu_clock ? "clock: GPU timestamps (GL_TIMESTAMP queries), one issued after a glFinish before the fog "
                       "work, one after fogvol_end_frame before a glFinish"
                     : "clock: the wall clock after a glFinish, before the fog work and after fogvol_end_frame");
     print_results(g_res, g_nres);
     print_summary(g_res, g_nres);
-    print_breakdown(g_res, g_nres);
-    if (only < 0) bench_colors(quick);
-    if (only < 0) msaa = bench_msaa(quick);
-    out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
-    out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
-    out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
-    out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
-    out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
-        cpu.validate_ms, cpu.validate_mtris);
-    print_scale(&scale);
-    for (t = 0; t < NTIER; ++t)
-        out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
-            g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
-    for (t = 0; t < NMETH; ++t)
-        out("| first frame of %s, %s %dx%d (target allocation + the driver's shader compiles on first use; wall clock) | %.1f ms |\n", g_meth_names[t],
-            g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
-    loadavg(load1, sizeof load1);
-    out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
-        "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
-        (now_ms() - t_start) / 1e3, load0, load1, ncpu);
-    print_summary_line(g_res, g_nres, &scale, msaa);
-    if (g_md) {
-        fclose(g_md);
-        plot(BENCH_PNG, g_res, g_nres, 1280, 720);
+    if (large) { /* the GPU-scale scenes: the tables and the summary line alone */
+        loadavg(load1, sizeof load1);
+        out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end.\n",
+            (now_ms() - t_start) / 1e3, load0, load1);
+        print_summary_line(g_res, g_nres, &scale, 0);
+        if (g_md) fclose(g_md);
+        g_md = NULL;
+    }
+    if (!large) { /* the default run: breakdown, colours, MSAA, CPU, summary, plot */
+        print_breakdown(g_res, g_nres);
+        if (only < 0) bench_colors(quick);
+        if (only < 0) msaa = bench_msaa(quick);
+        out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
+        out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
+        out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
+        out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
+        out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
+            cpu.validate_ms, cpu.validate_mtris);
+        print_scale(&scale);
+        for (t = 0; t < NTIER; ++t)
+            out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
+                g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
+        for (t = 0; t < NMETH; ++t)
+            out("| first frame of %s, %s %dx%d (target allocation + the driver's shader compiles on first use; wall clock) | %.1f ms |\n", g_meth_names[t],
+                g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
+        loadavg(load1, sizeof load1);
+        out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
+            "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
+            (now_ms() - t_start) / 1e3, load0, load1, ncpu);
+        print_summary_line(g_res, g_nres, &scale, msaa);
+        if (g_md) {
+            fclose(g_md);
+            plot(BENCH_PNG, g_res, g_nres, 1280, 720);
+        }
     }
     for (t = 0; t < NTIER; ++t) {
         fogvol_destroy_ramp(F.ctx[t], F.ramp[t]);
