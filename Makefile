@@ -263,11 +263,15 @@ bench-egl: deps-test
 	$(BUILD)/bench_egl --large
 
 # full run, 5-6 min: writes bench/RESULTS.md and bench/plot.png (ratios taken in one run); the
-# analytic fog's figures (bench_analytic, run first) join its summary line
+# analytic fog's figures (bench_analytic, run first) join its summary line, and the Vulkan example's
+# --bench (lavapipe beside llvmpipe, where it builds: make vulkan's packages) its own section
 bench: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/bench $(BUILD)/bench_analytic
 	$(BUILD)/bench_analytic | tee $(BUILD)/bench_analytic.txt
-	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt $(BUILD)/bench
+	@rm -f $(BUILD)/bench_vulkan.txt
+	-@$(MAKE) --no-print-directory $(BUILD)/vulkan_backend && $(VK_ENV) $(BUILD)/vulkan_backend --bench > $(BUILD)/bench_vulkan.txt.tmp && \
+	  mv $(BUILD)/bench_vulkan.txt.tmp $(BUILD)/bench_vulkan.txt && cat $(BUILD)/bench_vulkan.txt
+	FOGVOL_BENCH_ANALYTIC=$(BUILD)/bench_analytic.txt FOGVOL_BENCH_VULKAN=$(BUILD)/bench_vulkan.txt $(BUILD)/bench
 
 # smoke test (smallest scene, a few frames), also part of make test
 # the GPU-scale scenes (64 volumes, shells k=16, floor + pillars at 2560x1440 and 3840x2160; on

@@ -1928,6 +1928,25 @@ static void analytic_figures(char *buf, size_t size)
     if (f) fclose(f);
 }
 
+/* The Vulkan backend (examples/vulkan_backend.c on lavapipe) beside the GL backend (llvmpipe) on
+   the same scene in one run: the lines of vulkan_backend --bench, which make bench runs first into
+   the file named by FOGVOL_BENCH_VULKAN (left out where it is not set or not there). */
+static void vulkan_figures(void)
+{
+    const char *path = getenv("FOGVOL_BENCH_VULKAN");
+    char line[512];
+    FILE *f = path ? fopen(path, "r") : NULL;
+    int n = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (!n++)
+            out("\n## Vulkan (lavapipe) beside GL (llvmpipe)\n\nexamples/vulkan_backend.c --bench, run by make bench "
+                "just before this program (the same fogvol frames through the Vulkan example backend on lavapipe and "
+                "through the GL backend on llvmpipe, one scene, in one run):\n\n");
+        out("    %s", line);
+    }
+    if (f) fclose(f);
+}
+
 /* the last line of the output: the figures to compare between runs */
 static void print_summary_line(const result *rs, int n, const scale_figs *sc, double msaa)
 {
@@ -2390,6 +2409,7 @@ int main(int argc, char **argv)
         print_breakdown(g_res, g_nres);
         if (only < 0) bench_colors(quick);
         if (only < 0) msaa = bench_msaa(quick);
+        if (only < 0) vulkan_figures();
         out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
         out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
         out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
