@@ -1801,10 +1801,18 @@ static const char *pass_name(int m, int p, int np, int occluders)
             continue;
         names[k++] = src[i];
     }
-    if (np == k - 1) /* no check pass this frame */
+    if (np < k) /* no check pass this frame */
         for (i = 0; i < k; ++i)
             if (strcmp(names[i], "check") == 0) {
                 memmove(names + i, names + i + 1, (size_t)(k - i - 1) * sizeof names[0]);
+                --k;
+                break;
+            }
+    if (np < k) /* B and F in one pass: the integer sum (FOGVOL_SPEEDUP_EXACT_SUM) */
+        for (i = 0; i + 1 < k; ++i)
+            if (strcmp(names[i], "B") == 0 && strcmp(names[i + 1], "F") == 0) {
+                names[i] = "B+F (one sum)";
+                memmove(names + i + 1, names + i + 2, (size_t)(k - i - 2) * sizeof names[0]);
                 --k;
                 break;
             }
