@@ -26,7 +26,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test demo images fuzz run examples bench bench-egl bench-large gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test demo images fuzz run examples bench bench-egl bench-large proto-engine-depth gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web vulkan vulkan-bench
 
 all: test
@@ -122,7 +122,8 @@ TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/replay_api_san $(BUILD)/fuzz_api \
-            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/gl_compile $(BUILD)/egl/demo_headless \
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/proto_engine_depth $(BUILD)/gl_compile \
+            $(BUILD)/egl/demo_headless \
             $(BUILD)/vulkan_backend
 
 # every shader dump_shaders writes, compiled and linked by an EGL driver (Mesa's llvmpipe here;
@@ -228,6 +229,15 @@ examples: deps-demo deps-run
 
 $(BUILD)/bench: bench/bench.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+# the FLOAT + engine depth face pass as fogvol draws it against a depth-tested design (issue 34), on
+# the benchmark's scenes, outside the library: make proto-engine-depth
+$(BUILD)/proto_engine_depth: bench/proto_engine_depth.c bench/bench.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+proto-engine-depth: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/proto_engine_depth
+	$(BUILD)/proto_engine_depth 15
 
 # the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
 # build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
