@@ -1753,9 +1753,10 @@ typedef struct fogvol_shader_desc {
    DEPTH_FROM_Z (the engine's depth is linearised from its window depth alone, without the pixel's
    position: fv_lin.xy and fv_lin2.xy are zero, as for every perspective or orthographic projection,
    jittered, off-centre or mirrored, but not one with an oblique near plane; no effect on programs
-   that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT, PS20 and PS13 (not WIDE,
-   ENGINE_DEPTH or COUNT, nor with FOGVOL_SPECIALIZE_COUNT): FLOAT_O (fv_opaque is an R32F O holding
-   the normalised view depth, which ENCODE writes, encoded by the program where it needs O's digits;
+   that do not read the engine's depth). ENCODE, FACE and LIGHT of MRT, PS20 and PS13 (not WIDE or
+   COUNT, PS13 not ENGINE_DEPTH, nor with FOGVOL_SPECIALIZE_COUNT): FLOAT_O (fv_opaque is an R32F O
+   holding the normalised view depth, which ENCODE writes (PS20 + ENGINE_DEPTH: the engine's depth
+   linearised), encoded by the program where it needs O's digits;
    see FOGVOL_SPEEDUP_FLOAT_O). FACE, dialects GLSL 330 and 300 es, single-sample, reading O (not
    NO_OPAQUE, COUNT, WIDE, or FLOAT with ENGINE_DEPTH): FETCH_O (O is read from colour location 1,
    "inout vec4 fv_ofb" with EXT_shader_framebuffer_fetch, where the pass binds it:
@@ -1869,11 +1870,13 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  writes only its alpha (FOGVOL_SPECIALIZE_BLEND_COLOR), so no colour is carried
                  through the fragment shader (the same blend equation; the same pixels where the
                  blender rounds the constant colour as it rounds a shader's output, as Mesa does).
-   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE, ENGINE_DEPTH or COUNT),
+   FLOAT_O       MRT, and PS20 with FOGVOL_CAP_HIGHP_FRAGMENT (not WIDE or COUNT),
                  on a backend with FOGVOL_CAP_FLOAT_TARGET: O is an R32F
                  texture holding the normalised view depth d = (view depth - near) / (far - near),
                  written by the engine's MRT pass (fogvol_mrt_info.format; the snippet switches on its
-                 uniforms), by fogvol's O pass, or by the engine's occluder shaders
+                 uniforms), by fogvol's O pass (PS20 + ENGINE_DEPTH: the engine's depth linearised
+                 full-screen, so that its faces sum in integers too, EXACT_SUM), or by the engine's
+                 occluder shaders
                  (fogvol_occluder_info.format), and the faces encode min(own depth, O)
                  (FOGVOL_SPECIALIZE_FLOAT_O) instead of encoding their own depth and comparing it with
                  O's digits: one encode per fragment and no compare in the faces, and no encode where
@@ -5869,8 +5872,8 @@ static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
     {"PS20", "", 5, 4, 3, 0, 1, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
      FOGVOL__S | FOGVOL__C | FOGVOL__A | FOGVOL__N | FOGVOL__E | FOGVOL__W, FOGVOL__E, 0,
      {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
-      FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
-      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
+      FOGVOL__W | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
+      FOGVOL__W | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
       FOGVOL__X},
      {0}},
     /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
@@ -6215,7 +6218,12 @@ static const char fogvol__fs_encode[] =
     "FV_UNIFORM(vec4, fv_nf)\n"
     "void main() {\n"
     "    float depth = FV_ENGINE_Z(fv_opaque);\n"
-    "    FV_FRAGCOLOR = fv_encode(fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y);\n"
+    "    float d = fv_engine_view_depth(fv_st(), depth) * fv_nf.x + fv_nf.y;\n"
+    "#ifdef FV_O_FLOAT\n"                        /* an R32F O: d itself, as the occluders' O pass writes */
+    "    FV_FRAGCOLOR = vec4(clamp(d, 0.0, 1.0), 0.0, 0.0, 0.0);\n"
+    "#else\n"
+    "    FV_FRAGCOLOR = fv_encode(d);\n"
+    "#endif\n"
     "}\n"
     "#else\n"
     "FV_LOCATION(0) FV_VARYING_IN float fv_d;\n"

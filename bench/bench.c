@@ -29,7 +29,10 @@
    usage: bench [--quick]     (--quick: smallest scene, 640x360, few frames;
                                prints only; --scene I: scene I alone, prints only;
                                --cpu: the scale and lifetime figures of the CPU section
-                               alone, on the null backend, no GL, prints only)
+                               alone, on the null backend, no GL, prints only;
+                               --large: the GPU-scale scenes, 64 volumes, shells k=16 and
+                               floor + pillars at 2560x1440 and 3840x2160, few frames,
+                               into bench/RESULTS-large.md (GLU_EGL: RESULTS-gpu-large.md))
    full run: prints the tables, writes bench/RESULTS.md and bench/plot.png
    (GLU_EGL: bench/RESULTS-gpu.md and bench/plot-gpu.png) */
 #define FOGVOL_IMPLEMENTATION
@@ -45,7 +48,7 @@
 #include <time.h>
 #include <sys/utsname.h>
 
-#define NTIER 8
+#define NTIER 9
 #define NDEFAULT 5 /* the first NDEFAULT tiers: fogvol's default configuration (every speed-up on) */
 #define M_FLOOR NTIER
 #define M_OCCFLOOR (NTIER + 1)
@@ -57,7 +60,7 @@
      FOGVOL_SPEEDUP_SPECIALIZE | FOGVOL_SPEEDUP_ALU | FOGVOL_SPEEDUP_OVERFLOW_BANDS | FOGVOL_SPEEDUP_FAST_EXP | \
      FOGVOL_SPEEDUP_DEPTH_TEST | FOGVOL_SPEEDUP_INLINE_RESOLVE | FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_FLOAT_O | \
      FOGVOL_SPEEDUP_SKIP_CHECK | FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_EXACT_SUM)
-#define MAXI 32 /* instances per scene */
+#define MAXI 72 /* instances per scene */
 #define MAXMESH 24
 #define MAXLAYERS 96
 #define MAXSCENE 12
@@ -76,10 +79,15 @@ static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0, 0},
                                         {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0},
                                         {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL, 0},
                                         {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL, 0},
-                                        {"FLOAT, half resolution", FOGVOL_TIER_FLOAT, 0, 0, 2}};
+                                        {"FLOAT, half resolution", FOGVOL_TIER_FLOAT, 0, 0, 2},
+                                        {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0}};
+#define M_FLOAT 3
+#define M_FLOAT_ED 4 /* FLOAT + ENGINE_DEPTH */
+#define M_PS20 1
+#define M_PS20_ED 8 /* PS20 + ENGINE_DEPTH */
 static const char *const g_meth_names[NMETH] = {
     "PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "FLOAT, speed-ups off", "PS20, speed-ups off",
-    "FLOAT, half resolution", "floor", "occluder floor", "scissored floor", "depth peeling"};
+    "FLOAT, half resolution", "PS20+engine depth", "floor", "occluder floor", "scissored floor", "depth peeling"};
 
 /* ---- small utilities -------------------------------------------------------- */
 static double now_ms(void)
@@ -93,11 +101,13 @@ static double now_ms(void)
    device, a GPU driver through glvnd */
 #ifdef GLU_EGL
 #define BENCH_MD "bench/RESULTS-gpu.md"
+#define BENCH_MD_LARGE "bench/RESULTS-gpu-large.md"
 #define BENCH_PNG "bench/plot-gpu.png"
 #define BENCH_FRAMES 41 /* GPU frames are short: more of them for the medians */
 #define BENCH_CONTEXT "EGL context (OpenGL 3.3 core on an EGL device)"
 #else
 #define BENCH_MD "bench/RESULTS.md"
+#define BENCH_MD_LARGE "bench/RESULTS-large.md"
 #define BENCH_PNG "bench/plot.png"
 #define BENCH_FRAMES 15
 #define BENCH_CONTEXT "OSMesa context"
@@ -387,7 +397,7 @@ static void set_cam(scene *s, double ex, double ey, double ez, double ax, double
 }
 
 /* which: 0 16 spheres, 1 concave tori, 2..5 shells k = 2, 4, 8, 16, 6 floor and
-   pillars cutting volumes, 7 camera inside a volume */
+   pillars cutting volumes, 7 camera inside a volume; 8 64 spheres (--large only) */
 #define NSCENES 8
 static void build_scene(scene *s, int which)
 {
@@ -452,6 +462,16 @@ static void build_scene(scene *s, int which)
         a = add_mesh(s, shp_box(0.7f, 3.0f, 0.7f)); /* light beam through the floor */
         trs(m, 0.3f, 1.0f, 2.0f, 15, 0, 0, 1, 1, 1, 1);
         add_inst(s, a, m, 0);
+    } else if (which == 8) { /* 4 x 4 x 4 spheres, each layer shifted: rays through up to 4 of them */
+        strcpy(s->name, "64 spheres");
+        set_cam(s, 0, 0.5, 10.0, 0, 0, 0, 0.5f, 30);
+        a = add_mesh(s, shp_sphere(0.75f, 32, 16));
+        for (i = 0; i < 64; ++i) {
+            int x = i % 4, y = (i / 4) % 4, z = i / 16;
+            shp_mat_translate(m, -2.7f + 1.6f * (float)x + 0.45f * (float)z, -2.2f + 1.3f * (float)y + 0.3f * (float)z,
+                              1.5f - 1.4f * (float)z);
+            add_inst(s, a, m, 0);
+        }
     } else {
         strcpy(s->name, "camera inside a volume");
         set_cam(s, 0, 0.3, 0, 0.4, 0.1, -5, 0.3f, 40);
@@ -1583,7 +1603,7 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
 {
     static const unsigned char col[NMETH][3] = {{214, 39, 40},  {255, 127, 14}, {148, 103, 189}, {31, 119, 180},
                                                 {23, 190, 207}, {140, 86, 75},  {227, 119, 194}, {60, 60, 60},
-                                                {127, 127, 127}, {188, 189, 34}, {44, 160, 44}};
+                                                {200, 160, 40},  {127, 127, 127}, {188, 189, 34}, {44, 160, 44}};
     static const unsigned char black[3] = {0, 0, 0}, grid[3] = {225, 225, 225};
     static const char *xlabel = "depth complexity k (back faces per ray at the centre, log2 scale)";
     const char *renderer = (const char *)glGetString(GL_RENDERER);
@@ -1700,12 +1720,25 @@ static void loadavg(char *buf, size_t cap)
 static const char *pf(int ok) { return ok ? "PASS" : "MISS"; }
 
 /* The issue's target for tier row m in scene r: limit x the reference floor (the occluder floor
-   where the scene has occluders); 0: no target (the rows with speed-ups off). */
+   where the scene has occluders); 0: no target (the rows with speed-ups off). The engine's depth
+   (issue 34): FLOAT + engine depth <= 1.15x the floor without occluders and <= plain FLOAT (which
+   draws the occluders itself) with them; PS20 + engine depth likewise against PS20. */
 static double target(int m, const result *r, double *ref, const char **refname)
 {
     fogvol_tier t = g_tiers[m].tier;
     *ref = r->occluders ? r->ms[M_OCCFLOOR] : r->ms[M_FLOOR];
     *refname = r->occluders ? "occluder floor" : "floor";
+    if (m == M_FLOAT_ED && r->occluders) {
+        *ref = r->ms[M_FLOAT];
+        *refname = "FLOAT";
+        return 1.0;
+    }
+    if (m == M_FLOAT_ED) return 1.15;
+    if (m == M_PS20_ED) {
+        *ref = r->ms[M_PS20];
+        *refname = "PS20";
+        return r->occluders ? 1.0 : 1.15;
+    }
     if (m >= NDEFAULT) return 0;
     if (t == FOGVOL_TIER_FLOAT) return r->occluders ? 1.5 : 1.2;
     return t == FOGVOL_TIER_PS13 ? 2.5 : 2.0;
@@ -1725,7 +1758,7 @@ static void print_results(const result *rs, int n)
                 int is_float = g_tiers[m].tier == FOGVOL_TIER_FLOAT;
                 const char *rn;
                 double ref, lim = target(m, r, &ref, &rn);
-                if (lim > 0) snprintf(tgt, sizeof tgt, "<=%.1fx %s %s", lim, rn, pf(r->ms[m] <= lim * ref));
+                if (lim > 0) snprintf(tgt, sizeof tgt, "<=%.4gx %s %s", lim, rn, pf(r->ms[m] <= lim * ref));
                 if (lim > 0 && r->layers >= 6)
                     snprintf(tgt + strlen(tgt), sizeof tgt - strlen(tgt), "; peeling >=6x slower %s",
                              pf(r->ms[M_PEEL] >= 6.0 * r->ms[m]));
@@ -1756,19 +1789,30 @@ static const char *pass_name(int m, int p, int np, int occluders)
                                                  {"O", "B-F", "composite", "", "", ""},
                                                  {"O", "B", "F", "check", "composite", ""},
                                                  {"O", "B-F", "composite", "", "", ""},
+                                                 {"O", "B", "F", "check", "composite", ""},
                                                  {"geometry", "composite", "", "", "", ""}};
     const char *names[6];
     int full = 0, i, k = 0;
     const char *const *src = pn[m < NTIER ? m : NTIER];
     while (full < 6 && src[full][0]) ++full;
     for (i = 0; i < full; ++i) {
-        if (strcmp(src[i], "O") == 0 && m < NTIER && !g_tiers[m].speedups_off && !occluders) continue;
+        if (strcmp(src[i], "O") == 0 && m < NTIER && !g_tiers[m].speedups_off && !occluders &&
+            !(g_tiers[m].variants & FOGVOL_VARIANT_ENGINE_DEPTH)) /* (PS20 + engine depth: O from it, always) */
+            continue;
         names[k++] = src[i];
     }
-    if (np == k - 1) /* no check pass this frame */
+    if (np < k) /* no check pass this frame */
         for (i = 0; i < k; ++i)
             if (strcmp(names[i], "check") == 0) {
                 memmove(names + i, names + i + 1, (size_t)(k - i - 1) * sizeof names[0]);
+                --k;
+                break;
+            }
+    if (np < k) /* B and F in one pass: the integer sum (FOGVOL_SPEEDUP_EXACT_SUM) */
+        for (i = 0; i + 1 < k; ++i)
+            if (strcmp(names[i], "B") == 0 && strcmp(names[i + 1], "F") == 0) {
+                names[i] = "B+F (one sum)";
+                memmove(names + i + 1, names + i + 2, (size_t)(k - i - 2) * sizeof names[0]);
                 --k;
                 break;
             }
@@ -1853,7 +1897,10 @@ static void print_summary(const result *rs, int n)
         const char *what;
     } rows[] = {{3, 0, 1.2, "FLOAT, scenes without occluders, x floor"},
                 {3, 1, 1.5, "FLOAT, scenes with occluders, x occluder floor"},
-                {4, -1, 1.5, "FLOAT+engine depth (x floor / occluder floor)"},
+                {M_FLOAT_ED, 0, 1.15, "FLOAT+engine depth, scenes without occluders, x floor"},
+                {M_FLOAT_ED, 1, 1.0, "FLOAT+engine depth, scenes with occluders, x plain FLOAT"},
+                {M_PS20_ED, 0, 1.15, "PS20+engine depth, scenes without occluders, x PS20"},
+                {M_PS20_ED, 1, 1.0, "PS20+engine depth, scenes with occluders, x PS20"},
                 {1, -1, 2.0, "PS20 (x floor / occluder floor)"},
                 {2, -1, 2.0, "MRT (x floor / occluder floor)"},
                 {0, -1, 2.5, "PS13 (x floor / occluder floor)"},
@@ -1866,8 +1913,8 @@ static void print_summary(const result *rs, int n)
     for (j = 0; j < (int)(sizeof rows / sizeof rows[0]); ++j) {
         const char *w;
         double x = worst_ratio(rs, n, rows[j].m, rows[j].occ, &w);
-        out("| %s | %.2fx | %s | <=%.1fx %s |\n", rows[j].what, x, w, rows[j].lim,
-            rows[j].m < NDEFAULT && rows[j].m != 4 ? pf(x <= rows[j].lim) : "(info)");
+        out("| %s | %.2fx | %s | <=%.4gx %s |\n", rows[j].what, x, w, rows[j].lim,
+            rows[j].m < NDEFAULT || rows[j].m == M_PS20_ED ? pf(x <= rows[j].lim) : "(info)");
     }
     out("| depth peeling / fogvol, smallest over the default tiers at >= 6 layers | %.2fx | | >=6x %s |\n", pm,
         pf(pm >= 6.0));
@@ -1889,17 +1936,253 @@ static void analytic_figures(char *buf, size_t size)
     if (f) fclose(f);
 }
 
+/* The Vulkan backend (examples/vulkan_backend.c on lavapipe) beside the GL backend (llvmpipe) on
+   the same scene in one run: the lines of vulkan_backend --bench, which make bench runs first into
+   the file named by FOGVOL_BENCH_VULKAN (left out where it is not set or not there). */
+static void vulkan_figures(void)
+{
+    const char *path = getenv("FOGVOL_BENCH_VULKAN");
+    char line[512];
+    FILE *f = path ? fopen(path, "r") : NULL;
+    int n = 0;
+    while (f && fgets(line, sizeof line, f)) {
+        if (!n++)
+            out("\n## Vulkan (lavapipe) beside GL (llvmpipe)\n\nexamples/vulkan_backend.c --bench, run by make bench "
+                "just before this program (the same fogvol frames through the Vulkan example backend on lavapipe and "
+                "through the GL backend on llvmpipe, one scene, in one run):\n\n");
+        out("    %s", line);
+    }
+    if (f) fclose(f);
+}
+
 /* the last line of the output: the figures to compare between runs */
-static void print_summary_line(const result *rs, int n, const scale_figs *sc)
+static void print_summary_line(const result *rs, int n, const scale_figs *sc, double msaa)
 {
     const char *w;
-    char an[256], sf[256];
+    char an[256], sf[256], ms[32] = "n/a";
     analytic_figures(an, sizeof an);
     scale_summary(sc, sf, sizeof sf);
+    if (msaa > 0) snprintf(ms, sizeof ms, "%.2fx", msaa);
     out("\nsummary: FLOAT worst %.2fx floor, FLOAT occluders %.2fx occluder floor, PS20 worst %.2fx, MRT worst %.2fx, "
-        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, %s, %s\n",
+        "PS13 worst %.2fx, peeling/ours at k>=6 %.1fx, %s, %s, engine depth worst %.2fx floor, engine depth "
+        "occluders %.2fx plain FLOAT, MSAA 4x %s single-sample\n",
         worst_ratio(rs, n, 3, 0, &w), worst_ratio(rs, n, 3, 1, &w), worst_ratio(rs, n, 1, -1, &w),
-        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n), an, sf);
+        worst_ratio(rs, n, 2, -1, &w), worst_ratio(rs, n, 0, -1, &w), peel_min(rs, n), an, sf,
+        worst_ratio(rs, n, M_FLOAT_ED, 0, &w), worst_ratio(rs, n, M_FLOAT_ED, 1, &w), ms);
+}
+
+/* ---- MSAA: fog on a 4x multisampled engine framebuffer against a single-sample one ---------- */
+/* An engine framebuffer of 1 or 4 samples: an RGBA8 colour renderbuffer and a depth texture
+   (GL_TEXTURE_2D_MULTISAMPLE with 4 samples), as an engine that hands fogvol its depth has. */
+typedef struct msaa_fb {
+    GLuint fbo, color, depth;
+    int samples;
+} msaa_fb;
+
+static void msaa_fb_create(msaa_fb *f, int w, int h, int samples)
+{
+    GLenum target = samples > 1 ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
+    memset(f, 0, sizeof *f);
+    f->samples = samples;
+    glGenRenderbuffers(1, &f->color);
+    glBindRenderbuffer(GL_RENDERBUFFER, f->color);
+    if (samples > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+    else glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glGenTextures(1, &f->depth);
+    glBindTexture(target, f->depth);
+    if (samples > 1) {
+        glTexImage2DMultisample(target, samples, GL_DEPTH_COMPONENT24, w, h, GL_TRUE);
+    } else {
+        glTexImage2D(target, 0, GL_DEPTH_COMPONENT24, w, h, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
+        glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glBindTexture(target, 0);
+    glGenFramebuffers(1, &f->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f->color);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, target, f->depth, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) die("MSAA framebuffer incomplete");
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+static void msaa_fb_free(msaa_fb *f)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &f->fbo);
+    glDeleteRenderbuffers(1, &f->color);
+    glDeleteTextures(1, &f->depth);
+}
+
+/* the engine's opaque pass (the occluders) into an engine framebuffer of its own */
+static void msaa_engine_pass(const scene *s, const view *vw, const msaa_fb *f, int w, int h)
+{
+    static const float bg[4] = {0.2f, 0.35f, 0.55f, 1.0f};
+    glBindFramebuffer(GL_FRAMEBUFFER, f->fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glDepthMask(GL_TRUE);
+    glClearBufferfv(GL_COLOR, 0, bg);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(P.engine);
+    draw_insts(s, vw, P.engine, 1);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(0);
+}
+
+#define NMSAA 2 /* FLOAT (fogvol draws the occluders), FLOAT + engine depth */
+typedef struct msaa_ctx {
+    fogvol_context *ctx;
+    fogvol_ramp *ramp;
+    fogvol_mesh *fm[MAXMESH];
+} msaa_ctx;
+
+static void msaa_ctx_init(msaa_ctx *m, const scene *s, unsigned variants)
+{
+    fogvol_context_desc cd;
+    fogvol_ramp_desc rd;
+    int i;
+    memset(m, 0, sizeof *m);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = fv_log;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = variants;
+    if (fogvol_create_context(&cd, &m->ctx) != FOGVOL_SUCCESS) die("fogvol_create_context (MSAA)");
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = 0.5f;
+    if (fogvol_create_ramp(m->ctx, &rd, &m->ramp) != FOGVOL_SUCCESS) die("ramp (MSAA)");
+    for (i = 0; i < s->nmesh; ++i) {
+        fogvol_mesh_desc md;
+        int j, occ = 0;
+        for (j = 0; j < s->n; ++j) occ |= s->in[j].mesh == i && s->in[j].occluder;
+        memset(&md, 0, sizeof md);
+        md.positions = s->mesh[i].m.pos;
+        md.vertex_count = s->mesh[i].m.vcount;
+        md.indices = (const uint32_t *)s->mesh[i].m.idx;
+        md.index_count = s->mesh[i].m.icount;
+        md.allow_open = occ;
+        if (fogvol_create_mesh(m->ctx, &md, &m->fm[i], NULL) != FOGVOL_SUCCESS) die("mesh (MSAA)");
+    }
+}
+
+static void msaa_ctx_free(msaa_ctx *m, const scene *s)
+{
+    int i;
+    for (i = 0; i < s->nmesh; ++i) fogvol_destroy_mesh(m->ctx, m->fm[i]);
+    fogvol_destroy_ramp(m->ctx, m->ramp);
+    fogvol_destroy_context(m->ctx);
+}
+
+/* one fog frame on engine framebuffer f (its opaque pass drawn before the clock starts); fog ms */
+static double msaa_frame(msaa_ctx *m, int ed, const scene *s, const view *vw, const msaa_fb *f, int w, int h)
+{
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_frame_stats st;
+    fogvol_result res;
+    tick t0;
+    int i;
+    msaa_engine_pass(s, vw, f, w, h);
+    memset(&fd, 0, sizeof fd);
+    memcpy(fd.view, vw->v, sizeof fd.view);
+    memcpy(fd.projection, vw->p, sizeof fd.projection);
+    fd.znear = s->znear;
+    fd.zfar = s->zfar;
+    fd.viewport[2] = w;
+    fd.viewport[3] = h;
+    fd.engine_depth_texture = ed ? f->depth : 0;
+    t0 = tick_start();
+    if (fogvol_begin_frame(m->ctx, &fd) != FOGVOL_SUCCESS) die("begin_frame (MSAA)");
+    memset(&vd, 0, sizeof vd);
+    vd.ramp = m->ramp;
+    for (i = 0; i < s->n; ++i) {
+        const inst *in = &s->in[i];
+        if (in->occluder) {
+            if (!ed) fogvol_add_occluder(m->ctx, m->fm[in->mesh], in->model);
+            continue;
+        }
+        vd.mesh = m->fm[in->mesh];
+        memcpy(vd.model, in->model, sizeof vd.model);
+        fogvol_add_volume(m->ctx, &vd);
+    }
+    res = fogvol_end_frame(m->ctx, &st);
+    if (res != FOGVOL_SUCCESS) die(fogvol_result_string(res));
+    if (f->samples > 1 && st.samples != f->samples) die("MSAA: the frame was not drawn per sample");
+    return tick_ms(t0, tick_end());
+}
+
+/* The MSAA cost: FLOAT and FLOAT + engine depth on a 4x multisampled engine framebuffer against
+   the same on a single-sample one (fogvol shades its passes per sample on the 4x one), frames
+   interleaved, medians; the worst 4x / single-sample ratio goes to the summary line. */
+static double bench_msaa(int quick)
+{
+    static const char *const names[NMSAA] = {"FLOAT", "FLOAT+engine depth"};
+    static const int scenes[2] = {6, 0}; /* floor + pillars (occluder edges inside fog), 16 spheres */
+    int sc, mi, f, frames = quick ? 3 : 9, w = quick ? 320 : 640, h = quick ? 180 : 360;
+    double worst = 0;
+    out("\n## MSAA 4x against single-sample\n\nFog ms per frame on a 4x multisampled engine framebuffer (colour "
+        "renderbuffer + multisample depth texture; fogvol's targets get 4 samples and its passes are shaded per "
+        "sample) and on a single-sample one, %dx%d, medians of %d interleaved frames; FLOAT draws the occluders "
+        "itself, FLOAT+engine depth reads the engine's depth texture (per sample on the 4x one).\n\n"
+        "| scene | method | single-sample ms | 4x ms | 4x / single |\n|---|---|---:|---:|---:|\n",
+        w, h, frames);
+    for (sc = 0; sc < 2; ++sc) {
+        scene *s = (scene *)calloc(1, sizeof(scene));
+        msaa_fb fb[2];
+        msaa_ctx mc[NMSAA][2];
+        view vw;
+        double t[NMSAA][2][32];
+        int k;
+        if (!s) die("out of memory");
+        build_scene(s, scenes[sc]);
+        for (k = 0; k < s->nmesh; ++k) { /* the engine's vertex arrays (scene_upload without fogvol's meshes) */
+            gmesh *g = &s->mesh[k];
+            glGenVertexArrays(1, &g->vao);
+            glBindVertexArray(g->vao);
+            glGenBuffers(1, &g->vbo);
+            glGenBuffers(1, &g->ibo);
+            glBindBuffer(GL_ARRAY_BUFFER, g->vbo);
+            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)g->m.vcount), g->m.pos, GL_STATIC_DRAW);
+            glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+            glEnableVertexAttribArray(0);
+            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ibo);
+            glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)g->m.icount), g->m.idx, GL_STATIC_DRAW);
+            glBindVertexArray(0);
+        }
+        make_view(&vw, s, w, h);
+        msaa_fb_create(&fb[0], w, h, 1);
+        msaa_fb_create(&fb[1], w, h, 4);
+        for (mi = 0; mi < NMSAA; ++mi)
+            for (k = 0; k < 2; ++k) {
+                msaa_ctx_init(&mc[mi][k], s, mi ? FOGVOL_VARIANT_ENGINE_DEPTH : 0u);
+                msaa_frame(&mc[mi][k], mi, s, &vw, &fb[k], w, h); /* warm-up: targets, shader JIT */
+            }
+        for (f = 0; f < frames; ++f)
+            for (mi = 0; mi < NMSAA; ++mi)
+                for (k = 0; k < 2; ++k) t[mi][k][f] = msaa_frame(&mc[mi][k], mi, s, &vw, &fb[k], w, h);
+        for (mi = 0; mi < NMSAA; ++mi) {
+            double a = median(t[mi][0], frames), b = median(t[mi][1], frames);
+            out("| %s | %s | %.2f | %.2f | %.2f |\n", mi ? "" : s->name, names[mi], a, b, b / a);
+            if (b / a > worst) worst = b / a;
+            for (k = 0; k < 2; ++k) msaa_ctx_free(&mc[mi][k], s);
+        }
+        for (k = 0; k < 2; ++k) msaa_fb_free(&fb[k]);
+        for (k = 0; k < s->nmesh; ++k) {
+            glDeleteVertexArrays(1, &s->mesh[k].vao);
+            glDeleteBuffers(1, &s->mesh[k].vbo);
+            glDeleteBuffers(1, &s->mesh[k].ibo);
+            shp_free(&s->mesh[k].m);
+        }
+        free(s);
+    }
+    if (glGetError() != GL_NO_ERROR) die("GL error (MSAA)");
+    return worst;
 }
 
 /* ---- 16 coloured volumes: per-ramp groups against one pass (FOGVOL_VARIANT_COLORS) ------ */
@@ -2023,7 +2306,9 @@ int main(int argc, char **argv)
     int quick = argc > 1 && strcmp(argv[1], "--quick") == 0, si, sc, t;
     int only = argc > 2 && strcmp(argv[1], "--scene") == 0 ? atoi(argv[2]) : -1; /* diagnosis: one scene */
     int cpu_only = argc > 1 && strcmp(argv[1], "--cpu") == 0; /* the scale figures alone, no GL */
-    double t_start = now_ms(), v[5];
+    int large = argc > 1 && strcmp(argv[1], "--large") == 0; /* the GPU-scale scenes */
+    static const int large_sizes[2][2] = {{2560, 1440}, {3840, 2160}}, large_scenes[3] = {8, 5, 6};
+    double t_start = now_ms(), v[5], msaa = 0;
     glu_ctx g;
     fogs F;
     cpu_figs cpu;
@@ -2031,8 +2316,8 @@ int main(int argc, char **argv)
     struct utsname un;
     char cpu_model[256], load0[64], load1[64], line[256];
     int ncpu;
-    if (argc > 1 && !quick && !cpu_only && (only < 0 || only >= NSCENES)) {
-        fprintf(stderr, "usage: %s [--quick | --cpu | --scene 0..%d]\n", argv[0], NSCENES - 1);
+    if (argc > 1 && !quick && !cpu_only && !large && (only < 0 || only >= NSCENES)) {
+        fprintf(stderr, "usage: %s [--quick | --cpu | --large | --scene 0..%d]\n", argv[0], NSCENES - 1);
         return 2;
     }
     memset(&scale, 0, sizeof scale);
@@ -2069,8 +2354,8 @@ int main(int argc, char **argv)
     cpu_measure(&cpu, quick);
     scale_measure(&scale, quick);
     if (!quick && only < 0) {
-        g_md = fopen(BENCH_MD, "w");
-        if (!g_md) die("cannot write " BENCH_MD " (run from the repository root)");
+        g_md = fopen(large ? BENCH_MD_LARGE : BENCH_MD, "w");
+        if (!g_md) die("cannot write the results file (run from the repository root)");
     }
     uname(&un);
     cpu_info(cpu_model, sizeof cpu_model, &ncpu);
@@ -2081,18 +2366,18 @@ int main(int argc, char **argv)
         (const char *)glGetString(GL_VERSION), un.sysname, un.machine, ncpu, cpu_model);
 
     for (si = quick ? 1 : 0; si < 2; ++si) {
-        int w = sizes[si][0], h = sizes[si][1];
-        for (sc = 0; sc < NSCENES; ++sc) {
+        int w = large ? large_sizes[si][0] : sizes[si][0], h = large ? large_sizes[si][1] : sizes[si][1];
+        for (sc = 0; sc < (large ? 3 : NSCENES); ++sc) {
             scene *s = (scene *)calloc(1, sizeof(scene));
-            int frames, warm = quick ? 1 : 3;
+            int frames, warm = quick || large ? 1 : 3;
             if ((quick && sc != 2) || (only >= 0 && sc != only)) {
                 free(s);
                 continue;
             }
-            build_scene(s, sc);
+            build_scene(s, large ? large_scenes[sc] : sc);
             scene_upload(s, &F);
-            frames = quick ? 3 : BENCH_FRAMES;
-            g_res[g_nres].bd = !quick && w > 640;
+            frames = quick || large ? 3 : BENCH_FRAMES;
+            g_res[g_nres].bd = !quick && !large && w > 640;
             run_scene(&F, s, w, h, warm, frames, &g_res[g_nres]);
             fprintf(stderr, "  %-24s %4dx%-4d %3d layers  %6.1f s\n", s->name, w, h, g_res[g_nres].layers,
                     (now_ms() - t_start) / 1e3);
@@ -2114,35 +2399,47 @@ int main(int argc, char **argv)
         "occluder floor in scenes with occluders), PS20 and MRT <= 2.0x, PS13 <= 2.5x (against the occluder floor "
         "in scenes with occluders), depth peeling >= 6x slower at >= 6 layers. The rows \"speed-ups off\" run with "
         "fogvol_context_desc.disable_speedups = every FOGVOL_SPEEDUP_* bit (the configuration before them).\n\n",
-        quick ? 3 : BENCH_FRAMES, quick ? 1 : 3,
+        quick || large ? 3 : BENCH_FRAMES, quick || large ? 1 : 3,
         g_gpu_clock ? "clock: GPU timestamps (GL_TIMESTAMP queries), one issued after a glFinish before the fog "
                       "work, one after fogvol_end_frame before a glFinish"
                     : "clock: the wall clock after a glFinish, before the fog work and after fogvol_end_frame");
     print_results(g_res, g_nres);
     print_summary(g_res, g_nres);
-    print_breakdown(g_res, g_nres);
-    if (only < 0) bench_colors(quick);
-    out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
-    out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
-    out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
-    out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
-    out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
-        cpu.validate_ms, cpu.validate_mtris);
-    print_scale(&scale);
-    for (t = 0; t < NTIER; ++t)
-        out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
-            g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
-    for (t = 0; t < NMETH; ++t)
-        out("| first frame of %s, %s %dx%d (target allocation + the driver's shader compiles on first use; wall clock) | %.1f ms |\n", g_meth_names[t],
-            g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
-    loadavg(load1, sizeof load1);
-    out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
-        "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
-        (now_ms() - t_start) / 1e3, load0, load1, ncpu);
-    print_summary_line(g_res, g_nres, &scale);
-    if (g_md) {
-        fclose(g_md);
-        plot(BENCH_PNG, g_res, g_nres, 1280, 720);
+    if (large) { /* the GPU-scale scenes: the tables and the summary line alone */
+        loadavg(load1, sizeof load1);
+        out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end.\n",
+            (now_ms() - t_start) / 1e3, load0, load1);
+        print_summary_line(g_res, g_nres, &scale, 0);
+        if (g_md) fclose(g_md);
+        g_md = NULL;
+    }
+    if (!large) { /* the default run: breakdown, colours, MSAA, CPU, summary, plot */
+        print_breakdown(g_res, g_nres);
+        if (only < 0) bench_colors(quick);
+        if (only < 0) msaa = bench_msaa(quick);
+        if (only < 0) vulkan_figures();
+        out("\n## CPU\n\n| what | figure |\n|---|---:|\n");
+        out("| fogvol_make_rg_ramp (%dx%d) | %.2f us |\n", cpu.rg_w, cpu.rg_h, cpu.rg_us);
+        out("| fogvol_make_blue_ramp (%dx%d) | %.2f us |\n", cpu.blue_w, cpu.blue_h, cpu.blue_us);
+        out("| fogvol_make_color_ramp (%d texels, extinction) | %.2f us |\n", cpu.color_w, cpu.color_us);
+        out("| fogvol_validate_mesh (%d triangles) | %.1f ms = %.2f M triangles/s |\n", cpu.validate_tris,
+            cpu.validate_ms, cpu.validate_mtris);
+        print_scale(&scale);
+        for (t = 0; t < NTIER; ++t)
+            out("| fogvol_gl_backend_create + fogvol_create_context, %s (shader compile + link, textures; median of %d) | %.1f ms |\n",
+                g_tiers[t].name, quick ? 1 : 5, cpu.create_ms[t]);
+        for (t = 0; t < NMETH; ++t)
+            out("| first frame of %s, %s %dx%d (target allocation + the driver's shader compiles on first use; wall clock) | %.1f ms |\n", g_meth_names[t],
+                g_res[0].scene, g_res[0].w, g_res[0].h, g_res[0].first_ms[t]);
+        loadavg(load1, sizeof load1);
+        out("\nTotal run time %.0f s; 1-minute load average %s at the start, %s at the end (other processes share the "
+            "%d CPUs: absolute times move with the load, ratios less so since every method runs in every iteration).\n",
+            (now_ms() - t_start) / 1e3, load0, load1, ncpu);
+        print_summary_line(g_res, g_nres, &scale, msaa);
+        if (g_md) {
+            fclose(g_md);
+            plot(BENCH_PNG, g_res, g_nres, 1280, 720);
+        }
     }
     for (t = 0; t < NTIER; ++t) {
         fogvol_destroy_ramp(F.ctx[t], F.ramp[t]);

@@ -9,12 +9,12 @@
    L = 1..8 and refused above; FOGVOL_SPECIALIZE_INLINE_RESOLVE by PS13's COMPOSITE, COMPOSITE_MESH
    and CHECK only; FOGVOL_SPECIALIZE_BLEND_COLOR by COMPOSITE and COMPOSITE_MESH with EXP,
    NO_COLOR_TEXTURE and NO_OVERFLOW only; FOGVOL_SPECIALIZE_FLOAT_O by the programs that write or read
-   O (ENCODE, FACE, LIGHT) of MRT, PS20 and PS13 without WIDE, ENGINE_DEPTH and COUNT only;
+   O (ENCODE, FACE, LIGHT) of MRT, PS20 and PS13 without WIDE and COUNT (ENGINE_DEPTH: PS20's) only;
    FOGVOL_SPECIALIZE_FETCH_O by single-sample FACE programs in GLSL 330 and 300 es that read O (not
    with NO_OPAQUE or COUNT, nor the COUNT, WIDE and COLORS variants, nor FLOAT with ENGINE_DEPTH);
    FOGVOL_SPECIALIZE_EXACT_SUM in GLSL 330 and 300 es by PS20's, MRT's and PS13's FACE (with NO_DENSITY,
-   single-sample), COMPOSITE and COMPOSITE_MESH where FLOAT_O could be (not WIDE, ENGINE_DEPTH, COUNT,
-   SINGLE_TARGET), not with COUNT.
+   single-sample), COMPOSITE and COMPOSITE_MESH where FLOAT_O could be (not WIDE, COUNT, SINGLE_TARGET;
+   ENGINE_DEPTH: PS20's), not with COUNT.
    The Vulkan dialect (FOGVOL_GLSL_VULKAN, SPIR-V) goes apart: `dump_shaders --vulkan DIR` writes only
    its shaders (tests/vulkan_shaders.sh compiles them with glslangValidator -V), `dump_shaders DIR`
    only the GL dialects' (tests/shaders.sh, gl_compile). */
@@ -53,8 +53,8 @@ static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, 
 {
     if (bits & FOGVOL_SPECIALIZE_EXACT_SUM)
         return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20 || t == FOGVOL_TIER_PS13) &&
-               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT |
-                      FOGVOL_VARIANT_SINGLE_TARGET)) &&
+               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET)) &&
+               !(t != FOGVOL_TIER_PS20 && (v & FOGVOL_VARIANT_ENGINE_DEPTH)) &&
                !(bits & FOGVOL_SPECIALIZE_COUNT) &&
                (d == FOGVOL_GLSL_330 || d == FOGVOL_GLSL_300ES) &&
                (p == FOGVOL_PROGRAM_COMPOSITE || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
@@ -68,7 +68,8 @@ static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, 
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FETCH_O, ms);
     if (bits & FOGVOL_SPECIALIZE_FLOAT_O)
         return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20 || t == FOGVOL_TIER_PS13) &&
-               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_ENGINE_DEPTH | FOGVOL_VARIANT_COUNT)) &&
+               !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COUNT)) &&
+               !(t != FOGVOL_TIER_PS20 && (v & FOGVOL_VARIANT_ENGINE_DEPTH)) &&
                !(bits & FOGVOL_SPECIALIZE_COUNT) &&
                (p == FOGVOL_PROGRAM_ENCODE || p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_LIGHT) &&
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_FLOAT_O, ms);

@@ -96,6 +96,9 @@ static const combo g_combos[] = {
     {FOGVOL_TIER_PS20, 0, "PS20", 0},
     {FOGVOL_TIER_FLOAT, 0, "FLOAT", 0},
     {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth", 0},
+    /* O from the engine's depth, full-screen: an R32F O (FOGVOL_SPEEDUP_FLOAT_O), so the faces sum
+       in integers (FOGVOL_SPEEDUP_EXACT_SUM) on this GL, as PS20 does with occluders */
+    {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, "PS20+enginedepth", 0},
     {FOGVOL_TIER_PS13, 0, "PS13", 0},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_COUNT, "PS20+count", 0},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_SINGLE_TARGET, "PS20+single", 0},
@@ -572,6 +575,9 @@ static void scene_models(const scene *s, float model[3][16])
     model[0][10] = (float)((s->bmax[2] - s->bmin[2]) / 2);
 }
 
+/* frames drawn, and those of them whose faces summed in integers (fogvol_frame_stats.exact_sum) */
+static int g_frames_drawn, g_frames_exact;
+
 /* Render one view of a convention with one tier and compare: thickness and composite inside the
    viewport, and every pixel outside it as the engine left it. */
 static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_mesh *meshes[3],
@@ -629,6 +635,8 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     for (i = 0; i < W * H; ++i) thick[i] = -1e30f;
     memset(&st, 0, sizeof st);
     res.r = fogvol_end_frame(fv, &st);
+    g_frames_drawn += res.r == FOGVOL_SUCCESS;
+    g_frames_exact += res.r == FOGVOL_SUCCESS && st.exact_sum;
     glFinish();
     get_depth_state(&after);
     res.state_ok = before.origin == after.origin && before.mode == after.mode && before.func == after.func &&
@@ -811,6 +819,7 @@ static void test_conventions(void **state)
         rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
         rd.density = (float)DENSITY;
         assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        g_frames_drawn = g_frames_exact = 0;
         for (ci = 0; ci < NCONV; ++ci) {
             const conv *c = &g_convs[ci];
             char png[128], name[96], where[200];
@@ -829,7 +838,7 @@ static void test_conventions(void **state)
             sr.meshes = (const fogvol_mesh **)m;
             sr.fv = fv;
             sr.ramp = ramp;
-            sr.png = ti < 3 ? png : NULL;
+            sr.png = ti < 4 ? png : NULL;
             /* the camera stays outside the volume where COUNT or NEAR_CLAMP need it there (and the
                volume clear of the orthographic near plane); MRT: the engine writes O at the viewport's pixels, so
                the viewport stays at the origin */
@@ -843,6 +852,12 @@ static void test_conventions(void **state)
             if (t.wrong) printf("#   FAIL: the first wrong pixel in %s\n", where);
             failures += t.wrong != 0;
             views += t.views;
+        }
+        if (cb->tier == FOGVOL_TIER_PS20 && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH)) {
+            /* every frame of PS20 + engine depth summed in integers (Mesa has the framebuffer fetch) */
+            printf("# %s: %d of %d frames summed in integers\n", cb->name, g_frames_exact, g_frames_drawn);
+            assert_true(g_frames_drawn > 0);
+            assert_int_equal(g_frames_exact, g_frames_drawn);
         }
         fogvol_destroy_ramp(fv, ramp);
         fogvol_destroy_mesh(fv, m[0]);
