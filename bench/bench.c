@@ -1533,6 +1533,20 @@ static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
     return c;
 }
 
+/* a FLOAT context on the GL backend with the given variants (the MSAA and colour sections) */
+static fogvol_context *float_context(unsigned variants, const char *what)
+{
+    fogvol_context_desc cd;
+    fogvol_context *c = NULL;
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = fv_log;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = variants;
+    if (fogvol_create_context(&cd, &c) != FOGVOL_SUCCESS) die(what);
+    return c;
+}
+
 static void destroy_tier(fogvol_context *c, fogvol_backend *be)
 {
     fogvol_destroy_context(c);
@@ -2043,16 +2057,10 @@ typedef struct msaa_ctx {
 
 static void msaa_ctx_init(msaa_ctx *m, const scene *s, unsigned variants)
 {
-    fogvol_context_desc cd;
     fogvol_ramp_desc rd;
     int i;
     memset(m, 0, sizeof *m);
-    memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = fv_log;
-    cd.tier = FOGVOL_TIER_FLOAT;
-    cd.variants = variants;
-    if (fogvol_create_context(&cd, &m->ctx) != FOGVOL_SUCCESS) die("fogvol_create_context (MSAA)");
+    m->ctx = float_context(variants, "fogvol_create_context (MSAA)");
     memset(&rd, 0, sizeof rd);
     rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
     rd.density = 0.5f;
@@ -2196,16 +2204,10 @@ typedef struct colbench {
 
 static void colbench_init(colbench *b, unsigned variants, const shp_mesh *m)
 {
-    fogvol_context_desc cd;
     fogvol_mesh_desc md;
     int i;
     memset(b, 0, sizeof *b);
-    memset(&cd, 0, sizeof cd);
-    cd.gl.get_proc_address = glu_proc;
-    cd.logger.func = fv_log;
-    cd.tier = FOGVOL_TIER_FLOAT;
-    cd.variants = variants;
-    if (fogvol_create_context(&cd, &b->ctx) != FOGVOL_SUCCESS) die("fogvol_create_context (colours)");
+    b->ctx = float_context(variants, "fogvol_create_context (colours)");
     memset(&md, 0, sizeof md);
     md.positions = m->pos;
     md.vertex_count = m->vcount;
