@@ -74,18 +74,22 @@ libs_of = $(or $($(1)_LIBS),$(TEST_LIBS))
 
 $(BUILD)/%: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
-# (the sanitizer builds with the implementation inline, test_backend and test_post, at -O0: they run
-# for a few seconds, and gcc compiles fogvol.h under the sanitizers 3x faster at -O0 than at -O1)
 $(BUILD)/%_san: tests/%.c $(TEST_DEPS) | $(BUILD)
-	$(CC) -std=c99 $($*_FLAGS) $(subst -O1,-O0,$(SAN)) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+	$(CC) -std=c99 $($*_FLAGS) $(SAN) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+# test_backend and test_post keep fogvol's implementation inline (they read its internal tables and
+# state): both their builds at -O0, as they run for seconds and gcc compiles fogvol.h 3-4x faster so
+INLINE_TESTS = backend post
+$(foreach t,$(INLINE_TESTS),$(BUILD)/test_$(t)): $(BUILD)/test_%: tests/test_%.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 $(test_$*_FLAGS) $(subst -O2,-O0,$(CFLAGS)) $(WARN) $(INC) $< -o $@ $(call libs_of,test_$*)
+$(foreach t,$(INLINE_TESTS),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 $(test_$*_FLAGS) $(subst -O1,-O0,$(SAN)) $(WARN) $(INC) $< -o $@ $(call libs_of,test_$*)
 
-# The cmocka programs but test_backend and test_post (they read internal tables and state) link
-# fogvol's implementation built once per flag set (tests/fogvol_impl.c; tests/fogvol_test.h leaves it
-# out with FOGVOL_TEST_LINKED): the implementation is compiled twice per build instead of twice per
-# program. test_cpu's plain, C++ and valgrind builds keep it inline, built with FOGVOL_NO_GL; its
-# sanitizer build links the sanitizer object.
-LINKED_TESTS = $(filter-out cpu backend post,$(TESTS))
-SAN_LINKED   = $(filter-out backend post,$(TESTS))
+# The cmocka programs but test_backend and test_post (INLINE_TESTS above) link fogvol's implementation
+# built once per flag set (tests/fogvol_impl.c; tests/fogvol_test.h leaves it out with
+# FOGVOL_TEST_LINKED): the implementation is compiled twice per build instead of twice per program.
+# test_cpu's C++ and valgrind builds keep it inline, built with FOGVOL_NO_GL (and the compile matrix
+# builds FOGVOL_NO_GL with every compiler).
+LINKED_TESTS = $(filter-out $(INLINE_TESTS),$(TESTS))
 $(BUILD)/fogvol_impl.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -c $< -o $@
 $(BUILD)/fogvol_impl_san.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
@@ -93,7 +97,7 @@ $(BUILD)/fogvol_impl_san.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
 $(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)): $(BUILD)/test_%: tests/test_%.c $(TEST_DEPS) $(BUILD)/fogvol_impl.o
 	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< $(BUILD)/fogvol_impl.o -o $@ \
 	  $(call libs_of,test_$*)
-$(foreach t,$(SAN_LINKED),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) \
+$(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) \
 	  $(BUILD)/fogvol_impl_san.o
 	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(SAN) $(WARN) $(INC) $< $(BUILD)/fogvol_impl_san.o -o $@ \
 	  $(call libs_of,test_$*)

@@ -34,7 +34,7 @@ extern "C" { /* cmocka 1.1.5's header has no C++ guards of its own */
 #include <stdlib.h>
 #include <string.h>
 
-#ifndef FOGVOL_TEST_LINKED /* the sanitizer build links fogvol_impl_san.o (Makefile: SAN_LINKED) */
+#ifndef FOGVOL_TEST_LINKED /* make test links fogvol_impl.o / fogvol_impl_san.o (Makefile: LINKED_TESTS) */
 #define FOGVOL_IMPLEMENTATION
 #endif
 #define FOGVOL_NO_GL
