@@ -196,11 +196,11 @@ EOF
   done
   run "cmake: add_subdirectory consumer builds and runs (examples off)" bash -c "cmake -S '$cm/consumer' \
     -B '$cm/subdir' -DFOGVOL_SOURCE_DIR='$root' && cmake --build '$cm/subdir' && '$cm/subdir/consumer'"
-  # the tests through CMake: configure, build and ctest (one cmocka program, the ray-cast self-test and
-  # a script test, the README blocks: the cheapest; `make test` runs the whole list, the shader script
-  # with the dump_shaders that this build makes too among them)
+  # the tests through CMake (a Debug build: -O0, the fastest to compile): configure, build and ctest (one
+  # cmocka program, the ray-cast self-test and a script test, the README blocks: the cheapest; `make test`
+  # runs the whole list, the shader script with the dump_shaders that this build makes too among them)
   RUN_TIMEOUT=900 run "cmake -B b && cmake --build b && ctest --test-dir b (tests: $CTEST_PROGRAMS)" bash -c "cmake -S '$root' \
-    -B '$cm/ctest' -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=ON -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
+    -B '$cm/ctest' -DCMAKE_BUILD_TYPE=Debug -DFOGVOL_BUILD_EXAMPLES=OFF -DFOGVOL_BUILD_TESTS=ON -DFOGVOL_TESTS='$CTEST_PROGRAMS' && \
     cmake --build '$cm/ctest' -j '${JOBS:-2}' && ctest --test-dir '$cm/ctest' -R '^($CTEST_PROGRAMS|raycast_selftest|readme_blocks)\$' \
     --output-on-failure"
   expect "ctest: every test passed" '100% tests passed, 0 tests failed out of [3-9]'
