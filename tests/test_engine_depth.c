@@ -580,6 +580,88 @@ static int g_frames_drawn, g_frames_exact;
 
 /* Render one view of a convention with one tier and compare: thickness and composite inside the
    viewport, and every pixel outside it as the engine left it. */
+/* The truth of one view, per pixel of its viewport: interior (the pixel and the four points 0.75 px
+   diagonally off it cross the same faces and occluder), thickness, and the sum of the faces' depth
+   slopes (vertices snap to the subpixel grid: each face's depth moves by its slope times the snap).
+   Every tier combination draws the same views of a convention's sequence, so each view's truth is
+   traced once and kept, keyed by every input of trace(); freed at the end of test_conventions. */
+typedef struct gt_view {
+    double key[6 + 10 + 2 + 1 + 16 + 16 + 1 + 2];
+    unsigned char *ok;
+    double *t, *slope;
+} gt_view;
+static gt_view *g_views;
+static int g_nviews, g_capviews;
+
+static void free_truths(void)
+{
+    int k;
+    for (k = 0; k < g_nviews; ++k) {
+        free(g_views[k].ok);
+        free(g_views[k].t);
+        free(g_views[k].slope);
+    }
+    free(g_views);
+    g_views = NULL;
+    g_nviews = g_capviews = 0;
+}
+
+static const gt_view *truth_of_view(const scene *s, double far_end, const double *ivp, const double *v, int upper_left,
+                                    const int port[4])
+{
+    double key[sizeof g_views->key / sizeof(double)];
+    gt_view *gv;
+    int i, j, k, n = 0;
+    memcpy(key + n, s->bmin, 3 * sizeof(double)), n += 3;
+    memcpy(key + n, s->bmax, 3 * sizeof(double)), n += 3;
+    for (k = 0; k < 2; ++k) {
+        key[n++] = s->occ[k].z;
+        key[n++] = s->occ[k].x0;
+        key[n++] = s->occ[k].x1;
+        key[n++] = s->occ[k].y0;
+        key[n++] = s->occ[k].y1;
+    }
+    key[n++] = s->znear;
+    key[n++] = s->zfar;
+    key[n++] = far_end;
+    memcpy(key + n, ivp, 16 * sizeof(double)), n += 16;
+    memcpy(key + n, v, 16 * sizeof(double)), n += 16;
+    key[n++] = upper_left;
+    key[n++] = port[2];
+    key[n++] = port[3];
+    for (k = 0; k < g_nviews; ++k)
+        if (!memcmp(g_views[k].key, key, sizeof key)) return &g_views[k];
+    if (g_nviews == g_capviews) {
+        g_capviews = g_capviews ? 2 * g_capviews : 64;
+        g_views = (gt_view *)realloc(g_views, sizeof *g_views * (size_t)g_capviews);
+        assert_non_null(g_views);
+    }
+    gv = &g_views[g_nviews++];
+    memcpy(gv->key, key, sizeof key);
+    gv->ok = (unsigned char *)malloc((size_t)(port[2] * port[3]));
+    gv->t = (double *)malloc(sizeof(double) * (size_t)(port[2] * port[3]));
+    gv->slope = (double *)malloc(sizeof(double) * (size_t)(port[2] * port[3]));
+    assert_true(gv->ok && gv->t && gv->slope);
+    for (j = 0; j < port[3]; ++j)
+        for (i = 0; i < port[2]; ++i) {
+            int p = j * port[2] + i, ok = 1;
+            gt_px g = trace(s, far_end, ivp, v, upper_left, i + 0.5, j + 0.5);
+            for (k = 0; k < 4 && ok; ++k)
+                ok = trace(s, far_end, ivp, v, upper_left, i + 0.5 + ((k & 1) ? 0.75 : -0.75),
+                           j + 0.5 + ((k & 2) ? 0.75 : -0.75)).sig == g.sig;
+            gv->ok[p] = (unsigned char)ok;
+            gv->t[p] = g.t;
+            gv->slope[p] = 0.0;
+            if (ok && g.t > 0.0) {
+                const double eps = 1.0 / 1024.0;
+                gt_px gx = trace(s, far_end, ivp, v, upper_left, i + 0.5 + eps, j + 0.5),
+                      gy = trace(s, far_end, ivp, v, upper_left, i + 0.5, j + 0.5 + eps);
+                gv->slope[p] = (fabs(gx.from - g.from) + fabs(gx.to - g.to) + fabs(gy.from - g.from) + fabs(gy.to - g.to)) / eps;
+            }
+        }
+    return gv;
+}
+
 static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_mesh *meshes[3],
                        fogvol_context *fv, const fogvol_ramp *ramp, const char *png, const tview *tv)
 {
@@ -595,6 +677,7 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     depth_state before, after;
     const fogvol_encoding *enc = fogvol_context_encoding(fv);
     const int *port = tv->port;
+    const gt_view *gv;
     result res;
     int i, j;
     GLint subpixel = 0;
@@ -657,28 +740,19 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
                                             : s.znear + range * (1.0 - 1.5 / ((double)enc->levels * enc->levels * enc->levels));
     res.bound = cb->tier == FOGVOL_TIER_FLOAT || st.exact_sum ? 3e-5 * range
                                               : range / (double)(1 << enc->precision_bits) + 1e-6 * range;
+    gv = truth_of_view(&s, far_end, ivp, v, c->upper_left, port);
     for (j = 0; j < port[3]; ++j)
         for (i = 0; i < port[2]; ++i) {
-            gt_px g = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5, j + 0.5);
-            double err, a, comp = 0;
-            int k, ok = 1, ch, px = 4 * ((port[1] + j) * W + port[0] + i);
-            for (k = 0; k < 4 && ok; ++k)
-                ok = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5 + ((k & 1) ? 0.75 : -0.75),
-                           j + 0.5 + ((k & 2) ? 0.75 : -0.75)).sig == g.sig;
-            if (!ok) continue;
+            double err, a, comp = 0, t = gv->t[j * port[2] + i];
+            int ch, px = 4 * ((port[1] + j) * W + port[0] + i);
+            if (!gv->ok[j * port[2] + i]) continue;
             res.interior++;
-            if (g.t > 0.05) res.fogged++;
-            err = fabs((double)thick[j * port[2] + i] - g.t);
+            if (t > 0.05) res.fogged++;
+            err = fabs((double)thick[j * port[2] + i] - t);
             if (err > res.max_err) res.max_err = err;
-            if (g.t > 0.0) { /* vertices snap to 2^-GL_SUBPIXEL_BITS pixels: each face's depth moves by its slope */
-                const double eps = 1.0 / 1024.0;
-                gt_px gx = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5 + eps, j + 0.5),
-                      gy = trace(&s, far_end, ivp, v, c->upper_left, i + 0.5, j + 0.5 + eps);
-                err -= (fabs(gx.from - g.from) + fabs(gx.to - g.to) + fabs(gy.from - g.from) + fabs(gy.to - g.to)) /
-                       eps * snap;
-            }
+            err -= gv->slope[j * port[2] + i] * snap; /* vertices snap to 2^-GL_SUBPIXEL_BITS pixels */
             if (err > res.max_over) res.max_over = err;
-            a = 1.0 - exp(-DENSITY * g.t);
+            a = 1.0 - exp(-DENSITY * t);
             for (ch = 0; ch < 3; ++ch) {
                 double want = base[px + ch] / 255.0 + (0.8 - base[px + ch] / 255.0) * a;
                 double got = fogged[px + ch] / 255.0;
@@ -869,8 +943,9 @@ static void test_conventions(void **state)
     glu_destroy(&g);
     shp_free(&box);
     shp_free(&quad);
-    printf("# conventions: %d views in sequences of %d frames, %d sequences failed\n", views, SQ_DEFAULT_FRAMES,
-           failures);
+    printf("# conventions: %d views in sequences of %d frames, %d sequences failed; %d views' truths traced\n", views,
+           SQ_DEFAULT_FRAMES, failures, g_nviews);
+    free_truths();
     assert_int_equal(failures, 0);
 }
 
