@@ -501,6 +501,10 @@ typedef struct result {
     fogvol_result r;
     long wrong;   /* interior pixels off by more than the bound, or whose composite is */
     long outside; /* pixels outside the viewport fogvol changed */
+    int tested;   /* fogvol_frame_stats.engine_depth_tested */
+    int fits;     /* the frame fits the depth-tested faces (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST): the box's
+                     corners all between the planes (znear, zfar: the projection's too), the viewport
+                     at the origin, no oblique near plane; computed here from the scene */
 } result;
 
 /* One view of a convention's sequence: the camera's walk position, whether the occluder that comes
@@ -576,7 +580,7 @@ static void scene_models(const scene *s, float model[3][16])
 }
 
 /* frames drawn, and those of them whose faces summed in integers (fogvol_frame_stats.exact_sum) */
-static int g_frames_drawn, g_frames_exact;
+static int g_frames_drawn, g_frames_exact, g_frames_tested;
 
 /* Render one view of a convention with one tier and compare: thickness and composite inside the
    viewport, and every pixel outside it as the engine left it. */
@@ -635,7 +639,16 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     for (i = 0; i < W * H; ++i) thick[i] = -1e30f;
     memset(&st, 0, sizeof st);
     res.r = fogvol_end_frame(fv, &st);
+    res.tested = st.engine_depth_tested;
+    res.fits = port[0] == 0 && port[1] == 0 && c->proj != P_OBLIQUE;
+    for (i = 0; i < 8; ++i) { /* view depth of each corner of the box */
+        double p[3], e;
+        for (j = 0; j < 3; ++j) p[j] = (i >> j & 1) ? s.bmax[j] : s.bmin[j];
+        e = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
+        res.fits = res.fits && e >= s.znear && e <= s.zfar;
+    }
     g_frames_drawn += res.r == FOGVOL_SUCCESS;
+    g_frames_tested += res.r == FOGVOL_SUCCESS && res.tested;
     g_frames_exact += res.r == FOGVOL_SUCCESS && st.exact_sum;
     glFinish();
     get_depth_state(&after);
@@ -752,15 +765,19 @@ static void seq_view(void *user, const sq_view *v, sq_check *out)
     ok = r.r == FOGVOL_SUCCESS && r.max_over <= r.bound && r.comp_max <= 2.0 / 255.0 && r.state_ok &&
          r.outside == 0 && r.interior > v->viewport[2] * v->viewport[3] / 2;
     if (first) ok = ok && r.fogged > 200;
-    /* the faces that read the engine's depth linearise it from z alone unless the near
-       plane is oblique (x and y terms); nothing else reads it */
-    ok = ok && g_from_z_passes == ((cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && c->proj != P_OBLIQUE);
+    /* FLOAT + engine depth draws the frames that fit depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST), and
+       only those; every other combination none */
+    ok = ok && r.tested == (cb->tier == FOGVOL_TIER_FLOAT && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && r.fits);
+    /* the faces that read the engine's depth linearise it from z alone unless the near plane is oblique
+       (x and y terms); nothing else reads it; depth-tested frames read it in the composite and in the
+       debug read-back's pass instead */
+    ok = ok && g_from_z_passes == ((cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && c->proj != P_OBLIQUE ? 1 + r.tested : 0);
     if (first || !ok)
         printf("# %-18s %-48s f%d.%d max |err| %.3g (less vertex snapping: %.3f of bound %.3g), composite %.1f/255, "
-               "%d fogged of %d interior, %ld outside changed, state %s, %s%s\n",
+               "%d fogged of %d interior, %ld outside changed, state %s, %s%s%s\n",
                cb->name, c->name, v->frame, v->view, r.max_err, r.max_over / r.bound, r.bound, r.comp_max * 255.0,
                r.fogged, r.interior, r.outside, r.state_ok ? "restored" : "CHANGED", fogvol_result_string(r.r),
-               ok ? "" : "  FAIL");
+               r.tested ? ", depth-tested" : "", ok ? "" : "  FAIL");
     out->pixels = r.interior;
     out->wrong = r.wrong + r.outside + !ok;
     out->max_err = r.max_over;
@@ -819,7 +836,7 @@ static void test_conventions(void **state)
         rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
         rd.density = (float)DENSITY;
         assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-        g_frames_drawn = g_frames_exact = 0;
+        g_frames_drawn = g_frames_exact = g_frames_tested = 0;
         for (ci = 0; ci < NCONV; ++ci) {
             const conv *c = &g_convs[ci];
             char png[128], name[96], where[200];
@@ -858,6 +875,11 @@ static void test_conventions(void **state)
             printf("# %s: %d of %d frames summed in integers\n", cb->name, g_frames_exact, g_frames_drawn);
             assert_true(g_frames_drawn > 0);
             assert_int_equal(g_frames_exact, g_frames_drawn);
+        }
+        if (cb->tier == FOGVOL_TIER_FLOAT && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH)) {
+            /* both kinds of frame in the sequences: depth-tested and reading the depth per face */
+            printf("# %s: %d of %d frames depth-tested\n", cb->name, g_frames_tested, g_frames_drawn);
+            assert_true(g_frames_tested > 0 && g_frames_tested < g_frames_drawn);
         }
         fogvol_destroy_ramp(fv, ramp);
         fogvol_destroy_mesh(fv, m[0]);
