@@ -12964,7 +12964,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     }
     gl->FrontFace(FOGVOL__GL_CCW);
     fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
-    gl->DepthFunc(p->depth_greater ? FOGVOL__GL_GREATER : FOGVOL__GL_LESS);
+    gl->DepthFunc(p->depth_greater ? (fogvol__GLenum)FOGVOL__GL_GREATER : (fogvol__GLenum)FOGVOL__GL_LESS);
     gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
     gl->Disable(FOGVOL__GL_STENCIL_TEST); /* the engine's stencil buffer is its own */
     fogvol__gl_pass_program(gl, p);
