@@ -1069,6 +1069,122 @@ static void test_convex_welded(void **state)
     rec_free(&r);
 }
 
+/* ==== L6b the convexity test's tree against every (face, vertex) pair ==== */
+/* fogvol_mesh_report.convex by its documented rule, tested on every pair: every vertex within
+   1e-5 of the vertices' box diagonal of the inner side of every face plane (degenerate faces,
+   |n| <= 1e-12 diag^2, have none). Returns the largest (n . (p - a)) / |n| over the pairs in units
+   of that tolerance: convex exactly when <= 1. */
+static double reference_excess(const float *pos, const unsigned *idx, int nt, int nv)
+{
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, diag = 0, worst = -1e300;
+    int t, v, k;
+    for (v = 0; v < nv; ++v)
+        for (k = 0; k < 3; ++k) {
+            lo[k] = pos[3 * v + k] < lo[k] ? pos[3 * v + k] : lo[k];
+            hi[k] = pos[3 * v + k] > hi[k] ? pos[3 * v + k] : hi[k];
+        }
+    for (k = 0; k < 3; ++k) diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diag = sqrt(diag);
+    for (t = 0; t < nt; ++t) {
+        const float *a = pos + 3 * idx[3 * t], *b = pos + 3 * idx[3 * t + 1], *c = pos + 3 * idx[3 * t + 2];
+        double e1[3], e2[3], n[3], len;
+        for (k = 0; k < 3; ++k) {
+            e1[k] = (double)b[k] - a[k];
+            e2[k] = (double)c[k] - a[k];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 1e-12 * diag * diag)) continue;
+        for (v = 0; v < nv; ++v) {
+            const float *p = pos + 3 * v;
+            double d = (n[0] * (p[0] - (double)a[0]) + n[1] * (p[1] - (double)a[1]) + n[2] * (p[2] - (double)a[2])) / len;
+            if (d / (1e-5 * diag) > worst) worst = d / (1e-5 * diag);
+        }
+    }
+    return worst;
+}
+
+/* The mesh with vertex `moved` (and its copies: the cube's faces repeat their edges) at
+   base + s * dir: its excess by the rule. */
+static double excess_moved(shp_mesh *m, const float *base, int moved, const double dir[3], double s)
+{
+    int v, k;
+    memcpy(m->pos, base, sizeof(float) * 3 * (size_t)m->vcount);
+    for (v = 0; v < m->vcount; ++v)
+        if (!memcmp(base + 3 * v, base + 3 * moved, 3 * sizeof(float)))
+            for (k = 0; k < 3; ++k) m->pos[3 * v + k] = (float)(base[3 * moved + k] + s * dir[k]);
+    return reference_excess(m->pos, m->idx, m->icount / 3, m->vcount);
+}
+
+/* A sphere (1,106 vertices) and a cube of 12 x 12 squares a face (many vertices on each face plane,
+   welded): one vertex moved out (a bump) or in (a dent) along its outward direction. The distance
+   where the rule turns the mesh concave is found by bisection on the rule tested on every pair;
+   each mesh of a sweep across it (0.5, 0.99, 1.01 and 2 times that distance, and far beyond) must be
+   convex exactly as the rule says. The tree skips boxes more than half the tolerance inside a
+   plane: the answers near the border are the ones it could get wrong. */
+static void test_convex_tree(void **state)
+{
+    static const double at[] = {0.0, 0.5, 0.99, 1.01, 2.0, 50.0};
+    recorder r;
+    logcap lc;
+    fogvol_context *fv;
+    int shape, sign, j, seen[2] = {0, 0};
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    fv = rec_context(&r, 0u, FOGVOL_TIER_PS20, 0u, &lc, NULL);
+    for (shape = 0; shape < 2; ++shape) {
+        shp_mesh m = shape == 0 ? shp_sphere(1.0f, 48, 24) : shp_cube_faces(1.0f, 12);
+        int moved = shape == 0 ? 500 : 5 * 13 + 7, k; /* sphere: mid-latitude; cube: inside face 0 */
+        float *base = (float *)malloc(sizeof(float) * 3 * (size_t)m.vcount);
+        double dir[3], lo = 0.0, hi = 0.02, len = 0.0;
+        assert_true(m.pos && base);
+        memcpy(base, m.pos, sizeof(float) * 3 * (size_t)m.vcount);
+        for (k = 0; k < 3; ++k) len += (double)base[3 * moved + k] * base[3 * moved + k];
+        for (k = 0; k < 3; ++k) dir[k] = shape == 0 ? base[3 * moved + k] / sqrt(len) : (k == 0 ? 1.0 : 0.0);
+        for (sign = 1; sign >= -1; sign -= 2) {
+            int it;
+            lo = 0.0;
+            hi = 0.02;
+            assert_true(excess_moved(&m, base, moved, dir, 0.0) <= 1.0);
+            assert_true(excess_moved(&m, base, moved, dir, sign * hi) > 1.0);
+            for (it = 0; it < 40; ++it) { /* the border: excess 1 at distance (lo + hi) / 2 */
+                double mid = 0.5 * (lo + hi);
+                if (excess_moved(&m, base, moved, dir, sign * mid) <= 1.0) lo = mid;
+                else hi = mid;
+            }
+            for (j = 0; j < (int)(sizeof at / sizeof at[0]); ++j) {
+                double s = sign * at[j] * lo, excess = excess_moved(&m, base, moved, dir, s);
+                int want = excess <= 1.0;
+                fogvol_mesh_desc md;
+                fogvol_mesh_report rep;
+                fogvol_mesh *fm = NULL;
+                memset(&md, 0, sizeof md);
+                md.positions = m.pos;
+                md.vertex_count = m.vcount;
+                md.indices = (const uint32_t *)m.idx;
+                md.index_count = m.icount;
+                md.weld_distance = shape == 1 ? 1e-6f : 0.0f;
+                assert_int_equal(fogvol_create_mesh(fv, &md, &fm, &rep), FOGVOL_SUCCESS);
+                if (j == 2 || j == 3 || rep.convex != want)
+                    print_message("  %s, a %s of %.3g (%.2f x the border): largest excess %.4f tolerances, convex %d "
+                                  "(rule: %d)\n", shape ? "cube 12x12 a face" : "sphere 48x24", sign > 0 ? "bump" : "dent",
+                                  fabs(s), at[j], excess, rep.convex, want);
+                assert_int_equal(rep.convex, want);
+                seen[want]++;
+                fogvol_destroy_mesh(fv, fm);
+            }
+        }
+        free(base);
+        shp_free(&m);
+    }
+    print_message("  %d meshes convex and %d not, each as the rule tested on every pair says\n", seen[1], seen[0]);
+    assert_true(seen[0] >= 8 && seen[1] >= 8);
+    fogvol_destroy_context(fv);
+    rec_free(&r);
+}
+
 /* ==== L7 meshes without an index array ==== */
 static void test_non_indexed(void **state)
 {
@@ -1313,7 +1429,7 @@ int main(void)
         cmocka_unit_test(test_far_volumes_geometry), cmocka_unit_test(test_viewport_origins),
         cmocka_unit_test(test_weld_reference),       cmocka_unit_test(test_ramp_groups),
         cmocka_unit_test(test_lifetime_null),        cmocka_unit_test(test_lifetime_gl),
-        cmocka_unit_test(test_convex_welded),        cmocka_unit_test(test_non_indexed),
+        cmocka_unit_test(test_convex_welded),        cmocka_unit_test(test_convex_tree),        cmocka_unit_test(test_non_indexed),
         cmocka_unit_test(test_non_indexed_gl),       cmocka_unit_test(test_refusals_logged),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
