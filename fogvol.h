@@ -1472,7 +1472,7 @@ enum {
     FOGVOL_CAP_ATTACH_DEPTH = 1u << 10     /* begin_pass honours fogvol_pass.depth_texture and depth_greater,
                                               end_pass detaches it, and create_target makes RG32F targets
                                               (GL 3.0 / GLES 3.0 framebuffer objects and RG32F with
-                                              FOGVOL_CAP_FLOAT_BLEND): FLOAT + ENGINE_DEPTH frames drawn
+                                              FOGVOL_CAP_FLOAT_BLEND; not WebGL): FLOAT + ENGINE_DEPTH frames drawn
                                               depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */
 };
 
@@ -13392,7 +13392,9 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         gl->float_linear = gl->major >= 3;
         if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
     }
-    if (gl->major >= 3 && (caps & FOGVOL_CAP_FLOAT_BLEND)) caps |= FOGVOL_CAP_ATTACH_DEPTH; /* (RG32F, FBOs) */
+    /* RG32F targets and FBOs; not WebGL, whose feedback-loop rule forbids the composite's read of a depth
+       texture that is attached to the bound framebuffer, even with depth writes off (not tested here) */
+    if (gl->major >= 3 && (caps & FOGVOL_CAP_FLOAT_BLEND) && !gl->webgl) caps |= FOGVOL_CAP_ATTACH_DEPTH;
     return caps;
 }
 
