@@ -23,7 +23,12 @@
    the engine's depth texture) |error| <= 3e-5 of the range. The composite
    (fog colour over the engine's picture) is checked within 2/255 and the
    engine's depth state (clip control, depth range, depth func, clear depth)
-   must come back unchanged. */
+   must come back unchanged. FLOAT + engine depth draws the frames that fit depth-tested
+   (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: fogvol_frame_stats.engine_depth_tested exactly where the box lies
+   between the planes, the viewport at the origin and the near plane not oblique, worked out here from
+   the scene), and test_engine_tested_inputs runs it over the engine's depth formats (DEPTH24,
+   DEPTH32F, DEPTH24_STENCIL8), sources (texture, bound framebuffer, framebuffer by name), occluders
+   exactly on the box's faces and a walk into the box and out. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
