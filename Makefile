@@ -74,15 +74,18 @@ libs_of = $(or $($(1)_LIBS),$(TEST_LIBS))
 
 $(BUILD)/%: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+# (the sanitizer builds with the implementation inline, test_backend and test_post, at -O0: they run
+# for a few seconds, and gcc compiles fogvol.h under the sanitizers 3x faster at -O0 than at -O1)
 $(BUILD)/%_san: tests/%.c $(TEST_DEPS) | $(BUILD)
-	$(CC) -std=c99 $($*_FLAGS) $(SAN) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+	$(CC) -std=c99 $($*_FLAGS) $(subst -O1,-O0,$(SAN)) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
 
-# The cmocka programs but test_cpu (FOGVOL_NO_GL; its C++ and valgrind builds keep the
-# implementation inline too), test_backend and test_post (they read internal tables and state) link
-# fogvol's implementation built once per flag set
-# (tests/fogvol_impl.c; tests/fogvol_test.h leaves it out with FOGVOL_TEST_LINKED): the
-# implementation is compiled twice per build instead of twice per program.
+# The cmocka programs but test_backend and test_post (they read internal tables and state) link
+# fogvol's implementation built once per flag set (tests/fogvol_impl.c; tests/fogvol_test.h leaves it
+# out with FOGVOL_TEST_LINKED): the implementation is compiled twice per build instead of twice per
+# program. test_cpu's plain, C++ and valgrind builds keep it inline, built with FOGVOL_NO_GL; its
+# sanitizer build links the sanitizer object.
 LINKED_TESTS = $(filter-out cpu backend post,$(TESTS))
+SAN_LINKED   = $(filter-out backend post,$(TESTS))
 $(BUILD)/fogvol_impl.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 $(CFLAGS) $(WARN) $(INC) -c $< -o $@
 $(BUILD)/fogvol_impl_san.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
@@ -90,7 +93,7 @@ $(BUILD)/fogvol_impl_san.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
 $(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)): $(BUILD)/test_%: tests/test_%.c $(TEST_DEPS) $(BUILD)/fogvol_impl.o
 	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< $(BUILD)/fogvol_impl.o -o $@ \
 	  $(call libs_of,test_$*)
-$(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) \
+$(foreach t,$(SAN_LINKED),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/test_%.c $(TEST_DEPS) \
 	  $(BUILD)/fogvol_impl_san.o
 	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(SAN) $(WARN) $(INC) $< $(BUILD)/fogvol_impl_san.o -o $@ \
 	  $(call libs_of,test_$*)
@@ -105,18 +108,23 @@ $(BUILD)/test_raycast_san: tests/test_raycast_selftest.c tests/raycast.h tests/s
 	$(CC) -std=c99 -DRC_SANITIZE $(SAN) $(WARN) $(INC) -Itests $< -o $@ -lm
 $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
-$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
-	clang -g -O1 -fsanitize=fuzzer,address,undefined $(INC) $< -o $@ -lm
-# API sequences on the null and the GL backend (OSMesa): libFuzzer under ASan+UBSan with
-# float-cast-overflow, and its corpus replayed by the sanitizer build of the tests (GL under
-# valgrind would take minutes). make test's short run starts from the seeds (tests/fuzz/seed_api.py
-# writes them; loading the whole corpus into libFuzzer takes a minute), make fuzz from the corpus.
+# The three libFuzzer targets (ASan, UBSan with float-cast-overflow) link fogvol's implementation built
+# once with the fuzzer's coverage (fuzz_impl.o; the GL backend in it reaches GL through pointers only).
+FUZZ_SAN = -g -O1 -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all
+$(BUILD)/fuzz_impl.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
+	clang $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(INC) -c $< -o $@
+$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)/fuzz_impl.o | $(BUILD)
+	clang $(FUZZ_SAN) -fsanitize=fuzzer -DFOGVOL_TEST_LINKED $(INC) $< $(BUILD)/fuzz_impl.o -o $@ -lm
+# API sequences on the null and the GL backend (OSMesa): libFuzzer, and its corpus replayed by the
+# sanitizer build of the tests (linked with fogvol_impl_san.o; GL under valgrind would take minutes).
+# make test's short run starts from the seeds (tests/fuzz/seed_api.py writes them; loading the whole
+# corpus into libFuzzer takes a minute), make fuzz from the corpus.
 FUZZ_API_DEPS = tests/fuzz/fuzz_api.c fogvol.h tests/gl_util.h tests/shapes.h
-$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) | $(BUILD)
-	clang -g -O1 -fsanitize=fuzzer,address,undefined,float-cast-overflow -fno-sanitize-recover=all $(INC) $< -o $@ \
-	  -lOSMesa -lm
-$(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) | $(BUILD)
-	$(CC) -std=c99 -D_DEFAULT_SOURCE $(SAN) $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_api.c -o $@ -lOSMesa -lm
+$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) $(BUILD)/fuzz_impl.o | $(BUILD)
+	clang $(FUZZ_SAN) -fsanitize=fuzzer -DFOGVOL_TEST_LINKED $(INC) $< $(BUILD)/fuzz_impl.o -o $@ -lOSMesa -lm
+$(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) $(BUILD)/fogvol_impl_san.o | $(BUILD)
+	$(CC) -std=c99 -D_DEFAULT_SOURCE -DFOGVOL_TEST_LINKED $(SAN) $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_api.c \
+	  $(BUILD)/fogvol_impl_san.o -o $@ -lOSMesa -lm
 
 TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(foreach t,$(CXX_TESTS),$(BUILD)/test_$(t)_cpp) \
@@ -151,7 +159,8 @@ SCRIPT_RUNS = \
   "doc_figures=$(call built,$(BUILD)/dump_shaders) BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
   "demo_headless=$(call built,$(BUILD)/demo_headless) $(BUILD)/demo_headless $(BUILD)/demo --check" \
   "bench_quick=$(call built,$(BUILD)/bench) $(BUILD)/bench --quick" \
-  "egl_builds=$(BUILT) $(BUILD)/bench_egl $(BUILD)/egl/demo_headless" \
+  "egl_builds=$(BUILT) BUILD=$(BUILD)/egl_check CFLAGS=-O0 BENCH_OPT=-O0 $(BUILD)/egl_check/bench_egl \
+    $(BUILD)/egl_check/egl/demo_headless" \
   "raycast_selftest=$(call built,$(BUILD)/test_raycast) $(BUILD)/test_raycast" \
   "raycast_selftest_asan_ubsan=$(call built,$(BUILD)/test_raycast_san) $(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(call built,$(BUILD)/test_cpu_vg) $(TAP) FOGVOL_TEST_SUBSET=1 $(VALGRIND) $(BUILD)/test_cpu_vg" \
@@ -193,7 +202,7 @@ check: deps-test | $(BUILD)
 # everything; the README's test command and CI. The objects and programs that several entries use
 # (TEST_SHARED) are built first; every entry then builds its own programs (TEST_BINS) as it starts, so
 # that compiling and testing overlap on the JOBS that tests/run.sh runs at once.
-TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/dump_shaders $(BUILD)/vulkan_backend
+TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/fuzz_impl.o $(BUILD)/dump_shaders $(BUILD)/vulkan_backend
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_SHARED)
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) DURATIONS=tests/durations tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
@@ -262,8 +271,10 @@ proto-engine-depth: deps-demo
 
 # the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
 # build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
+# (make test's egl_builds entry only builds it and the EGL demo, with BENCH_OPT=-O0 CFLAGS=-O0: they run on a GPU)
+BENCH_OPT ?= -O2
 $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
-	$(CC) -std=c99 -O2 $(WARN) -DGLU_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
+	$(CC) -std=c99 $(BENCH_OPT) $(WARN) -DGLU_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
 
 # the GL tests built on tests/gl_util.h's EGL contexts (-DGLU_EGL) instead of OSMesa, for a GPU
 # driver: make gpu-test builds and runs them (on the EGL device FOGVOL_EGL_DEVICE, default 0), with

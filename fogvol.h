@@ -3194,10 +3194,13 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
     if (j0 < 0) j0 = 0;
     if (i1 > FOGVOL__WIND_GRID - 1) i1 = FOGVOL__WIND_GRID - 1;
     if (j1 > FOGVOL__WIND_GRID - 1) j1 = FOGVOL__WIND_GRID - 1;
-    for (j = j0; j <= j1; ++j)
+    for (j = j0; j <= j1; ++j) {
+        double qv = lo[v] + (j + offv) * step[v];
+        if (qv < vmin || qv > vmax) continue; /* outside the triangle's box: neither inside nor on an edge */
         for (i = i0; i <= i1; ++i) {
-            double qu = lo[u] + (i + offu) * step[u], qv = lo[v] + (j + offv) * step[v], e[3];
+            double qu = lo[u] + (i + offu) * step[u], e[3];
             int ray = (a * FOGVOL__WIND_GRID + j) * FOGVOL__WIND_GRID + i;
+            if (qu < umin || qu > umax) continue;
             for (k = 0; k < 3; ++k) { /* edge k (corner k to k+1) against q, sign-normalised */
                 const double *p0 = p[k], *p1 = p[(k + 1) % 3];
                 e[k] = ((p1[u] - p0[u]) * (qv - p0[v]) - (p1[v] - p0[v]) * (qu - p0[u])) * (area > 0 ? 1 : -1);
@@ -3217,6 +3220,7 @@ static void fogvol__grid_tri(double p[3][3], int a, const double lo[3], const do
                 x->tri = tri;
             }
         }
+    }
 }
 
 static fogvol_result fogvol__grid_winding(const fogvol__wind *w, const fogvol_allocator *alloc,

@@ -49,7 +49,7 @@ CTEST_PROGRAMS=${CTEST_PROGRAMS:-glstate} # the cmocka programs the CMake test b
 
 if [ "$part" != package ]; then # the examples: build, run, check
 # ---- build ---------------------------------------------------------------------------
-flags="-std=c99 -O2 -Wall -Wextra -pedantic -Werror -I."
+flags="-std=c99 -O1 -Wall -Wextra -pedantic -Werror -I." # -O1: the flow warnings; -O2 builds of the same code in make test
 # name, libraries: OSMesa for the headless ones (every GL call must reach OSMesa), GLFW + libGL for the windows
 builds="demo_headless:-lOSMesa custom_backend:-lOSMesa demo_glfw:-lglfw_-lGL engine_integration:-lglfw_-lGL"
 for b in $builds; do # in parallel; each writes its own log (300 s each: make test runs other jobs beside them)

@@ -104,9 +104,21 @@ typedef struct rc_scene_object {
   double bs_center[3], bs_radius; /* world-space bounding sphere */
 } rc_scene_object;
 
+/* rc_interior's samples: the signature of each sample point traced for one camera (a pixel's corners
+   and its neighbours' centres are its neighbours' samples too, so a whole image traces each point
+   once instead of 13 times). Open addressing; slots of other generations are empty (a new camera
+   starts a generation). */
+typedef struct rc__memo {
+  rc_camera cam;
+  double *key; /* sx, sy per slot */
+  unsigned *sig, *gen, cur;
+  int cap, n;
+} rc__memo;
+
 typedef struct rc_scene {
   rc_scene_object *objs;
   int count;
+  rc__memo *memo; /* rc_interior's, made on its first call (NULL: none yet) */
 } rc_scene;
 
 /* ---- small vector helpers ---- */
@@ -191,6 +203,12 @@ RC__FN void rc_scene_free(rc_scene *sc) {
     free(sc->objs[i].nodes);
   }
   free(sc->objs);
+  if (sc->memo) {
+    free(sc->memo->key);
+    free(sc->memo->sig);
+    free(sc->memo->gen);
+    free(sc->memo);
+  }
   memset(sc, 0, sizeof *sc);
 }
 
@@ -777,16 +795,96 @@ RC__FN double rc_depth_slope(const rc_scene *sc, const rc_camera *cam, int px, i
   return sum / eps;
 }
 
+RC__FN int rc__same_camera(const rc_camera *a, const rc_camera *b) {
+  int k;
+  for (k = 0; k < 3; k++)
+    if (a->eye[k] != b->eye[k] || a->target[k] != b->target[k] || a->up[k] != b->up[k]) return 0;
+  return a->fovy_deg == b->fovy_deg && a->aspect == b->aspect && a->znear == b->znear && a->zfar == b->zfar &&
+         a->width == b->width && a->height == b->height;
+}
+
+RC__FN unsigned rc__memo_hash(double sx, double sy) {
+  unsigned long long a, b;
+  memcpy(&a, &sx, sizeof a);
+  memcpy(&b, &sy, sizeof b);
+  a ^= b * 0x9e3779b97f4a7c15ull;
+  a ^= a >> 29;
+  a *= 0xbf58476d1ce4e5b9ull;
+  return (unsigned)(a ^ (a >> 32));
+}
+
+/* The memo's slots doubled (the live generation's entries moved over); 0: out of memory. */
+RC__FN int rc__memo_grow(rc__memo *m) {
+  int cap = m->cap ? 2 * m->cap : 4096, i;
+  double *key = (double *)malloc(sizeof(double) * 2 * (size_t)cap);
+  unsigned *sig = (unsigned *)malloc(sizeof(unsigned) * (size_t)cap), *gen = (unsigned *)calloc((size_t)cap, sizeof(unsigned));
+  if (!key || !sig || !gen) {
+    free(key);
+    free(sig);
+    free(gen);
+    return 0;
+  }
+  for (i = 0; i < m->cap; i++)
+    if (m->gen[i] == m->cur) {
+      unsigned h = rc__memo_hash(m->key[2 * i], m->key[2 * i + 1]) & (unsigned)(cap - 1);
+      while (gen[h] == m->cur) h = (h + 1) & (unsigned)(cap - 1);
+      key[2 * h] = m->key[2 * i];
+      key[2 * h + 1] = m->key[2 * i + 1];
+      sig[h] = m->sig[i];
+      gen[h] = m->cur;
+    }
+  free(m->key);
+  free(m->sig);
+  free(m->gen);
+  m->key = key;
+  m->sig = sig;
+  m->gen = gen;
+  m->cap = cap;
+  return 1;
+}
+
+/* The signature of sample (sx,sy), traced once per camera and scene (rc_trace where no memory). */
+RC__FN unsigned rc__sample_signature(const rc_scene *sc, const rc_camera *cam, double sx, double sy) {
+  rc__memo *m = sc->memo;
+  unsigned h, s;
+  if (!m) {
+    m = (rc__memo *)calloc(1, sizeof *m);
+    if (!m) return rc_trace(sc, cam, sx, sy).signature;
+    m->cur = 1;
+    m->cam = *cam;
+    ((rc_scene *)sc)->memo = m; /* the scene is the caller's (non-const) object */
+  } else if (!rc__same_camera(&m->cam, cam)) {
+    m->cam = *cam;
+    m->n = 0;
+    if (++m->cur == 0) { /* generations wrapped: clear the slots */
+      if (m->gen) memset(m->gen, 0, sizeof(unsigned) * (size_t)m->cap);
+      m->cur = 1;
+    }
+  }
+  if (2 * (m->n + 1) > m->cap && !rc__memo_grow(m)) return rc_trace(sc, cam, sx, sy).signature;
+  for (h = rc__memo_hash(sx, sy) & (unsigned)(m->cap - 1); m->gen[h] == m->cur; h = (h + 1) & (unsigned)(m->cap - 1))
+    if (m->key[2 * h] == sx && m->key[2 * h + 1] == sy) return m->sig[h];
+  s = rc_trace(sc, cam, sx, sy).signature;
+  m->key[2 * h] = sx;
+  m->key[2 * h + 1] = sy;
+  m->sig[h] = s;
+  m->gen[h] = m->cur;
+  m->n++;
+  return s;
+}
+
 /* 1 if pixel (px,py) is "interior": the signature at the pixel centre equals the signatures
    at the 4 pixel corners and at the 8 neighbouring pixel centres (so one-pixel silhouette
-   bands, opaque/volume intersection curves and near/far-plane crossings are excluded). */
+   bands, opaque/volume intersection curves and near/far-plane crossings are excluded). The
+   samples' signatures are kept with the scene for the camera (the next pixel shares most of
+   them); rc_scene_free frees them. */
 RC__FN int rc_interior(const rc_scene *sc, const rc_camera *cam, int px, int py) {
   const double off[12][2] = {{0, 0},      {1, 0},     {0, 1},     {1, 1},    {-0.5, -0.5}, {0.5, -0.5},
                              {1.5, -0.5}, {-0.5, 0.5}, {1.5, 0.5}, {-0.5, 1.5}, {0.5, 1.5},  {1.5, 1.5}};
-  unsigned s0 = rc_trace(sc, cam, px + 0.5, py + 0.5).signature;
+  unsigned s0 = rc__sample_signature(sc, cam, px + 0.5, py + 0.5);
   int i;
   for (i = 0; i < 12; i++)
-    if (rc_trace(sc, cam, px + off[i][0], py + off[i][1]).signature != s0) return 0;
+    if (rc__sample_signature(sc, cam, px + off[i][0], py + off[i][1]) != s0) return 0;
   return 1;
 }
 

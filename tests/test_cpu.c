@@ -30,10 +30,13 @@ extern "C" { /* cmocka 1.1.5's header has no C++ guards of its own */
 #endif
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef FOGVOL_TEST_LINKED /* the sanitizer build links fogvol_impl_san.o (Makefile: SAN_LINKED) */
 #define FOGVOL_IMPLEMENTATION
+#endif
 #define FOGVOL_NO_GL
 #include "../fogvol.h"
 #include "shapes.h"

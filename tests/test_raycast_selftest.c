@@ -1044,6 +1044,41 @@ static void test_winding(void) {
   for (s = 0; s < 5; s++) shp_free(&ms[s]);
 }
 
+/* ------------------------------------------------------------------ rc_interior's memo */
+
+/* rc_interior keeps its samples' signatures with the scene, per camera: with two cameras taking
+   turns pixel by pixel (each turn a new generation of the memo), every pixel's answer must be the
+   definition's, evaluated here with rc_trace alone. */
+static void test_interior_memo(void) {
+  shp_mesh m = shp_torus(1.0f, 0.35f, 24, 12);
+  rc_object o = make_obj(&m, NULL, +1);
+  rc_scene sc;
+  rc_camera c[2];
+  const double off[12][2] = {{0, 0},      {1, 0},     {0, 1},     {1, 1},    {-0.5, -0.5}, {0.5, -0.5},
+                             {1.5, -0.5}, {-0.5, 0.5}, {1.5, 0.5}, {-0.5, 1.5}, {0.5, 1.5},  {1.5, 1.5}};
+  int px, py, k, i, diff = 0, nint[2] = {0, 0};
+  printf("-- rc_interior's memo\n");
+  c[0] = make_cam(0.3, 1.2, 2.6, 0, 0, 0, 0, 1, 0, 60, 48, 40, 0.1, 100);
+  c[1] = make_cam(-1.9, 0.4, 1.7, 0, 0.1, 0, 0, 1, 0, 50, 48, 40, 0.1, 100);
+  check(rc_scene_init(&sc, &o, 1), "rc_scene_init memo");
+  for (py = 0; py < 40; py++)
+    for (px = 0; px < 48; px++)
+      for (k = 0; k < 2; k++) {
+        unsigned s0 = rc_trace(&sc, &c[k], px + 0.5, py + 0.5).signature;
+        int want = 1;
+        for (i = 0; i < 12; i++) want &= rc_trace(&sc, &c[k], px + off[i][0], py + off[i][1]).signature == s0;
+        diff += rc_interior(&sc, &c[k], px, py) != want;
+        nint[k] += want;
+      }
+  check(diff == 0 && nint[0] > 100 && nint[0] < 48 * 40 && nint[1] > 100 && nint[1] < 48 * 40,
+        "rc_interior with two cameras in turn: %d of %d answers differ from the definition (%d and %d interior)", diff,
+        2 * 48 * 40, nint[0], nint[1]);
+  printf("   two cameras in turn, 48x40: %d of %d answers differ from rc_trace's (%d, %d interior)\n", diff,
+         2 * 48 * 40, nint[0], nint[1]);
+  rc_scene_free(&sc);
+  shp_free(&m);
+}
+
 /* ------------------------------------------------------------------ performance */
 
 static void test_perf(void) {
@@ -1063,7 +1098,8 @@ static void test_perf(void) {
       nint += rc_interior(&sc, &c, px, py);
     }
   secs = (double)(clock() - t0) / CLOCKS_PER_SEC;
-  printf("   128x128, 2000 triangles, rc_trace + rc_interior per pixel (14 rays): %.3f s CPU (%d interior, sum %.3f)\n",
+  printf("   128x128, 2000 triangles, rc_trace + rc_interior per pixel (14 samples, each point traced once per "
+         "camera): %.3f s CPU (%d interior, sum %.3f)\n",
          secs, nint, sum);
   rc_scene_free(&sc);
   shp_free(&m);
@@ -1111,6 +1147,7 @@ int main(void) {
   test_ties();
   test_winding();
   test_depth_slope();
+  test_interior_memo();
   test_perf();
   printf("%d passed, %d failed\n", g_pass, g_fail);
   return g_fail ? 1 : 0;

@@ -39,7 +39,7 @@ check() {
   echo "$f done"
 }
 export -f check
-xargs -P "$jobs" -I{} bash -c 'check {}' < "$dir/list" | LC_ALL=C sort > "$dir/results"
+xargs -P "$jobs" -n 50 bash -c 'for f; do check "$f"; done' check_batch < "$dir/list" | LC_ALL=C sort > "$dir/results"
 awk -v names="$dir/names" -v glslc="$dir/glslc.log" '
   BEGIN { while ((getline l < names) > 0) { split(l, a, " "); n[a[1]]++; if (!(a[1] in ex)) ex[a[1]] = a[2] } }
   { bad[$1] = bad[$1] ($2 == "done" ? "" : " " $2); seen[$1] = 1 }

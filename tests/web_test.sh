@@ -65,7 +65,7 @@ for v in webgl1 webgl2; do
   shot="$dir/${v}_page.png"
   rm -f "$shot"
   timeout 120 "$chrome" --headless=new --no-sandbox --disable-gpu-sandbox --use-angle=swiftshader \
-    --enable-unsafe-swiftshader --user-data-dir="$profile" --window-size=800,520 --virtual-time-budget=1000 \
+    --enable-unsafe-swiftshader --user-data-dir="$profile" --window-size=800,520 --virtual-time-budget=250 \
     --screenshot="$shot" "$url?$v" > /dev/null 2> "$dir/chromium_${v}_page.log"
   n=$((n + 1))
   if [ -s "$shot" ] && [ "$(stat -c %s "$shot")" -gt 20000 ]; then

@@ -3,7 +3,9 @@
    an eye, a few vertices and the law/mix; fogvol_analytic_prepare, _eval,
    _batch (every kernel) and _segment must never crash, never read out of
    bounds and never return NaN or values outside [0, 1] for fog. */
+#ifndef FOGVOL_TEST_LINKED /* make test links fogvol's implementation built once (Makefile: FUZZ_IMPL) */
 #define FOGVOL_IMPLEMENTATION
+#endif
 #define FOGVOL_NO_GL
 #include "fogvol.h"
 #include <math.h>

@@ -15,7 +15,9 @@
    Checks, besides ASan, UBSan (float-cast-overflow on) and LSan: every call that a context refuses
    logs an error or a warning; after fogvol_destroy_context no allocation of its allocator is live
    and (null backend) every backend object it created is destroyed. */
+#ifndef FOGVOL_TEST_LINKED /* make test links fogvol's implementation built once (Makefile: FUZZ_IMPL) */
 #define FOGVOL_IMPLEMENTATION
+#endif
 #include "fogvol.h"
 #define GL_GLEXT_PROTOTYPES
 #include "tests/gl_util.h"

@@ -4,7 +4,9 @@
    16-bit indices, bit 4: weld with distance 1e-3), then floats and u32
    indices taken from the rest. Checks: no out-of-bounds access (ASan), no
    UB (UBSan), and invariants of the report that hold for any input. */
+#ifndef FOGVOL_TEST_LINKED /* make test links fogvol's implementation built once (Makefile: FUZZ_IMPL) */
 #define FOGVOL_IMPLEMENTATION
+#endif
 #define FOGVOL_NO_GL
 #include "fogvol.h"
 #include <stdlib.h>
