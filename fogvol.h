@@ -347,9 +347,12 @@ typedef enum fogvol_format {
     FOGVOL_FORMAT_R32F = 1,  /* FLOAT tier; renderable and blendable (FOGVOL_CAP_FLOAT_BLEND). The O of
                                 MRT and PS20 with FOGVOL_SPEEDUP_FLOAT_O: renderable
                                 (FOGVOL_CAP_FLOAT_TARGET) */
-    FOGVOL_FORMAT_RGBA32F = 2 /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
+    FOGVOL_FORMAT_RGBA32F = 2, /* FOGVOL_VARIANT_COLORS (two attachments); renderable and blendable
                                  wherever R32F is (FOGVOL_CAP_FLOAT_BLEND: GL 3.0, GLES 3 +
                                  EXT_color_buffer_float + EXT_float_blend) */
+    FOGVOL_FORMAT_RG32F = 3   /* FLOAT + ENGINE_DEPTH drawn depth-tested (FOGVOL_CAP_ATTACH_DEPTH): the
+                                 signed depth sum and the signed face count; asked only of backends
+                                 reporting that capability */
 } fogvol_format;
 
 /* An object of the backend's graphics API that the engine and fogvol hand each other (engine depth
@@ -785,6 +788,8 @@ typedef struct fogvol_frame_stats {
     int depth_tested;        /* 1: the faces were depth-tested against the occluders and counted (the
                                 COUNT variant, or FOGVOL_SPEEDUP_DEPTH_TEST took this frame) */
     int fetched_o;           /* 1: a face pass read O from the framebuffer (FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH) */
+    int engine_depth_tested; /* 1: FLOAT + ENGINE_DEPTH drew this frame's faces depth-tested against the
+                                engine's depth (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */
     int exact_sum;           /* groups summed as 32-bit integers (FOGVOL_SPEEDUP_EXACT_SUM) */
     int inline_resolved;     /* 1: PS13 resolved B - F in its composite (FOGVOL_SPEEDUP_INLINE_RESOLVE): one
                                 pass per group fewer than fogvol_tier_costs counts */
@@ -1403,8 +1408,15 @@ typedef struct fogvol_pass {
     float clear_color[4];
     fogvol_pass_blend blend;
     fogvol_cull cull;       /* front faces are counter-clockwise unless a draw says otherwise */
-    int depth_test;         /* LESS (against the target's own or shared depth buffer) */
+    int depth_test;         /* LESS (against the target's own or shared depth buffer, or depth_texture) */
     int depth_write;
+    /* non-zero (only for backends reporting FOGVOL_CAP_ATTACH_DEPTH): this depth texture of the engine
+       (API object: GL a texture name, single-sample, any depth or depth-stencil format; its texel
+       (0, 0) at the target's pixel (0, 0)) is the target's depth buffer for this pass, tested as
+       depth_test and depth_greater say, never written (depth_write 0) nor cleared; it is detached at
+       end_pass (GL: glFramebufferTexture2D on fogvol's own framebuffer object) */
+    fogvol_native depth_texture;
+    int depth_greater;      /* depth_test: GREATER instead of LESS (a reversed-Z engine depth) */
     int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
                                every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
     int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
@@ -1453,10 +1465,15 @@ enum {
                                              blending not needed (GL 3.0; GLES 3 with
                                              EXT_color_buffer_float where the engine's output is highp:
                                              fogvol_gl_desc.mrt_highp) */
-    FOGVOL_CAP_FRAMEBUFFER_FETCH = 1u << 9 /* begin_pass honours fogvol_pass.read_target, and FACE programs
+    FOGVOL_CAP_FRAMEBUFFER_FETCH = 1u << 9, /* begin_pass honours fogvol_pass.read_target, and FACE programs
                                               with FOGVOL_SPECIALIZE_FETCH_O build (GL:
                                               EXT_shader_framebuffer_fetch, GLSL 330 or 300 es, per-buffer
                                               colour masks) */
+    FOGVOL_CAP_ATTACH_DEPTH = 1u << 10     /* begin_pass honours fogvol_pass.depth_texture and depth_greater,
+                                              end_pass detaches it, and create_target makes RG32F targets
+                                              (GL 3.0 / GLES 3.0 framebuffer objects and RG32F with
+                                              FOGVOL_CAP_FLOAT_BLEND; not WebGL): FLOAT + ENGINE_DEPTH frames drawn
+                                              depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */
 };
 
 typedef struct fogvol_frame_info {
@@ -1556,7 +1573,7 @@ typedef struct fogvol_null_backend {
     int query_not_ready;
     int queries_begun, queries_ended, query_polls, query_active; /* query_active: begun, not ended */
 } fogvol_null_backend;
-/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT (AUTO picks PS20);
+/* The table reports caps HIGHP_FRAGMENT | MRT | DEPTH_TEXTURE | MESH_LAYOUT | ATTACH_DEPTH (AUTO picks PS20);
    change table->caps before creating a context to test other choices. */
 FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_backend *table);
 
@@ -1765,7 +1782,10 @@ typedef struct fogvol_shader_desc {
    (FOGVOL_SPEEDUP_EXACT_SUM: the face reads and writes its target's pixel as a 32-bit integer,
    "inout" at location 0, and adds or subtracts round(d 2^24); the composite decodes that integer
    times fv_rampmap.w = (far - near) / 2^24). Other bits, EXP with RAMP, L > 8, or bits for another
-   program: FOGVOL_ERROR_UNSUPPORTED. */
+   program: FOGVOL_ERROR_UNSUPPORTED. FACE (with NO_DENSITY) and COMPOSITE of FLOAT + ENGINE_DEPTH (not
+   COLORS; single-sample): ENGINE_TEST (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: the faces, depth-tested
+   against the engine's depth, add (+-d, +-1) into an RG32F sum without reading the engine's depth;
+   the composite reads it once per pixel where the count is not 0 and takes thickness r - o g). */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1786,7 +1806,8 @@ enum {
     FOGVOL_SPECIALIZE_DEPTH_FROM_Z = 1u << 19,
     FOGVOL_SPECIALIZE_FLOAT_O = 1u << 20,
     FOGVOL_SPECIALIZE_FETCH_O = 1u << 21,
-    FOGVOL_SPECIALIZE_EXACT_SUM = 1u << 22
+    FOGVOL_SPECIALIZE_EXACT_SUM = 1u << 22,
+    FOGVOL_SPECIALIZE_ENGINE_TEST = 1u << 23
 };
 #define FOGVOL_SPECIALIZE_ENCODING(bits) ((unsigned)(bits) << 13)
 
@@ -1916,7 +1937,23 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  overflow check pass: the signed 32-bit integer holds a pixel's summed thickness up
                  to 127 times the depth range, 127 layers each as deep as the whole range (groups of
                  128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
-                 Not the digits' bytes: closer to the true thickness. */
+                 Not the digits' bytes: closer to the true thickness.
+   ENGINE_DEPTH_TEST  FLOAT + ENGINE_DEPTH on a backend with FOGVOL_CAP_ATTACH_DEPTH (the GL backend on
+                 GL 3.0 / GLES 3.0), in single-sample frames whose viewport starts at the window
+                 origin, with no volume crossing the near or far plane (so the camera is inside none),
+                 no density-textured volume, no fogvol_add_light, no downsample, no debug read-back,
+                 not NEAR_CLAMP or COLORS, a projection without an oblique near plane: the engine's
+                 depth texture (or fogvol's copy of the framebuffer's depth) is attached as the depth
+                 buffer of the sum's target, tested (LESS, GREATER for a reversed depth) and never
+                 written, so only the faces in front of the opaque surface are shaded; each adds
+                 (+-d, +-1) into an RG32F sum without reading the engine's depth, and the composite
+                 reads that depth once per pixel where the count is not 0 and takes thickness
+                 r - o g (a face behind the surface adds +-o in the min compare; over a closed,
+                 unclipped volume their signs sum to -g). The faces' clip z is the engine's
+                 (fogvol_frame_desc.engine_depth_zero_to_one and engine_depth_range), so the test
+                 compares the depths the engine's own rasteriser would. The same thickness up to
+                 rounding (a face within one depth-buffer step of the surface adds d or o, which
+                 differ by less than that step); fogvol_frame_stats.engine_depth_tested. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -1932,7 +1969,8 @@ enum {
     FOGVOL_SPEEDUP_FLOAT_O = 1u << 11,
     FOGVOL_SPEEDUP_SKIP_CHECK = 1u << 12,
     FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH = 1u << 13,
-    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14
+    FOGVOL_SPEEDUP_EXACT_SUM = 1u << 14,
+    FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST = 1u << 15
 };
 #define FOGVOL_OVERFLOW_BANDS 8 /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: bands a picture's check is spread over */
 
@@ -5825,6 +5863,7 @@ enum {
     FOGVOL__F_EXACT_SUM,      /* FOGVOL_SPEEDUP_EXACT_SUM: 32-bit integer sums (FOGVOL_SPECIALIZE_EXACT_SUM) */
     FOGVOL__F_DEPTH_TEST,     /* FOGVOL_SPEEDUP_DEPTH_TEST: frames drawn as COUNT (FOGVOL_SPECIALIZE_COUNT) */
     FOGVOL__F_DOWNSAMPLE,     /* fogvol_frame_desc.downsample 2: the sums at half resolution */
+    FOGVOL__F_ENGINE_TEST,    /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: faces depth-tested against the engine's depth */
     FOGVOL__F_COUNT
 };
 #define FOGVOL__NEVER 0x80000000u /* in off[]: the tier has no such feature (no variant uses this bit) */
@@ -5858,7 +5897,7 @@ typedef struct fogvol__tier_row {
 static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
     {"auto", "", 0, 0, 0, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, 0, 0, 0,
      {FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X,
-      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
+      FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X, FOGVOL__X},
      {0}},
     /* PS13: O, B, F, T resolved, composite; lowp/mediump (texture ramps, per-channel compare) */
     {"PS13", "#define FV_PS13\n", 6, 5, 4, 0, 0, FOGVOL_FORMAT_RGBA8, 0, 0, FOGVOL__C | FOGVOL__A | FOGVOL__N, 0,
@@ -5869,8 +5908,8 @@ static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
       0, FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
       /* EXACT_SUM                                                     DEPTH_TEST */
       FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
-      /* DOWNSAMPLE */
-      FOGVOL__X},
+      /* DOWNSAMPLE ENGINE_TEST */
+      FOGVOL__X, FOGVOL__X},
      {0}},
     /* PS20: O, B, F, composite */
     {"PS20", "", 5, 4, 3, 0, 1, FOGVOL_FORMAT_RGBA8, 0, FOGVOL_CAP_HIGHP_FRAGMENT,
@@ -5878,20 +5917,22 @@ static const fogvol__tier_row fogvol__tiers[FOGVOL_TIER_COUNT] = {
      {0, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__W | FOGVOL__K, FOGVOL__W, FOGVOL__X,
       FOGVOL__W | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
       FOGVOL__W | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__C | FOGVOL__S | FOGVOL__W | FOGVOL__E | FOGVOL__K,
-      FOGVOL__X},
+      FOGVOL__X, FOGVOL__X},
      {0}},
     /* MRT: the engine writes O as a second output of its opaque pass; B, F, composite */
     {"MRT", "", 4, 3, 3, 1, 1, FOGVOL_FORMAT_RGBA8, FOGVOL_CAP_MRT, FOGVOL_CAP_MRT, FOGVOL__S | FOGVOL__A | FOGVOL__N, 0, 0,
      {FOGVOL__X, FOGVOL__X, 0, FOGVOL__C | FOGVOL__W, FOGVOL__W, FOGVOL__X, FOGVOL__X, FOGVOL__W, FOGVOL__X,
       FOGVOL__W | FOGVOL__E | FOGVOL__C, FOGVOL__C | FOGVOL__W | FOGVOL__K,
-      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X, FOGVOL__X},
+      FOGVOL__W | FOGVOL__E | FOGVOL__C | FOGVOL__S | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X},
      {0}},
     /* FLOAT: O (or the engine's depth texture), one signed pass for every face, composite */
     {"FLOAT", "#define FV_FLOAT\n", 3, 3, 2, 1, 0, FOGVOL_FORMAT_R32F, FOGVOL_CAP_FLOAT_BLEND, FOGVOL_CAP_FLOAT_BLEND,
      FOGVOL__N | FOGVOL__E | FOGVOL__K, 0, 0,
      {FOGVOL__E, FOGVOL__X, FOGVOL__X, 0, 0, 0, FOGVOL__W | FOGVOL__K, FOGVOL__X, FOGVOL__X, FOGVOL__X,
-      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__E | FOGVOL__K},
-     {0, 0, 0, 0, 0, FOGVOL__K}}};
+      FOGVOL__C | FOGVOL__W | FOGVOL__K | FOGVOL__E, FOGVOL__X, FOGVOL__X, FOGVOL__E | FOGVOL__K,
+      /* ENGINE_TEST: needs E */
+      FOGVOL__K | FOGVOL__N},
+     {0, 0, 0, 0, 0, FOGVOL__K, 0, 0, 0, 0, 0, 0, 0, 0, FOGVOL__E}}};
 #undef FOGVOL__S
 #undef FOGVOL__C
 #undef FOGVOL__A
@@ -6274,6 +6315,11 @@ static const char fogvol__fs_face[] =
     "FV_UNIFORM(vec4, fv_nf)\n"
     "FV_UNIFORM(vec4, fv_speed)\n"
     "void main() {\n"
+    "#if defined(FV_ENGINE_TEST)\n"             /* depth-tested against the engine's depth: nothing read */
+    "    vec2 v = vec2(max(fv_d, 0.0) * fv_sign, fv_sign);\n"
+    "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -v : v, 0.0, 0.0);\n"
+    "}\n"
+    "#else\n"
     "#ifdef FV_ENGINE_DEPTH\n"
     "    float z = FV_ENGINE_Z(fv_opaque);\n"
     "    float o = fv_engine_view_depth(fv_st(), z) * fv_nf.x + fv_nf.y;\n"
@@ -6291,6 +6337,7 @@ static const char fogvol__fs_face[] =
     "#endif\n"
     "    FV_FRAGCOLOR = vec4(gl_FrontFacing ? -d * fv_sign : d * fv_sign, 0.0, 0.0, 0.0);\n"
     "}\n"
+    "#endif\n"
     "#elif defined(FV_WIDE)\n"
     "FV_BINDING(4) uniform sampler2D fv_opaque2;\n"
     "void main() {\n"
@@ -6412,6 +6459,9 @@ static const char fogvol__fs_composite[] =
     "FV_BINDING(3) uniform FV_TARGET_SAMPLER fv_opaque;\n"
     "FV_BINDING(6) uniform sampler2D fv_ctex;\n"              /* colour texture, screen-space coordinates */
     "FV_UNIFORM(vec4, fv_speed)\n"
+    "#ifdef FV_ENGINE_TEST\n"
+    "FV_UNIFORM(vec4, fv_nf)\n"
+    "#endif\n"
     "FV_UNIFORM(vec4, fv_ctex_u)\n"
     "FV_UNIFORM(vec4, fv_ctex_v)\n"
     /* soft edges (fogvol_ramp_desc.softness): the optical thickness of a chord t whose density rises
@@ -6463,6 +6513,15 @@ static const char fogvol__fs_composite_main[] =
     "    highp uint u = cu.r | (cu.g << 8) | (cu.b << 16) | (cu.a << 24);\n"
     "    if (u == 0u) discard;\n"
     "    t = float(int(u)) * fv_rampmap.w;\n"
+    "#elif defined(FV_FLOAT) && defined(FV_ENGINE_TEST)\n" /* r - o g, o read where faces lay behind it */
+    "    if (b.rg == vec2(0.0)) discard;\n"
+    "    t = b.r;\n"
+    "    if (b.g != 0.0) t -= min(fv_engine_view_depth(st, FV_ENGINE_Z(fv_opaque)) * fv_nf.x + fv_nf.y, 1.0) * b.g;\n"
+    "    if (fv_rampmap.w > 0.5) {\n"             /* the debug read-back's pass: r - o g into B */
+    "        FV_FRAGCOLOR = vec4(t, 0.0, 0.0, 0.0);\n"
+    "        return;\n"
+    "    }\n"
+    "    t *= fv_dec.x;\n"
     "#elif defined(FV_FLOAT)\n"
     "    if (b.r == 0.0) discard;\n"
     "    t = b.r * fv_dec.x;\n"
@@ -6683,9 +6742,14 @@ static int fogvol__program_strings(const fogvol_shader_desc *d, const char **str
 static int fogvol__specialize_ok(fogvol_program p, unsigned bits)
 {
     unsigned face = FOGVOL_SPECIALIZE_NO_OPAQUE | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE |
-                    FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXACT_SUM;
+                    FOGVOL_SPECIALIZE_FETCH_O | FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_ENGINE_TEST;
     unsigned comp = FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
-                    FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_EXACT_SUM;
+                    FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_EXACT_SUM |
+                    FOGVOL_SPECIALIZE_ENGINE_TEST;
+    if ((bits & FOGVOL_SPECIALIZE_ENGINE_TEST) &&
+        ((p == FOGVOL_PROGRAM_FACE && !(bits & FOGVOL_SPECIALIZE_NO_DENSITY)) || p == FOGVOL_PROGRAM_COMPOSITE_MESH ||
+         (bits & (FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_FETCH_O))))
+        return 0; /* (one program pair: the faces without density textures, the full-screen composite) */
     if ((bits & FOGVOL_SPECIALIZE_EXACT_SUM) && (bits & FOGVOL_SPECIALIZE_COUNT)) return 0; /* (one target) */
     if ((bits & FOGVOL_SPECIALIZE_EXP) && (bits & FOGVOL_SPECIALIZE_RAMP)) return 0;
     if ((bits & FOGVOL_SPECIALIZE_OPAQUE) && (bits & FOGVOL_SPECIALIZE_NO_OPAQUE)) return 0;
@@ -6752,6 +6816,7 @@ static int fogvol__specialize_defines(const fogvol_shader_desc *d, const char **
     if (d->specialize & FOGVOL_SPECIALIZE_DEPTH_FROM_Z) strings[n++] = "#define FV_DEPTH_FROM_Z\n";
     if (d->specialize & FOGVOL_SPECIALIZE_FLOAT_O) strings[n++] = "#define FV_O_FLOAT\n";
     if (d->specialize & FOGVOL_SPECIALIZE_EXACT_SUM) strings[n++] = "#define FV_XSUM\n";
+    if (d->specialize & FOGVOL_SPECIALIZE_ENGINE_TEST) strings[n++] = "#define FV_ENGINE_TEST\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_NO_OPAQUE))
         strings[n++] = "#define FV_NO_OPAQUE\n";
     if (d->program == FOGVOL_PROGRAM_FACE && (d->specialize & FOGVOL_SPECIALIZE_OPAQUE))
@@ -6783,6 +6848,8 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         (d->tier != FOGVOL_TIER_FLOAT || (v & FOGVOL_VARIANT_COLORS) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
+        return FOGVOL_ERROR_UNSUPPORTED;
+    if ((d->specialize & FOGVOL_SPECIALIZE_ENGINE_TEST) && (!fogvol__tier_has(d->tier, v, FOGVOL__F_ENGINE_TEST) || d->samples > 1))
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__tier_has(d->tier, v, FOGVOL__F_DEPTH_TEST) ||
@@ -7056,7 +7123,8 @@ FOGVOL_API void fogvol_null_backend_init(fogvol_null_backend *state, fogvol_back
     memset(table, 0, sizeof *table);
     table->user_data = state;
     table->dialect = FOGVOL_GLSL_330;
-    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT;
+    table->caps = FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MRT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT |
+                  FOGVOL_CAP_ATTACH_DEPTH;
     table->begin_frame = fogvol__null_begin_frame;
     table->end_frame = fogvol__null_end_frame;
     table->create_texture = fogvol__null_create_texture;
@@ -7194,6 +7262,8 @@ typedef struct fogvol__config {
     int exact_sum;          /* FOGVOL_SPEEDUP_EXACT_SUM: groups may sum as 32-bit integers */
     fogvol_overflow_policy overflow_policy;
     int count_broken;       /* a COUNT program did not build: no FOGVOL_SPEEDUP_DEPTH_TEST from then on */
+    int engine_test;        /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: frames that fit may be drawn depth-tested (off
+                               from then on when its programs or its RG32F target cannot be made) */
 } fogvol__config;
 
 /* What the context holds on the GPU: lookup textures, programs, render targets (and what O holds). */
@@ -7209,6 +7279,7 @@ typedef struct fogvol__gpu {
                                                  FLOAT: B is the float sum */
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
+    fogvol_handle tgt_e;                      /* ENGINE_DEPTH_TEST: the depth sum and face count (RG32F) */
     fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
     fogvol_handle tgt_l; /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
     int target_w, target_h;
@@ -7285,6 +7356,10 @@ typedef struct fogvol__plan {
     int borrow;       /* the decode's alpha digit borrows (not with counts in alpha, PS13's or WIDE's) */
     int skip_check;   /* FOGVOL_SPEEDUP_SKIP_CHECK: groups that cannot saturate skip the check pass */
     int colors;       /* FOGVOL_VARIANT_COLORS: the one-pass colour group */
+    int engine_test;  /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: faces depth-tested against the engine's depth into
+                         (+-d, +-1), the composite takes r - o g (fogvol__engine_test_frame) */
+    int z_greater;    /* ... the test is GREATER (the engine's window depth falls with view depth) */
+    double zmap[2];   /* ... the faces' clip z = zmap[0] z + zmap[1] w: the engine's window depth in fogvol's passes */
     int exp_composite, fast_exp, blend_color; /* the composite's speed-ups */
     float near_clamp; /* fv_misc.w: NEAR_CLAMP */
     unsigned origin_bit, dither_bit, count_bit, depth_from_z_bit; /* SPECIALIZE bits of the passes */
@@ -7320,7 +7395,8 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->gpu.tgt_v) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_v);
     if (ctx->gpu.tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_l);
     if (ctx->gpu.tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_c);
-    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = 0;
+    if (ctx->gpu.tgt_e) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_e);
+    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = ctx->gpu.tgt_e = 0;
     if (ctx->gpu.tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_o);
     ctx->gpu.tgt_o = ctx->gpu.tgt_b = ctx->gpu.tgt_f = ctx->gpu.tgt_t = 0;
     ctx->gpu.tgt_o2 = ctx->gpu.tgt_b2 = ctx->gpu.tgt_f2 = 0;
@@ -7395,6 +7471,17 @@ static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_de
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
         if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
             r = FOGVOL_ERROR_BACKEND;
+    }
+    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples <= 1) {
+        td.format = FOGVOL_FORMAT_RG32F;
+        td.color_count = 1;
+        td.label = "fogvol depth sum and face count, depth-tested (float)";
+        if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no RG32F target: FLOAT + ENGINE_DEPTH frames read the "
+                                                       "engine's depth per face (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
+            ctx->cfg.engine_test = 0;
+            ctx->gpu.tgt_e = 0;
+        }
     }
     return r;
 }
@@ -7810,6 +7897,8 @@ static void fogvol__choose_speedups(fogvol_context *ctx)
                        (ctx->cfg.tier == FOGVOL_TIER_MRT || highp) && (ctx->cfg.tier != FOGVOL_TIER_PS13 || exact);
     ctx->cfg.fetch_o = fetch && !unspecialised && fogvol__speedup(ctx, FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, FOGVOL__F_FETCH_O);
     ctx->cfg.exact_sum = ctx->cfg.float_o && exact;
+    ctx->cfg.engine_test = (caps & FOGVOL_CAP_ATTACH_DEPTH) && (caps & FOGVOL_CAP_FLOAT_BLEND) &&
+                           fogvol__speedup(ctx, FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST, FOGVOL__F_ENGINE_TEST);
 }
 
 FOGVOL_API fogvol_result fogvol_create_context(const fogvol_context_desc *desc, fogvol_context **out)
@@ -7923,12 +8012,13 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
 {
     /* programs that have no general stand-in: 0 (DOWNSAMPLE: the pass is skipped; BLEND_COLOR: the
        caller asks again without it) */
-    const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR;
+    const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_ENGINE_TEST;
     fogvol__spec_program *sp;
     int i;
     if (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
         bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
-                FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED;
+                FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED |
+                ((bits & FOGVOL_SPECIALIZE_ENGINE_TEST) ? FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY : 0u);
     else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->cfg.tier != FOGVOL_TIER_FLOAT)
         bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->cfg.enc.bits); /* the context's encoding compiled in */
     if (!bits) return ctx->gpu.prog[p];
@@ -9126,24 +9216,33 @@ FOGVOL_API fogvol_result fogvol_mrt_prepare(fogvol_context *ctx, fogvol_mrt_info
     return FOGVOL_SUCCESS;
 }
 
+/* The engine depth's convention: NDC z in [0, 1] (1) or [-1, 1] (0), and the depth range r[0], r[1]
+   it was drawn with, from fd (overrides) or info (reported). */
+static int fogvol__engine_convention(const fogvol_frame_desc *fd, const fogvol_frame_info *info, double r[2])
+{
+    r[0] = info->depth_range[0];
+    r[1] = info->depth_range[1];
+    if (fd->engine_depth_range[0] != 0.0f || fd->engine_depth_range[1] != 0.0f) {
+        r[0] = fd->engine_depth_range[0];
+        r[1] = fd->engine_depth_range[1];
+    } else if (r[0] == 0.0 && r[1] == 0.0) {
+        r[1] = 1.0;
+    }
+    return fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
+}
+
 /* fv_lin, fv_lin2: the engine depth texture's window depth -> view depth, for the camera in
    ctx (eyerow, invvp) and the depth conventions of fd (overrides) or info (reported). */
 static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_desc *fd, const fogvol_frame_info *info,
                                  fogvol_pass *ps)
 {
-    double n[4], dn[4], a, b, sy, r0, r1;
+    double n[4], dn[4], a, b, sy, r0, r1, rr[2];
     int i, z01;
     /* q = (s, t, window depth, 1) -> NDC (2s - 1, +-(2t - 1), a z + b, 1), folded into the
        rows eyerow * invVP (numerator) and invVP row 3 (denominator) */
-    z01 = fd->engine_depth_zero_to_one ? fd->engine_depth_zero_to_one > 0 : info->depth_zero_to_one != 0;
-    r0 = info->depth_range[0];
-    r1 = info->depth_range[1];
-    if (fd->engine_depth_range[0] != 0.0f || fd->engine_depth_range[1] != 0.0f) {
-        r0 = fd->engine_depth_range[0];
-        r1 = fd->engine_depth_range[1];
-    } else if (r0 == 0.0 && r1 == 0.0) {
-        r1 = 1.0;
-    }
+    z01 = fogvol__engine_convention(fd, info, rr);
+    r0 = rr[0];
+    r1 = rr[1];
     a = (z01 ? 1.0 : 2.0) / (r1 != r0 ? r1 - r0 : 1.0);
     b = -r0 * a - (z01 ? 0.0 : 1.0);
     sy = info->clip_upper_left ? -1.0 : 1.0;
@@ -9836,6 +9935,75 @@ static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run,
     }
 }
 
+/* The face program of FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST frames. */
+static unsigned fogvol__engine_test_spec(const fogvol__run *run)
+{
+    return FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | run->p.origin_bit;
+}
+
+/* Whether the depth-tested face program exists (built on first use); if it does not, the speed-up is
+   off from this frame on (logged) and the frame reads the engine's depth per face. */
+static int fogvol__engine_test_programs(fogvol_context *ctx, const fogvol__run *run)
+{
+    if (fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run))) return 1;
+    fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no depth-tested face program: FLOAT + ENGINE_DEPTH reads the "
+                                               "engine's depth per face (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
+    ctx->cfg.engine_test = 0;
+    return 0;
+}
+
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: every face of the group in one pass into the RG32F sum E, whose depth
+   buffer is the engine's depth (run->engine_depth: its texture, or fogvol's copy), tested, not written;
+   each face's clip z is the engine's (plan zmap), so the test compares what the engine's rasteriser
+   wrote with what it would write for the face. */
+static void fogvol__engine_test_pass(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp)
+{
+    fogvol_pass ps = run->base;
+    fogvol_draw dr;
+    int i, j;
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run));
+    ps.target = ctx->gpu.tgt_e;
+    ps.clear = 1;
+    ps.blend = FOGVOL_PASS_BLEND_ADD;
+    ps.depth_test = 1;
+    ps.depth_texture = run->engine_depth;
+    ps.depth_greater = run->p.z_greater;
+    ps.uniforms[FOGVOL_U_MISC][1] = 0.0f; /* the projection's clip z (mapped below), not fogvol's */
+    ctx->be.begin_pass(ctx->be.user_data, &ps);
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next) {
+        const fogvol__volume *v = &ctx->cur.vols[i];
+        fogvol__draw_for(ctx, v->model, &dr);
+        for (j = 0; j < 4; ++j) /* row z of the column-major mvp */
+            dr.mvp[j * 4 + 2] = (float)(run->p.zmap[0] * dr.mvp[j * 4 + 2] + run->p.zmap[1] * dr.mvp[j * 4 + 3]);
+        if (v->negative) dr.sign = -1.0f;
+        ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);
+    }
+    fogvol__end_pass(ctx);
+    run->st.passes++;
+}
+
+/* The debug read-back of a FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group: r - o g, as its composite takes it,
+   written into B (R32F) by the composite program (fv_rampmap.w = 1: the thickness, not a colour),
+   for fogvol__debug_capture to read as any FLOAT sum. */
+static fogvol_result fogvol__engine_test_resolve(fogvol_context *ctx, fogvol__run *run)
+{
+    fogvol_pass ps = run->base;
+    memset(ps.textures, 0, sizeof ps.textures);
+    ps.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
+    ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    ps.target = ctx->gpu.tgt_b;
+    ps.clear = 1;
+    ps.uniforms[FOGVOL_U_RAMP][3] = 1.0f;
+    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_COMPOSITE,
+                                 FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                     FOGVOL_SPECIALIZE_NO_OVERFLOW | run->p.origin_bit | run->p.depth_from_z_bit);
+    if (!ps.program) return FOGVOL_ERROR_BACKEND;
+    ctx->be.begin_pass(ctx->be.user_data, &ps);
+    ctx->be.draw_fullscreen(ctx->be.user_data);
+    fogvol__end_pass(ctx);
+    return FOGVOL_SUCCESS;
+}
+
 /* The face sums of one ramp group: FLOAT one signed pass into B; SINGLE_TARGET back faces up and
    front faces down in B (with the overflow check at the peak); else back faces into B and front
    faces into F. The debug read-back, when asked for this group, follows the sums. */
@@ -9846,6 +10014,16 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     unsigned char *peak = NULL;
     fogvol_result r;
     unsigned spec = FOGVOL_SPECIALIZE_NO_DENSITY | p->origin_bit; /* textured volumes: below */
+    if (p->engine_test) { /* (no density texture in such frames) */
+        fogvol__engine_test_pass(ctx, run, ramp);
+        if (fogvol__want_debug(ctx, ramp, run->captured)) {
+            r = fogvol__engine_test_resolve(ctx, run);
+            if (r == FOGVOL_SUCCESS) r = fogvol__debug_capture(ctx, run, NULL, &run->overflow);
+            run->captured = 1;
+            if (r != FOGVOL_SUCCESS) run->r = r;
+        }
+        return;
+    }
     if (p->no_opaque) spec |= FOGVOL_SPECIALIZE_NO_OPAQUE;
     else if (p->float_sums) spec |= FOGVOL_SPECIALIZE_OPAQUE;
     if (p->engine_read) spec |= p->depth_from_z_bit; /* (the faces read the engine's depth) */
@@ -9976,6 +10154,7 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
     spec |= run->p.origin_bit | run->p.count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
+    if (run->p.engine_test) spec |= FOGVOL_SPECIALIZE_ENGINE_TEST | run->p.depth_from_z_bit;
     ps->uniforms[FOGVOL_U_RAMP][3] = run->xsum ? (float)((double)(fd->zfar - fd->znear) / 16777216.0) : 0.0f;
     fogvol__blend_color(run, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
@@ -9996,7 +10175,8 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     }
     if (!ps->program) {
         if (!run->xsum)
-            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no half-resolution composite program: group not drawn");
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s composite program: group not drawn",
+                        run->p.engine_test ? "depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST)" : "half-resolution");
         run->r = FOGVOL_ERROR_BACKEND;
         return;
     }
@@ -10622,6 +10802,54 @@ static int fogvol__depth_test_frame(const fogvol_context *ctx)
     return 1;
 }
 
+/* View depth at the engine's window depth z through fv_lin, fv_lin2 without x and y terms (DEPTH_FROM_Z);
+   a denominator of 0 (an infinite far plane) gives 1e300. */
+static double fogvol__engine_view_depth(const fogvol_pass *ps, double z)
+{
+    const float *a = ps->uniforms[FOGVOL_U_LINEAR], *b = ps->uniforms[FOGVOL_U_LINEAR_W];
+    double num = a[2] * z + a[3], den = b[2] * z + b[3];
+    return fabs(den) <= 1e-12 * fabs(num) ? 1e300 : num / den;
+}
+
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: whether this frame (FLOAT + ENGINE_DEPTH, single-sample, the viewport
+   at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o g equals the
+   min compare's sum where the faces on every pixel's ray close (each volume unclipped: between both
+   pairs of planes, fogvol's znear..zfar and the projection's, which now clips the faces, or wholly
+   outside both) and the engine's depth is linearised without the pixel (no oblique near plane). */
+static int fogvol__engine_test_frame(const fogvol_context *ctx, const fogvol__run *run, fogvol__plan *p)
+{
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
+    fogvol_pass lin;
+    double r[2], e0, e1, pn, pf, lo, hi;
+    int i, z01;
+    if (!ctx->cfg.engine_test || !p->engine_read || ctx->cur.samples > 1 || fd->downsample == 2 || ctx->cur.nlight > 0 ||
+        p->colors || p->near_clamp > 0.0f || !p->origin_bit)
+        return 0;
+    memset(&lin, 0, sizeof lin);
+    fogvol__lin_uniforms(ctx, fd, &run->info, &lin);
+    z01 = fogvol__engine_convention(fd, &run->info, r);
+    if (!fogvol__depth_from_z_bit(&lin) || r[0] == r[1]) return 0;
+    e0 = fogvol__engine_view_depth(&lin, r[0]); /* the projection's planes, in view depth */
+    e1 = fogvol__engine_view_depth(&lin, r[1]);
+    pn = e0 < e1 ? e0 : e1;
+    pf = e0 < e1 ? e1 : e0;
+    lo = pn > fd->znear ? pn : fd->znear;
+    hi = pf < fd->zfar ? pf : fd->zfar;
+    for (i = 0; i < ctx->cur.nvol; ++i) {
+        double emin = 0.0, emax = 0.0;
+        if (ctx->cur.vols[i].density) return 0;
+        fogvol__volume_depths(ctx, &ctx->cur.vols[i], &emin, &emax);
+        if (!((emin >= lo && emax <= hi) || emax <= (pn < fd->znear ? pn : fd->znear) ||
+              emin >= (pf > fd->zfar ? pf : fd->zfar)))
+            return 0;
+    }
+    /* window depth = a + b z_ndc; fogvol's passes map clip z' to (z' / w + 1) / 2: z' = 2 b z + (2 a - 1) w */
+    p->zmap[0] = z01 ? 2.0 * (r[1] - r[0]) : r[1] - r[0];
+    p->zmap[1] = (z01 ? 2.0 * r[0] : r[0] + r[1]) - 1.0;
+    p->z_greater = (e1 - e0) * (r[1] - r[0]) < 0.0;
+    return 1;
+}
+
 /* The frame's plan (fogvol__plan), once its sample count is known. Adding a speed-up: its FOGVOL__F_
    entry in the tier table, the context's switch (fogvol__choose_speedups), its field here and the one
    pass function that follows it. */
@@ -10656,6 +10884,7 @@ static void fogvol__plan_frame(fogvol_context *ctx, fogvol__run *run)
                      !(off & (FOGVOL_SPEEDUP_BLEND_COLOR | FOGVOL_SPEEDUP_SPECIALIZE));
     p->origin_bit = fogvol__origin_bit(ctx);
     p->dither_bit = fogvol__dither_bit(ctx);
+    p->engine_test = fogvol__engine_test_frame(ctx, run, p);
     run->st.depth_tested = p->count;
     run->st.inline_resolved = ctx->cfg.inline_resolve;
 }
@@ -10677,6 +10906,8 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
         r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
                                 : fogvol__ensure_targets(ctx, run->w, run->h, 0);
     if (r != FOGVOL_SUCCESS) return r;
+    run->p.engine_test = run->p.engine_test && ctx->gpu.tgt_e && fogvol__engine_test_programs(ctx, run);
+    run->st.engine_depth_tested = run->p.engine_test;
     run->engine_depth = fd->engine_depth_texture;
     if ((run->p.o_engine || run->p.engine_read) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {
         r = ctx->be.copy_depth(ctx->be.user_data, fd->engine_depth_framebuffer,
@@ -10728,6 +10959,10 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
+    if (run->p.engine_test) { /* r - o g: E, and the engine's depth read where g is not 0 */
+        ps.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
+        ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    }
     if (run->p.single) {
         if (run->counted) fogvol__check_pass(ctx, run, &ps, 0, &run->st); /* after the subtractions */
     } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, run, n, convex)) { /* (integers cannot saturate) */
@@ -11187,6 +11422,7 @@ typedef ptrdiff_t fogvol__GLsizeiptr;
 
 /* GL enums (values from the Khronos registry) */
 enum { FOGVOL__GL_SRC_COLOR = 0x0300, FOGVOL__GL_RGBA32F = 0x8814 }; /* FOGVOL_VARIANT_COLORS */
+enum { FOGVOL__GL_GREATER = 0x0204, FOGVOL__GL_RG = 0x8227, FOGVOL__GL_RG32F = 0x8230 }; /* FOGVOL_CAP_ATTACH_DEPTH */
 enum {
     FOGVOL__GL_NO_ERROR = 0, FOGVOL__GL_TRIANGLES = 0x0004, FOGVOL__GL_NEVER = 0x0200, FOGVOL__GL_LESS = 0x0201,
     FOGVOL__GL_NOTEQUAL = 0x0205, FOGVOL__GL_ZERO = 0, FOGVOL__GL_ONE = 1, FOGVOL__GL_SRC_ALPHA = 0x0302,
@@ -11607,6 +11843,7 @@ typedef struct fogvol__gl {
                                                            made at creation without VAOs, the context's mark) */
     int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
     int skip_draws;                                     /* this pass has an engine texture that is none */
+    fogvol__GLuint depth_attached; /* the FBO whose depth attachment is fogvol_pass.depth_texture until end_pass */
     fogvol_result own;                                  /* fogvol's own first error since take_error */
     void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
     void *user_data, *context_id;                       /* and what it returned at creation */
@@ -12268,6 +12505,8 @@ static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvo
         gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_R32F, w, h, 0, FOGVOL__GL_RED, FOGVOL__GL_FLOAT, pixels);
     else if (format == FOGVOL_FORMAT_RGBA32F)
         gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_RGBA32F, w, h, 0, FOGVOL__GL_RGBA, FOGVOL__GL_FLOAT, pixels);
+    else if (format == FOGVOL_FORMAT_RG32F)
+        gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, FOGVOL__GL_RG32F, w, h, 0, FOGVOL__GL_RG, FOGVOL__GL_FLOAT, pixels);
     else
         gl->TexImage2D(FOGVOL__GL_TEXTURE_2D, 0, gl->gles && gl->major < 3 ? FOGVOL__GL_RGBA : FOGVOL__GL_RGBA8, w, h,
                        0, FOGVOL__GL_RGBA, FOGVOL__GL_UNSIGNED_BYTE, pixels);
@@ -12761,6 +13000,31 @@ static void fogvol__gl_attach_read(fogvol__gl *gl, fogvol__gl_target *t, const f
     t->read_tex = tex;
 }
 
+/* fogvol_pass.depth_texture: the engine's depth texture as t's depth buffer (FBO state of our own FBO,
+   detached at end_pass); a framebuffer it does not complete draws nothing (INVALID_ARGUMENT, logged). */
+static void fogvol__gl_attach_depth(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_pass *p)
+{
+    fogvol__GLuint tex = fogvol__gl_native(gl, (fogvol__GLuint)p->depth_texture);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_TEXTURE_2D, tex, 0);
+    gl->depth_attached = t->fbo;
+    if (!tex || gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER) == FOGVOL__GL_FRAMEBUFFER_COMPLETE) return;
+    gl->skip_draws = 1;
+    if (gl->own == FOGVOL_SUCCESS) {
+        gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
+        fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine depth texture %u cannot be a depth buffer (not a "
+                    "single-sample 2D depth texture?): the depth-tested face pass draws nothing", tex);
+    }
+}
+
+static void fogvol__gl_end_pass(void *u)
+{
+    fogvol__gl *gl = (fogvol__gl *)u;
+    if (!gl->depth_attached) return;
+    gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->depth_attached);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_TEXTURE_2D, 0, 0);
+    gl->depth_attached = 0;
+}
+
 static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
 {
     fogvol__gl *gl = (fogvol__gl *)u;
@@ -12768,6 +13032,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     gl->skip_draws = 0;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
+    if (t && p->depth_texture) fogvol__gl_attach_depth(gl, t, p);
     gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
     fogvol__gl_pass_enables(gl);
     if (!gl->gles) gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
@@ -12802,7 +13067,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     }
     gl->FrontFace(FOGVOL__GL_CCW);
     fogvol__gl_enable(gl, FOGVOL__GL_DEPTH_TEST, p->depth_test);
-    gl->DepthFunc(FOGVOL__GL_LESS);
+    gl->DepthFunc(p->depth_greater ? (fogvol__GLenum)FOGVOL__GL_GREATER : (fogvol__GLenum)FOGVOL__GL_LESS);
     gl->DepthMask((fogvol__GLboolean)(p->depth_write != 0));
     gl->Disable(FOGVOL__GL_STENCIL_TEST); /* the engine's stencil buffer is its own */
     fogvol__gl_pass_program(gl, p);
@@ -13131,6 +13396,9 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
         gl->float_linear = gl->major >= 3;
         if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
     }
+    /* RG32F targets and FBOs; not WebGL, whose feedback-loop rule forbids the composite's read of a depth
+       texture that is attached to the bound framebuffer, even with depth writes off (not tested here) */
+    if (gl->major >= 3 && (caps & FOGVOL_CAP_FLOAT_BLEND) && !gl->webgl) caps |= FOGVOL_CAP_ATTACH_DEPTH;
     return caps;
 }
 
@@ -13465,6 +13733,7 @@ static void fogvol__gl_fill_table(fogvol__gl *gl, fogvol_backend *out)
     out->copy_depth = fogvol__gl_copy_depth;
     out->begin_frame = fogvol__gl_begin_frame;
     out->end_frame = fogvol__gl_end_frame;
+    out->end_pass = fogvol__gl_end_pass;
     out->create_texture = fogvol__gl_create_texture;
     out->destroy_texture = fogvol__gl_destroy_texture;
     out->create_target = fogvol__gl_create_target;

@@ -51,6 +51,13 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
+    if (bits & FOGVOL_SPECIALIZE_ENGINE_TEST) /* FLOAT + ENGINE_DEPTH (not COLORS, NEAR_CLAMP), single-sample */
+        return t == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH) &&
+               !(v & (FOGVOL_VARIANT_COLORS | FOGVOL_VARIANT_NEAR_CLAMP)) && !ms &&
+               ((p == FOGVOL_PROGRAM_FACE && (bits & FOGVOL_SPECIALIZE_NO_DENSITY)) || p == FOGVOL_PROGRAM_COMPOSITE) &&
+               !(bits & (FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED | FOGVOL_SPECIALIZE_EXACT_SUM |
+                         FOGVOL_SPECIALIZE_FETCH_O)) &&
+               variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_ENGINE_TEST, ms);
     if (bits & FOGVOL_SPECIALIZE_EXACT_SUM)
         return (t == FOGVOL_TIER_MRT || t == FOGVOL_TIER_PS20 || t == FOGVOL_TIER_PS13) &&
                !(v & (FOGVOL_VARIANT_WIDE | FOGVOL_VARIANT_COUNT | FOGVOL_VARIANT_SINGLE_TARGET)) &&
@@ -195,6 +202,18 @@ int main(int argc, char **argv)
                                          FOGVOL_SPECIALIZE_FAST_EXP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
                                          FOGVOL_SPECIALIZE_NO_OVERFLOW | FOGVOL_SPECIALIZE_BLEND_COLOR,
                                      FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_OPAQUE,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DEPTH_FROM_Z |
+                                         FOGVOL_SPECIALIZE_EXP | FOGVOL_SPECIALIZE_FAST_EXP |
+                                         FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE | FOGVOL_SPECIALIZE_NO_OVERFLOW |
+                                         FOGVOL_SPECIALIZE_BLEND_COLOR,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_ORIGIN | FOGVOL_SPECIALIZE_DEPTH_FROM_Z |
+                                         FOGVOL_SPECIALIZE_RAMP | FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE |
+                                         FOGVOL_SPECIALIZE_NO_OVERFLOW,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_DOWNSAMPLE,
+                                     FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_EXACT_SUM | FOGVOL_SPECIALIZE_NO_DENSITY,
                                      FOGVOL_SPECIALIZE_ENCODING(9),
                                      FOGVOL_SPECIALIZE_ENCODING(15) | FOGVOL_SPECIALIZE_NO_DENSITY};
     int vulkan = argc > 1 && strcmp(argv[1], "--vulkan") == 0;

@@ -3253,6 +3253,92 @@ static void test_targets_made_once_per_size(void **state)
     }
 }
 
+/* One FLOAT + ENGINE_DEPTH frame on the null backend: the camera of a_frame_desc, the viewport at the
+   origin unless offset, a box of half-size h at the origin (view depth 5 - h .. 5 + h), engine depth
+   texture 77, depth range r (both 0: as reported); the passes and stats in *nb and *st. */
+static void ed_frame(fogvol_context *fv, const fogvol_mesh *box, const fogvol_ramp *ramp, float h, int offset,
+                     float r0, float r1, fogvol_frame_stats *st)
+{
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    a_frame_desc(&fd);
+    fd.viewport[0] = offset ? A_X0 : 0;
+    fd.viewport[1] = offset ? A_Y0 : 0;
+    fd.engine_depth_texture = 77;
+    fd.engine_depth_range[0] = r0;
+    fd.engine_depth_range[1] = r1;
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = box;
+    vd.ramp = ramp;
+    glu_translate_scale(vd.model, 0.0f, 0.0f, 0.0f, h);
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, st), FOGVOL_SUCCESS);
+}
+
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST on the null backend (FOGVOL_CAP_ATTACH_DEPTH): a frame that fits draws
+   its faces into a target of fogvol's with the engine's depth texture as its depth buffer (tested,
+   not written; GREATER where the depth range reverses it) reading no depth, and the composite reads
+   that texture; a camera inside the box, an offset viewport, or a backend without the capability:
+   the faces read the engine's depth as before, nothing attached. */
+static void test_engine_depth_attached(void **state)
+{
+    fogvol_null_backend nb;
+    fogvol_backend be;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh_desc md;
+    fogvol_mesh *box;
+    fogvol_ramp_desc rd;
+    fogvol_ramp *ramp;
+    fogvol_frame_stats st;
+    shp_mesh s = shp_box(1.0f, 1.0f, 1.0f); /* half-size 0.5 */
+    int caps, i, k;
+    (void)state;
+    for (caps = 0; caps < 2; ++caps) {
+        fogvol_null_backend_init(&nb, &be);
+        be.caps |= FOGVOL_CAP_FLOAT_BLEND;
+        if (!caps) be.caps &= ~(unsigned)FOGVOL_CAP_ATTACH_DEPTH;
+        memset(&cd, 0, sizeof cd);
+        cd.backend = be;
+        cd.tier = FOGVOL_TIER_FLOAT;
+        cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        fx_mesh_desc(&md, &s, 0);
+        assert_int_equal(fogvol_create_mesh(fv, &md, &box, NULL), FOGVOL_SUCCESS);
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = 1.0f;
+        rd.density = 0.5f;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        for (k = 0; k < 5; ++k) {
+            /* 0: fits; 1: fits, depth range (1, 0); 2: the camera inside (half-size 8); 3: offset viewport;
+               4: fits again */
+            int fits = caps && (k < 2 || k == 4);
+            ed_frame(fv, box, ramp, k == 2 ? 16.0f : 1.0f, k == 3, k == 1 ? 1.0f : 0.0f, 0.0f, &st);
+            assert_int_equal(st.engine_depth_tested, fits);
+            assert_int_equal(nb.pass_count, 2); /* faces, composite */
+            assert_int_equal(nb.draws[0], 1);
+            assert_int_equal(nb.fullscreen[1], 1);
+            assert_true(nb.passes[0].target != 0);
+            assert_int_equal(nb.passes[0].blend, FOGVOL_PASS_BLEND_ADD);
+            assert_int_equal(nb.passes[0].depth_write, 0);
+            assert_true(nb.passes[1].target == 0);
+            for (i = 0; i < 2; ++i) assert_true(nb.passes[i].depth_texture == (fits && i == 0 ? 77u : 0u));
+            assert_int_equal(nb.passes[0].depth_test, fits);
+            assert_int_equal(nb.passes[0].depth_greater, fits && k == 1);
+            /* the faces read the engine's depth only when not depth-tested; the composite only when */
+            assert_true(nb.passes[0].native_textures[3] == (fits ? 0u : 77u));
+            assert_true(nb.passes[1].native_textures[3] == (fits ? 77u : 0u));
+            assert_true(nb.passes[1].textures[0] == nb.passes[0].target);
+        }
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_mesh(fv, box);
+        fogvol_destroy_context(fv);
+        assert_int_equal(nb.creates, nb.destroys);
+    }
+    shp_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest null_tests[] = {
@@ -3276,6 +3362,7 @@ int main(void)
         cmocka_unit_test(test_target_create_faults),
         cmocka_unit_test(test_downsample_half_resolution),
         cmocka_unit_test(test_targets_made_once_per_size),
+        cmocka_unit_test(test_engine_depth_attached),
     };
     const struct CMUnitTest gl_tests[] = {
         cmocka_unit_test_setup_teardown(test_gl_missing_entry_core33, setup_core, teardown_gl),

@@ -23,7 +23,12 @@
    the engine's depth texture) |error| <= 3e-5 of the range. The composite
    (fog colour over the engine's picture) is checked within 2/255 and the
    engine's depth state (clip control, depth range, depth func, clear depth)
-   must come back unchanged. */
+   must come back unchanged. FLOAT + engine depth draws the frames that fit depth-tested
+   (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: fogvol_frame_stats.engine_depth_tested exactly where the box lies
+   between the planes, the viewport at the origin and the near plane not oblique, worked out here from
+   the scene), and test_engine_tested_inputs runs it over the engine's depth formats (DEPTH24,
+   DEPTH32F, DEPTH24_STENCIL8), sources (texture, bound framebuffer, framebuffer by name), occluders
+   exactly on the box's faces and a walk into the box and out. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -122,6 +127,10 @@ typedef struct scene {
 } scene;
 
 static const double g_eye[3] = {1.2, 0.8, 1.0};
+/* test_engine_tested_inputs: where fogvol takes the engine's depth from (fogvol_frame_desc.engine_depth_source),
+   and the cut occluder moved onto a face of the box (1: its back face, 2: its front face; 0: at z -6.3) */
+static fogvol_depth_source g_source = FOGVOL_DEPTH_SOURCE_TEXTURE;
+static int g_coplanar;
 static int g_vw = W, g_vh = H; /* the viewport of the frame being drawn (projection aspect, jitter, rays) */
 
 /* The camera at walk position w of a sequence (tests/sequence.h): w = 0 is g_eye; outside cases walk
@@ -155,6 +164,7 @@ static void make_scene(scene *s, int ortho, int inside)
         s->bmax[2] = 3.0;
     }
     s->occ[0] = cut;
+    if (g_coplanar) s->occ[0].z = g_coplanar == 1 ? s->bmin[2] : s->bmax[2]; /* exactly on a face of the box */
     s->occ[1] = back;
     s->znear = ortho ? 4.0 : 1.0;
     s->zfar = ortho ? 8.0 : 50.0;
@@ -378,6 +388,27 @@ static void engine_init(engine *e)
     assert_non_null(e->clip_control);
 }
 
+/* The engine's framebuffer again with a depth texture of another format (DEPTH24_STENCIL8: packed, at the
+   depth-stencil attachment) */
+static void engine_depth_format(engine *e, GLenum format)
+{
+    int packed = format == GL_DEPTH24_STENCIL8;
+    GLenum type = format == GL_DEPTH_COMPONENT32F ? GL_FLOAT : packed ? GL_UNSIGNED_INT_24_8 : GL_UNSIGNED_INT;
+    glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
+    glDeleteTextures(1, &e->depth);
+    glGenTextures(1, &e->depth);
+    glBindTexture(GL_TEXTURE_2D, e->depth);
+    glTexImage2D(GL_TEXTURE_2D, 0, (GLint)format, W, H, 0, packed ? GL_DEPTH_STENCIL : GL_DEPTH_COMPONENT, type, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, packed ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D,
+                           e->depth, 0);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
 static void engine_free(engine *e)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -501,6 +532,10 @@ typedef struct result {
     fogvol_result r;
     long wrong;   /* interior pixels off by more than the bound, or whose composite is */
     long outside; /* pixels outside the viewport fogvol changed */
+    int tested;   /* fogvol_frame_stats.engine_depth_tested */
+    int fits;     /* the frame fits the depth-tested faces (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST): the box's
+                     corners all between the planes (znear, zfar: the projection's too), the viewport
+                     at the origin, no oblique near plane; computed here from the scene */
 } result;
 
 /* One view of a convention's sequence: the camera's walk position, whether the occluder that comes
@@ -547,6 +582,8 @@ static void view_desc(const conv *c, const tview *tv, engine *e, scene *s, float
     fd->zfar = (float)s->zfar;
     memcpy(fd->viewport, tv->port, sizeof fd->viewport);
     fd->engine_depth_texture = e->depth;
+    fd->engine_depth_source = g_source;
+    fd->engine_depth_framebuffer = g_source == FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT ? e->fbo : 0;
     if (c->told) {
         fd->engine_depth_zero_to_one = c->zero_to_one ? 1 : -1;
         fd->engine_depth_range[0] = c->range_rev ? 1.0f : 0.0f;
@@ -576,7 +613,7 @@ static void scene_models(const scene *s, float model[3][16])
 }
 
 /* frames drawn, and those of them whose faces summed in integers (fogvol_frame_stats.exact_sum) */
-static int g_frames_drawn, g_frames_exact;
+static int g_frames_drawn, g_frames_exact, g_frames_tested;
 
 /* Render one view of a convention with one tier and compare: thickness and composite inside the
    viewport, and every pixel outside it as the engine left it. */
@@ -718,7 +755,16 @@ static result run_case(engine *e, const conv *c, const combo *cb, const fogvol_m
     for (i = 0; i < W * H; ++i) thick[i] = -1e30f;
     memset(&st, 0, sizeof st);
     res.r = fogvol_end_frame(fv, &st);
+    res.tested = st.engine_depth_tested;
+    res.fits = port[0] == 0 && port[1] == 0 && c->proj != P_OBLIQUE;
+    for (i = 0; i < 8; ++i) { /* view depth of each corner of the box */
+        double p[3], e;
+        for (j = 0; j < 3; ++j) p[j] = (i >> j & 1) ? s.bmax[j] : s.bmin[j];
+        e = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
+        res.fits = res.fits && e >= s.znear && e <= s.zfar;
+    }
     g_frames_drawn += res.r == FOGVOL_SUCCESS;
+    g_frames_tested += res.r == FOGVOL_SUCCESS && res.tested;
     g_frames_exact += res.r == FOGVOL_SUCCESS && st.exact_sum;
     glFinish();
     get_depth_state(&after);
@@ -785,6 +831,8 @@ typedef struct seqrun {
     double walk_scale;
 } seqrun;
 
+static int g_tested_seq[16]; /* fogvol_frame_stats.engine_depth_tested of each frame's first view */
+
 static void seq_cancel(void *user, const sq_view *v)
 {
     seqrun *sr = (seqrun *)user;
@@ -826,15 +874,20 @@ static void seq_view(void *user, const sq_view *v, sq_check *out)
     ok = r.r == FOGVOL_SUCCESS && r.max_over <= r.bound && r.comp_max <= 2.0 / 255.0 && r.state_ok &&
          r.outside == 0 && r.interior > v->viewport[2] * v->viewport[3] / 2;
     if (first) ok = ok && r.fogged > 200;
-    /* the faces that read the engine's depth linearise it from z alone unless the near
-       plane is oblique (x and y terms); nothing else reads it */
-    ok = ok && g_from_z_passes == ((cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && c->proj != P_OBLIQUE);
+    /* FLOAT + engine depth draws the frames that fit depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST), and
+       only those; every other combination none */
+    ok = ok && r.tested == (cb->tier == FOGVOL_TIER_FLOAT && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && r.fits);
+    /* the faces that read the engine's depth linearise it from z alone unless the near plane is oblique
+       (x and y terms); nothing else reads it; depth-tested frames read it in the composite and in the
+       debug read-back's pass instead */
+    ok = ok && g_from_z_passes == ((cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH) && c->proj != P_OBLIQUE ? 1 + r.tested : 0);
     if (first || !ok)
         printf("# %-18s %-48s f%d.%d max |err| %.3g (less vertex snapping: %.3f of bound %.3g), composite %.1f/255, "
-               "%d fogged of %d interior, %ld outside changed, state %s, %s%s\n",
+               "%d fogged of %d interior, %ld outside changed, state %s, %s%s%s\n",
                cb->name, c->name, v->frame, v->view, r.max_err, r.max_over / r.bound, r.bound, r.comp_max * 255.0,
                r.fogged, r.interior, r.outside, r.state_ok ? "restored" : "CHANGED", fogvol_result_string(r.r),
-               ok ? "" : "  FAIL");
+               r.tested ? ", depth-tested" : "", ok ? "" : "  FAIL");
+    if (v->frame < 16 && v->view == 0) g_tested_seq[v->frame] = r.tested;
     out->pixels = r.interior;
     out->wrong = r.wrong + r.outside + !ok;
     out->max_err = r.max_over;
@@ -893,7 +946,7 @@ static void test_conventions(void **state)
         rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
         rd.density = (float)DENSITY;
         assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-        g_frames_drawn = g_frames_exact = 0;
+        g_frames_drawn = g_frames_exact = g_frames_tested = 0;
         for (ci = 0; ci < NCONV; ++ci) {
             const conv *c = &g_convs[ci];
             char png[128], name[96], where[200];
@@ -932,6 +985,11 @@ static void test_conventions(void **state)
             printf("# %s: %d of %d frames summed in integers\n", cb->name, g_frames_exact, g_frames_drawn);
             assert_true(g_frames_drawn > 0);
             assert_int_equal(g_frames_exact, g_frames_drawn);
+        }
+        if (cb->tier == FOGVOL_TIER_FLOAT && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH)) {
+            /* both kinds of frame in the sequences: depth-tested and reading the depth per face */
+            printf("# %s: %d of %d frames depth-tested\n", cb->name, g_frames_tested, g_frames_drawn);
+            assert_true(g_frames_tested > 0 && g_frames_tested < g_frames_drawn);
         }
         fogvol_destroy_ramp(fv, ramp);
         fogvol_destroy_mesh(fv, m[0]);
@@ -1086,12 +1144,135 @@ static void test_camera_refused(void **state)
     fogvol_destroy_context(fv);
 }
 
+/* ---- FLOAT + engine depth drawn depth-tested: its inputs ---- */
+typedef struct tested_run {
+    engine *e;
+    fogvol_context *fv;
+    fogvol_mesh *m[3];
+    fogvol_ramp *ramp;
+} tested_run;
+
+/* One FLOAT + engine depth sequence of convention ci; returns 1 if a view was wrong (printed). */
+static int tested_sequence(tested_run *t, int ci, const sq_step *script, int n, unsigned allow, const char *what)
+{
+    seqrun sr;
+    sq_totals tot;
+    char name[160], where[200];
+    snprintf(name, sizeof name, "FLOAT+enginedepth %s, %s", g_convs[ci].name, what);
+    memset(&sr, 0, sizeof sr);
+    sr.e = t->e;
+    sr.c = &g_convs[ci];
+    sr.cb = &g_combos[2];
+    sr.meshes = (const fogvol_mesh **)t->m;
+    sr.fv = t->fv;
+    sr.ramp = t->ramp;
+    sr.walk_scale = 1.0;
+    tot = sq_play(name, W, H, script, n, allow, seq_view, seq_cancel, &sr, where);
+    if (tot.wrong) printf("#   FAIL: the first wrong pixel in %s\n", where);
+    return tot.wrong != 0;
+}
+
+/* FLOAT + engine depth (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST where the frame fits, the per-face read where it
+   does not, each view checked against its ray cast and its stats against the scene, as in
+   test_conventions) for every depth format the engine's texture or framebuffer may have (DEPTH24,
+   DEPTH32F, DEPTH24_STENCIL8: the texture attached, or fogvol's copy of that format) and every
+   source (the texture, the bound framebuffer, the framebuffer by name), under [-1,1] and [0,1]
+   depth, reversed-Z by clip control, by depth range and by matrix; an occluder exactly on the box's
+   back face and exactly on its front face (the faces there tie with the engine's depth); and a
+   sequence in which the camera walks into the volume (the frames stop fitting) and out again. */
+static void test_engine_tested_inputs(void **state)
+{
+    static const GLenum formats[3] = {GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT32F, GL_DEPTH24_STENCIL8};
+    static const char *const fnames[3] = {"DEPTH24", "DEPTH32F", "DEPTH24_STENCIL8"};
+    static const fogvol_depth_source sources[3] = {FOGVOL_DEPTH_SOURCE_TEXTURE, FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER,
+                                                   FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT};
+    static const char *const snames[3] = {"texture", "bound framebuffer", "framebuffer by name"};
+    static const int convs[5] = {0, 1, 2, 5, 6}; /* GL, ZERO_TO_ONE reversed, ZERO_TO_ONE, range (1,0), reversed matrix */
+    /* the camera walks in (0.9: the near plane cuts the box; 1: inside it) and out, full viewport */
+    static const sq_step walk[6] = {{{0.0, 0.0}, 1, 1, 0, 0}, {{0.9, 0.0}, 1, 1, 0, 0}, {{1.0, 0.0}, 1, 1, 0, 0},
+                                    {{0.5, 0.0}, 1, 1, 0, 0}, {{0.0, 0.0}, 0, 1, 0, 0}, {{0.0, 0.0}, 1, 1, 0, 0}};
+    glu_ctx g;
+    engine e;
+    tested_run t;
+    fogvol_context_desc cd;
+    fogvol_mesh_desc md;
+    fogvol_ramp_desc rd;
+    shp_mesh box = shp_box(1.0f, 1.0f, 1.0f), quad = shp_grid_plane(1.0f, 1.0f, 1);
+    int fi, si, ci, k, failures = 0;
+    char what[96];
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    engine_init(&e);
+    engine_mesh(&e, 0, &box);
+    engine_mesh(&e, 1, &quad);
+    engine_mesh(&e, 2, &quad);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = logger;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
+    cd.backend = g_inner;
+    cd.backend.create_program = watch_program;
+    cd.backend.begin_pass = watch_pass;
+    g_nfrom_z = 0;
+    memset(&t, 0, sizeof t);
+    t.e = &e;
+    assert_int_equal(fogvol_create_context(&cd, &t.fv), FOGVOL_SUCCESS);
+    fx_mesh_desc(&md, &box, 0);
+    assert_int_equal(fogvol_create_mesh(t.fv, &md, &t.m[0], NULL), FOGVOL_SUCCESS);
+    fx_mesh_desc(&md, &quad, 1);
+    assert_int_equal(fogvol_create_mesh(t.fv, &md, &t.m[1], NULL), FOGVOL_SUCCESS);
+    t.m[2] = t.m[1];
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = (float)DENSITY;
+    assert_int_equal(fogvol_create_ramp(t.fv, &rd, &t.ramp), FOGVOL_SUCCESS);
+    for (fi = 0; fi < 3; ++fi) {
+        engine_depth_format(&e, formats[fi]);
+        for (si = 0; si < 3; ++si) {
+            g_source = sources[si];
+            for (ci = 0; ci < 5; ++ci) {
+                snprintf(what, sizeof what, "%s %s", fnames[fi], snames[si]);
+                failures += tested_sequence(&t, convs[ci], sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, what);
+            }
+        }
+        g_source = FOGVOL_DEPTH_SOURCE_TEXTURE;
+        for (k = 1; k <= 2; ++k) { /* the cut occluder on the box's back, then front face */
+            g_coplanar = k;
+            for (ci = 0; ci < 2; ++ci) {
+                snprintf(what, sizeof what, "%s, occluder on the box's %s face", fnames[fi], k == 1 ? "back" : "front");
+                failures += tested_sequence(&t, convs[ci], sq_default_script, SQ_DEFAULT_FRAMES, SQ_ALL, what);
+            }
+        }
+        g_coplanar = 0;
+        for (ci = 0; ci < 2; ++ci) {
+            snprintf(what, sizeof what, "%s, walking into the box and out", fnames[fi]);
+            memset(g_tested_seq, 0, sizeof g_tested_seq);
+            failures += tested_sequence(&t, convs[ci], walk, 6, SQ_CAMERA | SQ_OCCLUDER, what);
+            /* fits, stops fitting (the near plane cuts the box), fits again */
+            assert_true(g_tested_seq[0] && !g_tested_seq[1] && !g_tested_seq[2] && g_tested_seq[3] && g_tested_seq[5]);
+        }
+    }
+    fogvol_destroy_ramp(t.fv, t.ramp);
+    fogvol_destroy_mesh(t.fv, t.m[0]);
+    fogvol_destroy_mesh(t.fv, t.m[1]);
+    fogvol_destroy_context(t.fv);
+    g_inner.destroy(g_inner.user_data);
+    engine_free(&e);
+    glu_destroy(&g);
+    shp_free(&box);
+    shp_free(&quad);
+    assert_int_equal(failures, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_projection_planes),
         cmocka_unit_test(test_camera_refused),
         cmocka_unit_test(test_conventions),
+        cmocka_unit_test(test_engine_tested_inputs),
     };
     if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests(tests, NULL, NULL);

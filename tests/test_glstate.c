@@ -381,6 +381,7 @@ typedef struct fx {
     fogvol_ramp *r_fog, *r_light;
     float thick[W * H];
     int warnings;
+    unsigned variants; /* FOGVOL_VARIANT_ENGINE_DEPTH: FLOAT with the engine's depth, depth-tested (else PS20) */
 } fx;
 
 static void fv_log(void *user, fogvol_log_level level, const char *message)
@@ -628,7 +629,8 @@ static void fv_create(fx *x, const snap *check)
     snap now;
     memset(&cd, 0, sizeof cd);
     cd.gl.get_proc_address = glu_proc;
-    cd.tier = FOGVOL_TIER_PS20; /* pass counts below are those of PS20 */
+    cd.tier = x->variants ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_PS20; /* pass counts below are those of PS20 */
+    cd.variants = x->variants;
     cd.logger.func = fv_log;
     cd.logger.user_data = x;
     if (x->compat) {
@@ -717,9 +719,11 @@ static void run_frame(fx *x, fogvol_composite composite, int w, int h)
     fd.composite = composite;
     for (i = 0; i < W * H; ++i) x->thick[i] = -1.0f;
     fd.debug_thickness = x->thick;
+    if (x->variants) /* the engine's depth (cleared to the far plane), copied from the bound framebuffer */
+        fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;
     assert_int_equal(fogvol_begin_frame(x->fv, &fd), FOGVOL_SUCCESS);
     glu_translate_scale(box_model, 0.8f, -0.6f, 1.2f, 1.0f);
-    assert_int_equal(fogvol_add_occluder(x->fv, x->m_box, box_model), FOGVOL_SUCCESS);
+    if (!x->variants) assert_int_equal(fogvol_add_occluder(x->fv, x->m_box, box_model), FOGVOL_SUCCESS);
     memset(&vd, 0, sizeof vd);
     vd.mesh = x->m_big;
     vd.ramp = x->r_fog;
@@ -735,6 +739,12 @@ static void run_frame(fx *x, fogvol_composite composite, int w, int h)
     assert_int_equal(fogvol_add_volume(x->fv, &vd), FOGVOL_SUCCESS);
     r = fogvol_end_frame(x->fv, &st);
     if (r != FOGVOL_SUCCESS) fail_msg("fogvol_end_frame: %s", fogvol_result_string(r));
+    if (x->variants) { /* each group: its faces depth-tested against the engine's depth, its composite */
+        assert_int_equal(st.engine_depth_tested, 1);
+        assert_int_equal(st.passes, 4);
+        assert_int_equal(st.groups, 2);
+        return;
+    }
     /* O; fog group: B, B negative, F, F negative, composite; light group: B, F, composite. Summed as
        integers (FOGVOL_SPEEDUP_EXACT_SUM, GL 3.3 here): one sum pass a group, negative volumes in it */
     assert_int_equal(st.exact_sum, x->compat ? 0 : 2);
@@ -822,6 +832,13 @@ static void frame_case(fx *x, fogvol_composite composite, int split_read)
 }
 
 static void test_core_geometry(void **state) { frame_case((fx *)*state, FOGVOL_COMPOSITE_GEOMETRY, 1); }
+/* FLOAT + ENGINE_DEPTH drawn depth-tested: the copy of the engine's depth attached to fogvol's sum target
+   (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST), GREATER or LESS, and detached */
+static void test_core_engine_depth_tested(void **state)
+{
+    ((fx *)*state)->variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    frame_case((fx *)*state, FOGVOL_COMPOSITE_FULLSCREEN, 1);
+}
 static void test_core_fullscreen(void **state) { frame_case((fx *)*state, FOGVOL_COMPOSITE_FULLSCREEN, 1); }
 static void test_compat21_geometry(void **state) { frame_case((fx *)*state, FOGVOL_COMPOSITE_GEOMETRY, 0); }
 static void test_compat21_fullscreen(void **state) { frame_case((fx *)*state, FOGVOL_COMPOSITE_FULLSCREEN, 0); }
@@ -915,6 +932,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_core_geometry, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_fullscreen, setup_core, teardown),
+        cmocka_unit_test_setup_teardown(test_core_engine_depth_tested, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_rasterizer_discard, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_resources, setup_core, teardown),
         cmocka_unit_test_setup_teardown(test_core_deleted_program, setup_core, teardown),
