@@ -20,7 +20,7 @@ SAN      = -O1 -g1 -fsanitize=address,undefined,float-cast-overflow -fno-omit-fr
 # (-g1: line tables for the sanitizers' stack traces; gcc builds fogvol.h under them 30% faster than with -g)
 INC      = -I.
 GL_LIBS  = -lOSMesa -lm
-LSAN_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
+LSAN_ENV = ASAN_OPTIONS=detect_leaks=1:malloc_context_size=8 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
            UBSAN_OPTIONS=print_stacktrace=1
 TAP      = CMOCKA_MESSAGE_OUTPUT=TAP
 VALGRIND = valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite
@@ -114,19 +114,29 @@ $(BUILD)/test_raycast_san: tests/test_raycast_selftest.c tests/raycast.h tests/s
 $(BUILD)/replay_%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c fogvol.h | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -O1 -g $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_$*.c -o $@ -lm
 # The three libFuzzer targets (ASan, UBSan with float-cast-overflow) link fogvol's implementation built
-# once with the fuzzer's coverage (fuzz_impl.o; the GL backend in it reaches GL through pointers only).
-FUZZ_SAN = -g -O1 -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all
-$(BUILD)/fuzz_impl.o: tests/fogvol_impl.c fogvol.h | $(BUILD)
-	clang $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(INC) -c $< -o $@
-$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)/fuzz_impl.o | $(BUILD)
-	clang $(FUZZ_SAN) -fsanitize=fuzzer -DFOGVOL_TEST_LINKED $(INC) $< $(BUILD)/fuzz_impl.o -o $@ -lm
+# once with the fuzzer's coverage (fuzz_impl.o; the GL backend in it reaches GL through pointers only):
+# -O1 for make fuzz; make test's 5-second smoke runs build them at -O0 in $(BUILD)/smoke (clang compiles
+# fogvol.h under the sanitizers 3x faster so).
+FUZZ_SAN = -g -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all
+fuzz_opt = $(if $(findstring /smoke/,$@),-O0,-O1)
+FUZZ_LINK = clang $(FUZZ_SAN) $(fuzz_opt) -fsanitize=fuzzer -DFOGVOL_TEST_LINKED $(INC) $< $(@D)/fuzz_impl.o -o $@ \
+            -lOSMesa -lm
+$(BUILD)/fuzz_impl.o $(BUILD)/smoke/fuzz_impl.o: tests/fogvol_impl.c fogvol.h
+	@mkdir -p $(@D)
+	clang $(FUZZ_SAN) $(fuzz_opt) -fsanitize=fuzzer-no-link $(INC) -c $< -o $@
 # API sequences on the null and the GL backend (OSMesa): libFuzzer, and its corpus replayed by the
 # sanitizer build of the tests (linked with fogvol_impl_san.o; GL under valgrind would take minutes).
 # make test's short run starts from the seeds (tests/fuzz/seed_api.py writes them; loading the whole
 # corpus into libFuzzer takes a minute), make fuzz from the corpus.
 FUZZ_API_DEPS = tests/fuzz/fuzz_api.c fogvol.h tests/gl_util.h tests/shapes.h
-$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) $(BUILD)/fuzz_impl.o | $(BUILD)
-	clang $(FUZZ_SAN) -fsanitize=fuzzer -DFOGVOL_TEST_LINKED $(INC) $< $(BUILD)/fuzz_impl.o -o $@ -lOSMesa -lm
+$(BUILD)/fuzz_api: $(FUZZ_API_DEPS) $(BUILD)/fuzz_impl.o
+	$(FUZZ_LINK)
+$(BUILD)/smoke/fuzz_api: $(FUZZ_API_DEPS) $(BUILD)/smoke/fuzz_impl.o
+	$(FUZZ_LINK)
+$(BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)/fuzz_impl.o
+	$(FUZZ_LINK)
+$(BUILD)/smoke/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)/smoke/fuzz_impl.o
+	$(FUZZ_LINK)
 $(BUILD)/replay_api_san: tests/fuzz/replay.c $(FUZZ_API_DEPS) $(BUILD)/fogvol_impl_san.o | $(BUILD)
 	$(CC) -std=c99 -D_DEFAULT_SOURCE -DFOGVOL_TEST_LINKED $(SAN) $(WARN) $(INC) tests/fuzz/replay.c tests/fuzz/fuzz_api.c \
 	  $(BUILD)/fogvol_impl_san.o -o $@ -lOSMesa -lm
@@ -170,16 +180,16 @@ SCRIPT_RUNS = \
   "raycast_selftest_asan_ubsan=$(call built,$(BUILD)/test_raycast_san) $(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(call built,$(BUILD)/test_cpu_vg) $(TAP) FOGVOL_TEST_SUBSET=1 $(VALGRIND) $(BUILD)/test_cpu_vg" \
   "fuzz_corpus_valgrind=$(call built,$(BUILD)/replay_mesh) $(VALGRIND) $(BUILD)/replay_mesh tests/fuzz/corpus_mesh" \
-  "fuzz_mesh_5s=$(call built,$(BUILD)/fuzz_mesh) mkdir -p $(BUILD)/fuzz/mesh && \
-    $(BUILD)/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
+  "fuzz_mesh_5s=$(call built,$(BUILD)/smoke/fuzz_mesh) mkdir -p $(BUILD)/fuzz/mesh && \
+    $(BUILD)/smoke/fuzz_mesh -max_total_time=5 $(BUILD)/fuzz/mesh tests/fuzz/corpus_mesh" \
   "fuzz_analytic_corpus_valgrind=$(call built,$(BUILD)/replay_analytic) $(VALGRIND) $(BUILD)/replay_analytic \
     tests/fuzz/corpus_analytic" \
-  "fuzz_analytic_5s=$(call built,$(BUILD)/fuzz_analytic) mkdir -p $(BUILD)/fuzz/analytic && \
-    $(BUILD)/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
+  "fuzz_analytic_5s=$(call built,$(BUILD)/smoke/fuzz_analytic) mkdir -p $(BUILD)/fuzz/analytic && \
+    $(BUILD)/smoke/fuzz_analytic -max_total_time=5 $(BUILD)/fuzz/analytic tests/fuzz/corpus_analytic" \
   "fuzz_api_corpus_asan_ubsan=$(call built,$(BUILD)/replay_api_san) $(LSAN_ENV) $(BUILD)/replay_api_san \
     tests/fuzz/corpus_api" \
-  "fuzz_api_5s=$(call built,$(BUILD)/fuzz_api) rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && \
-    $(LSAN_ENV) $(BUILD)/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
+  "fuzz_api_5s=$(call built,$(BUILD)/smoke/fuzz_api) rm -rf $(BUILD)/fuzz/api5 && mkdir -p $(BUILD)/fuzz/api5 && \
+    $(LSAN_ENV) $(BUILD)/smoke/fuzz_api -max_total_time=5 -detect_leaks=0 $(BUILD)/fuzz/api5 tests/fuzz/seeds_api"
 # the browser test runs in make test when emscripten and chromium are installed (tools/deps.sh web)
 HAVE_WEB := $(shell command -v $(EMCC) >/dev/null 2>&1 && command -v $(CHROMIUM) >/dev/null 2>&1 && echo 1)
 ifeq ($(HAVE_WEB),1)
@@ -207,7 +217,8 @@ check: deps-test | $(BUILD)
 # everything; the README's test command and CI. The objects and programs that several entries use
 # (TEST_SHARED) are built first; every entry then builds its own programs (TEST_BINS) as it starts, so
 # that compiling and testing overlap on the JOBS that tests/run.sh runs at once.
-TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/fuzz_impl.o $(BUILD)/dump_shaders $(BUILD)/vulkan_backend
+TEST_SHARED = $(BUILD)/fogvol_impl.o $(BUILD)/fogvol_impl_san.o $(BUILD)/smoke/fuzz_impl.o $(BUILD)/dump_shaders \
+              $(BUILD)/vulkan_backend
 test: deps-test deps-run
 	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_SHARED)
 	@LOGDIR=$(BUILD)/logs JOBS=$(JOBS) DURATIONS=tests/durations tests/run.sh $(SCRIPT_RUNS) $(TEST_RUNS)
