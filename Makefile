@@ -103,7 +103,7 @@ $(foreach t,$(LINKED_TESTS),$(BUILD)/test_$(t)_san): $(BUILD)/test_%_san: tests/
 	$(CC) -std=c99 -DFOGVOL_TEST_LINKED $(test_$*_FLAGS) $(SAN) $(WARN) $(INC) $< $(BUILD)/fogvol_impl_san.o -o $@ \
 	  $(call libs_of,test_$*)
 $(BUILD)/%_cpp: tests/%.c $(TEST_DEPS) | $(BUILD)
-	$(CXX) -x c++ -std=c++11 $($*_FLAGS) $(CFLAGS) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
+	$(CXX) -x c++ -std=c++11 $($*_FLAGS) $(subst -O2,-O0,$(CFLAGS)) $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
 $(BUILD)/%_vg: tests/%.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $($*_FLAGS) -O1 -g $(WARN) $(INC) $< -o $@ $(call libs_of,$*)
 
@@ -164,7 +164,7 @@ SCRIPT_RUNS = \
   "vulkan_shaders=BUILD=$(BUILD) tests/vulkan_shaders.sh" \
   "vulkan_check=$(VK_ENV) $(BUILD)/vulkan_backend --check" \
   $(foreach t,$(VULKAN_PICTURES),"vulkan_picture_$(t)=$(call VULKAN_PICTURE,$(t))") \
-  "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh examples" \
+  "examples=BUILD=$(BUILD) CC=$(CC) BUILT_ELSEWHERE=demo_headless tests/examples.sh examples" \
   "examples_package=BUILD=$(BUILD) CC=$(CC) tests/examples.sh package" \
   $(foreach c,gcc clang g++ clang++,"compile_matrix_$(c)=BUILD=$(BUILD) tests/compile_matrix.sh $(c)") \
   "shaders=BUILD=$(BUILD) tests/shaders.sh" \
@@ -173,7 +173,7 @@ SCRIPT_RUNS = \
   "doc_index=tests/doc_index.sh" \
   "doc_figures=$(call built,$(BUILD)/dump_shaders) BUILD=$(BUILD) tests/doc_figures.sh --no-tiers" \
   "demo_headless=$(call built,$(BUILD)/demo_headless) $(BUILD)/demo_headless $(BUILD)/demo --check" \
-  "bench_quick=$(call built,$(BUILD)/bench) $(BUILD)/bench --quick" \
+  "bench_quick=$(BUILT) BUILD=$(BUILD)/quick BENCH_OPT=-O1 $(BUILD)/quick/bench && $(BUILD)/quick/bench --quick" \
   "egl_builds=$(BUILT) BUILD=$(BUILD)/egl_check CFLAGS=-O0 BENCH_OPT=-O0 $(BUILD)/egl_check/bench_egl \
     $(BUILD)/egl_check/egl/demo_headless" \
   "raycast_selftest=$(call built,$(BUILD)/test_raycast) $(BUILD)/test_raycast" \
@@ -274,7 +274,7 @@ examples: deps-demo deps-run
 	@LOGDIR=$(BUILD)/logs tests/run.sh "examples=BUILD=$(BUILD) CC=$(CC) tests/examples.sh"
 
 $(BUILD)/bench: bench/bench.c $(TEST_DEPS) | $(BUILD)
-	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+	$(CC) -std=c99 $(BENCH_OPT) $(WARN) $(INC) $< -o $@ $(GL_LIBS)
 
 # the FLOAT + engine depth face pass as fogvol draws it against a depth-tested design (issue 34), on
 # the benchmark's scenes, outside the library: make proto-engine-depth
