@@ -1234,7 +1234,9 @@ typedef uintptr_t fogvol_handle;
                         (gl_FragCoord + zw) * xy in [0,1]
    DECODE   fv_dec:     decode weights (world units)
    RAMP     fv_rampmap: (slope, offset, overflow flag, 0): thickness -> ramp s
-   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 0)
+   MISC     fv_misc:    (z scale k, 1 = replace clip z, near-clamp w, 1 = NEAR_CLAMP in the face programs;
+                        in the depth-tested (ENGINE_TEST) composite the near plane's count c:
+                        fogvol__engine_test_sources)
    LINEAR   fv_lin:     engine depth texture -> view depth, numerator row:
                         view depth = dot(fv_lin, q) / dot(fv_lin2, q), q = (s, t, window depth, 1),
                         (s, t) in [0,1] across the viewport (fv_engine_view_depth in the shaders)
@@ -1940,16 +1942,19 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  Not the digits' bytes: closer to the true thickness.
    ENGINE_DEPTH_TEST  FLOAT + ENGINE_DEPTH on a backend with FOGVOL_CAP_ATTACH_DEPTH (the GL backend on
                  GL 3.0 / GLES 3.0), in single-sample frames whose viewport starts at the window
-                 origin, with no volume crossing the near or far plane (so the camera is inside none),
-                 no density-textured volume, no fogvol_add_light, no downsample, no debug read-back,
+                 origin, with every volume clear of the near and far planes or, the camera inside it,
+                 convex and holding the projection's whole near plane rectangle (its far side before
+                 the far plane), no density-textured volume, no fogvol_add_light, no downsample, no debug read-back,
                  not NEAR_CLAMP or COLORS, a projection without an oblique near plane: the engine's
                  depth texture (or fogvol's copy of the framebuffer's depth) is attached as the depth
                  buffer of the sum's target, tested (LESS, GREATER for a reversed depth) and never
                  written, so only the faces in front of the opaque surface are shaded; each adds
                  (+-d, +-1) into an RG32F sum without reading the engine's depth, and the composite
                  reads that depth once per pixel where the count is not 0 and takes thickness
-                 r - o g (a face behind the surface adds +-o in the min compare; over a closed,
-                 unclipped volume their signs sum to -g). The faces' clip z is the engine's
+                 r - o (g - c) (a face behind the surface adds +-o in the min compare; over a closed,
+                 unclipped volume their signs sum to -g, and the front face the near plane clips
+                 from a volume around the camera makes that c - g, c the number of such volumes
+                 in the group, negative ones counted -1). The faces' clip z is the engine's
                  (fogvol_frame_desc.engine_depth_zero_to_one and engine_depth_range), so the test
                  compares the depths the engine's own rasteriser would. The same thickness up to
                  rounding (a face within one depth-buffer step of the surface adds d or o, which
@@ -6461,6 +6466,7 @@ static const char fogvol__fs_composite[] =
     "FV_UNIFORM(vec4, fv_speed)\n"
     "#ifdef FV_ENGINE_TEST\n"
     "FV_UNIFORM(vec4, fv_nf)\n"
+    "FV_UNIFORM(vec4, fv_misc)\n"
     "#endif\n"
     "FV_UNIFORM(vec4, fv_ctex_u)\n"
     "FV_UNIFORM(vec4, fv_ctex_v)\n"
@@ -6513,10 +6519,11 @@ static const char fogvol__fs_composite_main[] =
     "    highp uint u = cu.r | (cu.g << 8) | (cu.b << 16) | (cu.a << 24);\n"
     "    if (u == 0u) discard;\n"
     "    t = float(int(u)) * fv_rampmap.w;\n"
-    "#elif defined(FV_FLOAT) && defined(FV_ENGINE_TEST)\n" /* r - o g, o read where faces lay behind it */
-    "    if (b.rg == vec2(0.0)) discard;\n"
+    "#elif defined(FV_FLOAT) && defined(FV_ENGINE_TEST)\n" /* r - o (g - c), o read where faces lay behind it */
+    "    float g = b.g - fv_misc.w;\n"             /* c: volumes whose front faces the near plane clips */
+    "    if (b.r == 0.0 && g == 0.0) discard;\n"
     "    t = b.r;\n"
-    "    if (b.g != 0.0) t -= min(fv_engine_view_depth(st, FV_ENGINE_Z(fv_opaque)) * fv_nf.x + fv_nf.y, 1.0) * b.g;\n"
+    "    if (g != 0.0) t -= min(fv_engine_view_depth(st, FV_ENGINE_Z(fv_opaque)) * fv_nf.x + fv_nf.y, 1.0) * g;\n"
     "    if (fv_rampmap.w > 0.5) {\n"             /* the debug read-back's pass: r - o g into B */
     "        FV_FRAGCOLOR = vec4(t, 0.0, 0.0, 0.0);\n"
     "        return;\n"
@@ -7168,6 +7175,10 @@ struct fogvol_mesh {
     int convex; /* fogvol_mesh_report.convex */
     float bmin[3], bmax[3]; /* model-space bounds of the vertices (orthographic clip depth scale,
                                geometry composite's scissor) */
+    float *planes;          /* convex == 1: the face planes (unit n, d: n.p <= d inside), 4 floats each, model
+                               space, for fogvol__near_inside; NULL otherwise (or out of memory) */
+    int nplanes;
+    double plane_tol;       /* the convexity test's tolerance (model units) */
 };
 
 /* A program built for one configuration (fogvol_shader_desc.specialize) of one sample set; handle 0:
@@ -7214,6 +7225,8 @@ typedef struct fogvol__volume {
     const fogvol_volume_texture *density, *color; /* NULL: none */
     float density_map[8], color_map[6];
     int next; /* the next volume of the same ramp in the frame's order, -1: none (fogvol__link_groups) */
+    int near_inside; /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST frames: 1 = it holds the projection's whole near
+                        plane rectangle (fogvol__near_inside), the camera inside it */
 } fogvol__volume;
 
 typedef struct fogvol__light {
@@ -8260,9 +8273,10 @@ static int fogvol__pts_outside(const double *pts, const double *box, int n, cons
    diagonal; decided on the triangles as validated (idx: welded), where the slivers that a weld closes
    (repeated corners) have no plane. The used vertices are read once into doubles (pts: 3 per used
    vertex, then fogvol__hull_nodes(nused) boxes of 6) and put in a tree of boxes, which each face
-   plane tests (fogvol__pts_outside). */
+   plane tests (fogvol__pts_outside). m->planes (room for a plane a triangle, or NULL) gets the planes,
+   a run of coplanar triangles once, and m->plane_tol the tolerance. */
 static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, const uint32_t *used, int nused,
-                             double *pts)
+                             double *pts, fogvol_mesh *m)
 {
     int t, v, k, tris = fogvol__index_count(desc) / 3;
     double *box = pts + 3 * (size_t)nused, diag = 0.0, tol;
@@ -8273,6 +8287,7 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, 
     for (k = 0; k < 3; ++k) diag += (box[6 + 3 + k] - box[6 + k]) * (box[6 + 3 + k] - box[6 + k]);
     diag = FOGVOL_SQRT(diag);
     tol = 1e-5 * diag;
+    m->plane_tol = tol;
     for (t = 0; t < tris; ++t) {
         double a[3], b[3], c[3], n[3], len;
         fogvol__vertex(desc, idx[3 * t], a);
@@ -8288,6 +8303,12 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, 
         len = FOGVOL_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (!(len > 1e-12 * diag * diag)) continue; /* degenerate: no plane */
         if (fogvol__pts_outside(pts, box, nused, n, a, len, tol)) return 0;
+        if (m->planes) {
+            float q[4], *last = m->nplanes ? m->planes + 4 * (m->nplanes - 1) : NULL;
+            for (k = 0; k < 3; ++k) q[k] = (float)(n[k] / len);
+            q[3] = (float)((n[0] * a[0] + n[1] * a[1] + n[2] * a[2]) / len);
+            if (!last || memcmp(last, q, sizeof q) != 0) memcpy(m->planes + 4 * m->nplanes++, q, sizeof q);
+        }
     }
     return 1;
 }
@@ -8346,7 +8367,14 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc, used, nused);
-    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused, pts) : -1;
+    if (rep.valid) /* (without room for the planes the mesh is still convex, only never near_inside) */
+        m->planes = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 4u * (size_t)(fogvol__index_count(desc) / 3 + 1));
+    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused, pts, m) : -1;
+    if (m->convex != 1) {
+        fogvol__free(&ctx->alloc, m->planes);
+        m->planes = NULL;
+        m->nplanes = 0;
+    }
     fogvol__free(&ctx->alloc, pts);
     fogvol__free(&ctx->alloc, used);
     r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
@@ -8355,6 +8383,7 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: mesh upload failed: %s", fogvol_result_string(r));
         if (m->handle) ctx->be.destroy_mesh(ctx->be.user_data, m->handle);
         (void)fogvol__be_result(ctx, r);
+        fogvol__free(&ctx->alloc, m->planes);
         fogvol__free(&ctx->alloc, m);
         return r;
     }
@@ -8395,6 +8424,7 @@ FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
     ctx->be.destroy_mesh(ctx->be.user_data, mesh->handle);
     (void)fogvol__be_result(ctx, FOGVOL_SUCCESS); /* (logged by the backend) */
     fogvol__live_remove(&mesh->live, &ctx->live_meshes);
+    fogvol__free(&ctx->alloc, mesh->planes);
     fogvol__free(&ctx->alloc, mesh);
 }
 
@@ -9982,15 +10012,28 @@ static void fogvol__engine_test_pass(fogvol_context *ctx, fogvol__run *run, cons
     run->st.passes++;
 }
 
-/* The debug read-back of a FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group: r - o g, as its composite takes it,
-   written into B (R32F) by the composite program (fv_rampmap.w = 1: the thickness, not a colour),
+/* A FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group's composite and debug read-back: E, the engine's depth, and
+   fv_misc.w = c, the sum of the signs of the group's volumes that hold the near plane's rectangle (their
+   front faces clipped on every pixel: r - o (g - c)). */
+static void fogvol__engine_test_sources(const fogvol_context *ctx, const fogvol__run *run, const fogvol_ramp *ramp,
+                                        fogvol_pass *ps)
+{
+    int i, c = 0;
+    for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next)
+        if (ctx->cur.vols[i].near_inside) c += ctx->cur.vols[i].negative ? -1 : 1;
+    ps->textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
+    ps->native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    ps->uniforms[FOGVOL_U_MISC][3] = (float)c;
+}
+
+/* The debug read-back of a FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group: r - o (g - c), as its composite takes
+   it, written into B (R32F) by the composite program (fv_rampmap.w = 1: the thickness, not a colour),
    for fogvol__debug_capture to read as any FLOAT sum. */
-static fogvol_result fogvol__engine_test_resolve(fogvol_context *ctx, fogvol__run *run)
+static fogvol_result fogvol__engine_test_resolve(fogvol_context *ctx, fogvol__run *run, const fogvol_ramp *ramp)
 {
     fogvol_pass ps = run->base;
     memset(ps.textures, 0, sizeof ps.textures);
-    ps.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
-    ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
+    fogvol__engine_test_sources(ctx, run, ramp, &ps);
     ps.target = ctx->gpu.tgt_b;
     ps.clear = 1;
     ps.uniforms[FOGVOL_U_RAMP][3] = 1.0f;
@@ -10017,7 +10060,7 @@ static void fogvol__sum_passes(fogvol_context *ctx, fogvol__run *run, const fogv
     if (p->engine_test) { /* (no density texture in such frames) */
         fogvol__engine_test_pass(ctx, run, ramp);
         if (fogvol__want_debug(ctx, ramp, run->captured)) {
-            r = fogvol__engine_test_resolve(ctx, run);
+            r = fogvol__engine_test_resolve(ctx, run, ramp);
             if (r == FOGVOL_SUCCESS) r = fogvol__debug_capture(ctx, run, NULL, &run->overflow);
             run->captured = 1;
             if (r != FOGVOL_SUCCESS) run->r = r;
@@ -10811,17 +10854,50 @@ static double fogvol__engine_view_depth(const fogvol_pass *ps, double z)
     return fabs(den) <= 1e-12 * fabs(num) ? 1e300 : num / den;
 }
 
+/* Whether volume v holds the whole rectangle where the projection's near plane cuts the frustum (world
+   corners c, at view depth pn): every corner inside every face plane of its convex mesh, by twice the
+   convexity test's tolerance and 1/1000 of pn (in view depth: the clipper's rounding), so that on every
+   pixel's ray the near plane clips v's one front face and leaves its one back face. The rectangle is
+   convex, so its corners decide. */
+static int fogvol__near_inside(const fogvol_context *ctx, const fogvol__volume *v, const double c[4][3], double pn)
+{
+    const fogvol_mesh *m = v->mesh;
+    double mm[16], im[16], fro = 0.0, eye, margin;
+    int i, j, k;
+    if (m->convex != 1 || !m->planes) return 0;
+    for (i = 0; i < 16; ++i) mm[i] = v->model[i];
+    if (!fogvol__inv4(mm, im)) return 0;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) fro += im[j * 4 + i] * im[j * 4 + i];
+    eye = FOGVOL_SQRT(ctx->cur.eyerow[0] * ctx->cur.eyerow[0] + ctx->cur.eyerow[1] * ctx->cur.eyerow[1] +
+                      ctx->cur.eyerow[2] * ctx->cur.eyerow[2]);
+    if (!(eye > 0.0)) return 0;
+    /* a view-depth length L is at most L / eye world units, at most |im| L / eye model units */
+    margin = 2.0 * m->plane_tol + 1e-3 * FOGVOL_FABS(pn) * FOGVOL_SQRT(fro) / eye;
+    for (k = 0; k < 4; ++k) {
+        double q[3];
+        for (i = 0; i < 3; ++i) q[i] = im[i] * c[k][0] + im[4 + i] * c[k][1] + im[8 + i] * c[k][2] + im[12 + i];
+        for (j = 0; j < m->nplanes; ++j) {
+            const float *pl = m->planes + 4 * j;
+            if (!(pl[0] * q[0] + pl[1] * q[1] + pl[2] * q[2] - pl[3] < -margin)) return 0;
+        }
+    }
+    return 1;
+}
+
 /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: whether this frame (FLOAT + ENGINE_DEPTH, single-sample, the viewport
-   at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o g equals the
-   min compare's sum where the faces on every pixel's ray close (each volume unclipped: between both
-   pairs of planes, fogvol's znear..zfar and the projection's, which now clips the faces, or wholly
-   outside both) and the engine's depth is linearised without the pixel (no oblique near plane). */
-static int fogvol__engine_test_frame(const fogvol_context *ctx, const fogvol__run *run, fogvol__plan *p)
+   at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o (g - c) equals
+   the min compare's sum where the faces on every pixel's ray close but for c volumes the near plane
+   opens (each volume unclipped: between both pairs of planes, fogvol's znear..zfar and the projection's,
+   which now clips the faces, or wholly outside both; or, the camera inside it, convex and holding the
+   projection's whole near plane rectangle at or beyond znear: fogvol__volume.near_inside, c their signs'
+   sum in a group) and the engine's depth is linearised without the pixel (no oblique near plane). */
+static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run, fogvol__plan *p)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_pass lin;
-    double r[2], e0, e1, pn, pf, lo, hi;
-    int i, z01;
+    double r[2], e0, e1, pn, pf, lo, hi, corner[4][3];
+    int i, z01, corners = 0;
     if (!ctx->cfg.engine_test || !p->engine_read || ctx->cur.samples > 1 || fd->downsample == 2 || ctx->cur.nlight > 0 ||
         p->colors || p->near_clamp > 0.0f || !p->origin_bit)
         return 0;
@@ -10835,13 +10911,31 @@ static int fogvol__engine_test_frame(const fogvol_context *ctx, const fogvol__ru
     pf = e0 < e1 ? e1 : e0;
     lo = pn > fd->znear ? pn : fd->znear;
     hi = pf < fd->zfar ? pf : fd->zfar;
+    for (i = 0; i < ctx->cur.nvol; ++i) ctx->cur.vols[i].near_inside = 0;
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
         if (ctx->cur.vols[i].density) return 0;
         fogvol__volume_depths(ctx, &ctx->cur.vols[i], &emin, &emax);
-        if (!((emin >= lo && emax <= hi) || emax <= (pn < fd->znear ? pn : fd->znear) ||
-              emin >= (pf > fd->zfar ? pf : fd->zfar)))
-            return 0;
+        if ((emin >= lo && emax <= hi) || emax <= (pn < fd->znear ? pn : fd->znear) ||
+            emin >= (pf > fd->zfar ? pf : fd->zfar))
+            continue;
+        /* the camera inside: the near plane at or beyond znear (no face nearer than znear), within hi */
+        if (emax > hi || pn < fd->znear - 1e-6 * ((double)fd->zfar - fd->znear)) return 0;
+        if (!corners) { /* the near plane's rectangle: NDC (+-1, +-1) at the window depth of pn */
+            double a = (z01 ? 1.0 : 2.0) / (r[1] - r[0]), zw = e0 < e1 ? r[0] : r[1], zn = a * (zw - r[0]) - (z01 ? 0.0 : 1.0);
+            int k, j;
+            for (k = 0; k < 4; ++k) {
+                double q[4] = {(k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, zn, 1.0}, w[4];
+                for (j = 0; j < 4; ++j)
+                    w[j] = ctx->cur.invvp[j] * q[0] + ctx->cur.invvp[4 + j] * q[1] + ctx->cur.invvp[8 + j] * q[2] +
+                           ctx->cur.invvp[12 + j] * q[3];
+                if (!(FOGVOL_FABS(w[3]) > 0.0)) return 0;
+                for (j = 0; j < 3; ++j) corner[k][j] = w[j] / w[3];
+            }
+            corners = 1;
+        }
+        if (!fogvol__near_inside(ctx, &ctx->cur.vols[i], (const double(*)[3])corner, pn)) return 0;
+        ctx->cur.vols[i].near_inside = 1;
     }
     /* window depth = a + b z_ndc; fogvol's passes map clip z' to (z' / w + 1) / 2: z' = 2 b z + (2 a - 1) w */
     p->zmap[0] = z01 ? 2.0 * (r[1] - r[0]) : r[1] - r[0];
@@ -10959,10 +11053,7 @@ static void fogvol__group(fogvol_context *ctx, fogvol__run *run, int g)
     run->st.volumes += n;
     fogvol__sum_passes(ctx, run, ramp, has_neg);
     fogvol__sum_sources(ctx, run, ramp, &ps);
-    if (run->p.engine_test) { /* r - o g: E, and the engine's depth read where g is not 0 */
-        ps.textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
-        ps.native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
-    }
+    if (run->p.engine_test) fogvol__engine_test_sources(ctx, run, ramp, &ps); /* r - o (g - c) */
     if (run->p.single) {
         if (run->counted) fogvol__check_pass(ctx, run, &ps, 0, &run->st); /* after the subtractions */
     } else if (run->counted && !run->xsum && !fogvol__unsaturable(ctx, run, n, convex)) { /* (integers cannot saturate) */

@@ -10,6 +10,9 @@
                thickness = sum.r - o sum.g (the faces behind the opaque surface add +-o each, and
                their signs sum to -sum.g where every volume lies between the near and far planes)
      none      no opaque depth at all (plain FLOAT without occluders: the least the faces can cost)
+     two       the faces twice against the attached depth: LESS adding +-d into an R32F sum, then
+               GEQUAL adding +-o (read per fragment) for those behind the surface; the composite
+               reads the sum alone (no depth read, no count; no closed-volume assumption)
 
    Each: one face pass + one full-screen composite (exp) into the engine framebuffer. Frames
    interleaved, medians; the thickness of "tested" against "read" over every pixel.
@@ -28,6 +31,11 @@ static const char *FS_TESTED = "#version 330 core\nin float vd; in float d;\nout
                                "void main() { o = gl_FrontFacing ? vec4(-d, -1.0, 0.0, 0.0) : vec4(d, 1.0, 0.0, 0.0); }\n";
 static const char *FS_NONE = "#version 330 core\nin float vd; in float d;\nout vec4 o;\n"
                              "void main() { o = vec4(gl_FrontFacing ? -d : d, 0.0, 0.0, 0.0); }\n";
+static const char *FS_FAIL =
+    "#version 330 core\nin float vd; in float d;\nuniform sampler2D ez;\nuniform vec4 lin;\nout vec4 o;\n"
+    "void main() { float z = texelFetch(ez, ivec2(gl_FragCoord.xy), 0).r;\n"
+    "  float w = lin.x / (lin.y - (2.0 * z - 1.0) * lin.z), od = (w - lin.w) / lin.z;\n"
+    "  o = vec4(gl_FrontFacing ? -od : od, 0.0, 0.0, 0.0); }\n";
 static const char *FS_COMP_R = "#version 330 core\nuniform sampler2D s;\nuniform float range;\nout vec4 o;\n"
                                "void main() { float t = texelFetch(s, ivec2(gl_FragCoord.xy), 0).r;\n"
                                "  if (t == 0.0) discard;\n"
@@ -42,12 +50,12 @@ static const char *FS_COMP_RG =
     "    t -= min(od, 1.0) * v.y;\n  }\n"
     "  o = vec4(0.8, 0.8, 0.8, 1.0 - exp(-0.5 * max(t * range, 0.0))); }\n";
 
-enum { PM_READ, PM_TESTED, PM_NONE, NPM };
+enum { PM_READ, PM_TESTED, PM_NONE, PM_TWO, NPM };
 static const char *const pm_names[NPM] = {"read per fragment (as now)", "depth-tested (proposed)",
-                                          "no opaque depth (plain FLOAT, no occluders)"};
+                                          "no opaque depth (plain FLOAT, no occluders)", "two passes: LESS +-d, GEQUAL +-o read"};
 
 typedef struct proto {
-    GLuint face[NPM], comp_r, comp_rg;
+    GLuint face[NPM], comp_r, comp_rg, fail, fbo_rd;
     GLuint sum_r, sum_rg, fbo_r, fbo_rg;
 } proto;
 
@@ -62,7 +70,7 @@ static void set_lin(GLuint prog, const scene *s)
 static void proto_frame(proto *p, int m, const scene *s, const view *vw, const rt *r)
 {
     static const float zero[4] = {0, 0, 0, 0};
-    GLuint fbo = m == PM_TESTED ? p->fbo_rg : p->fbo_r, comp = m == PM_TESTED ? p->comp_rg : p->comp_r;
+    GLuint fbo = m == PM_TESTED ? p->fbo_rg : m == PM_TWO ? p->fbo_rd : p->fbo_r, comp = m == PM_TESTED ? p->comp_rg : p->comp_r;
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, r->w, r->h);
     glClearBufferfv(GL_COLOR, 0, zero);
@@ -70,7 +78,7 @@ static void proto_frame(proto *p, int m, const scene *s, const view *vw, const r
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glDepthMask(GL_FALSE);
-    if (m == PM_TESTED) {
+    if (m == PM_TESTED || m == PM_TWO) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
     }
@@ -81,6 +89,15 @@ static void proto_frame(proto *p, int m, const scene *s, const view *vw, const r
         set_lin(p->face[m], s);
     }
     draw_insts(s, vw, p->face[m], 0);
+    if (m == PM_TWO) {
+        glDepthFunc(GL_GEQUAL);
+        glUseProgram(p->fail);
+        bind_tex(0, r->eng_depth); /* (read while attached, not written: fine on desktop GL) */
+        glUniform1i(glGetUniformLocation(p->fail, "ez"), 0);
+        set_lin(p->fail, s);
+        draw_insts(s, vw, p->fail, 0);
+        bind_tex(0, 0);
+    }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, r->eng_fbo); /* (its depth attachment: no depth test, no writes) */
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -130,7 +147,7 @@ static double proto_compare(proto *p, const scene *s, const rt *r, long *nonzero
 
 int main(int argc, char **argv)
 {
-    static const int scenes[4] = {0, 1, 5, 6};
+    static const int scenes[5] = {0, 1, 5, 6, 7};
     int frames = argc > 1 ? atoi(argv[1]) : 9, sc, it, m, k, w = 1280, h = 720;
     glu_ctx g;
     proto p;
@@ -141,13 +158,15 @@ int main(int argc, char **argv)
     p.face[PM_READ] = prog1(VS_MESH, FS_READ);
     p.face[PM_TESTED] = prog1(VS_MESH, FS_TESTED);
     p.face[PM_NONE] = prog1(VS_MESH, FS_NONE);
+    p.face[PM_TWO] = prog1(VS_MESH, FS_NONE);
+    p.fail = prog1(VS_MESH, FS_FAIL);
     p.comp_r = prog1(VS_FULL, FS_COMP_R);
     p.comp_rg = prog1(VS_FULL, FS_COMP_RG);
     printf("%dx%d on %s, medians of %d interleaved frames; fog ms = face pass + composite, after the engine's "
            "opaque pass\n\n| scene | method | fog ms | x no opaque depth | tested vs read: max |thickness diff| "
            "|\n|---|---|---:|---:|---|\n",
            w, h, (const char *)glGetString(GL_RENDERER), frames);
-    for (sc = 0; sc < 4; ++sc) {
+    for (sc = 0; sc < 5; ++sc) {
         scene *s = (scene *)calloc(1, sizeof(scene));
         rt r;
         view vw;
@@ -176,6 +195,7 @@ int main(int argc, char **argv)
         p.sum_rg = tex2d(GL_RG32F, w, h, GL_RG, GL_FLOAT);
         p.fbo_r = fbo2(p.sum_r, 0, 0);
         p.fbo_rg = fbo2(p.sum_rg, r.eng_depth, 0); /* the engine's depth texture as the depth buffer */
+        p.fbo_rd = fbo2(p.sum_r, r.eng_depth, 0);
         for (it = 0; it < frames + 1; ++it)
             for (m = 0; m < NPM; ++m) {
                 int mm = (m + it) % NPM;
@@ -197,6 +217,7 @@ int main(int argc, char **argv)
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         glDeleteFramebuffers(1, &p.fbo_r);
         glDeleteFramebuffers(1, &p.fbo_rg);
+        glDeleteFramebuffers(1, &p.fbo_rd);
         glDeleteTextures(1, &p.sum_r);
         glDeleteTextures(1, &p.sum_rg);
         rt_free(&r);
