@@ -28,7 +28,7 @@ FUZZ_TIME ?= 60
 EMCC     ?= emcc
 CHROMIUM ?= chromium
 
-.PHONY: all check test docs demo images fuzz run examples bench bench-egl bench-large proto-engine-depth gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
+.PHONY: all check test docs demo images fuzz run examples bench bench-egl bench-large proto-engine-depth proto-msaa gl-compile gpu-test bench-quick bench-analytic deps-test deps-demo deps-run clean \
         web test-web deps-web vulkan vulkan-bench
 
 all: test
@@ -146,7 +146,7 @@ TEST_BINS = $(foreach t,$(TESTS),$(BUILD)/test_$(t) $(BUILD)/test_$(t)_san) \
             $(BUILD)/test_raycast $(BUILD)/test_raycast_san $(BUILD)/test_cpu_vg $(BUILD)/dump_shaders \
             $(BUILD)/replay_mesh $(BUILD)/fuzz_mesh $(BUILD)/replay_analytic $(BUILD)/fuzz_analytic \
             $(BUILD)/replay_api_san $(BUILD)/fuzz_api \
-            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/proto_engine_depth $(BUILD)/gl_compile \
+            $(BUILD)/demo_headless $(BUILD)/bench $(BUILD)/bench_egl $(BUILD)/proto_engine_depth $(BUILD)/proto_msaa $(BUILD)/gl_compile \
             $(BUILD)/egl/demo_headless \
             $(BUILD)/vulkan_backend
 
@@ -284,6 +284,14 @@ $(BUILD)/proto_engine_depth: bench/proto_engine_depth.c bench/bench.c $(TEST_DEP
 proto-engine-depth: deps-demo
 	@$(MAKE) --no-print-directory $(BUILD)/proto_engine_depth
 	$(BUILD)/proto_engine_depth 15
+
+# what MSAA 4x costs on this renderer against single-sample, designs outside the library: make proto-msaa
+$(BUILD)/proto_msaa: bench/proto_msaa.c bench/bench.c $(TEST_DEPS) | $(BUILD)
+	$(CC) -std=c99 -O2 $(WARN) $(INC) $< -o $@ $(GL_LIBS)
+
+proto-msaa: deps-demo
+	@$(MAKE) --no-print-directory $(BUILD)/proto_msaa
+	$(BUILD)/proto_msaa 9
 
 # the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
 # build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
