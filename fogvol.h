@@ -543,7 +543,11 @@ typedef struct fogvol_gl_desc {
    fragment work and 4x the target memory of fogvol's passes (measured by
    fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
    3.9-4.6x the time of the same scene on a single-sample framebuffer, one
-   run each). Error at occluder edges inside fog, 4x, resolved, /255: mean
+   run each). FLOAT + ENGINE_DEPTH on a backend with
+   FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE (the GL backend with per-sample
+   shading) shades its faces once per pixel, depth-tested per sample against
+   the engine's multisample depth (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST), and only
+   its composite per sample. Error at occluder edges inside fog, 4x, resolved, /255: mean
    29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample; with
    ENGINE_DEPTH (its depth copied or read per sample) mean 0.8, max 2, where
    the single-sample fallback's resolved depth gives mean 35.6, max 100. */
@@ -1420,7 +1424,11 @@ typedef struct fogvol_pass {
     fogvol_native depth_texture;
     int depth_greater;      /* depth_test: GREATER instead of LESS (a reversed-Z engine depth) */
     int per_sample;         /* 1: the targets are multisampled: rasterise with multisampling and shade
-                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0) */
+                               every sample (GL: GL_MULTISAMPLE, GL_SAMPLE_SHADING with min 1.0); 2 (only
+                               for backends reporting FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE): multisampled
+                               targets, rasterised and depth-tested per sample, shaded once per pixel (GL:
+                               GL_MULTISAMPLE, no sample shading); a backend that shades such a pass per
+                               sample draws the same */
     int scissor[4];         /* scissor[2] > 0: draw only inside this window rectangle (x, y, w, h) */
     int draw_buffer;        /* target 0: write only the engine's draw buffer of this index */
     int alpha_coverage;     /* FOG/LIGHT blends: alpha becomes a + dst.a * (1 - a) instead of dst.a */
@@ -1475,7 +1483,13 @@ enum {
                                               end_pass detaches it, and create_target makes RG32F targets
                                               (GL 3.0 / GLES 3.0 framebuffer objects and RG32F with
                                               FOGVOL_CAP_FLOAT_BLEND; not WebGL): FLOAT + ENGINE_DEPTH frames drawn
-                                              depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */
+                                              depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */,
+    FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE = 1u << 11 /* with FOGVOL_CAP_ATTACH_DEPTH and FOGVOL_CAP_MULTISAMPLE:
+                                              depth_texture may also be a multisample depth texture of a
+                                              multisampled target's samples, and per_sample 2 (rasterised
+                                              per sample, shaded once per pixel) is honoured: multisampled
+                                              FLOAT + ENGINE_DEPTH frames drawn depth-tested (GL 3.2 with
+                                              per-sample shading) */
 };
 
 typedef struct fogvol_frame_info {
@@ -1784,10 +1798,11 @@ typedef struct fogvol_shader_desc {
    (FOGVOL_SPEEDUP_EXACT_SUM: the face reads and writes its target's pixel as a 32-bit integer,
    "inout" at location 0, and adds or subtracts round(d 2^24); the composite decodes that integer
    times fv_rampmap.w = (far - near) / 2^24). Other bits, EXP with RAMP, L > 8, or bits for another
-   program: FOGVOL_ERROR_UNSUPPORTED. FACE (with NO_DENSITY) and COMPOSITE of FLOAT + ENGINE_DEPTH (not
-   COLORS; single-sample): ENGINE_TEST (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: the faces, depth-tested
-   against the engine's depth, add (+-d, +-1) into an RG32F sum without reading the engine's depth;
-   the composite reads it once per pixel where the count is not 0 and takes thickness r - o g). */
+   program: FOGVOL_ERROR_UNSUPPORTED. FACE (with NO_DENSITY; single-sample) and COMPOSITE (also per
+   sample) of FLOAT + ENGINE_DEPTH (not COLORS): ENGINE_TEST (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: the
+   faces, depth-tested against the engine's depth, add (+-d, +-1) into an RG32F sum without reading
+   the engine's depth; the composite reads it once per pixel (per sample) where the count is not c and
+   takes thickness r - o (g - c), fv_misc.w = c). */
 enum {
     FOGVOL_SPECIALIZE_NO_OPAQUE = 1u << 0,
     FOGVOL_SPECIALIZE_NO_DENSITY = 1u << 1,
@@ -1941,24 +1956,27 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
                  Not the digits' bytes: closer to the true thickness.
    ENGINE_DEPTH_TEST  FLOAT + ENGINE_DEPTH on a backend with FOGVOL_CAP_ATTACH_DEPTH (the GL backend on
-                 GL 3.0 / GLES 3.0), in single-sample frames whose viewport starts at the window
-                 origin, with every volume clear of the near and far planes or, the camera inside it,
+                 GL 3.0 / GLES 3.0), in single-sample frames (and multisampled ones without a debug
+                 read-back with FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE: the faces shaded once per pixel,
+                 tested per sample against the engine's multisample depth, the composite per sample)
+                 whose viewport starts at the window origin, with every volume clear of the near and far planes or, the camera inside it,
                  convex and holding the projection's whole near plane rectangle (its far side before
-                 the far plane), no density-textured volume, no fogvol_add_light, no downsample, no debug read-back,
-                 not NEAR_CLAMP or COLORS, a projection without an oblique near plane: the engine's
-                 depth texture (or fogvol's copy of the framebuffer's depth) is attached as the depth
-                 buffer of the sum's target, tested (LESS, GREATER for a reversed depth) and never
-                 written, so only the faces in front of the opaque surface are shaded; each adds
-                 (+-d, +-1) into an RG32F sum without reading the engine's depth, and the composite
-                 reads that depth once per pixel where the count is not 0 and takes thickness
-                 r - o (g - c) (a face behind the surface adds +-o in the min compare; over a closed,
-                 unclipped volume their signs sum to -g, and the front face the near plane clips
-                 from a volume around the camera makes that c - g, c the number of such volumes
-                 in the group, negative ones counted -1). The faces' clip z is the engine's
-                 (fogvol_frame_desc.engine_depth_zero_to_one and engine_depth_range), so the test
-                 compares the depths the engine's own rasteriser would. The same thickness up to
-                 rounding (a face within one depth-buffer step of the surface adds d or o, which
-                 differ by less than that step); fogvol_frame_stats.engine_depth_tested. */
+                 the far plane), no density-textured volume, no fogvol_add_light, no downsample, no
+                 debug read-back, not NEAR_CLAMP or COLORS, a projection without an oblique near
+                 plane: the engine's depth texture (or fogvol's copy of the framebuffer's depth) is
+                 attached as the depth buffer of the sum's target, tested (LESS, GREATER for a
+                 reversed depth) and never written, so only the faces in front of the opaque surface
+                 are shaded; each adds (+-d, +-1) into an RG32F sum without reading the engine's
+                 depth, and the composite reads that depth once per pixel where the count is not c
+                 and takes thickness r - o (g - c) (a face behind the surface adds +-o in the min
+                 compare; over a closed, unclipped volume their signs sum to -g, and the front face
+                 the near plane clips from a volume around the camera makes that c - g, c the
+                 number of such volumes in the group, negative ones counted -1). The faces' clip z
+                 is the engine's (fogvol_frame_desc.engine_depth_zero_to_one and
+                 engine_depth_range), so the test compares the depths the engine's own rasteriser
+                 would. The same thickness up to rounding (a face within one depth-buffer step of
+                 the surface adds d or o, which differ by less than that step);
+                 fogvol_frame_stats.engine_depth_tested. */
 enum {
     FOGVOL_SPEEDUP_SKIP_OPAQUE = 1u << 0,
     FOGVOL_SPEEDUP_TEXEL_FETCH = 1u << 1,
@@ -6524,7 +6542,7 @@ static const char fogvol__fs_composite_main[] =
     "    if (b.r == 0.0 && g == 0.0) discard;\n"
     "    t = b.r;\n"
     "    if (g != 0.0) t -= min(fv_engine_view_depth(st, FV_ENGINE_Z(fv_opaque)) * fv_nf.x + fv_nf.y, 1.0) * g;\n"
-    "    if (fv_rampmap.w > 0.5) {\n"             /* the debug read-back's pass: r - o g into B */
+    "    if (fv_rampmap.w > 0.5) {\n"             /* the debug read-back's pass: r - o (g - c) into B */
     "        FV_FRAGCOLOR = vec4(t, 0.0, 0.0, 0.0);\n"
     "        return;\n"
     "    }\n"
@@ -6856,7 +6874,9 @@ FOGVOL_API fogvol_result fogvol_shader_strings(const fogvol_shader_desc *d, cons
         return FOGVOL_ERROR_UNSUPPORTED;
     if ((d->specialize & FOGVOL_SPECIALIZE_INLINE_RESOLVE) && d->tier != FOGVOL_TIER_PS13)
         return FOGVOL_ERROR_UNSUPPORTED;
-    if ((d->specialize & FOGVOL_SPECIALIZE_ENGINE_TEST) && (!fogvol__tier_has(d->tier, v, FOGVOL__F_ENGINE_TEST) || d->samples > 1))
+    /* (multisampled frames: the faces shaded once per pixel, a single-sample program; the composite per sample) */
+    if ((d->specialize & FOGVOL_SPECIALIZE_ENGINE_TEST) &&
+        (!fogvol__tier_has(d->tier, v, FOGVOL__F_ENGINE_TEST) || (d->samples > 1 && d->program != FOGVOL_PROGRAM_COMPOSITE)))
         return FOGVOL_ERROR_UNSUPPORTED;
     if (d->specialize & FOGVOL_SPECIALIZE_COUNT) {
         if (!fogvol__tier_has(d->tier, v, FOGVOL__F_DEPTH_TEST) ||
@@ -7485,7 +7505,17 @@ static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_de
         if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
             r = FOGVOL_ERROR_BACKEND;
     }
-    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples <= 1) {
+    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples > 1 &&
+        (ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE)) { /* multisampled: these frames only */
+        td.format = FOGVOL_FORMAT_RG32F;
+        td.color_count = 1;
+        td.label = "fogvol depth sum and face count, depth-tested (float, multisample)";
+        if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
+            fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: no multisample RG32F target: multisampled FLOAT + "
+                                                    "ENGINE_DEPTH frames read the engine's depth per sample");
+            ctx->gpu.tgt_e = 0;
+        }
+    } else if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples <= 1) {
         td.format = FOGVOL_FORMAT_RG32F;
         td.color_count = 1;
         td.label = "fogvol depth sum and face count, depth-tested (float)";
@@ -9971,11 +10001,23 @@ static unsigned fogvol__engine_test_spec(const fogvol__run *run)
     return FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | run->p.origin_bit;
 }
 
+/* The depth-tested face program: a single-sample one in multisampled frames too, which draw it shaded
+   once per pixel and tested per sample (fogvol_pass.per_sample 2); it reads nothing. */
+static fogvol_handle fogvol__engine_test_face(fogvol_context *ctx, const fogvol__run *run)
+{
+    int ms = ctx->gpu.prog_ms;
+    fogvol_handle h;
+    ctx->gpu.prog_ms = 0;
+    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run));
+    ctx->gpu.prog_ms = ms;
+    return h;
+}
+
 /* Whether the depth-tested face program exists (built on first use); if it does not, the speed-up is
    off from this frame on (logged) and the frame reads the engine's depth per face. */
 static int fogvol__engine_test_programs(fogvol_context *ctx, const fogvol__run *run)
 {
-    if (fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run))) return 1;
+    if (fogvol__engine_test_face(ctx, run)) return 1;
     fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no depth-tested face program: FLOAT + ENGINE_DEPTH reads the "
                                                "engine's depth per face (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
     ctx->cfg.engine_test = 0;
@@ -9991,7 +10033,8 @@ static void fogvol__engine_test_pass(fogvol_context *ctx, fogvol__run *run, cons
     fogvol_pass ps = run->base;
     fogvol_draw dr;
     int i, j;
-    ps.program = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run));
+    ps.program = fogvol__engine_test_face(ctx, run);
+    ps.per_sample = ctx->cur.samples > 1 ? 2 : 0; /* multisampled: tested per sample, shaded per pixel */
     ps.target = ctx->gpu.tgt_e;
     ps.clear = 1;
     ps.blend = FOGVOL_PASS_BLEND_ADD;
@@ -10885,8 +10928,8 @@ static int fogvol__near_inside(const fogvol_context *ctx, const fogvol__volume *
     return 1;
 }
 
-/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: whether this frame (FLOAT + ENGINE_DEPTH, single-sample, the viewport
-   at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o (g - c) equals
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: whether this frame (FLOAT + ENGINE_DEPTH, single-sample or, with
+   FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE and no debug read-back, multisampled, the viewport at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o (g - c) equals
    the min compare's sum where the faces on every pixel's ray close but for c volumes the near plane
    opens (each volume unclipped: between both pairs of planes, fogvol's znear..zfar and the projection's,
    which now clips the faces, or wholly outside both; or, the camera inside it, convex and holding the
@@ -10898,9 +10941,11 @@ static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run
     fogvol_pass lin;
     double r[2], e0, e1, pn, pf, lo, hi, corner[4][3];
     int i, z01, corners = 0;
-    if (!ctx->cfg.engine_test || !p->engine_read || ctx->cur.samples > 1 || fd->downsample == 2 || ctx->cur.nlight > 0 ||
-        p->colors || p->near_clamp > 0.0f || !p->origin_bit)
+    if (!ctx->cfg.engine_test || !p->engine_read || fd->downsample == 2 || ctx->cur.nlight > 0 || p->colors ||
+        p->near_clamp > 0.0f || !p->origin_bit)
         return 0;
+    if (ctx->cur.samples > 1 && (!(ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE) || fd->debug_thickness))
+        return 0; /* (multisampled: the debug read-back keeps the per-sample read) */
     memset(&lin, 0, sizeof lin);
     fogvol__lin_uniforms(ctx, fd, &run->info, &lin);
     z01 = fogvol__engine_convention(fd, &run->info, r);
@@ -11935,6 +11980,7 @@ typedef struct fogvol__gl {
     int has_debug_output;                               /* GL_DEBUG_OUTPUT can be switched (KHR_debug) */
     int skip_draws;                                     /* this pass has an engine texture that is none */
     fogvol__GLuint depth_attached; /* the FBO whose depth attachment is fogvol_pass.depth_texture until end_pass */
+    fogvol__GLenum depth_attached_target; /* ... and its texture target (2D or 2D_MULTISAMPLE) */
     fogvol_result own;                                  /* fogvol's own first error since take_error */
     void *(*current_context)(void *user_data);          /* fogvol_gl_desc.current_context, its user_data, */
     void *user_data, *context_id;                       /* and what it returned at creation */
@@ -12170,8 +12216,8 @@ static void fogvol__gl_restore_msaa(fogvol__gl *gl, const fogvol__gl_state *s)
 static fogvol__GLuint fogvol__gl_native(fogvol__gl *gl, fogvol__GLuint tex); /* (with the pass's program) */
 
 /* A pass on multisampled targets: their textures on the multisample binding
-   points, multisampling on and every sample shaded (per_sample); other passes
-   shade once per pixel. An engine texture of a per-sample pass (its depth) is
+   points, multisampling on and every sample shaded (per_sample 1; 2: shaded
+   once per pixel, tested per sample); other passes shade once per pixel. An engine texture of a per-sample pass (its depth) is
    a multisample texture as well. */
 static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
 {
@@ -12185,7 +12231,7 @@ static void fogvol__gl_sample_pass(fogvol__gl *gl, const fogvol_pass *p)
         gl->ActiveTexture((fogvol__GLenum)(FOGVOL__GL_TEXTURE0 + i));
         gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
     }
-    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, p->per_sample);
+    fogvol__gl_enable(gl, FOGVOL__GL_SAMPLE_SHADING, p->per_sample == 1);
     if (p->per_sample) {
         gl->Enable(FOGVOL__GL_MULTISAMPLE);
         gl->MinSampleShading(1.0f);
@@ -12604,15 +12650,16 @@ static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvo
     return tex;
 }
 
-/* A new multisample colour texture (RGBA8 or R32F, fixed sample locations) bound on the active unit. */
+/* A new multisample colour texture (RGBA8, R32F or RG32F, fixed sample locations) bound on the active unit. */
 static fogvol__GLuint fogvol__gl_new_texture_ms(fogvol__gl *gl, const fogvol_target_desc *d)
 {
     fogvol__GLuint tex = 0;
+    fogvol__GLenum f = d->format == FOGVOL_FORMAT_R32F    ? (fogvol__GLenum)FOGVOL__GL_R32F
+                       : d->format == FOGVOL_FORMAT_RG32F ? (fogvol__GLenum)FOGVOL__GL_RG32F
+                                                          : (fogvol__GLenum)FOGVOL__GL_RGBA8;
     gl->GenTextures(1, &tex);
     gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
-    gl->TexImage2DMultisample(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, d->samples,
-                              d->format == FOGVOL_FORMAT_R32F ? (fogvol__GLenum)FOGVOL__GL_R32F : (fogvol__GLenum)FOGVOL__GL_RGBA8, d->width,
-                              d->height, 1);
+    gl->TexImage2DMultisample(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, d->samples, f, d->width, d->height, 1);
     return tex;
 }
 
@@ -13092,18 +13139,22 @@ static void fogvol__gl_attach_read(fogvol__gl *gl, fogvol__gl_target *t, const f
 }
 
 /* fogvol_pass.depth_texture: the engine's depth texture as t's depth buffer (FBO state of our own FBO,
-   detached at end_pass); a framebuffer it does not complete draws nothing (INVALID_ARGUMENT, logged). */
+   detached at end_pass; a multisample one on a multisampled t); a framebuffer it does not complete draws
+   nothing (INVALID_ARGUMENT, logged). */
 static void fogvol__gl_attach_depth(fogvol__gl *gl, fogvol__gl_target *t, const fogvol_pass *p)
 {
     fogvol__GLuint tex = fogvol__gl_native(gl, (fogvol__GLuint)p->depth_texture);
-    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_TEXTURE_2D, tex, 0);
+    fogvol__GLenum target = t->base.samples > 1 ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
+                                                : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D;
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, target, tex, 0);
     gl->depth_attached = t->fbo;
+    gl->depth_attached_target = target;
     if (!tex || gl->CheckFramebufferStatus(FOGVOL__GL_FRAMEBUFFER) == FOGVOL__GL_FRAMEBUFFER_COMPLETE) return;
     gl->skip_draws = 1;
     if (gl->own == FOGVOL_SUCCESS) {
         gl->own = FOGVOL_ERROR_INVALID_ARGUMENT;
         fogvol__log(&gl->log, FOGVOL_LOG_ERROR, "fogvol: engine depth texture %u cannot be a depth buffer (not a "
-                    "single-sample 2D depth texture?): the depth-tested face pass draws nothing", tex);
+                    "2D depth texture of the target's samples?): the depth-tested face pass draws nothing", tex);
     }
 }
 
@@ -13112,7 +13163,7 @@ static void fogvol__gl_end_pass(void *u)
     fogvol__gl *gl = (fogvol__gl *)u;
     if (!gl->depth_attached) return;
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, gl->depth_attached);
-    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, FOGVOL__GL_TEXTURE_2D, 0, 0);
+    gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, gl->depth_attached_target, 0, 0);
     gl->depth_attached = 0;
 }
 
@@ -13786,6 +13837,8 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
     gl->mrt_highp = desc->mrt_highp != 0;
     gl->caps = fogvol__gl_caps(gl, ext);
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
+    if ((gl->caps & FOGVOL_CAP_ATTACH_DEPTH) && (gl->caps & FOGVOL_CAP_MULTISAMPLE))
+        gl->caps |= FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE; /* (GL_TEXTURE_2D_MULTISAMPLE depth attachments) */
     if ((gl->dialect == FOGVOL_GLSL_330 || gl->dialect == FOGVOL_GLSL_300ES) && gl->has_indexed_mask &&
         gl->DrawBuffers &&
         (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_shader_framebuffer_fetch")

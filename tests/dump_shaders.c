@@ -51,10 +51,12 @@ static int spec_applies(int p, unsigned bits)
    for PS20 and PS13 whose variants COUNT can join (not SINGLE_TARGET, WIDE, ENGINE_DEPTH, COLORS) */
 static int variant_spec_applies(int t, unsigned v, int d, int p, unsigned bits, int ms)
 {
-    if (bits & FOGVOL_SPECIALIZE_ENGINE_TEST) /* FLOAT + ENGINE_DEPTH (not COLORS, NEAR_CLAMP), single-sample */
+    /* FLOAT + ENGINE_DEPTH (not COLORS, NEAR_CLAMP); the face single-sample (multisampled frames shade it once
+       per pixel), the composite per sample too */
+    if (bits & FOGVOL_SPECIALIZE_ENGINE_TEST)
         return t == FOGVOL_TIER_FLOAT && (v & FOGVOL_VARIANT_ENGINE_DEPTH) &&
-               !(v & (FOGVOL_VARIANT_COLORS | FOGVOL_VARIANT_NEAR_CLAMP)) && !ms &&
-               ((p == FOGVOL_PROGRAM_FACE && (bits & FOGVOL_SPECIALIZE_NO_DENSITY)) || p == FOGVOL_PROGRAM_COMPOSITE) &&
+               !(v & (FOGVOL_VARIANT_COLORS | FOGVOL_VARIANT_NEAR_CLAMP)) &&
+               ((p == FOGVOL_PROGRAM_FACE && !ms && (bits & FOGVOL_SPECIALIZE_NO_DENSITY)) || p == FOGVOL_PROGRAM_COMPOSITE) &&
                !(bits & (FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_FILTERED | FOGVOL_SPECIALIZE_EXACT_SUM |
                          FOGVOL_SPECIALIZE_FETCH_O)) &&
                variant_spec_applies(t, v, d, p, bits & ~(unsigned)FOGVOL_SPECIALIZE_ENGINE_TEST, ms);

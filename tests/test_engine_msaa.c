@@ -19,7 +19,10 @@
 
    Before: FOGVOL_MSAA_SINGLE_SAMPLE, i.e. single-sample targets and one fog
    value per pixel (what fogvol did before it looked at the engine's samples).
-   After: FOGVOL_MSAA_AUTO (per-sample targets and shading).
+   After: FOGVOL_MSAA_AUTO (per-sample targets and shading; FLOAT + engine depth: the faces depth-tested
+   against the engine's multisample depth per sample and shaded once per pixel into a multisample RG32F
+   sum, the composite per sample, FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST, asserted on every single frame and
+   on the sequences' views at the framebuffer's origin).
    Figures (llvmpipe, 160x120, 4x; printed by the test), /255, over the 82
    pixels on occluder edges inside fog ("edges") and over all pixels:
      before (every tier): edges mean 29.7, max 60; all pixels mean 0.46, max 60
@@ -771,6 +774,10 @@ static void test_tier(void **state)
     assert_int_equal(fv_frame(&s, W, H, &st, NULL), FOGVOL_SUCCESS);
     assert_int_equal(st.msaa_fallback, 0);
     assert_int_equal(st.samples, NS);
+    /* FLOAT + engine depth: the faces depth-tested against the engine's multisample depth, shaded once per
+       pixel (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST); the others read the depth per sample */
+    assert_int_equal(st.engine_depth_tested,
+                     tc->tier == FOGVOL_TIER_FLOAT && (tc->variants & FOGVOL_VARIANT_ENGINE_DEPTH) ? 1 : 0);
     assert_int_equal(glGetError(), GL_NO_ERROR);
     engine_resolve(&e, after);
     /* a second frame reuses the targets and programs and gives the same image */
@@ -828,6 +835,7 @@ typedef struct mseq {
     fv_scene s;
     unsigned char *img, *truth, *edge, *sheet;
     int failed; /* views whose end_frame failed */
+    int tested, drawn; /* views drawn depth-tested (fogvol_frame_stats.engine_depth_tested), views drawn */
     double edge_sum;
     long edges;
 } mseq;
@@ -879,6 +887,8 @@ static void mseq_view(void *user, const sq_view *v, sq_check *out)
     if (r != FOGVOL_SUCCESS && !m->failed++) print_message("#   end_frame: %s\n", fogvol_result_string(r));
     assert_int_equal(glGetError(), GL_NO_ERROR);
     if (r == FOGVOL_SUCCESS) assert_int_equal(st.samples, e->samples > 1 ? NS : 1);
+    m->tested += r == FOGVOL_SUCCESS && st.engine_depth_tested;
+    m->drawn += r == FOGVOL_SUCCESS;
     engine_resolve(e, m->img);
     truth_rect(e, v->viewport, m->truth, m->edge);
     out->bound = m->tc->bound;
@@ -934,9 +944,16 @@ static void run_mseq(const tcase *tc, const sq_step *steps, int n, const char *w
         m.sheet = (unsigned char *)calloc((size_t)W * SQ_DEFAULT_FRAMES * H * 3, 3);
     snprintf(name, sizeof name, "MSAA %s%s", what, tc->name);
     t = sq_play(name, W, H, steps, n, SQ_ALL, mseq_view, mseq_cancel, &m, where);
-    print_message("#   occluder edges inside fog: mean %.2f over %ld pixels, max %.0f [/255]%s\n",
+    print_message("#   occluder edges inside fog: mean %.2f over %ld pixels, max %.0f [/255]%s; %d of %d views "
+                  "depth-tested\n",
                   m.edges ? m.edge_sum / m.edges : 0.0, m.edges, t.worst * tc->bound,
-                  m.failed ? "; end_frame failed" : "");
+                  m.failed ? "; end_frame failed" : "", m.tested, m.drawn);
+    /* FLOAT + engine depth: views at the origin of the framebuffer depth-tested (multisampled or not),
+       the offset ones reading the depth per sample; the other tiers never */
+    if (tc->tier == FOGVOL_TIER_FLOAT && (tc->variants & FOGVOL_VARIANT_ENGINE_DEPTH))
+        assert_true(m.tested > 0 && m.tested < m.drawn);
+    else
+        assert_int_equal(m.tested, 0);
     if (m.sheet) {
         mkdir("build", 0755);
         stbi_write_png("build/engine_msaa_sequence.png", W * SQ_DEFAULT_FRAMES, H * 3, 3, m.sheet,
