@@ -1958,12 +1958,14 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
    ENGINE_DEPTH_TEST  FLOAT + ENGINE_DEPTH on a backend with FOGVOL_CAP_ATTACH_DEPTH (the GL backend on
                  GL 3.0 / GLES 3.0), in single-sample frames (and multisampled ones without a debug
                  read-back with FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE: the faces shaded once per pixel,
-                 tested per sample against the engine's multisample depth, the composite per sample)
-                 whose viewport starts at the window origin, with every volume clear of the near and far planes or, the camera inside it,
-                 convex and holding the projection's whole near plane rectangle (its far side before
-                 the far plane), no density-textured volume, no fogvol_add_light, no downsample, no
-                 debug read-back, not NEAR_CLAMP or COLORS, a projection without an oblique near
-                 plane: the engine's depth texture (or fogvol's copy of the framebuffer's depth) is
+                 tested per sample against the engine's multisample depth, the composite per sample),
+                 at any viewport (one away from the window origin sums into a target in the window's
+                 coordinates, grown to the viewports' far corners and shared by the views of a split
+                 screen; then no colour-textured volume), with every volume clear of the near and far
+                 planes or, the camera inside it, convex and holding the projection's whole near
+                 plane rectangle (its far side before the far plane), no density-textured volume, no
+                 fogvol_add_light, no downsample, not NEAR_CLAMP or COLORS, a projection without an
+                 oblique near plane: the engine's depth texture (or fogvol's copy of the framebuffer's depth) is
                  attached as the depth buffer of the sum's target, tested (LESS, GREATER for a
                  reversed depth) and never written, so only the faces in front of the opaque surface
                  are shaded; each adds (+-d, +-1) into an RG32F sum without reading the engine's
@@ -7313,6 +7315,9 @@ typedef struct fogvol__gpu {
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
     fogvol_handle tgt_e;                      /* ENGINE_DEPTH_TEST: the depth sum and face count (RG32F) */
+    fogvol_handle tgt_ew;  /* ... for viewports away from the window origin: E in the window's (the engine
+                              depth's) texel coordinates, ew_w x ew_h, grown as viewports need (fogvol__window_e) */
+    int ew_w, ew_h, ew_samples;
     fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
     fogvol_handle tgt_l; /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
     int target_w, target_h;
@@ -7405,6 +7410,8 @@ typedef struct fogvol__run {
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
     fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
+    fogvol_handle e;             /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: this frame's E (tgt_e, or tgt_ew when the
+                                    viewport is away from the window origin) */
     int w, h;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
@@ -7429,7 +7436,9 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->gpu.tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_l);
     if (ctx->gpu.tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_c);
     if (ctx->gpu.tgt_e) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_e);
-    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = ctx->gpu.tgt_e = 0;
+    if (ctx->gpu.tgt_ew) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_ew);
+    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = ctx->gpu.tgt_e = ctx->gpu.tgt_ew = 0;
+    ctx->gpu.ew_w = ctx->gpu.ew_h = ctx->gpu.ew_samples = 0;
     if (ctx->gpu.tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_o);
     ctx->gpu.tgt_o = ctx->gpu.tgt_b = ctx->gpu.tgt_f = ctx->gpu.tgt_t = 0;
     ctx->gpu.tgt_o2 = ctx->gpu.tgt_b2 = ctx->gpu.tgt_f2 = 0;
@@ -9996,28 +10005,68 @@ static fogvol_handle fogvol__face_program(fogvol_context *ctx, fogvol__run *run,
 }
 
 /* The face program of FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST frames. */
-static unsigned fogvol__engine_test_spec(const fogvol__run *run)
+static unsigned fogvol__engine_test_spec(void)
 {
-    return FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | run->p.origin_bit;
+    return FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN; /* (reads nothing) */
+}
+
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST with the viewport away from the window origin: E in the texel
+   coordinates of the engine's depth (its texture, or copy_depth's copy, which keeps them), so that the
+   depth lines up with E as its depth buffer: the window up to the viewport's far corner, grown as the
+   viewports of later frames need (the two halves of a split screen share it), never shrunk. 0: none
+   (logged; the frame reads the engine's depth per face). */
+static fogvol_handle fogvol__window_e(fogvol_context *ctx)
+{
+    const int *vp = ctx->cur.frame.viewport;
+    int w = vp[0] + vp[2], h = vp[1] + vp[3];
+    fogvol_target_desc td;
+    if (ctx->gpu.tgt_ew && ctx->gpu.ew_samples == ctx->cur.samples && ctx->gpu.ew_w >= w && ctx->gpu.ew_h >= h)
+        return ctx->gpu.tgt_ew;
+    if (ctx->gpu.tgt_ew) {
+        if (ctx->gpu.ew_samples == ctx->cur.samples) {
+            if (ctx->gpu.ew_w > w) w = ctx->gpu.ew_w;
+            if (ctx->gpu.ew_h > h) h = ctx->gpu.ew_h;
+        }
+        ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_ew);
+        ctx->gpu.tgt_ew = 0;
+        ctx->gpu.ew_w = ctx->gpu.ew_h = ctx->gpu.ew_samples = 0;
+    }
+    memset(&td, 0, sizeof td);
+    td.width = w;
+    td.height = h;
+    td.samples = ctx->cur.samples;
+    td.format = FOGVOL_FORMAT_RG32F;
+    td.color_count = 1;
+    td.label = "fogvol depth sum and face count, depth-tested, in window coordinates (float)";
+    if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_ew) != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: no %dx%d RG32F target: this frame reads the engine's depth "
+                                                "per face", w, h);
+        ctx->gpu.tgt_ew = 0;
+        return 0;
+    }
+    ctx->gpu.ew_w = w;
+    ctx->gpu.ew_h = h;
+    ctx->gpu.ew_samples = ctx->cur.samples;
+    return ctx->gpu.tgt_ew;
 }
 
 /* The depth-tested face program: a single-sample one in multisampled frames too, which draw it shaded
    once per pixel and tested per sample (fogvol_pass.per_sample 2); it reads nothing. */
-static fogvol_handle fogvol__engine_test_face(fogvol_context *ctx, const fogvol__run *run)
+static fogvol_handle fogvol__engine_test_face(fogvol_context *ctx)
 {
     int ms = ctx->gpu.prog_ms;
     fogvol_handle h;
     ctx->gpu.prog_ms = 0;
-    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(run));
+    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec());
     ctx->gpu.prog_ms = ms;
     return h;
 }
 
 /* Whether the depth-tested face program exists (built on first use); if it does not, the speed-up is
    off from this frame on (logged) and the frame reads the engine's depth per face. */
-static int fogvol__engine_test_programs(fogvol_context *ctx, const fogvol__run *run)
+static int fogvol__engine_test_programs(fogvol_context *ctx)
 {
-    if (fogvol__engine_test_face(ctx, run)) return 1;
+    if (fogvol__engine_test_face(ctx)) return 1;
     fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no depth-tested face program: FLOAT + ENGINE_DEPTH reads the "
                                                "engine's depth per face (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
     ctx->cfg.engine_test = 0;
@@ -10033,10 +10082,14 @@ static void fogvol__engine_test_pass(fogvol_context *ctx, fogvol__run *run, cons
     fogvol_pass ps = run->base;
     fogvol_draw dr;
     int i, j;
-    ps.program = fogvol__engine_test_face(ctx, run);
+    ps.program = fogvol__engine_test_face(ctx);
     ps.per_sample = ctx->cur.samples > 1 ? 2 : 0; /* multisampled: tested per sample, shaded per pixel */
-    ps.target = ctx->gpu.tgt_e;
+    ps.target = run->e;
     ps.clear = 1;
+    if (!run->p.origin_bit) { /* E in window coordinates: the viewport as the engine's, the clear inside it */
+        memcpy(ps.viewport, ctx->cur.frame.viewport, sizeof ps.viewport);
+        memcpy(ps.scissor, ctx->cur.frame.viewport, sizeof ps.scissor);
+    }
     ps.blend = FOGVOL_PASS_BLEND_ADD;
     ps.depth_test = 1;
     ps.depth_texture = run->engine_depth;
@@ -10064,9 +10117,13 @@ static void fogvol__engine_test_sources(const fogvol_context *ctx, const fogvol_
     int i, c = 0;
     for (i = fogvol__first(ctx, ramp); i >= 0; i = ctx->cur.vols[i].next)
         if (ctx->cur.vols[i].near_inside) c += ctx->cur.vols[i].negative ? -1 : 1;
-    ps->textures[FOGVOL__UNIT_BACK] = ctx->gpu.tgt_e;
+    ps->textures[FOGVOL__UNIT_BACK] = run->e;
     ps->native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ps->uniforms[FOGVOL_U_MISC][3] = (float)c;
+    if (!run->p.origin_bit) { /* E in window coordinates (the program is ORIGIN): FV_SCREEN's scale */
+        ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.ew_w;
+        ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.ew_h;
+    }
 }
 
 /* The debug read-back of a FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group: r - o (g - c), as its composite takes
@@ -10077,6 +10134,10 @@ static fogvol_result fogvol__engine_test_resolve(fogvol_context *ctx, fogvol__ru
     fogvol_pass ps = run->base;
     memset(ps.textures, 0, sizeof ps.textures);
     fogvol__engine_test_sources(ctx, run, ramp, &ps);
+    if (!run->p.origin_bit) { /* B's pixel -> E's (window) pixel; the engine's texel likewise (fv_nf.zw) */
+        ps.uniforms[FOGVOL_U_SCREEN][2] = (float)ctx->cur.frame.viewport[0];
+        ps.uniforms[FOGVOL_U_SCREEN][3] = (float)ctx->cur.frame.viewport[1];
+    }
     ps.target = ctx->gpu.tgt_b;
     ps.clear = 1;
     ps.uniforms[FOGVOL_U_RAMP][3] = 1.0f;
@@ -10240,7 +10301,8 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     if (ps->uniforms[FOGVOL_U_COLOR_U][3] < 0.5f) spec |= FOGVOL_SPECIALIZE_NO_COLOR_TEXTURE;
     if (!fd->show_overflow) spec |= FOGVOL_SPECIALIZE_NO_OVERFLOW;
     spec |= run->p.origin_bit | run->p.count_bit | (run->xsum ? (unsigned)FOGVOL_SPECIALIZE_EXACT_SUM : 0u);
-    if (run->p.engine_test) spec |= FOGVOL_SPECIALIZE_ENGINE_TEST | run->p.depth_from_z_bit;
+    if (run->p.engine_test) /* E and the engine's depth both at gl_FragCoord (fogvol__window_e) */
+        spec |= FOGVOL_SPECIALIZE_ENGINE_TEST | run->p.depth_from_z_bit | FOGVOL_SPECIALIZE_ORIGIN;
     ps->uniforms[FOGVOL_U_RAMP][3] = run->xsum ? (float)((double)(fd->zfar - fd->znear) / 16777216.0) : 0.0f;
     fogvol__blend_color(run, ps, &spec);
     if (fd->downsample == 2) { /* window space at the viewport's resolution, sums at half */
@@ -10929,9 +10991,10 @@ static int fogvol__near_inside(const fogvol_context *ctx, const fogvol__volume *
 }
 
 /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: whether this frame (FLOAT + ENGINE_DEPTH, single-sample or, with
-   FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE and no debug read-back, multisampled, the viewport at the origin) fits the depth-tested faces, and p's depth test and clip z if so. r - o (g - c) equals
-   the min compare's sum where the faces on every pixel's ray close but for c volumes the near plane
-   opens (each volume unclipped: between both pairs of planes, fogvol's znear..zfar and the projection's,
+   FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE and no debug read-back, multisampled; away from the window origin
+   no colour-textured volume) fits the depth-tested faces, and p's depth test and clip z if so.
+   r - o (g - c) equals the min compare's sum where the faces on every pixel's ray close but for c
+   volumes the near plane opens (each volume unclipped: between both pairs of planes, fogvol's znear..zfar and the projection's,
    which now clips the faces, or wholly outside both; or, the camera inside it, convex and holding the
    projection's whole near plane rectangle at or beyond znear: fogvol__volume.near_inside, c their signs'
    sum in a group) and the engine's depth is linearised without the pixel (no oblique near plane). */
@@ -10942,7 +11005,7 @@ static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run
     double r[2], e0, e1, pn, pf, lo, hi, corner[4][3];
     int i, z01, corners = 0;
     if (!ctx->cfg.engine_test || !p->engine_read || fd->downsample == 2 || ctx->cur.nlight > 0 || p->colors ||
-        p->near_clamp > 0.0f || !p->origin_bit)
+        p->near_clamp > 0.0f)
         return 0;
     if (ctx->cur.samples > 1 && (!(ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE) || fd->debug_thickness))
         return 0; /* (multisampled: the debug read-back keeps the per-sample read) */
@@ -10960,6 +11023,7 @@ static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run
     for (i = 0; i < ctx->cur.nvol; ++i) {
         double emin = 0.0, emax = 0.0;
         if (ctx->cur.vols[i].density) return 0;
+        if (ctx->cur.vols[i].color && !p->origin_bit) return 0; /* (its coordinates: across the viewport) */
         fogvol__volume_depths(ctx, &ctx->cur.vols[i], &emin, &emax);
         if ((emin >= lo && emax <= hi) || emax <= (pn < fd->znear ? pn : fd->znear) ||
             emin >= (pf > fd->zfar ? pf : fd->zfar))
@@ -11045,7 +11109,8 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
         r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
                                 : fogvol__ensure_targets(ctx, run->w, run->h, 0);
     if (r != FOGVOL_SUCCESS) return r;
-    run->p.engine_test = run->p.engine_test && ctx->gpu.tgt_e && fogvol__engine_test_programs(ctx, run);
+    run->e = !run->p.engine_test ? 0 : run->p.origin_bit ? ctx->gpu.tgt_e : fogvol__window_e(ctx);
+    run->p.engine_test = run->p.engine_test && run->e && fogvol__engine_test_programs(ctx);
     run->st.engine_depth_tested = run->p.engine_test;
     run->engine_depth = fd->engine_depth_texture;
     if ((run->p.o_engine || run->p.engine_read) && fd->engine_depth_source != FOGVOL_DEPTH_SOURCE_TEXTURE) {

@@ -3279,8 +3279,10 @@ static void ed_frame(fogvol_context *fv, const fogvol_mesh *box, const fogvol_ra
 /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST on the null backend (FOGVOL_CAP_ATTACH_DEPTH): a frame that fits draws
    its faces into a target of fogvol's with the engine's depth texture as its depth buffer (tested,
    not written; GREATER where the depth range reverses it) reading no depth, and the composite reads
-   that texture; a camera inside the box, an offset viewport, or a backend without the capability:
-   the faces read the engine's depth as before, nothing attached. */
+   that texture; at an offset viewport the faces draw at the engine's own viewport into a target in
+   window coordinates (the texture's), so the depth lines up; a box around the camera that also crosses
+   the far plane, or a backend without the capability: the faces read the engine's depth as before,
+   nothing attached. */
 static void test_engine_depth_attached(void **state)
 {
     fogvol_null_backend nb;
@@ -3311,9 +3313,9 @@ static void test_engine_depth_attached(void **state)
         rd.density = 0.5f;
         assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
         for (k = 0; k < 5; ++k) {
-            /* 0: fits; 1: fits, depth range (1, 0); 2: the camera inside (half-size 8); 3: offset viewport;
-               4: fits again */
-            int fits = caps && (k < 2 || k == 4);
+            /* 0: fits; 1: fits, depth range (1, 0); 2: the camera inside (half-size 8: it also crosses the
+               far plane); 3: offset viewport; 4: fits again */
+            int fits = caps && k != 2;
             ed_frame(fv, box, ramp, k == 2 ? 16.0f : 1.0f, k == 3, k == 1 ? 1.0f : 0.0f, 0.0f, &st);
             assert_int_equal(st.engine_depth_tested, fits);
             assert_int_equal(nb.pass_count, 2); /* faces, composite */
@@ -3330,6 +3332,12 @@ static void test_engine_depth_attached(void **state)
             assert_true(nb.passes[0].native_textures[3] == (fits ? 0u : 77u));
             assert_true(nb.passes[1].native_textures[3] == (fits ? 77u : 0u));
             assert_true(nb.passes[1].textures[0] == nb.passes[0].target);
+            if (fits) { /* the faces at the engine's viewport (window coordinates), or the target's own */
+                assert_int_equal(nb.passes[0].viewport[0], k == 3 ? A_X0 : 0);
+                assert_int_equal(nb.passes[0].viewport[1], k == 3 ? A_Y0 : 0);
+                assert_int_equal(nb.passes[0].viewport[2], A_W);
+                assert_int_equal(nb.passes[0].viewport[3], A_H);
+            }
         }
         fogvol_destroy_ramp(fv, ramp);
         fogvol_destroy_mesh(fv, box);

@@ -22,7 +22,7 @@
    After: FOGVOL_MSAA_AUTO (per-sample targets and shading; FLOAT + engine depth: the faces depth-tested
    against the engine's multisample depth per sample and shaded once per pixel into a multisample RG32F
    sum, the composite per sample, FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST, asserted on every single frame and
-   on the sequences' views at the framebuffer's origin).
+   counted on the sequences' views).
    Figures (llvmpipe, 160x120, 4x; printed by the test), /255, over the 82
    pixels on occluder edges inside fog ("edges") and over all pixels:
      before (every tier): edges mean 29.7, max 60; all pixels mean 0.46, max 60
@@ -948,10 +948,10 @@ static void run_mseq(const tcase *tc, const sq_step *steps, int n, const char *w
                   "depth-tested\n",
                   m.edges ? m.edge_sum / m.edges : 0.0, m.edges, t.worst * tc->bound,
                   m.failed ? "; end_frame failed" : "", m.tested, m.drawn);
-    /* FLOAT + engine depth: views at the origin of the framebuffer depth-tested (multisampled or not),
-       the offset ones reading the depth per sample; the other tiers never */
+    /* FLOAT + engine depth: views that fit depth-tested (multisampled or not, at any viewport); the
+       other tiers never */
     if (tc->tier == FOGVOL_TIER_FLOAT && (tc->variants & FOGVOL_VARIANT_ENGINE_DEPTH))
-        assert_true(m.tested > 0 && m.tested < m.drawn);
+        assert_true(m.tested > 0);
     else
         assert_int_equal(m.tested, 0);
     if (m.sheet) {
