@@ -1965,11 +1965,11 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  planes or, the camera inside it, convex and holding the projection's whole near
                  plane rectangle (its far side before the far plane), no density-textured volume, no
                  fogvol_add_light, no downsample, not NEAR_CLAMP or COLORS, a projection without an
-                 oblique near plane: the engine's depth texture (or fogvol's copy of the framebuffer's depth) is
-                 attached as the depth buffer of the sum's target, tested (LESS, GREATER for a
-                 reversed depth) and never written, so only the faces in front of the opaque surface
-                 are shaded; each adds (+-d, +-1) into an RG32F sum without reading the engine's
-                 depth, and the composite reads that depth once per pixel where the count is not c
+                 oblique near plane: the engine's depth texture (or fogvol's copy of the framebuffer's
+                 depth) is attached as the depth buffer of the sum's target, tested (LESS, GREATER
+                 for a reversed depth) and never written, so only the faces in front of the opaque
+                 surface are shaded; each adds (+-d, +-1) into an RG32F sum without reading the
+                 engine's depth, and the composite reads that depth once per pixel where the count is not c
                  and takes thickness r - o (g - c) (a face behind the surface adds +-o in the min
                  compare; over a closed, unclipped volume their signs sum to -g, and the front face
                  the near plane clips from a volume around the camera makes that c - g, c the
@@ -7514,24 +7514,21 @@ static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_de
         if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
             r = FOGVOL_ERROR_BACKEND;
     }
-    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples > 1 &&
-        (ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE)) { /* multisampled: these frames only */
+    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half &&
+        (td.samples <= 1 || (ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE))) {
+        int ms = td.samples > 1;
         td.format = FOGVOL_FORMAT_RG32F;
         td.color_count = 1;
-        td.label = "fogvol depth sum and face count, depth-tested (float, multisample)";
+        td.label = ms ? "fogvol depth sum and face count, depth-tested (float, multisample)"
+                      : "fogvol depth sum and face count, depth-tested (float)";
         if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: no multisample RG32F target: multisampled FLOAT + "
-                                                    "ENGINE_DEPTH frames read the engine's depth per sample");
-            ctx->gpu.tgt_e = 0;
-        }
-    } else if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half && td.samples <= 1) {
-        td.format = FOGVOL_FORMAT_RG32F;
-        td.color_count = 1;
-        td.label = "fogvol depth sum and face count, depth-tested (float)";
-        if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
-            fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: no RG32F target: FLOAT + ENGINE_DEPTH frames read the "
-                                                       "engine's depth per face (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
-            ctx->cfg.engine_test = 0;
+            /* single-sample: off from now on; multisampled: these targets' frames only */
+            fogvol__log(&ctx->log, ms ? FOGVOL_LOG_INFO : FOGVOL_LOG_WARNING,
+                        ms ? "fogvol: no multisample RG32F target: multisampled FLOAT + ENGINE_DEPTH frames read the "
+                             "engine's depth per sample"
+                           : "fogvol: no RG32F target: FLOAT + ENGINE_DEPTH frames read the engine's depth per face "
+                             "(FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
+            if (!ms) ctx->cfg.engine_test = 0;
             ctx->gpu.tgt_e = 0;
         }
     }
@@ -10994,10 +10991,11 @@ static int fogvol__near_inside(const fogvol_context *ctx, const fogvol__volume *
    FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE and no debug read-back, multisampled; away from the window origin
    no colour-textured volume) fits the depth-tested faces, and p's depth test and clip z if so.
    r - o (g - c) equals the min compare's sum where the faces on every pixel's ray close but for c
-   volumes the near plane opens (each volume unclipped: between both pairs of planes, fogvol's znear..zfar and the projection's,
-   which now clips the faces, or wholly outside both; or, the camera inside it, convex and holding the
-   projection's whole near plane rectangle at or beyond znear: fogvol__volume.near_inside, c their signs'
-   sum in a group) and the engine's depth is linearised without the pixel (no oblique near plane). */
+   volumes the near plane opens (each volume unclipped: between both pairs of planes, fogvol's
+   znear..zfar and the projection's, which now clips the faces, or wholly outside both; or, the camera
+   inside it, convex and holding the projection's whole near plane rectangle at or beyond znear:
+   fogvol__volume.near_inside, c their signs' sum in a group) and the engine's depth is linearised
+   without the pixel (no oblique near plane). */
 static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run, fogvol__plan *p)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;

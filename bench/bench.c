@@ -877,6 +877,22 @@ static void peel_read(const scene *s, const rt *r, float *thick, int *count)
 }
 
 /* ---- uploading a scene ----------------------------------------------------------- */
+/* a mesh's vertex array for the engine's and the references' draws */
+static void gmesh_upload(gmesh *g)
+{
+    glGenVertexArrays(1, &g->vao);
+    glBindVertexArray(g->vao);
+    glGenBuffers(1, &g->vbo);
+    glGenBuffers(1, &g->ibo);
+    glBindBuffer(GL_ARRAY_BUFFER, g->vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)g->m.vcount), g->m.pos, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
+    glEnableVertexAttribArray(0);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)g->m.icount), g->m.idx, GL_STATIC_DRAW);
+    glBindVertexArray(0);
+}
+
 static void scene_upload(scene *s, fogs *F)
 {
     int i, t;
@@ -890,17 +906,7 @@ static void scene_upload(scene *s, fogs *F)
             if (g->m.pos[j] < g->bmin[j % 3]) g->bmin[j % 3] = g->m.pos[j];
             if (g->m.pos[j] > g->bmax[j % 3]) g->bmax[j % 3] = g->m.pos[j];
         }
-        glGenVertexArrays(1, &g->vao);
-        glBindVertexArray(g->vao);
-        glGenBuffers(1, &g->vbo);
-        glGenBuffers(1, &g->ibo);
-        glBindBuffer(GL_ARRAY_BUFFER, g->vbo);
-        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)g->m.vcount), g->m.pos, GL_STATIC_DRAW);
-        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
-        glEnableVertexAttribArray(0);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ibo);
-        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)g->m.icount), g->m.idx, GL_STATIC_DRAW);
-        glBindVertexArray(0);
+        gmesh_upload(g);
         memset(&md, 0, sizeof md);
         md.positions = g->m.pos;
         md.vertex_count = g->m.vcount;
@@ -2049,6 +2055,25 @@ static void msaa_engine_pass(const scene *s, const view *vw, const msaa_fb *f, i
     glUseProgram(0);
 }
 
+/* The engine's vertex arrays of s's meshes (scene_upload without fogvol's meshes), and their release
+   with the meshes (the MSAA section and the prototypes that include this file). */
+static void engine_meshes_upload(scene *s)
+{
+    int k;
+    for (k = 0; k < s->nmesh; ++k) gmesh_upload(&s->mesh[k]);
+}
+
+static void engine_meshes_free(scene *s)
+{
+    int k;
+    for (k = 0; k < s->nmesh; ++k) {
+        glDeleteVertexArrays(1, &s->mesh[k].vao);
+        glDeleteBuffers(1, &s->mesh[k].vbo);
+        glDeleteBuffers(1, &s->mesh[k].ibo);
+        shp_free(&s->mesh[k].m);
+    }
+}
+
 #define NMSAA 2 /* FLOAT (fogvol draws the occluders), FLOAT + engine depth */
 typedef struct msaa_ctx {
     fogvol_context *ctx;
@@ -2150,20 +2175,7 @@ static double bench_msaa(int quick)
         int k;
         if (!s) die("out of memory");
         build_scene(s, scenes[sc]);
-        for (k = 0; k < s->nmesh; ++k) { /* the engine's vertex arrays (scene_upload without fogvol's meshes) */
-            gmesh *g = &s->mesh[k];
-            glGenVertexArrays(1, &g->vao);
-            glBindVertexArray(g->vao);
-            glGenBuffers(1, &g->vbo);
-            glGenBuffers(1, &g->ibo);
-            glBindBuffer(GL_ARRAY_BUFFER, g->vbo);
-            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)g->m.vcount), g->m.pos, GL_STATIC_DRAW);
-            glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
-            glEnableVertexAttribArray(0);
-            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ibo);
-            glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)g->m.icount), g->m.idx, GL_STATIC_DRAW);
-            glBindVertexArray(0);
-        }
+        engine_meshes_upload(s);
         make_view(&vw, s, w, h);
         msaa_fb_create(&fb[0], w, h, 1);
         msaa_fb_create(&fb[1], w, h, 4);
@@ -2182,12 +2194,7 @@ static double bench_msaa(int quick)
             for (k = 0; k < 2; ++k) msaa_ctx_free(&mc[mi][k], s);
         }
         for (k = 0; k < 2; ++k) msaa_fb_free(&fb[k]);
-        for (k = 0; k < s->nmesh; ++k) {
-            glDeleteVertexArrays(1, &s->mesh[k].vao);
-            glDeleteBuffers(1, &s->mesh[k].vbo);
-            glDeleteBuffers(1, &s->mesh[k].ibo);
-            shp_free(&s->mesh[k].m);
-        }
+        engine_meshes_free(s);
         free(s);
     }
     if (glGetError() != GL_NO_ERROR) die("GL error (MSAA)");

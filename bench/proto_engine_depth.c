@@ -148,7 +148,7 @@ static double proto_compare(proto *p, const scene *s, const rt *r, long *nonzero
 int main(int argc, char **argv)
 {
     static const int scenes[5] = {0, 1, 5, 6, 7};
-    int frames = argc > 1 ? atoi(argv[1]) : 9, sc, it, m, k, w = 1280, h = 720;
+    int frames = argc > 1 ? atoi(argv[1]) : 9, sc, it, m, w = 1280, h = 720;
     glu_ctx g;
     proto p;
     if (frames < 1 || frames > 64) frames = 9;
@@ -175,20 +175,7 @@ int main(int argc, char **argv)
         long nz;
         if (!s) die("out of memory");
         build_scene(s, scenes[sc]);
-        for (k = 0; k < s->nmesh; ++k) {
-            gmesh *gm = &s->mesh[k];
-            glGenVertexArrays(1, &gm->vao);
-            glBindVertexArray(gm->vao);
-            glGenBuffers(1, &gm->vbo);
-            glGenBuffers(1, &gm->ibo);
-            glBindBuffer(GL_ARRAY_BUFFER, gm->vbo);
-            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)gm->m.vcount), gm->m.pos, GL_STATIC_DRAW);
-            glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
-            glEnableVertexAttribArray(0);
-            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gm->ibo);
-            glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)gm->m.icount), gm->m.idx, GL_STATIC_DRAW);
-            glBindVertexArray(0);
-        }
+        engine_meshes_upload(s);
         rt_create(&r, w, h);
         make_view(&vw, s, w, h);
         p.sum_r = tex2d(GL_R32F, w, h, GL_RED, GL_FLOAT);
@@ -221,12 +208,7 @@ int main(int argc, char **argv)
         glDeleteTextures(1, &p.sum_r);
         glDeleteTextures(1, &p.sum_rg);
         rt_free(&r);
-        for (k = 0; k < s->nmesh; ++k) {
-            glDeleteVertexArrays(1, &s->mesh[k].vao);
-            glDeleteBuffers(1, &s->mesh[k].vbo);
-            glDeleteBuffers(1, &s->mesh[k].ibo);
-            shp_free(&s->mesh[k].m);
-        }
+        engine_meshes_free(s);
         free(s);
     }
     if (glGetError() != GL_NO_ERROR) die("GL error");

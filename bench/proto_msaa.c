@@ -148,7 +148,7 @@ static double frame(int m, const scene *s, const view *vw, const msaa_fb *fb, GL
 int main(int argc, char **argv)
 {
     static const int scenes[2] = {6, 0};
-    int frames = argc > 1 ? atoi(argv[1]) : 9, sc, it, m, k, w = 640, h = 360;
+    int frames = argc > 1 ? atoi(argv[1]) : 9, sc, it, m, w = 640, h = 360;
     glu_ctx g;
     if (!glu_create(&g, 64, 64, 1)) die(BENCH_CONTEXT);
     clock_init();
@@ -170,20 +170,7 @@ int main(int argc, char **argv)
         GLuint sum[2], sfbo[2];
         double t[NM][64], tf[NM][64];
         build_scene(s, scenes[sc]);
-        for (k = 0; k < s->nmesh; ++k) {
-            gmesh *gm = &s->mesh[k];
-            glGenVertexArrays(1, &gm->vao);
-            glBindVertexArray(gm->vao);
-            glGenBuffers(1, &gm->vbo);
-            glGenBuffers(1, &gm->ibo);
-            glBindBuffer(GL_ARRAY_BUFFER, gm->vbo);
-            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(12 * (size_t)gm->m.vcount), gm->m.pos, GL_STATIC_DRAW);
-            glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, NULL);
-            glEnableVertexAttribArray(0);
-            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gm->ibo);
-            glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(4 * (size_t)gm->m.icount), gm->m.idx, GL_STATIC_DRAW);
-            glBindVertexArray(0);
-        }
+        engine_meshes_upload(s);
         make_view(&vw, s, w, h);
         msaa_fb_create(&fb[0], w, h, 1);
         msaa_fb_create(&fb[1], w, h, 4);
@@ -239,6 +226,8 @@ int main(int argc, char **argv)
             printf("| %s | %s | %.2f ms | face pass %.2f | x1 %.2f |\n", m ? "" : s->name, mnames[m], a, fp, a / median(t[M_1], frames));
         }
         if (glGetError() != GL_NO_ERROR) die("GL error");
+        engine_meshes_free(s);
+        free(s);
     }
     return 0;
 }
