@@ -3339,6 +3339,16 @@ static void test_engine_depth_attached(void **state)
                 assert_int_equal(nb.passes[0].viewport[3], A_H);
             }
         }
+        if (caps) { /* a split screen: the two views alternate, each depth-tested; after the first pair
+                       nothing is created again (the offset view's target in window coordinates is kept) */
+            int creates = 0;
+            for (k = 0; k < 6; ++k) {
+                ed_frame(fv, box, ramp, 1.0f, k & 1, 0.0f, 0.0f, &st);
+                assert_int_equal(st.engine_depth_tested, 1);
+                if (k == 1) creates = nb.creates;
+                if (k > 1) assert_int_equal(nb.creates, creates);
+            }
+        }
         fogvol_destroy_ramp(fv, ramp);
         fogvol_destroy_mesh(fv, box);
         fogvol_destroy_context(fv);
