@@ -8056,13 +8056,16 @@ static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
    it); the general program when specialising is off or the build failed (logged once). COUNT and
    DOWNSAMPLE are not options but other programs, built with SPECIALIZE off too. If COUNT cannot
    be, the frame is wrong and FOGVOL_SPEEDUP_DEPTH_TEST is off from the next frame on (logged); if
-   DOWNSAMPLE cannot be, 0 (the caller skips the pass). */
-static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
+   DOWNSAMPLE cannot be, 0 (the caller skips the pass). fogvol__program_set: in sample set ms (0:
+   single-sample, 1: per sample) rather than the frame's; outside the frame's set there is no general
+   stand-in (0). */
+static fogvol_handle fogvol__program_set(fogvol_context *ctx, fogvol_program p, unsigned bits, int ms)
 {
     /* programs that have no general stand-in: 0 (DOWNSAMPLE: the pass is skipped; BLEND_COLOR: the
        caller asks again without it) */
     const unsigned none = FOGVOL_SPECIALIZE_DOWNSAMPLE | FOGVOL_SPECIALIZE_BLEND_COLOR | FOGVOL_SPECIALIZE_ENGINE_TEST;
     fogvol__spec_program *sp;
+    fogvol_handle general = ms == ctx->gpu.prog_ms ? ctx->gpu.prog[p] : 0;
     int i;
     if (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_SPECIALIZE) /* COUNT (and a COUNT face's NO_DENSITY), DOWNSAMPLE */
         bits &= ((bits & FOGVOL_SPECIALIZE_COUNT) ? FOGVOL_SPECIALIZE_COUNT | FOGVOL_SPECIALIZE_NO_DENSITY : 0u) |
@@ -8070,21 +8073,21 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
                 ((bits & FOGVOL_SPECIALIZE_ENGINE_TEST) ? FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY : 0u);
     else if ((p == FOGVOL_PROGRAM_FACE || p == FOGVOL_PROGRAM_ENCODE) && ctx->cfg.tier != FOGVOL_TIER_FLOAT)
         bits |= FOGVOL_SPECIALIZE_ENCODING(ctx->cfg.enc.bits); /* the context's encoding compiled in */
-    if (!bits) return ctx->gpu.prog[p];
+    if (!bits) return general;
     for (i = 0; i < ctx->gpu.nspec; ++i) {
         sp = &ctx->gpu.spec[i];
-        if (sp->program == p && sp->bits == bits && sp->ms == ctx->gpu.prog_ms)
-            return sp->handle ? sp->handle : (bits & none) ? 0 : ctx->gpu.prog[p];
+        if (sp->program == p && sp->bits == bits && sp->ms == ms)
+            return sp->handle ? sp->handle : (bits & none) ? 0 : general;
     }
     if (ctx->gpu.nspec == FOGVOL__SPEC_MAX) {
         if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->cfg.count_broken = 1;
-        return (bits & none) ? 0 : ctx->gpu.prog[p];
+        return (bits & none) ? 0 : general;
     }
     sp = &ctx->gpu.spec[ctx->gpu.nspec++];
     sp->program = p;
     sp->bits = bits;
-    sp->ms = ctx->gpu.prog_ms;
-    ctx->gpu.compile_samples = ctx->gpu.prog_ms ? 2 : 0;
+    sp->ms = ms;
+    ctx->gpu.compile_samples = ms ? 2 : 0;
     if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
         int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
         sp->handle = 0;
@@ -8098,7 +8101,12 @@ static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsi
     }
     ctx->gpu.compile_samples = 0;
     if (!sp->handle && (bits & none)) return 0;
-    return sp->handle ? sp->handle : ctx->gpu.prog[p];
+    return sp->handle ? sp->handle : general;
+}
+
+static fogvol_handle fogvol__program(fogvol_context *ctx, fogvol_program p, unsigned bits)
+{
+    return fogvol__program_set(ctx, p, bits, ctx->gpu.prog_ms);
 }
 
 /* >>resources ============================================================= */
@@ -8349,63 +8357,62 @@ static int fogvol__convexity(const fogvol_mesh_desc *desc, const uint32_t *idx, 
     return 1;
 }
 
-FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
-                                            fogvol_mesh_report *report)
+/* fogvol_create_mesh's verdict on fogvol__check_mesh's result r and report: FOGVOL_SUCCESS (warnings
+   logged) or the refusal, logged with what is wrong (idx is freed then). */
+static fogvol_result fogvol__mesh_verdict(const fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_result r,
+                                          const fogvol_mesh_report *rep, uint32_t *idx)
 {
-    fogvol_mesh_report rep;
-    fogvol_mesh *m;
-    uint32_t *idx = NULL, *used;
-    double *pts;
-    fogvol_result r;
-    const char *problem;
-    int nused;
-    if (out) *out = NULL;
-    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
-    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_mesh: desc or out is NULL");
-    problem = fogvol__mesh_problem(desc);
-    r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
-    if (report) *report = rep;
     if (r == FOGVOL_ERROR_INVALID_ARGUMENT || r == FOGVOL_ERROR_OUT_OF_MEMORY) {
+        const char *problem = fogvol__mesh_problem(desc);
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: %s%s%s", fogvol_result_string(r),
                     problem ? ": " : "", problem ? problem : "");
         return r;
     }
-    if (rep.nonfinite_vertices || rep.out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
+    if (rep->nonfinite_vertices || rep->out_of_range_indices || (r != FOGVOL_SUCCESS && !desc->allow_open)) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
                     "fogvol: mesh rejected: %d open edges, %d non-manifold edges, %d inconsistent edges, "
                     "%d flipped faces, %d non-finite vertices, %d indices out of range, %d probes in regions of "
                     "negative winding (a part wound inward that nothing encloses: triangle %d)%s%s",
-                    rep.open_edges, rep.nonmanifold_edges, rep.inconsistent_edges, rep.flipped_faces,
-                    rep.nonfinite_vertices, rep.out_of_range_indices, rep.negative_winding, rep.negative_triangle,
-                    rep.inverted ? ", wound inward (reverse the triangles)" : "",
-                    rep.open_edges && desc->weld_distance <= 0
+                    rep->open_edges, rep->nonmanifold_edges, rep->inconsistent_edges, rep->flipped_faces,
+                    rep->nonfinite_vertices, rep->out_of_range_indices, rep->negative_winding, rep->negative_triangle,
+                    rep->inverted ? ", wound inward (reverse the triangles)" : "",
+                    rep->open_edges && desc->weld_distance <= 0
                         ? " (vertices repeated at seams or per face? set fogvol_mesh_desc.weld_distance)"
                         : "");
         fogvol__free(&ctx->alloc, idx);
         return FOGVOL_ERROR_INVALID_MESH;
     }
-    if (rep.degenerate_triangles)
+    if (rep->degenerate_triangles)
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING, "fogvol: mesh has %d degenerate triangles",
-                    rep.degenerate_triangles);
-    if (rep.welded_vertices)
-        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep.welded_vertices,
+                    rep->degenerate_triangles);
+    if (rep->welded_vertices)
+        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: weld merged %d of %d vertices", rep->welded_vertices,
                     desc->vertex_count);
-    m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
-    used = m ? fogvol__referenced(ctx, desc, idx ? idx : desc->indices, &nused) : NULL;
+    return FOGVOL_SUCCESS;
+}
+
+/* A new mesh's shape from its used vertices (idx: the validated triangles): bounds, convexity (valid
+   hulls) and, convex, its face planes. 0: out of memory (logged, nothing allocated). */
+static fogvol_mesh *fogvol__mesh_shape(fogvol_context *ctx, const fogvol_mesh_desc *desc, const uint32_t *idx, int valid)
+{
+    fogvol_mesh *m = (fogvol_mesh *)fogvol__alloc(&ctx->alloc, sizeof *m);
+    uint32_t *used;
+    double *pts;
+    int nused;
+    used = m ? fogvol__referenced(ctx, desc, idx, &nused) : NULL;
     pts = used ? (double *)fogvol__alloc(&ctx->alloc, sizeof(double) * (3u * (size_t)nused + 6u * fogvol__hull_nodes(nused)))
                : NULL;
     if (!m || !used || !pts) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: create_mesh: out of memory");
         fogvol__free(&ctx->alloc, used);
         fogvol__free(&ctx->alloc, m);
-        fogvol__free(&ctx->alloc, idx);
-        return FOGVOL_ERROR_OUT_OF_MEMORY;
+        return NULL;
     }
     memset(m, 0, sizeof *m);
     fogvol__mesh_box(m, desc, used, nused);
-    if (rep.valid) /* (without room for the planes the mesh is still convex, only never near_inside) */
+    if (valid) /* (without room for the planes the mesh is still convex, only never near_inside) */
         m->planes = (float *)fogvol__alloc(&ctx->alloc, sizeof(float) * 4u * (size_t)(fogvol__index_count(desc) / 3 + 1));
-    m->convex = rep.valid ? fogvol__convexity(desc, idx ? idx : desc->indices, used, nused, pts, m) : -1;
+    m->convex = valid ? fogvol__convexity(desc, idx, used, nused, pts, m) : -1;
     if (m->convex != 1) {
         fogvol__free(&ctx->alloc, m->planes);
         m->planes = NULL;
@@ -8413,6 +8420,27 @@ FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_me
     }
     fogvol__free(&ctx->alloc, pts);
     fogvol__free(&ctx->alloc, used);
+    return m;
+}
+
+FOGVOL_API fogvol_result fogvol_create_mesh(fogvol_context *ctx, const fogvol_mesh_desc *desc, fogvol_mesh **out,
+                                            fogvol_mesh_report *report)
+{
+    fogvol_mesh_report rep;
+    fogvol_mesh *m;
+    uint32_t *idx = NULL;
+    fogvol_result r;
+    if (out) *out = NULL;
+    if (!ctx) return FOGVOL_ERROR_INVALID_ARGUMENT;
+    if (!desc || !out) return fogvol__refuse(ctx, FOGVOL_ERROR_INVALID_ARGUMENT, "create_mesh: desc or out is NULL");
+    r = fogvol__check_mesh(desc, &ctx->alloc, &rep, &idx);
+    if (report) *report = rep;
+    if ((r = fogvol__mesh_verdict(ctx, desc, r, &rep, idx)) != FOGVOL_SUCCESS) return r;
+    m = fogvol__mesh_shape(ctx, desc, idx ? idx : desc->indices, rep.valid);
+    if (!m) {
+        fogvol__free(&ctx->alloc, idx);
+        return FOGVOL_ERROR_OUT_OF_MEMORY;
+    }
     r = fogvol__be_result(ctx, fogvol__upload_mesh(ctx, desc, idx, &m->handle));
     fogvol__free(&ctx->alloc, idx);
     if (r != FOGVOL_SUCCESS) {
@@ -10051,12 +10079,7 @@ static fogvol_handle fogvol__window_e(fogvol_context *ctx)
    once per pixel and tested per sample (fogvol_pass.per_sample 2); it reads nothing. */
 static fogvol_handle fogvol__engine_test_face(fogvol_context *ctx)
 {
-    int ms = ctx->gpu.prog_ms;
-    fogvol_handle h;
-    ctx->gpu.prog_ms = 0;
-    h = fogvol__program(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec());
-    ctx->gpu.prog_ms = ms;
-    return h;
+    return fogvol__program_set(ctx, FOGVOL_PROGRAM_FACE, fogvol__engine_test_spec(), 0);
 }
 
 /* Whether the depth-tested face program exists (built on first use); if it does not, the speed-up is
