@@ -2632,7 +2632,7 @@ static int g_plain_calls;
 static fogvol_gl_proc plain_proc(const char *name)
 {
     g_plain_calls++;
-    return (fogvol_gl_proc)OSMesaGetProcAddress(name);
+    return (fogvol_gl_proc)glu_proc(name, NULL);
 }
 static void *plain_pointer(const char *name)
 {
