@@ -197,6 +197,30 @@ static inline unsigned char *glu_pixels(glu_ctx *c)
 }
 #endif
 
+/* 1 when the current context lists extension name (GL 3+: glGetStringi; before: the one string) */
+static inline int glu_has_ext(const char *name)
+{
+    typedef const GLubyte *(*stringi_fn)(GLenum, GLuint);
+    stringi_fn stringi = (stringi_fn)glu_proc("glGetStringi", NULL);
+    const char *all;
+    GLint n = 0, i;
+    glGetIntegerv(0x821D /* GL_NUM_EXTENSIONS */, &n);
+    if (stringi && glGetError() == GL_NO_ERROR && n > 0) {
+        for (i = 0; i < n; ++i)
+            if (strcmp((const char *)stringi(GL_EXTENSIONS, (GLuint)i), name) == 0) return 1;
+        return 0;
+    }
+    all = (const char *)glGetString(GL_EXTENSIONS);
+    if (!all) return 0;
+    for (; (all = strstr(all, name)) != NULL; all += strlen(name))
+        if (all[strlen(name)] == ' ' || all[strlen(name)] == '\0') return 1;
+    return 0;
+}
+
+/* 1 when the current context has framebuffer fetch (EXT_shader_framebuffer_fetch: what fogvol's
+   FRAMEBUFFER_FETCH and EXACT_SUM speed-ups need; Mesa has it, NVIDIA's desktop driver does not) */
+static inline int glu_has_fetch(void) { return glu_has_ext("GL_EXT_shader_framebuffer_fetch"); }
+
 /* column-major matrices, OpenGL conventions */
 static inline void glu_identity(float m[16])
 {

@@ -310,15 +310,6 @@ static void ground_truth(const tscene *s, double *gt, int *pairs, unsigned char 
     rc_scene_free(&rs);
 }
 
-/* The grid the current GL context snaps vertices to, in pixels: 2^-GL_SUBPIXEL_BITS (the GL
-   minimum of 4 bits where the context reports fewer). */
-static inline double snap_pixels(void)
-{
-    GLint bits = 0;
-    glGetIntegerv(0x0D50 /* GL_SUBPIXEL_BITS */, &bits);
-    return ldexp(1.0, -(bits < 4 ? 4 : bits));
-}
-
 /* Every tier and variant combination the GL tests render (test_tiers on desktop dialects,
    test_gles on OpenGL ES), and the scenes they compare against the ray cast. */
 typedef struct tier_combo {

@@ -31,6 +31,19 @@
 #include <stdio.h>
 #include <string.h>
 
+#ifdef GL_SUBPIXEL_BITS /* (after a GL or GLES header) */
+#include <math.h>
+/* The grid the current GL context snaps vertices to, in pixels: 2^-GL_SUBPIXEL_BITS (the GL
+   minimum of 4 bits where the context reports fewer; 8 on llvmpipe and NVIDIA). A sample's depths
+   move by up to about that times their slope (rc_depth_slope): the tests add it to their bounds. */
+static inline double snap_pixels(void)
+{
+    GLint bits = 0;
+    glGetIntegerv(GL_SUBPIXEL_BITS, &bits);
+    return ldexp(1.0, -(bits < 4 ? 4 : bits));
+}
+#endif
+
 /* what a frame may change against the frame before it */
 enum {
     SQ_CAMERA = 1,   /* the camera moves along the test's walk (into the volume and out) */

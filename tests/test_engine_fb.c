@@ -839,6 +839,7 @@ static void fbseq_view(void *user, const sq_view *v, sq_check *out)
     rc_object ro[MAXOBJ];
     rc_scene rs;
     int i, x, y, named = v->frame % 4;
+    double snap = snap_pixels();
     glBindFramebuffer(GL_FRAMEBUFFER, q->f.fbo);
     for (i = 0; i < 4; ++i) {
         tex_fill(q->f.tex[i], 11u * (unsigned)v->frame + (unsigned)i);
@@ -882,6 +883,8 @@ static void fbseq_view(void *user, const sq_view *v, sq_check *out)
             r = rc_trace(&rs, &q->e.cam, x + 0.5, y + 0.5);
             pairs = r.faces_front > r.faces_back ? r.faces_front : r.faces_back;
             err = fabs(q->thick[y * vp[2] + x] - r.thickness) / (pairs > 1 ? pairs : 1);
+            /* the bound + what the GL's vertex snapping may move (snap_pixels), err scaled to LSB */
+            err *= LSB / (LSB + rc_depth_slope(&rs, &q->e.cam, x, y) * snap / (pairs > 1 ? pairs : 1));
             out->pixels++;
             out->wrong += err > LSB;
             if (err > out->max_err) out->max_err = err;

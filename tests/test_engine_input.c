@@ -616,7 +616,7 @@ typedef struct walk {
     GLuint fbo, rb[2], dtex; /* the engine's framebuffer (fbo 0: the default one) */
     tobj o[3];               /* the fog box, a column and a wall */
     float *thick, *zb, *za;
-    double *gt, *spread;
+    double *gt, *spread, *slope; /* slope: rc_depth_slope of interior pixels (the GL's vertex snapping) */
     unsigned char *interior;
     long depth_changed;      /* depth values of the engine's buffers fogvol changed */
     int failed, gl_errors;   /* views whose end_frame failed, that left a GL error */
@@ -660,7 +660,7 @@ static void walk_scene(tobj *o)
 /* The ray casts of the walk's views, made once for all sources and tiers (slot frame * 2 + view). */
 static struct {
     int have[WALK_FRAMES * 2];
-    double *gt, *spread;
+    double *gt, *spread, *slope;
     unsigned char *interior;
 } g_walk_truth;
 
@@ -675,11 +675,13 @@ static void walk_truth(walk *wk, const rc_camera *c, const sq_view *v)
     if (!g_walk_truth.gt) {
         g_walk_truth.gt = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
         g_walk_truth.spread = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
+        g_walk_truth.slope = (double *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, sizeof(double));
         g_walk_truth.interior = (unsigned char *)calloc((size_t)WALK_FRAMES * 2 * SW * SH, 1);
     }
     if (g_walk_truth.have[slot]) {
         memcpy(wk->gt, g_walk_truth.gt + off, np * sizeof(double));
         memcpy(wk->spread, g_walk_truth.spread + off, np * sizeof(double));
+        memcpy(wk->slope, g_walk_truth.slope + off, np * sizeof(double));
         memcpy(wk->interior, g_walk_truth.interior + off, np);
         return;
     }
@@ -699,8 +701,9 @@ static void walk_truth(walk *wk, const rc_camera *c, const sq_view *v)
             rc_result r = rc_trace(&rs, c, x + 0.5, y + 0.5);
             wk->gt[p] = r.thickness;
             wk->interior[p] = (unsigned char)rc_interior(&rs, c, x, y);
-            wk->spread[p] = 0.0;
+            wk->spread[p] = wk->slope[p] = 0.0;
             if (!wk->interior[p]) continue;
+            wk->slope[p] = rc_depth_slope(&rs, c, x, y);
             ctr = r.opaque_w;
             for (k = 0; k < 4; ++k) {
                 double o = rc_trace(&rs, c, x + (k & 1), y + (k >> 1)).opaque_w;
@@ -711,6 +714,7 @@ static void walk_truth(walk *wk, const rc_camera *c, const sq_view *v)
     rc_scene_free(&rs);
     memcpy(g_walk_truth.gt + off, wk->gt, np * sizeof(double));
     memcpy(g_walk_truth.spread + off, wk->spread, np * sizeof(double));
+    memcpy(g_walk_truth.slope + off, wk->slope, np * sizeof(double));
     memcpy(g_walk_truth.interior + off, wk->interior, np);
     g_walk_truth.have[slot] = 1;
 }
@@ -781,7 +785,7 @@ static void walk_view(void *user, const sq_view *v, sq_check *out)
     walk *wk = (walk *)user;
     rc_camera c = walk_camera(v->walk, v->viewport);
     fogvol_frame_desc fd;
-    double range = c.zfar - c.znear, wmax = 12.0;
+    double range = c.zfar - c.znear, wmax = 12.0, snap = snap_pixels();
     int i, npx = v->viewport[2] * v->viewport[3];
     fogvol_result r;
     walk_desc(wk, v, &c, &fd);
@@ -799,13 +803,15 @@ static void walk_view(void *user, const sq_view *v, sq_check *out)
     walk_truth(wk, &c, v);
     /* as test_engine_depth_buffers: FLOAT 1e-4 of the range, PS20 1 LSB of the 12-bit encoding
        (one pair of faces), + the depth quantum at the farthest occluder; a multisampled source's
-       resolve keeps one of the pixel's samples: + the occluder's depth spread over the pixel */
+       resolve keeps one of the pixel's samples: + the occluder's depth spread over the pixel; + the
+       depths' slope times the GL's vertex snapping grid (snap_pixels: 1/256 pixel on NVIDIA) */
     out->bound = (wk->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0) +
                  (wk->src->bits ? ldexp(1.0, -wk->src->bits) * wmax * wmax * range / (c.zfar * c.znear) : 0.0);
     for (i = 0; i < npx; ++i) {
         double err;
         if (!wk->interior[i]) continue;
         err = fabs(wk->thick[i] - wk->gt[i]) - (wk->src->samples ? wk->spread[i] : 0.0);
+        err *= out->bound / (out->bound + wk->slope[i] * snap); /* (scaled to the bound without it) */
         out->pixels++;
         if (r != FOGVOL_SUCCESS) { /* no fog drawn: the whole view is wrong */
             out->wrong++;
@@ -833,6 +839,7 @@ static void walk_setup(walk *wk, const walk_src *src, fogvol_tier tier)
     wk->za = (float *)calloc((size_t)SW * SH, sizeof(float));
     wk->gt = (double *)calloc((size_t)SW * SH, sizeof(double));
     wk->spread = (double *)calloc((size_t)SW * SH, sizeof(double));
+    wk->slope = (double *)calloc((size_t)SW * SH, sizeof(double));
     wk->interior = (unsigned char *)calloc((size_t)SW * SH, 1);
     wk->sheet = (unsigned char *)calloc((size_t)SW * 10 * SH * 2, 3);
     if (!src->format) return;
@@ -875,6 +882,7 @@ static void walk_teardown(walk *wk)
     free(wk->za);
     free(wk->gt);
     free(wk->spread);
+    free(wk->slope);
     free(wk->interior);
     free(wk->sheet);
 }
@@ -914,6 +922,7 @@ static void test_engine_depth_walk(void **state)
     glu_destroy(&g);
     free(g_walk_truth.gt);
     free(g_walk_truth.spread);
+    free(g_walk_truth.slope);
     free(g_walk_truth.interior);
     memset(&g_walk_truth, 0, sizeof g_walk_truth);
     print_message("# walk: %ld wrong pixels, %ld engine depth values changed, %d failed views\n", wrong, changed,
@@ -1099,7 +1108,7 @@ static void occseq_view(void *user, const sq_view *v, sq_check *out)
     rc_object ro[2];
     rc_scene rs;
     int i, x, y, n = v->occluders ? 2 : 1;
-    double range = c.zfar - c.znear;
+    double range = c.zfar - c.znear, snap = snap_pixels();
     frame_of(&fd, &c, q->thick);
     memcpy(fd.viewport, v->viewport, sizeof fd.viewport);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -1117,12 +1126,13 @@ static void occseq_view(void *user, const sq_view *v, sq_check *out)
         ro[i].sign = q->o[i].sign;
     }
     assert_true(rc_scene_init(&rs, ro, n));
-    out->bound = q->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0;
+    out->bound = q->tier == FOGVOL_TIER_FLOAT ? 1e-4 * range : range / 4096.0; /* + the snapping term */
     for (y = 0; y < c.height; ++y)
         for (x = 0; x < c.width; ++x) {
             double err;
             if (!rc_interior(&rs, &c, x, y)) continue;
-            err = fabs(q->thick[y * c.width + x] - rc_trace(&rs, &c, x + 0.5, y + 0.5).thickness);
+            err = fabs(q->thick[y * c.width + x] - rc_trace(&rs, &c, x + 0.5, y + 0.5).thickness) * out->bound /
+                  (out->bound + rc_depth_slope(&rs, &c, x, y) * snap); /* (scaled to the bound without it) */
             out->pixels++;
             out->wrong += err > out->bound;
             if (err > out->max_err) out->max_err = err;

@@ -439,6 +439,13 @@ static void test_exact_sum(void **state)
         cd.tier = tier ? FOGVOL_TIER_MRT : FOGVOL_TIER_PS20;
         cd.encoding_bits = 4;
         rig_open(&rig, &cd);
+        if (!glu_has_fetch()) { /* no integer sums without framebuffer fetch (NVIDIA's desktop driver) */
+            print_message("  this GL has no EXT_shader_framebuffer_fetch: skipped\n");
+            rig_close(&rig);
+            g_rig_exact = 0;
+            free(thick);
+            skip();
+        }
         range = rig.t->s->cam.zfar - rig.t->s->cam.znear;
         for (frame = 0; frame < 3; ++frame) {
             assert_int_equal(rig_frame(&rig, thick, &st), FOGVOL_SUCCESS);
