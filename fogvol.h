@@ -72,6 +72,7 @@
                 fogvol_tier_costs            passes and targets of a tier
                 fogvol_tier_uses_program     which programs a tier draws with
    backends     fogvol_gl_backend_create     the GL backend on its own
+                fogvol_renderer_is_software  does a GL_RENDERER name a CPU renderer (a backend's caps)
                 fogvol_null_backend_init     a recording backend without a GPU (tests)
                 fogvol_uniform_name          the GLSL name of a uniform slot
                 fogvol_dialect_layout        where the Vulkan dialect puts uniforms, per-draw values, samplers
@@ -510,6 +511,10 @@ typedef struct fogvol_gl_desc {
     int version_major;        /* 0 = from the context; else treat the context as this GL version */
     int version_minor;
     int gles;                 /* with version_major: 1 = treat as OpenGL ES */
+    int software;             /* 0 = from GL_RENDERER (fogvol_renderer_is_software); 1 = treat the
+                                 renderer as drawing on the CPU, -1 = as a GPU: the backend's
+                                 FOGVOL_CAP_SOFTWARE_RENDERER, which picks how FLOAT + ENGINE_DEPTH
+                                 reads the engine's depth (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) */
     int mrt_highp;            /* OpenGL ES: 1 = the engine declares the output it writes fogvol's O with
                                  highp (layout(location = 1) out highp vec4, or precision highp float):
                                  on GLES 3 with EXT_color_buffer_float the backend then reports
@@ -543,9 +548,9 @@ typedef struct fogvol_gl_desc {
    fragment work and 4x the target memory of fogvol's passes (measured by
    fogvol's MSAA test, FLOAT at 640x480 on llvmpipe: 4x per sample took
    3.9-4.6x the time of the same scene on a single-sample framebuffer, one
-   run each). FLOAT + ENGINE_DEPTH on a backend with
+   run each). FLOAT + ENGINE_DEPTH on a software renderer's backend with
    FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE (the GL backend with per-sample
-   shading) shades its faces once per pixel, depth-tested per sample against
+   shading on llvmpipe) shades its faces once per pixel, depth-tested per sample against
    the engine's multisample depth (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST), and only
    its composite per sample. Error at occluder edges inside fog, 4x, resolved, /255: mean
    29.7, max 60 with single-sample targets; mean 1.0, max 2 per sample; with
@@ -1489,8 +1494,24 @@ enum {
                                               multisampled target's samples, and per_sample 2 (rasterised
                                               per sample, shaded once per pixel) is honoured: multisampled
                                               FLOAT + ENGINE_DEPTH frames drawn depth-tested (GL 3.2 with
-                                              per-sample shading) */
+                                              per-sample shading) */,
+    FOGVOL_CAP_SOFTWARE_RENDERER = 1u << 12 /* the backend draws on the CPU (llvmpipe, softpipe,
+                                              SwiftShader, WARP, Apple's software renderer; the GL backend
+                                              tells them by GL_RENDERER: fogvol_renderer_is_software), where
+                                              a texture read per fragment costs more than blending a
+                                              second float channel: FLOAT + ENGINE_DEPTH frames are drawn
+                                              depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST) only then. On
+                                              a GPU every face reads the engine's depth into an R32F sum
+                                              (H200: 0.95-1.00x the floor against 1.7-1.9x depth-tested,
+                                              whose RG32F blending costs twice the bandwidth) */
 };
+
+/* 1 when a GL_RENDERER (or a similar device name) names a renderer that draws on the CPU: Mesa's
+   llvmpipe and softpipe (also under zink or virgl), its old swrast ("Software Rasterizer"),
+   SwiftShader (also under ANGLE), Microsoft's WARP ("Basic Render Driver") and GDI renderer, Apple's
+   software renderer. The GL backend sets FOGVOL_CAP_SOFTWARE_RENDERER by it (unless
+   fogvol_gl_desc.software says otherwise); a backend of an engine's own may too. NULL: 0. */
+FOGVOL_API int fogvol_renderer_is_software(const char *renderer);
 
 typedef struct fogvol_frame_info {
     int samples;      /* samples per pixel of the engine framebuffer (GL: GL_SAMPLES when
@@ -1956,8 +1977,9 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  128 volumes or more keep the digits and their check; fogvol_frame_stats.exact_sum).
                  Not the digits' bytes: closer to the true thickness.
    ENGINE_DEPTH_TEST  FLOAT + ENGINE_DEPTH on a backend with FOGVOL_CAP_ATTACH_DEPTH (the GL backend on
-                 GL 3.0 / GLES 3.0), in single-sample frames (and multisampled ones without a debug
-                 read-back with FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE: the faces shaded once per pixel,
+                 GL 3.0 / GLES 3.0) that draws on the CPU (FOGVOL_CAP_SOFTWARE_RENDERER: on a GPU the
+                 per-face read is the faster), in single-sample frames (and multisampled ones without a
+                 debug read-back with FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE: the faces shaded once per pixel,
                  tested per sample against the engine's multisample depth, the composite per sample),
                  at any viewport (one away from the window origin sums into a target in the window's
                  coordinates, grown to the viewports' far corners and shared by the views of a split
@@ -2332,6 +2354,17 @@ extern "C" {
 #endif
 
 /* >>cpu =================================================================== */
+
+FOGVOL_API int fogvol_renderer_is_software(const char *renderer)
+{
+    static const char *const names[] = {"llvmpipe", "softpipe", "Software Rasterizer", "SwiftShader",
+                                        "Basic Render Driver", "GDI Generic", "Apple Software Renderer"};
+    size_t i;
+    if (!renderer) return 0;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (strstr(renderer, names[i])) return 1;
+    return 0;
+}
 
 FOGVOL_API const char *fogvol_result_string(fogvol_result result)
 {
@@ -7947,6 +7980,7 @@ static void fogvol__choose_speedups(fogvol_context *ctx)
     ctx->cfg.fetch_o = fetch && !unspecialised && fogvol__speedup(ctx, FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH, FOGVOL__F_FETCH_O);
     ctx->cfg.exact_sum = ctx->cfg.float_o && exact;
     ctx->cfg.engine_test = (caps & FOGVOL_CAP_ATTACH_DEPTH) && (caps & FOGVOL_CAP_FLOAT_BLEND) &&
+                           (caps & FOGVOL_CAP_SOFTWARE_RENDERER) &&
                            fogvol__speedup(ctx, FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST, FOGVOL__F_ENGINE_TEST);
 }
 
@@ -11666,7 +11700,7 @@ enum {
     FOGVOL__GL_PACK_ALIGNMENT = 0x0D05, FOGVOL__GL_STENCIL_BITS = 0x0D57, FOGVOL__GL_TEXTURE_2D = 0x0DE1,
     FOGVOL__GL_UNSIGNED_BYTE = 0x1401, FOGVOL__GL_UNSIGNED_SHORT = 0x1403, FOGVOL__GL_UNSIGNED_INT = 0x1405,
     FOGVOL__GL_FLOAT = 0x1406, FOGVOL__GL_STENCIL = 0x1802, FOGVOL__GL_RGBA = 0x1908, FOGVOL__GL_FILL = 0x1B02,
-    FOGVOL__GL_KEEP = 0x1E00, FOGVOL__GL_REPLACE = 0x1E01, FOGVOL__GL_VERSION = 0x1F02,
+    FOGVOL__GL_KEEP = 0x1E00, FOGVOL__GL_REPLACE = 0x1E01, FOGVOL__GL_VERSION = 0x1F02, FOGVOL__GL_RENDERER = 0x1F01,
     FOGVOL__GL_EXTENSIONS = 0x1F03, FOGVOL__GL_NEAREST = 0x2600, FOGVOL__GL_LINEAR = 0x2601,
     FOGVOL__GL_TEXTURE_MAG_FILTER = 0x2800, FOGVOL__GL_TEXTURE_MIN_FILTER = 0x2801,
     FOGVOL__GL_TEXTURE_WRAP_S = 0x2802, FOGVOL__GL_TEXTURE_WRAP_T = 0x2803, FOGVOL__GL_REPEAT = 0x2901,
@@ -13925,6 +13959,9 @@ static fogvol_result fogvol__gl_setup(fogvol__gl *gl, const fogvol_gl_desc *desc
     if (fogvol__gl_load_msaa(gl, desc)) gl->caps |= FOGVOL_CAP_MULTISAMPLE;
     if ((gl->caps & FOGVOL_CAP_ATTACH_DEPTH) && (gl->caps & FOGVOL_CAP_MULTISAMPLE))
         gl->caps |= FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE; /* (GL_TEXTURE_2D_MULTISAMPLE depth attachments) */
+    if (desc->software > 0 ||
+        (desc->software == 0 && fogvol_renderer_is_software((const char *)gl->GetString(FOGVOL__GL_RENDERER))))
+        gl->caps |= FOGVOL_CAP_SOFTWARE_RENDERER;
     if ((gl->dialect == FOGVOL_GLSL_330 || gl->dialect == FOGVOL_GLSL_300ES) && gl->has_indexed_mask &&
         gl->DrawBuffers &&
         (gl->major >= 3 ? fogvol__gl_has_ext3(gl, "GL_EXT_shader_framebuffer_fetch")

@@ -2756,6 +2756,32 @@ static void test_gl_dialect_choice_compat(void **state)
     expect_dialect(&d, FOGVOL_GLSL_300ES, "override GLES 3.0");
 }
 
+/* FOGVOL_CAP_SOFTWARE_RENDERER: from GL_RENDERER by fogvol_renderer_is_software (llvmpipe: set; a GPU
+   driver: not), or as fogvol_gl_desc.software says (1: set, -1: not, whatever the renderer) */
+static void test_gl_software_renderer(void **state)
+{
+    fogvol_gl_desc d;
+    fogvol_backend be;
+    loader l;
+    const char *renderer = (const char *)glGetString(GL_RENDERER);
+    int k;
+    (void)state;
+    for (k = -1; k <= 1; ++k) {
+        memset(&l, 0, sizeof l);
+        memset(&d, 0, sizeof d);
+        d.get_proc_address = test_loader;
+        d.user_data = &l;
+        d.software = k;
+        assert_int_equal(fogvol_gl_backend_create(&d, NULL, NULL, &be), FOGVOL_SUCCESS);
+        assert_int_equal((be.caps & FOGVOL_CAP_SOFTWARE_RENDERER) != 0,
+                         k ? k > 0 : fogvol_renderer_is_software(renderer));
+        be.destroy(be.user_data);
+    }
+    print_message("  GL_RENDERER \"%s\": %s\n", renderer,
+                  fogvol_renderer_is_software(renderer) ? "software (engine depth depth-tested)"
+                                                        : "a GPU (engine depth read per face)");
+}
+
 /* ---- rendering a sphere for the thickness checks ---- */
 
 /* w-extent of a ray through the pixel centre (px, py) inside a sphere of radius r whose
@@ -3281,8 +3307,9 @@ static void ed_frame(fogvol_context *fv, const fogvol_mesh *box, const fogvol_ra
    not written; GREATER where the depth range reverses it) reading no depth, and the composite reads
    that texture; at an offset viewport the faces draw at the engine's own viewport into a target in
    window coordinates (the texture's), so the depth lines up; a box around the camera that also crosses
-   the far plane, or a backend without the capability: the faces read the engine's depth as before,
-   nothing attached. */
+   the far plane, a backend without the capability, or one on a GPU (without
+   FOGVOL_CAP_SOFTWARE_RENDERER: per-face reads are the faster there): the faces read the engine's depth
+   as before, nothing attached. */
 static void test_engine_depth_attached(void **state)
 {
     fogvol_null_backend nb;
@@ -3297,10 +3324,11 @@ static void test_engine_depth_attached(void **state)
     shp_mesh s = shp_box(1.0f, 1.0f, 1.0f); /* half-size 0.5 */
     int caps, i, k;
     (void)state;
-    for (caps = 0; caps < 2; ++caps) {
+    for (caps = 0; caps < 3; ++caps) { /* 0: no ATTACH_DEPTH; 1: a GPU's; 2: a software renderer's */
         fogvol_null_backend_init(&nb, &be);
         be.caps |= FOGVOL_CAP_FLOAT_BLEND;
         if (!caps) be.caps &= ~(unsigned)FOGVOL_CAP_ATTACH_DEPTH;
+        if (caps == 2) be.caps |= FOGVOL_CAP_SOFTWARE_RENDERER;
         memset(&cd, 0, sizeof cd);
         cd.backend = be;
         cd.tier = FOGVOL_TIER_FLOAT;
@@ -3315,7 +3343,7 @@ static void test_engine_depth_attached(void **state)
         for (k = 0; k < 5; ++k) {
             /* 0: fits; 1: fits, depth range (1, 0); 2: the camera inside (half-size 8: it also crosses the
                far plane); 3: offset viewport; 4: fits again */
-            int fits = caps && k != 2;
+            int fits = caps == 2 && k != 2;
             ed_frame(fv, box, ramp, k == 2 ? 16.0f : 1.0f, k == 3, k == 1 ? 1.0f : 0.0f, 0.0f, &st);
             assert_int_equal(st.engine_depth_tested, fits);
             assert_int_equal(nb.pass_count, 2); /* faces, composite */
@@ -3339,7 +3367,7 @@ static void test_engine_depth_attached(void **state)
                 assert_int_equal(nb.passes[0].viewport[3], A_H);
             }
         }
-        if (caps) { /* a split screen: the two views alternate, each depth-tested; after the first pair
+        if (caps == 2) { /* a split screen: the two views alternate, each depth-tested; after the first pair
                        nothing is created again (the offset view's target in window coordinates is kept) */
             int creates = 0;
             for (k = 0; k < 6; ++k) {
@@ -3389,6 +3417,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_gl_plain_loaders, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_gl_dialect_choice_core, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_gl_dialect_choice_compat, setup_compat, teardown_gl),
+        cmocka_unit_test_setup_teardown(test_gl_software_renderer, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_gl_glsl100_renders_in_core, setup_core, teardown_gl),
         cmocka_unit_test_setup_teardown(test_gl_override21_renders, setup_compat, teardown_gl),
         cmocka_unit_test_setup_teardown(test_gl_shader_compile_failure, setup_core, teardown_gl),

@@ -1814,8 +1814,38 @@ static void test_mesh_alloc_and_stride(void **state)
 }
 
 /* ------------------------------------------------------------------------ */
-/* 9. result strings                                                        */
+/* 9. result strings, renderer names                                        */
 /* ------------------------------------------------------------------------ */
+
+/* fogvol_renderer_is_software on renderer strings as drivers report them (GL_RENDERER, ANGLE's,
+   Vulkan device names under zink): the CPU renderers by name, GPUs not (an LLVM in a GPU driver's
+   name is not llvmpipe) */
+static void test_software_renderer_names(void **state)
+{
+    static const struct {
+        const char *name;
+        int software;
+    } t[] = {{"llvmpipe (LLVM 15.0.6, 256 bits)", 1},
+             {"softpipe", 1},
+             {"Software Rasterizer", 1},
+             {"zink Vulkan 1.3(llvmpipe (LLVM 15.0.6, 256 bits) (MESA_LLVMPIPE))", 1},
+             {"ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device (Subzero) (0x0000C0DE)), SwiftShader driver-5.0.0)", 1},
+             {"Google SwiftShader", 1},
+             {"ANGLE (Microsoft, Microsoft Basic Render Driver Direct3D11 vs_5_0 ps_5_0, D3D11)", 1},
+             {"GDI Generic", 1},
+             {"Apple Software Renderer", 1},
+             {"NVIDIA H200/PCIe/SSE2", 0},
+             {"AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.7, DRM 3.54, 6.5.0)", 0},
+             {"Mesa Intel(R) UHD Graphics 620 (KBL GT2)", 0},
+             {"Apple M1", 0},
+             {"ANGLE (NVIDIA, NVIDIA GeForce RTX 3080 Direct3D11 vs_5_0 ps_5_0, D3D11)", 0},
+             {"", 0}};
+    size_t i;
+    (void)state;
+    for (i = 0; i < sizeof t / sizeof t[0]; ++i)
+        assert_int_equal(fogvol_renderer_is_software(t[i].name), t[i].software);
+    assert_int_equal(fogvol_renderer_is_software(NULL), 0);
+}
 
 static void test_result_strings(void **state)
 {
@@ -2041,6 +2071,7 @@ int main(void)
         cmocka_unit_test(test_mesh_winding_grid),
         cmocka_unit_test(test_mesh_alloc_and_stride),
         cmocka_unit_test(test_result_strings),
+        cmocka_unit_test(test_software_renderer_names),
         cmocka_unit_test(test_vulkan_layout),
         cmocka_unit_test(test_vulkan_programs),
     };

@@ -971,6 +971,7 @@ static void test_conventions(void **state)
         cd.variants = cb->variants;
         cd.disable_dither = 1;
         cd.disable_speedups = cb->speedups_off;
+        cd.gl.software = 1; /* the depth-tested frames on any GL (on a GPU's the faces would read the depth) */
         assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
         cd.backend = g_inner;
         cd.backend.create_program = watch_program;
@@ -1029,10 +1030,11 @@ static void test_conventions(void **state)
             views += t.views;
         }
         if (cb->tier == FOGVOL_TIER_PS20 && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH)) {
-            /* every frame of PS20 + engine depth summed in integers (Mesa has the framebuffer fetch) */
+            /* every frame of PS20 + engine depth summed in integers where the GL has framebuffer
+               fetch (Mesa), none where it has not (NVIDIA's desktop driver) */
             printf("# %s: %d of %d frames summed in integers\n", cb->name, g_frames_exact, g_frames_drawn);
             assert_true(g_frames_drawn > 0);
-            assert_int_equal(g_frames_exact, g_frames_drawn);
+            assert_int_equal(g_frames_exact, glu_has_fetch() ? g_frames_drawn : 0);
         }
         if (cb->tier == FOGVOL_TIER_FLOAT && (cb->variants & FOGVOL_VARIANT_ENGINE_DEPTH)) {
             /* both kinds of frame in the sequences: depth-tested and reading the depth per face */
@@ -1261,6 +1263,7 @@ static void test_engine_tested_inputs(void **state)
     cd.logger.func = logger;
     cd.tier = FOGVOL_TIER_FLOAT;
     cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    cd.gl.software = 1; /* (as above) */
     assert_int_equal(fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, &g_inner), FOGVOL_SUCCESS);
     cd.backend = g_inner;
     cd.backend.create_program = watch_program;

@@ -631,6 +631,7 @@ static void fv_create(fx *x, const snap *check)
     cd.gl.get_proc_address = glu_proc;
     cd.tier = x->variants ? FOGVOL_TIER_FLOAT : FOGVOL_TIER_PS20; /* pass counts below are those of PS20 */
     cd.variants = x->variants;
+    cd.gl.software = 1; /* (FLOAT + ENGINE_DEPTH: depth-tested on any GL) */
     cd.logger.func = fv_log;
     cd.logger.user_data = x;
     if (x->compat) {
@@ -747,7 +748,7 @@ static void run_frame(fx *x, fogvol_composite composite, int w, int h)
     }
     /* O; fog group: B, B negative, F, F negative, composite; light group: B, F, composite. Summed as
        integers (FOGVOL_SPEEDUP_EXACT_SUM, GL 3.3 here): one sum pass a group, negative volumes in it */
-    assert_int_equal(st.exact_sum, x->compat ? 0 : 2);
+    assert_int_equal(st.exact_sum, x->compat || !glu_has_fetch() ? 0 : 2);
     assert_int_equal(st.passes, st.exact_sum ? 5 : 9);
     assert_int_equal(st.groups, 2);
     assert_int_equal(st.occluders, 1);
@@ -876,7 +877,7 @@ static void deleted_program_case(fx *x)
 {
     snap before, after;
     GLuint p;
-    GLint cur = -1, isp = 1;
+    GLint cur = -1;
     fv_create(x, NULL);
     engine_clear(x);
     set_engine_state(x, !x->compat, 0, &before);
@@ -889,8 +890,8 @@ static void deleted_program_case(fx *x)
     expect_no_gl_error("frame after the engine deleted its current program");
     glGetIntegerv(GL_CURRENT_PROGRAM, &cur);
     assert_int_equal(cur, 0);
-    isp = gf.IsProgram(p);
-    assert_false(isp);
+    /* (whether the name is gone now is the driver's: Mesa frees it, NVIDIA's compatibility profile
+       keeps it; fogvol's part is that it is not current again) */
     gf.UseProgram((GLuint)before.program); /* the rest of the engine's state is untouched */
     snapshot(&after, x->compat);
     expect_same_state(&before, &after, "frame after the engine deleted its current program");
