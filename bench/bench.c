@@ -48,7 +48,7 @@
 #include <time.h>
 #include <sys/utsname.h>
 
-#define NTIER 9
+#define NTIER 11
 #define NDEFAULT 5 /* the first NDEFAULT tiers: fogvol's default configuration (every speed-up on) */
 #define M_FLOOR NTIER
 #define M_OCCFLOOR (NTIER + 1)
@@ -72,23 +72,31 @@ typedef struct tier_cfg {
     unsigned variants;
     unsigned speedups_off; /* fogvol_context_desc.disable_speedups */
     int downsample;        /* fogvol_frame_desc.downsample */
+    int software;          /* fogvol_gl_desc.software (1: depth-tested engine depth on any GL) */
 } tier_cfg;
-static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0, 0},
-                                        {"PS20", FOGVOL_TIER_PS20, 0, 0, 0},
-                                        {"MRT", FOGVOL_TIER_MRT, 0, 0, 0},
-                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0, 0, 0},
-                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0},
-                                        {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL, 0},
-                                        {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL, 0},
-                                        {"FLOAT, half resolution", FOGVOL_TIER_FLOAT, 0, 0, 2},
-                                        {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0}};
+static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0, 0, 0},
+                                        {"PS20", FOGVOL_TIER_PS20, 0, 0, 0, 0},
+                                        {"MRT", FOGVOL_TIER_MRT, 0, 0, 0, 0},
+                                        {"FLOAT", FOGVOL_TIER_FLOAT, 0, 0, 0, 0},
+                                        {"FLOAT+engine depth", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0, 0},
+                                        {"FLOAT, speed-ups off", FOGVOL_TIER_FLOAT, 0, SPEEDUPS_ALL, 0, 0},
+                                        {"PS20, speed-ups off", FOGVOL_TIER_PS20, 0, SPEEDUPS_ALL, 0, 0},
+                                        {"FLOAT, half resolution", FOGVOL_TIER_FLOAT, 0, 0, 2, 0},
+                                        {"PS20+engine depth", FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, 0, 0, 0},
+                                        {"FLOAT+engine depth, depth-tested", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, 0,
+                                         0, 1},
+                                        {"FLOAT+engine depth, per-face read", FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH,
+                                         FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST, 0, 0}};
 #define M_FLOAT 3
 #define M_FLOAT_ED 4 /* FLOAT + ENGINE_DEPTH */
 #define M_PS20 1
 #define M_PS20_ED 8 /* PS20 + ENGINE_DEPTH */
+#define M_FLOAT_ED_TESTED 9 /* FLOAT + ENGINE_DEPTH depth-tested on any renderer (fogvol_gl_desc.software 1) */
+#define M_FLOAT_ED_READ 10  /* FLOAT + ENGINE_DEPTH with every face reading the depth (its depth test off) */
 static const char *const g_meth_names[NMETH] = {
     "PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "FLOAT, speed-ups off", "PS20, speed-ups off",
-    "FLOAT, half resolution", "PS20+engine depth", "floor", "occluder floor", "scissored floor", "depth peeling"};
+    "FLOAT, half resolution", "PS20+engine depth", "FLOAT+engine depth, depth-tested",
+    "FLOAT+engine depth, per-face read", "floor", "occluder floor", "scissored floor", "depth peeling"};
 
 /* ---- small utilities -------------------------------------------------------- */
 static double now_ms(void)
@@ -1526,6 +1534,7 @@ static fogvol_context *create_tier(int t, double *ms, fogvol_backend *be)
     cd.variants = g_tiers[t].variants;
     cd.engine_mrt = g_tiers[t].tier == FOGVOL_TIER_MRT;
     cd.disable_speedups = g_tiers[t].speedups_off;
+    cd.gl.software = g_tiers[t].software;
     glFinish();
     t0 = now_ms();
     if (fogvol_gl_backend_create(&cd.gl, NULL, &cd.logger, be) != FOGVOL_SUCCESS) die("fogvol_gl_backend_create");
@@ -1802,7 +1811,7 @@ static void print_results(const result *rs, int n)
    (FOGVOL_SPEEDUP_INLINE_RESOLVE: every GL here has fp32 fragment shaders) */
 static const char *pass_name(int m, int p, int np, int occluders)
 {
-    static const char *const pn[NTIER + 1][6] = {{"O", "B", "F", "check", "composite", ""},
+    static const char *const pn[][6] = {{"O", "B", "F", "check", "composite", ""},
                                                  {"O", "B", "F", "check", "composite", ""},
                                                  {"B", "F", "check", "composite", "", ""},
                                                  {"O", "B-F", "composite", "", "", ""},
@@ -1811,10 +1820,14 @@ static const char *pass_name(int m, int p, int np, int occluders)
                                                  {"O", "B", "F", "check", "composite", ""},
                                                  {"O", "B-F", "composite", "", "", ""},
                                                  {"O", "B", "F", "check", "composite", ""},
+                                                 {"B-F", "composite", "", "", "", ""},
+                                                 {"B-F", "composite", "", "", "", ""},
                                                  {"geometry", "composite", "", "", "", ""}};
     const char *names[6];
     int full = 0, i, k = 0;
     const char *const *src = pn[m < NTIER ? m : NTIER];
+    typedef char one_row_per_tier_and_the_floor[sizeof pn / sizeof pn[0] == NTIER + 1 ? 1 : -1];
+    (void)sizeof(one_row_per_tier_and_the_floor);
     while (full < 6 && src[full][0]) ++full;
     for (i = 0; i < full; ++i) {
         if (strcmp(src[i], "O") == 0 && m < NTIER && !g_tiers[m].speedups_off && !occluders &&
