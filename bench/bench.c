@@ -1667,7 +1667,7 @@ static void plot(const char *path, const result *rs, int n, int w, int h)
     stb_easy_font_spacing(0.5f);
     for (v = lo; v <= hi * 1.0001; v = step125(v * 1.01, 1)) { /* grid and y labels, 1-2-5 */
         line(&c, L, PY(v), c.w - R, PY(v), 1, grid, 0);
-        snprintf(s, sizeof s, v < 1 ? "%.1f" : "%.0f", v);
+        snprintf(s, sizeof s, v < 1 ? "%g" : "%.0f", v); /* (0.05, not 0.1 twice) */
         text(&c, L - 10 - text_w(s, 2), (int)PY(v) - 6, s, 2, black);
     }
     for (i = 0; i < np; ++i) { /* x ticks at the measured k */
