@@ -906,9 +906,10 @@ static void half_check(const tscene *s, const char *name, int f, int vw, int vh,
             e = fabs(half->th[f][k] - want);
             /* + the taps' snapping (half-resolution pixels: twice the slope) + the filter's weights: the
                GL computes them in fixed point (NVIDIA: 8 bits of the sub-texel position; the spec leaves
-               it open), up to 2^-9 off in each direction: 2^-8 of the taps' spread */
+               it open), up to 2^-8 off in each direction if truncated: 2^-7 of the taps' spread (on an
+               H200 a pixel 0.0036 off with taps 0.444 apart, which llvmpipe draws 0.00001 off) */
             tol = 3e-5 * range * (1 + r.faces_back) + 2.0 * rc_depth_slope(&rs, &s->cam, x, y) * snap +
-                  ldexp(tap_spread(tap[ya * tw + xa], tap[ya * tw + xb], tap[yb * tw + xa], tap[yb * tw + xb]), -8);
+                  ldexp(tap_spread(tap[ya * tw + xa], tap[ya * tw + xb], tap[yb * tw + xa], tap[yb * tw + xb]), -7);
             if (e > tol)
                 fail_msg("%s frame %d pixel (%d,%d): half-resolution thickness %.6f, bilinear ray cast %.6f (bound %.2g; "
                          "taps %.5f %.5f %.5f %.5f, depth slope %.4f per pixel)",
