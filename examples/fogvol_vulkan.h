@@ -1391,9 +1391,12 @@ static VkResult fogvk__samplers(fogvk *vk)
 static unsigned fogvk__caps(fogvk *vk)
 {
     VkFormatProperties r32, rgba32;
+    VkPhysicalDeviceProperties props;
     const VkFormatFeatureFlags blend = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT;
     unsigned caps = FOGVOL_CAP_MRT | FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_DEPTH_TEXTURE | FOGVOL_CAP_MESH_LAYOUT |
                     FOGVOL_CAP_BLEND_CONSTANT | FOGVOL_CAP_FLOAT_TARGET;
+    vkGetPhysicalDeviceProperties(vk->pd, &props);
+    if (props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) caps |= FOGVOL_CAP_SOFTWARE_RENDERER; /* (lavapipe) */
     vkGetPhysicalDeviceFormatProperties(vk->pd, VK_FORMAT_R32_SFLOAT, &r32);
     vkGetPhysicalDeviceFormatProperties(vk->pd, VK_FORMAT_R32G32B32A32_SFLOAT, &rgba32);
     if ((r32.optimalTilingFeatures & blend) && (rgba32.optimalTilingFeatures & blend)) caps |= FOGVOL_CAP_FLOAT_BLEND;
