@@ -91,8 +91,6 @@ static const tier_cfg g_tiers[NTIER] = {{"PS13", FOGVOL_TIER_PS13, 0, 0, 0, 0},
 #define M_FLOAT_ED 4 /* FLOAT + ENGINE_DEPTH */
 #define M_PS20 1
 #define M_PS20_ED 8 /* PS20 + ENGINE_DEPTH */
-#define M_FLOAT_ED_TESTED 9 /* FLOAT + ENGINE_DEPTH depth-tested on any renderer (fogvol_gl_desc.software 1) */
-#define M_FLOAT_ED_READ 10  /* FLOAT + ENGINE_DEPTH with every face reading the depth (its depth test off) */
 static const char *const g_meth_names[NMETH] = {
     "PS13", "PS20", "MRT", "FLOAT", "FLOAT+engine depth", "FLOAT, speed-ups off", "PS20, speed-ups off",
     "FLOAT, half resolution", "PS20+engine depth", "FLOAT+engine depth, depth-tested",
@@ -1812,17 +1810,17 @@ static void print_results(const result *rs, int n)
 static const char *pass_name(int m, int p, int np, int occluders)
 {
     static const char *const pn[][6] = {{"O", "B", "F", "check", "composite", ""},
-                                                 {"O", "B", "F", "check", "composite", ""},
-                                                 {"B", "F", "check", "composite", "", ""},
-                                                 {"O", "B-F", "composite", "", "", ""},
-                                                 {"B-F", "composite", "", "", "", ""},
-                                                 {"O", "B-F", "composite", "", "", ""},
-                                                 {"O", "B", "F", "check", "composite", ""},
-                                                 {"O", "B-F", "composite", "", "", ""},
-                                                 {"O", "B", "F", "check", "composite", ""},
-                                                 {"B-F", "composite", "", "", "", ""},
-                                                 {"B-F", "composite", "", "", "", ""},
-                                                 {"geometry", "composite", "", "", "", ""}};
+                                        {"O", "B", "F", "check", "composite", ""},
+                                        {"B", "F", "check", "composite", "", ""},
+                                        {"O", "B-F", "composite", "", "", ""},
+                                        {"B-F", "composite", "", "", "", ""},
+                                        {"O", "B-F", "composite", "", "", ""},
+                                        {"O", "B", "F", "check", "composite", ""},
+                                        {"O", "B-F", "composite", "", "", ""},
+                                        {"O", "B", "F", "check", "composite", ""},
+                                        {"B-F", "composite", "", "", "", ""},
+                                        {"B-F", "composite", "", "", "", ""},
+                                        {"geometry", "composite", "", "", "", ""}};
     const char *names[6];
     int full = 0, i, k = 0;
     const char *const *src = pn[m < NTIER ? m : NTIER];
