@@ -176,7 +176,8 @@ SCRIPT_RUNS = \
   "bench_quick=$(BUILT) BUILD=$(BUILD)/quick BENCH_OPT=-O1 $(BUILD)/quick/bench && $(BUILD)/quick/bench --quick" \
   "egl_builds=$(BUILT) BUILD=$(BUILD)/egl_check CFLAGS=-O0 BENCH_OPT=-O0 $(BUILD)/egl_check/bench_egl \
     $(BUILD)/egl_check/egl/demo_headless && $(foreach t,$(EGL_TESTS),$(CC) -std=c99 -DGLU_EGL -fsyntax-only \
-    $(test_$(t)_FLAGS) $(WARN) $(INC) tests/test_$(t).c && ) true" \
+    $(test_$(t)_FLAGS) $(WARN) $(INC) tests/test_$(t).c && ) $(foreach p,proto_engine_depth proto_msaa,$(CC) -std=c99 \
+    -fsyntax-only $(WARN) $(INC) bench/$(p).c && ) true" \
   "raycast_selftest=$(call built,$(BUILD)/test_raycast) $(BUILD)/test_raycast" \
   "raycast_selftest_asan_ubsan=$(call built,$(BUILD)/test_raycast_san) $(LSAN_ENV) $(BUILD)/test_raycast_san" \
   "cpu_valgrind=$(call built,$(BUILD)/test_cpu_vg) $(TAP) FOGVOL_TEST_SUBSET=1 $(VALGRIND) $(BUILD)/test_cpu_vg" \
@@ -297,7 +298,7 @@ proto-msaa: deps-demo
 # the same benchmark through EGL and libOpenGL (glvnd) instead of OSMesa, for a GPU driver:
 # build/bench_egl writes bench/RESULTS-gpu.md and bench/plot-gpu.png, timed with GPU timestamps
 # (make test's egl_builds entry builds it and the EGL demo with BENCH_OPT=-O0 CFLAGS=-O0 and compiles
-# the EGL test programs with -fsyntax-only: they run on a GPU)
+# the EGL test programs and the bench prototypes with -fsyntax-only: make test runs none of them)
 BENCH_OPT ?= -O2
 $(BUILD)/bench_egl: bench/bench.c $(TEST_DEPS) | $(BUILD)
 	$(CC) -std=c99 $(BENCH_OPT) $(WARN) -DGLU_EGL $(INC) $< -o $@ -lEGL -lOpenGL -lm
