@@ -1981,9 +1981,9 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  per-face read is the faster), in single-sample frames (and multisampled ones without a
                  debug read-back with FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE: the faces shaded once per pixel,
                  tested per sample against the engine's multisample depth, the composite per sample),
-                 at any viewport (one away from the window origin sums into a target in the window's
-                 coordinates, grown to the viewports' far corners and shared by the views of a split
-                 screen; then no colour-textured volume), with every volume clear of the near and far
+                 at any viewport (the sum is a target in the window's coordinates, grown to the
+                 viewports' far corners and shared by the views of a split screen; away from the window
+                 origin no colour-textured volume), with every volume clear of the near and far
                  planes or, the camera inside it, convex and holding the projection's whole near
                  plane rectangle (its far side before the far plane), no density-textured volume, no
                  fogvol_add_light, no downsample, not NEAR_CLAMP or COLORS, a projection without an
@@ -7347,10 +7347,9 @@ typedef struct fogvol__gpu {
                                                  FLOAT: B is the float sum */
     fogvol_handle tgt_o2, tgt_b2, tgt_f2;     /* WIDE: the second attachments */
     fogvol_handle tgt_c, tgt_c2;              /* COLORS: optical depth and emission sums (RGBA32F) */
-    fogvol_handle tgt_e;                      /* ENGINE_DEPTH_TEST: the depth sum and face count (RG32F) */
-    fogvol_handle tgt_ew;  /* ... for viewports away from the window origin: E in the window's (the engine
-                              depth's) texel coordinates, ew_w x ew_h, grown as viewports need (fogvol__window_e) */
-    int ew_w, ew_h, ew_samples;
+    fogvol_handle tgt_e; /* ENGINE_DEPTH_TEST: the depth sum and face count (RG32F) in the window's (the
+                            engine depth's) texel coordinates, e_w x e_h, grown as viewports need (fogvol__window_e) */
+    int e_w, e_h, e_samples, e_refused; /* e_refused: a sample count (> 1) the backend made no E of */
     fogvol_handle tgt_v; /* overflow mask written by the check passes (SINGLE: with depth) */
     fogvol_handle tgt_l; /* the lights' front depth L (R32F on FLOAT, else encoded RGBA8) */
     int target_w, target_h;
@@ -7443,8 +7442,7 @@ typedef struct fogvol__run {
     fogvol_frame_info info;
     fogvol_pass base;        /* target-space pass state holding the frame's uniforms and lookup textures */
     fogvol_native engine_depth;  /* ENGINE_DEPTH: the engine's depth texture (or fogvol's copy of it) */
-    fogvol_handle e;             /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: this frame's E (tgt_e, or tgt_ew when the
-                                    viewport is away from the window origin) */
+    fogvol_handle e;             /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: this frame's E (tgt_e) */
     int w, h;
     int counted, checks, fresh; /* overflow: query-counted check passes, any check pass, a new count */
     int captured, overflow;     /* debug read-back done; its overflow pixel count */
@@ -7469,9 +7467,8 @@ static void fogvol__destroy_targets(fogvol_context *ctx)
     if (ctx->gpu.tgt_l) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_l);
     if (ctx->gpu.tgt_c) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_c);
     if (ctx->gpu.tgt_e) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_e);
-    if (ctx->gpu.tgt_ew) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_ew);
-    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = ctx->gpu.tgt_e = ctx->gpu.tgt_ew = 0;
-    ctx->gpu.ew_w = ctx->gpu.ew_h = ctx->gpu.ew_samples = 0;
+    ctx->gpu.tgt_v = ctx->gpu.tgt_l = ctx->gpu.tgt_c = ctx->gpu.tgt_c2 = ctx->gpu.tgt_e = 0;
+    ctx->gpu.e_w = ctx->gpu.e_h = ctx->gpu.e_samples = ctx->gpu.e_refused = 0;
     if (ctx->gpu.tgt_o) ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_o);
     ctx->gpu.tgt_o = ctx->gpu.tgt_b = ctx->gpu.tgt_f = ctx->gpu.tgt_t = 0;
     ctx->gpu.tgt_o2 = ctx->gpu.tgt_b2 = ctx->gpu.tgt_f2 = 0;
@@ -7546,24 +7543,6 @@ static fogvol_result fogvol__float_targets(fogvol_context *ctx, fogvol_target_de
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_c);
         if (r == FOGVOL_SUCCESS && !(ctx->gpu.tgt_c2 = ctx->be.target_attachment(ctx->be.user_data, ctx->gpu.tgt_c, 1)))
             r = FOGVOL_ERROR_BACKEND;
-    }
-    if (r == FOGVOL_SUCCESS && ctx->cfg.engine_test && !half &&
-        (td.samples <= 1 || (ctx->be.caps & FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE))) {
-        int ms = td.samples > 1;
-        td.format = FOGVOL_FORMAT_RG32F;
-        td.color_count = 1;
-        td.label = ms ? "fogvol depth sum and face count, depth-tested (float, multisample)"
-                      : "fogvol depth sum and face count, depth-tested (float)";
-        if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
-            /* single-sample: off from now on; multisampled: these targets' frames only */
-            fogvol__log(&ctx->log, ms ? FOGVOL_LOG_INFO : FOGVOL_LOG_WARNING,
-                        ms ? "fogvol: no multisample RG32F target: multisampled FLOAT + ENGINE_DEPTH frames read the "
-                             "engine's depth per sample"
-                           : "fogvol: no RG32F target: FLOAT + ENGINE_DEPTH frames read the engine's depth per face "
-                             "(FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)");
-            if (!ms) ctx->cfg.engine_test = 0;
-            ctx->gpu.tgt_e = 0;
-        }
     }
     return r;
 }
@@ -10069,26 +10048,28 @@ static unsigned fogvol__engine_test_spec(void)
     return FOGVOL_SPECIALIZE_ENGINE_TEST | FOGVOL_SPECIALIZE_NO_DENSITY | FOGVOL_SPECIALIZE_ORIGIN; /* (reads nothing) */
 }
 
-/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST with the viewport away from the window origin: E in the texel
-   coordinates of the engine's depth (its texture, or copy_depth's copy, which keeps them), so that the
-   depth lines up with E as its depth buffer: the window up to the viewport's far corner, grown as the
-   viewports of later frames need (the two halves of a split screen share it), never shrunk. 0: none
-   (logged; the frame reads the engine's depth per face). */
+/* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST: E in the texel coordinates of the engine's depth (its texture, or
+   copy_depth's copy, which keeps them) at any viewport, so that the depth lines up with E as its depth
+   buffer: the window up to the viewport's far corner, grown as the viewports of later frames need (the
+   two halves of a split screen share it), never shrunk. 0: none; a backend that makes no such target
+   turns the speed-up off (single-sample, logged) or leaves that sample count's frames to the per-sample
+   read (logged once). */
 static fogvol_handle fogvol__window_e(fogvol_context *ctx)
 {
     const int *vp = ctx->cur.frame.viewport;
-    int w = vp[0] + vp[2], h = vp[1] + vp[3];
+    int w = vp[0] + vp[2], h = vp[1] + vp[3], ms = ctx->cur.samples > 1;
     fogvol_target_desc td;
-    if (ctx->gpu.tgt_ew && ctx->gpu.ew_samples == ctx->cur.samples && ctx->gpu.ew_w >= w && ctx->gpu.ew_h >= h)
-        return ctx->gpu.tgt_ew;
-    if (ctx->gpu.tgt_ew) {
-        if (ctx->gpu.ew_samples == ctx->cur.samples) {
-            if (ctx->gpu.ew_w > w) w = ctx->gpu.ew_w;
-            if (ctx->gpu.ew_h > h) h = ctx->gpu.ew_h;
+    if (ctx->gpu.tgt_e && ctx->gpu.e_samples == ctx->cur.samples && ctx->gpu.e_w >= w && ctx->gpu.e_h >= h)
+        return ctx->gpu.tgt_e;
+    if (ms && ctx->gpu.e_refused == ctx->cur.samples) return 0;
+    if (ctx->gpu.tgt_e) {
+        if (ctx->gpu.e_samples == ctx->cur.samples) {
+            if (ctx->gpu.e_w > w) w = ctx->gpu.e_w;
+            if (ctx->gpu.e_h > h) h = ctx->gpu.e_h;
         }
-        ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_ew);
-        ctx->gpu.tgt_ew = 0;
-        ctx->gpu.ew_w = ctx->gpu.ew_h = ctx->gpu.ew_samples = 0;
+        ctx->be.destroy_target(ctx->be.user_data, ctx->gpu.tgt_e);
+        ctx->gpu.tgt_e = 0;
+        ctx->gpu.e_w = ctx->gpu.e_h = ctx->gpu.e_samples = 0;
     }
     memset(&td, 0, sizeof td);
     td.width = w;
@@ -10096,17 +10077,24 @@ static fogvol_handle fogvol__window_e(fogvol_context *ctx)
     td.samples = ctx->cur.samples;
     td.format = FOGVOL_FORMAT_RG32F;
     td.color_count = 1;
-    td.label = "fogvol depth sum and face count, depth-tested, in window coordinates (float)";
-    if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_ew) != FOGVOL_SUCCESS) {
-        fogvol__log(&ctx->log, FOGVOL_LOG_INFO, "fogvol: no %dx%d RG32F target: this frame reads the engine's depth "
-                                                "per face", w, h);
-        ctx->gpu.tgt_ew = 0;
+    td.label = ms ? "fogvol depth sum and face count, depth-tested (float, multisample)"
+                  : "fogvol depth sum and face count, depth-tested (float)";
+    if (ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_e) != FOGVOL_SUCCESS) {
+        fogvol__log(&ctx->log, ms ? FOGVOL_LOG_INFO : FOGVOL_LOG_WARNING,
+                    ms ? "fogvol: no %dx%d multisample RG32F target: multisampled FLOAT + ENGINE_DEPTH frames read the "
+                         "engine's depth per sample"
+                       : "fogvol: no %dx%d RG32F target: FLOAT + ENGINE_DEPTH frames read the engine's depth per face "
+                         "(FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST off)",
+                    w, h);
+        if (ms) ctx->gpu.e_refused = ctx->cur.samples;
+        else ctx->cfg.engine_test = 0;
+        ctx->gpu.tgt_e = 0;
         return 0;
     }
-    ctx->gpu.ew_w = w;
-    ctx->gpu.ew_h = h;
-    ctx->gpu.ew_samples = ctx->cur.samples;
-    return ctx->gpu.tgt_ew;
+    ctx->gpu.e_w = w;
+    ctx->gpu.e_h = h;
+    ctx->gpu.e_samples = ctx->cur.samples;
+    return ctx->gpu.tgt_e;
 }
 
 /* The depth-tested face program: a single-sample one in multisampled frames too, which draw it shaded
@@ -10140,10 +10128,8 @@ static void fogvol__engine_test_pass(fogvol_context *ctx, fogvol__run *run, cons
     ps.per_sample = ctx->cur.samples > 1 ? 2 : 0; /* multisampled: tested per sample, shaded per pixel */
     ps.target = run->e;
     ps.clear = 1;
-    if (!run->p.origin_bit) { /* E in window coordinates: the viewport as the engine's, the clear inside it */
-        memcpy(ps.viewport, ctx->cur.frame.viewport, sizeof ps.viewport);
-        memcpy(ps.scissor, ctx->cur.frame.viewport, sizeof ps.scissor);
-    }
+    memcpy(ps.viewport, ctx->cur.frame.viewport, sizeof ps.viewport); /* E in window coordinates: the */
+    memcpy(ps.scissor, ctx->cur.frame.viewport, sizeof ps.scissor);   /* engine's viewport, cleared inside */
     ps.blend = FOGVOL_PASS_BLEND_ADD;
     ps.depth_test = 1;
     ps.depth_texture = run->engine_depth;
@@ -10174,10 +10160,8 @@ static void fogvol__engine_test_sources(const fogvol_context *ctx, const fogvol_
     ps->textures[FOGVOL__UNIT_BACK] = run->e;
     ps->native_textures[FOGVOL__UNIT_OPAQUE] = run->engine_depth;
     ps->uniforms[FOGVOL_U_MISC][3] = (float)c;
-    if (!run->p.origin_bit) { /* E in window coordinates (the program is ORIGIN): FV_SCREEN's scale */
-        ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.ew_w;
-        ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.ew_h;
-    }
+    ps->uniforms[FOGVOL_U_SCREEN][0] = 1.0f / (float)ctx->gpu.e_w; /* E in window coordinates (the */
+    ps->uniforms[FOGVOL_U_SCREEN][1] = 1.0f / (float)ctx->gpu.e_h; /* program is ORIGIN): FV_SCREEN's scale */
 }
 
 /* The debug read-back of a FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST group: r - o (g - c), as its composite takes
@@ -10188,10 +10172,8 @@ static fogvol_result fogvol__engine_test_resolve(fogvol_context *ctx, fogvol__ru
     fogvol_pass ps = run->base;
     memset(ps.textures, 0, sizeof ps.textures);
     fogvol__engine_test_sources(ctx, run, ramp, &ps);
-    if (!run->p.origin_bit) { /* B's pixel -> E's (window) pixel; the engine's texel likewise (fv_nf.zw) */
-        ps.uniforms[FOGVOL_U_SCREEN][2] = (float)ctx->cur.frame.viewport[0];
-        ps.uniforms[FOGVOL_U_SCREEN][3] = (float)ctx->cur.frame.viewport[1];
-    }
+    ps.uniforms[FOGVOL_U_SCREEN][2] = (float)ctx->cur.frame.viewport[0]; /* B's pixel -> E's (window) */
+    ps.uniforms[FOGVOL_U_SCREEN][3] = (float)ctx->cur.frame.viewport[1]; /* pixel; the engine's texel too */
     ps.target = ctx->gpu.tgt_b;
     ps.clear = 1;
     ps.uniforms[FOGVOL_U_RAMP][3] = 1.0f;
@@ -11164,7 +11146,7 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
         r = fd->downsample == 2 ? fogvol__ensure_targets(ctx, (run->w + 1) / 2, (run->h + 1) / 2, 1)
                                 : fogvol__ensure_targets(ctx, run->w, run->h, 0);
     if (r != FOGVOL_SUCCESS) return r;
-    run->e = !run->p.engine_test ? 0 : run->p.origin_bit ? ctx->gpu.tgt_e : fogvol__window_e(ctx);
+    run->e = run->p.engine_test ? fogvol__window_e(ctx) : 0;
     run->p.engine_test = run->p.engine_test && run->e && fogvol__engine_test_programs(ctx);
     run->st.engine_depth_tested = run->p.engine_test;
     run->engine_depth = fd->engine_depth_texture;

@@ -3302,6 +3302,35 @@ static void ed_frame(fogvol_context *fv, const fogvol_mesh *box, const fogvol_ra
     assert_int_equal(fogvol_end_frame(fv, st), FOGVOL_SUCCESS);
 }
 
+/* A FLOAT + ENGINE_DEPTH context on backend table be (logger lg: may be NULL), with the box s as a mesh
+   and one ramp; ed_free frees them. */
+static void ed_context(const fogvol_backend *be, const fogvol_logger *lg, const shp_mesh *s, fogvol_context **fv,
+                       fogvol_mesh **box, fogvol_ramp **ramp)
+{
+    fogvol_context_desc cd;
+    fogvol_mesh_desc md;
+    fogvol_ramp_desc rd;
+    memset(&cd, 0, sizeof cd);
+    cd.backend = *be;
+    if (lg) cd.logger = *lg;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    assert_int_equal(fogvol_create_context(&cd, fv), FOGVOL_SUCCESS);
+    fx_mesh_desc(&md, s, 0);
+    assert_int_equal(fogvol_create_mesh(*fv, &md, box, NULL), FOGVOL_SUCCESS);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = 1.0f;
+    rd.density = 0.5f;
+    assert_int_equal(fogvol_create_ramp(*fv, &rd, ramp), FOGVOL_SUCCESS);
+}
+
+static void ed_free(fogvol_context *fv, fogvol_mesh *box, fogvol_ramp *ramp)
+{
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_mesh(fv, box);
+    fogvol_destroy_context(fv);
+}
+
 /* FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST on the null backend (FOGVOL_CAP_ATTACH_DEPTH): a frame that fits draws
    its faces into a target of fogvol's with the engine's depth texture as its depth buffer (tested,
    not written; GREATER where the depth range reverses it) reading no depth, and the composite reads
@@ -3314,11 +3343,8 @@ static void test_engine_depth_attached(void **state)
 {
     fogvol_null_backend nb;
     fogvol_backend be;
-    fogvol_context_desc cd;
     fogvol_context *fv;
-    fogvol_mesh_desc md;
     fogvol_mesh *box;
-    fogvol_ramp_desc rd;
     fogvol_ramp *ramp;
     fogvol_frame_stats st;
     shp_mesh s = shp_box(1.0f, 1.0f, 1.0f); /* half-size 0.5 */
@@ -3329,17 +3355,7 @@ static void test_engine_depth_attached(void **state)
         be.caps |= FOGVOL_CAP_FLOAT_BLEND;
         if (!caps) be.caps &= ~(unsigned)FOGVOL_CAP_ATTACH_DEPTH;
         if (caps == 2) be.caps |= FOGVOL_CAP_SOFTWARE_RENDERER;
-        memset(&cd, 0, sizeof cd);
-        cd.backend = be;
-        cd.tier = FOGVOL_TIER_FLOAT;
-        cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
-        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-        fx_mesh_desc(&md, &s, 0);
-        assert_int_equal(fogvol_create_mesh(fv, &md, &box, NULL), FOGVOL_SUCCESS);
-        memset(&rd, 0, sizeof rd);
-        rd.color[0] = 1.0f;
-        rd.density = 0.5f;
-        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        ed_context(&be, NULL, &s, &fv, &box, &ramp);
         for (k = 0; k < 5; ++k) {
             /* 0: fits; 1: fits, depth range (1, 0); 2: the camera inside (half-size 8: it also crosses the
                far plane); 3: offset viewport; 4: fits again */
@@ -3367,19 +3383,89 @@ static void test_engine_depth_attached(void **state)
                 assert_int_equal(nb.passes[0].viewport[3], A_H);
             }
         }
-        if (caps == 2) { /* a split screen: the two views alternate, each depth-tested; after the first pair
-                       nothing is created again (the offset view's target in window coordinates is kept) */
+        if (caps == 2) { /* a split screen: the two views alternate, each depth-tested into one sum in window
+                       coordinates; after the first pair nothing is created again */
             int creates = 0;
+            fogvol_handle e = 0;
             for (k = 0; k < 6; ++k) {
                 ed_frame(fv, box, ramp, 1.0f, k & 1, 0.0f, 0.0f, &st);
                 assert_int_equal(st.engine_depth_tested, 1);
-                if (k == 1) creates = nb.creates;
+                if (k == 1) {
+                    creates = nb.creates;
+                    e = nb.passes[0].target;
+                }
                 if (k > 1) assert_int_equal(nb.creates, creates);
+                if (k > 0) assert_true(nb.passes[0].target == e);
             }
         }
-        fogvol_destroy_ramp(fv, ramp);
-        fogvol_destroy_mesh(fv, box);
-        fogvol_destroy_context(fv);
+        ed_free(fv, box, ramp);
+        assert_int_equal(nb.creates, nb.destroys);
+    }
+    shp_free(&s);
+}
+
+/* A backend that makes no RG32F target (its create_target refuses them: all, or the multisampled ones)
+   for FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST's sum E. Single-sample: the frame still draws, reading the
+   engine's depth per face, the speed-up goes off (one warning) and no later frame asks again.
+   Multisampled: those frames read it per sample, asked once (one INFO), while single-sample frames in
+   between still draw depth-tested; a change of the sample count asks once more. */
+static fogvol_backend g_rg_inner;
+static int g_rg_refuse_ms_only, g_rg_refused;
+static fogvol_result refuse_rg32f(void *u, const fogvol_target_desc *d, fogvol_handle *out)
+{
+    if (d->format == FOGVOL_FORMAT_RG32F && (!g_rg_refuse_ms_only || d->samples > 1)) {
+        g_rg_refused++;
+        *out = 0;
+        return FOGVOL_ERROR_BACKEND;
+    }
+    return g_rg_inner.create_target(u, d, out);
+}
+
+static void test_engine_depth_no_rg32f(void **state)
+{
+    shp_mesh s = shp_box(1.0f, 1.0f, 1.0f);
+    int ms, k;
+    (void)state;
+    for (ms = 0; ms < 2; ++ms) {
+        /* the frames' sample counts (0: single-sample), whether each is depth-tested, refusals so far */
+        static const int samples[2][6] = {{0, 0, 0, 0, 0, 0}, {4, 4, 0, 4, 0, 2}};
+        static const int tested[2][6] = {{0, 0, 0, 0, 0, 0}, {0, 0, 1, 0, 1, 0}};
+        static const int refused[2][6] = {{1, 1, 1, 1, 1, 1}, {1, 1, 1, 2, 2, 3}};
+        fogvol_null_backend nb;
+        fogvol_backend be;
+        fogvol_logger lg;
+        fogvol_context *fv;
+        fogvol_mesh *box;
+        fogvol_ramp *ramp;
+        fogvol_frame_stats st;
+        logcap lc;
+        log_reset(&lc);
+        lg = cap_logger(&lc);
+        fogvol_null_backend_init(&nb, &g_rg_inner);
+        be = g_rg_inner;
+        be.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_SOFTWARE_RENDERER | FOGVOL_CAP_MULTISAMPLE |
+                   FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE;
+        be.create_target = refuse_rg32f;
+        g_rg_refuse_ms_only = ms;
+        g_rg_refused = 0;
+        ed_context(&be, &lg, &s, &fv, &box, &ramp);
+        for (k = 0; k < 6; ++k) {
+            nb.samples = samples[ms][k];
+            ed_frame(fv, box, ramp, 1.0f, 0, 0.0f, 0.0f, &st); /* (a frame that fits) */
+            assert_int_equal(st.engine_depth_tested, tested[ms][k]);
+            assert_int_equal(g_rg_refused, refused[ms][k]);
+            /* the faces read the engine's depth exactly when not depth-tested */
+            assert_true(nb.passes[0].native_textures[3] == (tested[ms][k] ? 0u : 77u));
+        }
+        if (ms) {
+            assert_true(log_has(&lc, FOGVOL_LOG_INFO, "multisample RG32F"));
+            assert_int_equal(lc.warnings, 0);
+        } else {
+            assert_int_equal(lc.warnings, 1);
+            assert_true(log_has(&lc, FOGVOL_LOG_WARNING, "RG32F"));
+        }
+        assert_int_equal(lc.errors, 0);
+        ed_free(fv, box, ramp);
         assert_int_equal(nb.creates, nb.destroys);
     }
     shp_free(&s);
@@ -3409,6 +3495,7 @@ int main(void)
         cmocka_unit_test(test_downsample_half_resolution),
         cmocka_unit_test(test_targets_made_once_per_size),
         cmocka_unit_test(test_engine_depth_attached),
+        cmocka_unit_test(test_engine_depth_no_rg32f),
     };
     const struct CMUnitTest gl_tests[] = {
         cmocka_unit_test_setup_teardown(test_gl_missing_entry_core33, setup_core, teardown_gl),
