@@ -1985,7 +1985,8 @@ FOGVOL_API fogvol_result fogvol_post_shader_strings(fogvol_post_effect effect, i
                  viewports' far corners and shared by the views of a split screen; away from the window
                  origin no colour-textured volume), with every volume clear of the near and far
                  planes or, the camera inside it, convex and holding the projection's whole near
-                 plane rectangle (its far side before the far plane), no density-textured volume, no
+                 plane rectangle and, where that plane lies beyond znear, znear's too (its far side
+                 before the far plane), no density-textured volume, no
                  fogvol_add_light, no downsample, not NEAR_CLAMP or COLORS, a projection without an
                  oblique near plane: the engine's depth texture (or fogvol's copy of the framebuffer's
                  depth) is attached as the depth buffer of the sum's target, tested (LESS, GREATER
@@ -10995,6 +10996,34 @@ static double fogvol__engine_view_depth(const fogvol_pass *ps, double z)
     return fabs(den) <= 1e-12 * fabs(num) ? 1e300 : num / den;
 }
 
+/* The engine's window depth at view depth e (the inverse of fogvol__engine_view_depth); 0: none. */
+static int fogvol__engine_window_z(const fogvol_pass *ps, double e, double *z)
+{
+    const float *a = ps->uniforms[FOGVOL_U_LINEAR], *b = ps->uniforms[FOGVOL_U_LINEAR_W];
+    double den = e * b[2] - a[2];
+    if (!(fabs(den) > 0.0)) return 0;
+    *z = (a[3] - e * b[3]) / den;
+    return 1;
+}
+
+/* The world corners of the frustum's cross-section at the engine's window depth zw: NDC (+-1, +-1) at
+   zw through the inverse view-projection (z01: the engine's NDC depth runs 0..1; r: window depths of
+   NDC depth -1 or 0 and 1). 0: a corner at infinity. */
+static int fogvol__window_rect(const fogvol_context *ctx, int z01, const double r[2], double zw, double c[4][3])
+{
+    double a = (z01 ? 1.0 : 2.0) / (r[1] - r[0]), zn = a * (zw - r[0]) - (z01 ? 0.0 : 1.0);
+    int k, j;
+    for (k = 0; k < 4; ++k) {
+        double q[4] = {(k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, zn, 1.0}, w[4];
+        for (j = 0; j < 4; ++j)
+            w[j] = ctx->cur.invvp[j] * q[0] + ctx->cur.invvp[4 + j] * q[1] + ctx->cur.invvp[8 + j] * q[2] +
+                   ctx->cur.invvp[12 + j] * q[3];
+        if (!(FOGVOL_FABS(w[3]) > 0.0)) return 0;
+        for (j = 0; j < 3; ++j) c[k][j] = w[j] / w[3];
+    }
+    return 1;
+}
+
 /* Whether volume v holds the whole rectangle where the projection's near plane cuts the frustum (world
    corners c, at view depth pn): every corner inside every face plane of its convex mesh, by twice the
    convexity test's tolerance and 1/1000 of pn (in view depth: the clipper's rounding), so that on every
@@ -11032,15 +11061,17 @@ static int fogvol__near_inside(const fogvol_context *ctx, const fogvol__volume *
    r - o (g - c) equals the min compare's sum where the faces on every pixel's ray close but for c
    volumes the near plane opens (each volume unclipped: between both pairs of planes, fogvol's
    znear..zfar and the projection's, which now clips the faces, or wholly outside both; or, the camera
-   inside it, convex and holding the projection's whole near plane rectangle at or beyond znear:
-   fogvol__volume.near_inside, c their signs' sum in a group) and the engine's depth is linearised
-   without the pixel (no oblique near plane). */
+   inside it, convex and holding the projection's whole near plane rectangle at or beyond znear and,
+   where that plane lies beyond znear, the rectangle at znear too: by convexity it then holds the
+   frustum between the two, so no face lies between znear and the plane that clips it, which the
+   count c would otherwise place at znear; fogvol__volume.near_inside, c their signs' sum in a group)
+   and the engine's depth is linearised without the pixel (no oblique near plane). */
 static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run, fogvol__plan *p)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_pass lin;
-    double r[2], e0, e1, pn, pf, lo, hi, corner[4][3];
-    int i, z01, corners = 0;
+    double r[2], e0, e1, pn, pf, lo, hi, zw, corner[2][4][3];
+    int i, z01, corners = 0, gap = 0;
     if (!ctx->cfg.engine_test || !p->engine_read || fd->downsample == 2 || ctx->cur.nlight > 0 || p->colors ||
         p->near_clamp > 0.0f)
         return 0;
@@ -11067,20 +11098,16 @@ static int fogvol__engine_test_frame(fogvol_context *ctx, const fogvol__run *run
             continue;
         /* the camera inside: the near plane at or beyond znear (no face nearer than znear), within hi */
         if (emax > hi || pn < fd->znear - 1e-6 * ((double)fd->zfar - fd->znear)) return 0;
-        if (!corners) { /* the near plane's rectangle: NDC (+-1, +-1) at the window depth of pn */
-            double a = (z01 ? 1.0 : 2.0) / (r[1] - r[0]), zw = e0 < e1 ? r[0] : r[1], zn = a * (zw - r[0]) - (z01 ? 0.0 : 1.0);
-            int k, j;
-            for (k = 0; k < 4; ++k) {
-                double q[4] = {(k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, zn, 1.0}, w[4];
-                for (j = 0; j < 4; ++j)
-                    w[j] = ctx->cur.invvp[j] * q[0] + ctx->cur.invvp[4 + j] * q[1] + ctx->cur.invvp[8 + j] * q[2] +
-                           ctx->cur.invvp[12 + j] * q[3];
-                if (!(FOGVOL_FABS(w[3]) > 0.0)) return 0;
-                for (j = 0; j < 3; ++j) corner[k][j] = w[j] / w[3];
-            }
+        if (!corners) { /* the near plane's rectangle, and znear's where the near plane lies beyond it */
+            if (!fogvol__window_rect(ctx, z01, r, e0 < e1 ? r[0] : r[1], corner[0])) return 0;
+            gap = pn > fd->znear + 1e-6 * ((double)fd->zfar - fd->znear);
+            if (gap && (!fogvol__engine_window_z(&lin, fd->znear, &zw) || !fogvol__window_rect(ctx, z01, r, zw, corner[1])))
+                return 0;
             corners = 1;
         }
-        if (!fogvol__near_inside(ctx, &ctx->cur.vols[i], (const double(*)[3])corner, pn)) return 0;
+        if (!fogvol__near_inside(ctx, &ctx->cur.vols[i], (const double(*)[3])corner[0], pn) ||
+            (gap && !fogvol__near_inside(ctx, &ctx->cur.vols[i], (const double(*)[3])corner[1], fd->znear)))
+            return 0;
         ctx->cur.vols[i].near_inside = 1;
     }
     /* window depth = a + b z_ndc; fogvol's passes map clip z' to (z' / w + 1) / 2: z' = 2 b z + (2 a - 1) w */

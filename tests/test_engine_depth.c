@@ -1338,6 +1338,99 @@ static void test_engine_tested_inputs(void **state)
     assert_int_equal(failures, 0);
 }
 
+/* The camera near a convex volume, the projection's near plane beyond fogvol's znear (here 1 and 0.1):
+   where the volume holds that plane's whole rectangle but begins after znear, its front face lies
+   between the two planes on every pixel's ray. The per-face read keeps it (thickness from the face);
+   the depth-tested sum, whose count c places the clipped face at znear, would add the gap before it.
+   Frames in one context: a box 10 x 10 wide and 3 deep with its front face at view depth 0.5 (between
+   the planes), at -1 (the camera inside), at 0.05 (before znear), at 0.5 again, then with the
+   projection's near plane at 0.1 and 0.3 (the box clear of both planes). Every pixel against the box's
+   depth extent from max(front, znear) to its back at 3.5, and the composite against 1 - exp(-density t).
+   (Before the rectangle at znear was asked for too, the frames at 0.5 drew 3.4 for 3.) */
+static void test_near_plane_beyond_znear(void **state)
+{
+    static const struct { double front, pn; int tested; } fr[6] = {
+        {0.5, 1.0, 0}, {-1.0, 1.0, 1}, {0.05, 1.0, 1}, {0.5, 1.0, 0}, {0.5, 0.1, 1}, {0.5, 0.3, 1}};
+    static float thick[W * H];
+    static unsigned char px[W * H * 4];
+    const double back = 3.5, znear = 0.1;
+    glu_ctx g;
+    engine e;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh_desc md;
+    fogvol_mesh *mesh;
+    fogvol_ramp_desc rd;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    fogvol_frame_stats st;
+    int f, i, ch;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    engine_init(&e);
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.gl.software = 1; /* the depth-tested faces wherever a frame fits them, on any GL */
+    cd.logger.func = logger;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = (float)DENSITY;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    for (f = 0; f < 6; ++f) {
+        shp_mesh box = shp_box(5.0f, 5.0f, (float)(0.5 * (back - fr[f].front)));
+        double want = back - (fr[f].front > znear ? fr[f].front : znear), a = 1.0 - exp(-DENSITY * want), terr = 0, cerr = 0;
+        fx_mesh_desc(&md, &box, 0);
+        assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+        glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
+        glViewport(0, 0, W, H);
+        glClearColor(0.2f, 0.3f, 0.4f, 1.0f);
+        glClearDepth(1.0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        memset(&fd, 0, sizeof fd);
+        glu_identity(fd.view);
+        glu_perspective(fd.projection, 60.0, 1.0, fr[f].pn, 100.0);
+        fd.znear = (float)znear;
+        fd.zfar = 100.0f;
+        fd.viewport[2] = W;
+        fd.viewport[3] = H;
+        fd.engine_depth_texture = e.depth;
+        fd.debug_thickness = thick;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = mesh;
+        vd.ramp = ramp;
+        glu_identity(vd.model);
+        vd.model[14] = (float)(-0.5 * (back + fr[f].front));
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        for (i = 0; i < W * H; ++i) {
+            if (fabs(thick[i] - want) > terr) terr = fabs(thick[i] - want);
+            for (ch = 0; ch < 3; ++ch) {
+                double base = ch == 0 ? 0.2 : ch == 1 ? 0.3 : 0.4, d = fabs(px[4 * i + ch] / 255.0 - (base + (0.8 - base) * a));
+                if (d > cerr) cerr = d;
+            }
+        }
+        print_message("  front face at %5.2f, projection near %.1f: thickness %.4f (max |error| %.2g), composite max |error| "
+                      "%.1f/255, %s\n", fr[f].front, fr[f].pn, want, terr, cerr * 255.0,
+                      st.engine_depth_tested ? "depth-tested" : "read per face");
+        assert_true(terr <= 3e-5 * (100.0 - znear));
+        assert_true(cerr <= 2.0 / 255.0);
+        assert_int_equal(st.engine_depth_tested, fr[f].tested);
+        fogvol_destroy_mesh(fv, mesh);
+        shp_free(&box);
+    }
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    engine_free(&e);
+    glu_destroy(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1345,6 +1438,7 @@ int main(void)
         cmocka_unit_test(test_camera_refused),
         cmocka_unit_test(test_conventions),
         cmocka_unit_test(test_engine_tested_inputs),
+        cmocka_unit_test(test_near_plane_beyond_znear),
     };
     if (getenv("FV_TEST_FILTER")) cmocka_set_test_filter(getenv("FV_TEST_FILTER")); /* e.g. "*sequence*" */
     return cmocka_run_group_tests(tests, NULL, NULL);
