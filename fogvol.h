@@ -13411,6 +13411,15 @@ static fogvol__GLenum fogvol__gl_depth_format(fogvol__gl *gl, int default_fb)
     return bits == 32 && !gl->gles ? FOGVOL__GL_DEPTH_COMPONENT32 : 0;
 }
 
+/* The copy texture and its framebuffer deleted: the next copy makes them again. */
+static void fogvol__gl_depth_release(fogvol__gl *gl)
+{
+    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
+    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    gl->depth_fbo = gl->depth_tex = 0;
+    gl->depth_w = gl->depth_h = gl->depth_samples = 0;
+}
+
 /* The copy texture and its framebuffer for a format, size and sample count (0: single-sample),
    recreated only when the format or samples differ or it is too small (it keeps the engine's
    texel coordinates, so the views of a split screen share one); leaves the draw framebuffer alone. */
@@ -13431,8 +13440,7 @@ static void fogvol__gl_depth_target(fogvol__gl *gl, fogvol__GLenum format, int w
         w = w > gl->depth_w ? w : gl->depth_w; /* grow only: views of other sizes keep fitting */
         h = h > gl->depth_h ? h : gl->depth_h;
     }
-    if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-    if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+    fogvol__gl_depth_release(gl);
     gl->GetIntegerv(FOGVOL__GL_DRAW_FRAMEBUFFER_BINDING, (fogvol__GLint *)&fbo);
     gl->GenTextures(1, &gl->depth_tex);
     gl->ActiveTexture(FOGVOL__GL_TEXTURE0);
@@ -13531,6 +13539,7 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
     gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, (fogvol__GLuint)gl->saved.draw_fbo);
     r = fogvol__gl_check(gl, "copy_depth (glBlitFramebuffer of the engine's depth)");
     if (r == FOGVOL_SUCCESS) *texture = gl->depth_tex;
+    else fogvol__gl_depth_release(gl); /* (a texture the GL refused, e.g. too large: not kept for later frames) */
     return r;
 }
 
@@ -13623,8 +13632,7 @@ static void fogvol__gl_destroy(void *u)
         if (gl->native_sampler) gl->DeleteSamplers(1, &gl->native_sampler);
         if (gl->err_shader) gl->DeleteShader(gl->err_shader);
         if (gl->err_fbo) gl->DeleteFramebuffers(1, &gl->err_fbo); /* never left bound: no binding changes */
-        if (gl->depth_fbo) gl->DeleteFramebuffers(1, &gl->depth_fbo);
-        if (gl->depth_tex) gl->DeleteTextures(1, &gl->depth_tex);
+        fogvol__gl_depth_release(gl);
     }
     a = gl->alloc;
     fogvol__free(&a, gl);

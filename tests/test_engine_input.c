@@ -487,6 +487,78 @@ static void test_engine_depth_buffers(void **state)
     free(thick);
 }
 
+/* A copy of the engine's depth that the GL refuses fails its frame, logged, and keeps nothing: the
+   frames after it copy again. Frame 1 of five has its viewport's far corner past GL_MAX_TEXTURE_SIZE
+   (the copy keeps the engine's texel coordinates, so its texture is that wide); the others, the whole
+   framebuffer, each against the ray-cast thickness. (A refused texture kept as if made failed every
+   later copy: the frames after it returned FOGVOL_ERROR_BACKEND and drew no fog.) */
+static void test_engine_depth_copy_recovers(void **state)
+{
+    rc_camera c = camera();
+    tobj o[2];
+    int n = scene(o), f, i, pixels;
+    double *gt = (double *)malloc(sizeof(double) * W * H), range = c.zfar - c.znear, err, bound;
+    unsigned char *interior = (unsigned char *)malloc((size_t)W * H);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    glu_ctx g;
+    engine e;
+    fogvol_context *fv;
+    fogvol_mesh *vol;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_result r;
+    GLint maxtex = 0;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    truth(&c, o, n, gt, interior);
+    engine_init(&e);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxtex);
+    fv = make_ctx(FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH);
+    vol = mesh_of(fv, &o[0].m, 0);
+    ramp = ramp_of(fv);
+    /* the default framebuffer's 24-bit depth: its quantum at the farthest occluder (as run_depth_case) */
+    bound = 1e-4 * range + ldexp(1.0, -24) * 81.0 * range / (c.zfar * c.znear);
+    for (f = 0; f < 5; ++f) {
+        int refused = f == 1 && maxtex <= 32767;
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, W, H);
+        glClearColor(0.2f, 0.3f, 0.4f, 1.0f);
+        glClearDepth(1.0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+        frame_of(&fd, &c, refused ? NULL : thick);
+        engine_draw(&e, o, n, fd.view, fd.projection, NULL);
+        fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;
+        if (refused) fd.viewport[0] = maxtex;
+        for (i = 0; i < W * H; ++i) thick[i] = -1.0f;
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        add_volume(fv, vol, o[0].model, ramp);
+        g_log[0] = 0;
+        r = fogvol_end_frame(fv, NULL);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        if (refused) {
+            assert_int_equal(r, FOGVOL_ERROR_BACKEND);
+            assert_non_null(strstr(g_log, "copy the engine's depth"));
+            print_message("  frame %d, viewport at x = %d: %s\n", f, maxtex, g_log);
+            continue;
+        }
+        assert_int_equal(r, FOGVOL_SUCCESS);
+        err = max_err(thick, gt, interior, &pixels);
+        print_message("  frame %d: max |error| %.3g of the range (bound %.3g), %d fogged pixels\n", f, err / range,
+                      bound / range, pixels);
+        assert_true(pixels > 1000);
+        assert_true(err <= bound);
+    }
+    glDeleteProgram(e.prog);
+    fogvol_destroy_mesh(fv, vol);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    free_objs(o, n);
+    free(gt);
+    free(interior);
+    free(thick);
+}
+
 /* refusals: no depth buffer, unknown source, a texture source without a texture */
 static void test_engine_depth_refusals(void **state)
 {
@@ -1731,6 +1803,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_engine_depth_buffers),     cmocka_unit_test(test_engine_depth_refusals),
+        cmocka_unit_test(test_engine_depth_copy_recovers),
         cmocka_unit_test(test_engine_depth_walk),
         cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluders_sequence),
         cmocka_unit_test(test_engine_occluder_refusals), cmocka_unit_test(test_cancelled_frames),
