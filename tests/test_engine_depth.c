@@ -1344,13 +1344,15 @@ static void test_engine_tested_inputs(void **state)
    the depth-tested sum, whose count c places the clipped face at znear, would add the gap before it.
    Frames in one context: a box 10 x 10 wide and 3 deep with its front face at view depth 0.5 (between
    the planes), at -1 (the camera inside), at 0.05 (before znear), at 0.5 again, then with the
-   projection's near plane at 0.1 and 0.3 (the box clear of both planes). Every pixel against the box's
-   depth extent from max(front, znear) to its back at 3.5, and the composite against 1 - exp(-density t).
-   (Before the rectangle at znear was asked for too, the frames at 0.5 drew 3.4 for 3.) */
+   projection's near plane at 0.1 and 0.3 (the box clear of both planes); in standard GL, ZERO_TO_ONE
+   reversed-Z, a reversed-Z matrix and orthographic. Every pixel against the box's depth extent from
+   max(front, znear) to its back at 3.5, and the composite against 1 - exp(-density t). (Before the
+   rectangle at znear was asked for too, the frames at 0.5 drew 3.4 for 3.) */
 static void test_near_plane_beyond_znear(void **state)
 {
     static const struct { double front, pn; int tested; } fr[6] = {
         {0.5, 1.0, 0}, {-1.0, 1.0, 1}, {0.05, 1.0, 1}, {0.5, 1.0, 0}, {0.5, 0.1, 1}, {0.5, 0.3, 1}};
+    static const int convs[4] = {0, 1, 6, 7};
     static float thick[W * H];
     static unsigned char px[W * H * 4];
     const double back = 3.5, znear = 0.1;
@@ -1365,7 +1367,8 @@ static void test_near_plane_beyond_znear(void **state)
     fogvol_frame_desc fd;
     fogvol_volume_desc vd;
     fogvol_frame_stats st;
-    int f, i, ch;
+    scene s;
+    int f, i, ch, k;
     (void)state;
     assert_true(glu_create(&g, W, H, 1));
     engine_init(&e);
@@ -1380,51 +1383,63 @@ static void test_near_plane_beyond_znear(void **state)
     rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
     rd.density = (float)DENSITY;
     assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-    for (f = 0; f < 6; ++f) {
-        shp_mesh box = shp_box(5.0f, 5.0f, (float)(0.5 * (back - fr[f].front)));
-        double want = back - (fr[f].front > znear ? fr[f].front : znear), a = 1.0 - exp(-DENSITY * want), terr = 0, cerr = 0;
-        fx_mesh_desc(&md, &box, 0);
-        assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
-        glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
-        glViewport(0, 0, W, H);
-        glClearColor(0.2f, 0.3f, 0.4f, 1.0f);
-        glClearDepth(1.0);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        memset(&fd, 0, sizeof fd);
-        glu_identity(fd.view);
-        glu_perspective(fd.projection, 60.0, 1.0, fr[f].pn, 100.0);
-        fd.znear = (float)znear;
-        fd.zfar = 100.0f;
-        fd.viewport[2] = W;
-        fd.viewport[3] = H;
-        fd.engine_depth_texture = e.depth;
-        fd.debug_thickness = thick;
-        memset(&vd, 0, sizeof vd);
-        vd.mesh = mesh;
-        vd.ramp = ramp;
-        glu_identity(vd.model);
-        vd.model[14] = (float)(-0.5 * (back + fr[f].front));
-        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
-        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
-        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
-        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
-        assert_int_equal(glGetError(), GL_NO_ERROR);
-        for (i = 0; i < W * H; ++i) {
-            if (fabs(thick[i] - want) > terr) terr = fabs(thick[i] - want);
-            for (ch = 0; ch < 3; ++ch) {
-                double base = ch == 0 ? 0.2 : ch == 1 ? 0.3 : 0.4, d = fabs(px[4 * i + ch] / 255.0 - (base + (0.8 - base) * a));
-                if (d > cerr) cerr = d;
+    g_vw = W;
+    g_vh = H;
+    for (k = 0; k < 4; ++k)
+        for (f = 0; f < 6; ++f) {
+            const conv *c = &g_convs[convs[k]];
+            const GLfloat zclear = c->greater ? 0.0f : 1.0f;
+            shp_mesh box = shp_box(5.0f, 5.0f, (float)(0.5 * (back - fr[f].front)));
+            double want = back - (fr[f].front > znear ? fr[f].front : znear), a = 1.0 - exp(-DENSITY * want);
+            double terr = 0, cerr = 0;
+            fx_mesh_desc(&md, &box, 0);
+            assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+            e.clip_control(GL_LOWER_LEFT, c->zero_to_one ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+            glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
+            glViewport(0, 0, W, H);
+            glClearColor(0.2f, 0.3f, 0.4f, 1.0f);
+            glClear(GL_COLOR_BUFFER_BIT);
+            glClearBufferfv(GL_DEPTH, 0, &zclear);
+            memset(&s, 0, sizeof s);
+            s.znear = fr[f].pn;
+            s.zfar = 100.0;
+            memset(&fd, 0, sizeof fd);
+            glu_identity(fd.view);
+            make_projection(c->proj, &s, fd.projection);
+            fd.znear = (float)znear;
+            fd.zfar = 100.0f;
+            fd.viewport[2] = W;
+            fd.viewport[3] = H;
+            fd.engine_depth_texture = e.depth;
+            fd.debug_thickness = thick;
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = mesh;
+            vd.ramp = ramp;
+            glu_identity(vd.model);
+            vd.model[14] = (float)(-0.5 * (back + fr[f].front));
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+            e.clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+            glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+            assert_int_equal(glGetError(), GL_NO_ERROR);
+            for (i = 0; i < W * H; ++i) {
+                if (fabs(thick[i] - want) > terr) terr = fabs(thick[i] - want);
+                for (ch = 0; ch < 3; ++ch) {
+                    double base = ch == 0 ? 0.2 : ch == 1 ? 0.3 : 0.4;
+                    double d = fabs(px[4 * i + ch] / 255.0 - (base + (0.8 - base) * a));
+                    if (d > cerr) cerr = d;
+                }
             }
+            print_message("  %-36s front face at %5.2f, near plane %.1f: thickness %.2f (max |error| %.2g), composite "
+                          "%.1f/255, %s\n", c->name, fr[f].front, fr[f].pn, want, terr, cerr * 255.0,
+                          st.engine_depth_tested ? "depth-tested" : "read per face");
+            assert_true(terr <= 3e-5 * (100.0 - znear));
+            assert_true(cerr <= 2.0 / 255.0);
+            assert_int_equal(st.engine_depth_tested, fr[f].tested);
+            fogvol_destroy_mesh(fv, mesh);
+            shp_free(&box);
         }
-        print_message("  front face at %5.2f, projection near %.1f: thickness %.4f (max |error| %.2g), composite max |error| "
-                      "%.1f/255, %s\n", fr[f].front, fr[f].pn, want, terr, cerr * 255.0,
-                      st.engine_depth_tested ? "depth-tested" : "read per face");
-        assert_true(terr <= 3e-5 * (100.0 - znear));
-        assert_true(cerr <= 2.0 / 255.0);
-        assert_int_equal(st.engine_depth_tested, fr[f].tested);
-        fogvol_destroy_mesh(fv, mesh);
-        shp_free(&box);
-    }
     fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
     engine_free(&e);
