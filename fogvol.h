@@ -7366,6 +7366,7 @@ typedef struct fogvol__frame_state {
     int64_t serial; /* fogvol_begin_frame calls (ramps mark the frame their volumes are textured in) */
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
+    int debug_gone;       /* frame.debug_ramp was destroyed inside the frame: its read-back writes 0 */
     fogvol_frame_desc frame;
     double viewproj[16];
     double eyerow[4];  /* view depth e = dot(eyerow, (world position, 1)) */
@@ -8492,6 +8493,10 @@ static void fogvol__forget(fogvol_context *ctx, const fogvol_mesh *mesh, const f
         fogvol__log(&ctx->log, FOGVOL_LOG_WARNING,
                     "fogvol: %s destroyed inside a frame: %d volumes and %d occluders that use it are dropped from "
                     "the frame", mesh ? "mesh" : "ramp", dv, doc);
+    if (ramp && ramp == ctx->cur.frame.debug_ramp) { /* (its volumes are gone: the frame draws none of it) */
+        ctx->cur.frame.debug_ramp = NULL;
+        ctx->cur.debug_gone = 1;
+    }
 }
 
 FOGVOL_API void fogvol_destroy_mesh(fogvol_context *ctx, fogvol_mesh *mesh)
@@ -9015,7 +9020,7 @@ FOGVOL_API fogvol_result fogvol_begin_frame(fogvol_context *ctx, const fogvol_fr
     ctx->cur.in_frame = 1;
     ctx->cur.serial++;
     ctx->cur.nlight = 0;
-    ctx->cur.mrt_ready = ctx->cur.engine_occluders = 0;
+    ctx->cur.mrt_ready = ctx->cur.engine_occluders = ctx->cur.debug_gone = 0;
     return FOGVOL_SUCCESS;
 }
 
@@ -9843,7 +9848,8 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const fogvol__ru
 
 static int fogvol__want_debug(const fogvol_context *ctx, const fogvol_ramp *ramp, int captured)
 {
-    return ctx->cur.frame.debug_thickness && !captured && (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
+    return ctx->cur.frame.debug_thickness && !captured && !ctx->cur.debug_gone &&
+           (ctx->cur.frame.debug_ramp == NULL || ctx->cur.frame.debug_ramp == ramp);
 }
 
 /* After the groups: a debug read-back that no group made (the frame draws no volume of debug_ramp,

@@ -497,6 +497,45 @@ static void test_textures_and_debug(void **state)
     assert_int_equal(textured_frame(&c, &s, NULL, 0, NULL, NV, NV - 1, dbg, c.ramp[NV - 1], img), FOGVOL_SUCCESS);
     for (untouched = 0, k = 0; k < CW * CH; ++k) untouched += dbg[k] != 0.0f;
     assert_int_equal(untouched, 0);
+    /* debug_ramp destroyed inside the frame (volume 3's): its volume is dropped, the read-back is 0
+       everywhere (the frame draws nothing of that ramp) and the picture is the model without volume 3
+       (the colour group read the destroyed ramp: a use-after-free under ASan) */
+    {
+        fogvol_frame_desc fd;
+        fogvol_volume_desc vd;
+        cscene m3 = s;
+        m3.density[3] = 0.0f;
+        reference(&m3, ref, exact, nhit, interior);
+        memset(&fd, 0, sizeof fd);
+        rc_camera_matrices(&s.cam, fd.view, fd.projection);
+        fd.znear = (float)s.cam.znear;
+        fd.zfar = (float)s.cam.zfar;
+        fd.viewport[2] = CW;
+        fd.viewport[3] = CH;
+        fd.debug_thickness = dbg;
+        fd.debug_ramp = c.ramp[3];
+        for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+        glClearColor(g_scene_rgb[0], g_scene_rgb[1], g_scene_rgb[2], 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        assert_int_equal(fogvol_begin_frame(c.fv, &fd), FOGVOL_SUCCESS);
+        for (i = 0; i < NV; ++i) {
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = c.mesh;
+            vd.ramp = c.ramp[i];
+            memcpy(vd.model, s.model[i], sizeof vd.model);
+            assert_int_equal(fogvol_add_volume(c.fv, &vd), FOGVOL_SUCCESS);
+        }
+        fogvol_destroy_ramp(c.fv, c.ramp[3]);
+        c.ramp[3] = NULL;
+        assert_int_equal(fogvol_end_frame(c.fv, NULL), FOGVOL_SUCCESS);
+        memcpy(img, glu_pixels(&c.g), (size_t)CW * CH * 4);
+        for (untouched = 0, k = 0; k < CW * CH; ++k) untouched += dbg[k] != 0.0f;
+        assert_int_equal(untouched, 0);
+        d = max_diff(img, NULL, ref, interior);
+        print_message("# COLORS, debug_ramp destroyed in the frame: read-back 0, max |picture - model without it| "
+                      "%.2f/255\n", d);
+        assert_true(d <= 2.0);
+    }
     fogvol_destroy_volume_texture(c.fv, dens);
     fogvol_destroy_volume_texture(c.fv, col);
     gpu_teardown(&c);
