@@ -1100,7 +1100,9 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
    before fogvol_end_frame: makes fogvol's O target the size of the viewport
    (touches the GPU, state restored) and returns what the engine needs to draw
    its occluders into it: attach texture as the only colour target of a
-   framebuffer of width x height with the engine's own depth buffer, clear
+   framebuffer of width x height with the engine's own depth buffer (of
+   info.samples samples: multisampled where the engine framebuffer bound now
+   is drawn per sample, and bound again for end_frame), clear
    colour to clear_color and depth to "far", draw with a depth test that keeps
    the nearest surface, and write fogvol_occluder_color(view_depth) from
    fogvol_occluder_snippet() (view_depth: the distance along the view axis,
@@ -1110,6 +1112,10 @@ FOGVOL_API const char *fogvol_mrt_snippet(void);
 typedef struct fogvol_occluder_info {
     fogvol_native texture;        /* backend API object (GL: texture name) */
     int width, height;
+    int samples;              /* 0: a single-sample texture (GL_TEXTURE_2D); n > 1: the engine
+                                 framebuffer bound now has n samples and fogvol draws per sample, so
+                                 texture is multisampled (GL_TEXTURE_2D_MULTISAMPLE), to be drawn with
+                                 a depth buffer of n samples; end_frame must find the same count */
     fogvol_format format;     /* RGBA8 (PS20: encoded depth) or R32F (FLOAT, and PS20 with
                                  FOGVOL_SPEEDUP_FLOAT_O: d = (view depth - near)/(far - near)) */
     float clear_color[4];
@@ -7367,6 +7373,7 @@ typedef struct fogvol__frame_state {
     int in_frame, in_occluder_pass, mrt_ready;
     int engine_occluders; /* fogvol_occluder_prepare: the engine draws O */
     int debug_gone;       /* frame.debug_ramp was destroyed inside the frame: its read-back writes 0 */
+    int prepared_samples; /* the sample count O was made with at fogvol_occluder_prepare / fogvol_mrt_prepare */
     fogvol_frame_desc frame;
     double viewproj[16];
     double eyerow[4];  /* view depth e = dot(eyerow, (world position, 1)) */
@@ -9285,9 +9292,15 @@ static fogvol_result fogvol__begin_backend_frame(fogvol_context *ctx, fogvol_fra
 static fogvol_result fogvol__prepare_o(fogvol_context *ctx, fogvol_constants *k, fogvol_native *texture)
 {
     fogvol_frame_info fi;
+    fogvol_frame_stats st;
     fogvol_result r = fogvol__begin_backend_frame(ctx, &fi);
     if (r != FOGVOL_SUCCESS) return r;
-    r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
+    /* this frame's sample count, as end_frame will find it: O made with an earlier frame's was made
+       again at end_frame, and what the engine drew into it lost */
+    memset(&st, 0, sizeof st);
+    r = fogvol__frame_samples(ctx, &fi, &st);
+    ctx->cur.prepared_samples = ctx->cur.samples;
+    if (r == FOGVOL_SUCCESS) r = fogvol__ensure_targets(ctx, ctx->cur.frame.viewport[2], ctx->cur.frame.viewport[3], 0);
     if (ctx->be.end_frame) ctx->be.end_frame(ctx->be.user_data);
     r = fogvol__be_result(ctx, r);
     if (r != FOGVOL_SUCCESS) return r;
@@ -9439,6 +9452,7 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
     fl = fl || ctx->cfg.float_o; /* from here: O is R32F (FLOAT, or PS20 with FOGVOL_SPEEDUP_FLOAT_O) */
     info->width = ctx->gpu.target_w;
     info->height = ctx->gpu.target_h;
+    info->samples = ctx->cur.samples;
     info->format = fl ? FOGVOL_FORMAT_R32F : FOGVOL_FORMAT_RGBA8;
     if (fl) info->clear_color[0] = 1.0f;
     else info->clear_color[0] = info->clear_color[1] = info->clear_color[2] = (float)(ctx->cfg.enc.levels - 1) / 255.0f;
@@ -11168,6 +11182,15 @@ static fogvol_result fogvol__frame_setup(fogvol_context *ctx, fogvol__run *run)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
     fogvol_result r = fogvol__frame_samples(ctx, &run->info, &run->st);
+    if (r == FOGVOL_SUCCESS && (ctx->cur.engine_occluders || ctx->cur.mrt_ready) &&
+        ctx->cur.samples != ctx->cur.prepared_samples) {
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR,
+                    "fogvol: the engine framebuffer bound at end_frame is drawn with %d samples per pixel, the one "
+                    "bound at fogvol_%s_prepare with %d: O, which the engine drew, has the other count; nothing drawn",
+                    ctx->cur.samples ? ctx->cur.samples : 1, ctx->cur.mrt_ready ? "mrt" : "occluder",
+                    ctx->cur.prepared_samples ? ctx->cur.prepared_samples : 1);
+        r = FOGVOL_ERROR_INVALID_STATE;
+    }
     fogvol__plan_frame(ctx, run);
     if (r == FOGVOL_SUCCESS && fd->downsample == 2 && ctx->cur.samples > 1) {
         fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: downsample 2 on a %d-sample engine framebuffer drawn per "

@@ -453,6 +453,7 @@ static void engine_resolve(engine *e, unsigned char *rgba)
 }
 
 /* ---- fogvol ------------------------------------------------------------------ */
+static fogvol_msaa g_msaa; /* of the context fv_create made last */
 typedef struct fv_scene {
     fogvol_context *fv;
     fogvol_mesh *vol, *occ;
@@ -477,6 +478,7 @@ static fogvol_result fv_create(fv_scene *s, fogvol_tier tier, unsigned variants,
     cd.gl.get_proc_address = glu_proc;
     cd.gl.dialect = dialect;
     cd.gl.software = 1; /* FLOAT + ENGINE_DEPTH depth-tested on any GL (a GPU's would read the depth per face) */
+    g_msaa = msaa;
     r = fogvol_create_context(&cd, &s->fv);
     if (r != FOGVOL_SUCCESS) return r;
     memset(&md, 0, sizeof md);
@@ -506,9 +508,73 @@ static void fv_destroy(fv_scene *s)
 
 static fogvol_composite g_composite; /* of the next frames */
 /* ENGINE_DEPTH cases: where the engine's depth comes from (else fogvol draws the occluder) */
-enum { DEPTH_NONE, DEPTH_BOUND, DEPTH_BY_NAME, DEPTH_TEXTURE };
-static int g_depth;
+enum { DEPTH_NONE, DEPTH_BOUND, DEPTH_BY_NAME, DEPTH_TEXTURE, DEPTH_ENGINE_O };
+static int g_depth; /* (DEPTH_ENGINE_O: no ENGINE_DEPTH; the engine draws the occluder into fogvol's O) */
 static const engine *g_engine; /* whose depth */
+
+/* DEPTH_ENGINE_O: the engine draws the occluder box (model) into fogvol's O itself
+   (fogvol_occluder_prepare, fogvol_occluder_snippet) with a depth buffer of O's sample count, which is
+   the engine framebuffer's bound now (single-sample with FOGVOL_MSAA_SINGLE_SAMPLE), then binds that
+   framebuffer again for end_frame. */
+static void engine_o(fv_scene *s, const float model[16])
+{
+    static const char *vs = "#version 330 core\nlayout(location = 0) in vec3 p;\nuniform mat4 mv, proj;\n"
+                            "out float vd;\nvoid main() { vec4 q = mv * vec4(p, 1.0); vd = -q.z; gl_Position = proj * q; }\n";
+    const char *fs[3];
+    fogvol_occluder_info oi;
+    GLint bound = 0, samples = 0, ok = 0;
+    GLuint prog, a, b, fbo, rb;
+    GLenum target;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+    glGetIntegerv(GL_SAMPLES, &samples);
+    assert_int_equal(fogvol_occluder_prepare(s->fv, &oi), FOGVOL_SUCCESS);
+    assert_int_equal(oi.samples, samples > 1 && g_msaa != FOGVOL_MSAA_SINGLE_SAMPLE ? samples : 0);
+    fs[0] = "#version 330 core\n";
+    fs[1] = fogvol_occluder_snippet();
+    fs[2] = "in float vd;\nout vec4 o;\nvoid main() { o = fogvol_occluder_color(vd); }\n";
+    prog = glCreateProgram();
+    a = compile(GL_VERTEX_SHADER, vs);
+    b = glCreateShader(GL_FRAGMENT_SHADER);
+    glShaderSource(b, 3, fs, NULL);
+    glCompileShader(b);
+    glAttachShader(prog, a);
+    glAttachShader(prog, b);
+    glLinkProgram(prog);
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    assert_true(ok);
+    glDeleteShader(a);
+    glDeleteShader(b);
+    target = oi.samples ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
+    glGenRenderbuffers(1, &rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb);
+    if (oi.samples) glRenderbufferStorageMultisample(GL_RENDERBUFFER, oi.samples, GL_DEPTH_COMPONENT24, oi.width, oi.height);
+    else glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, oi.width, oi.height);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, target, (GLuint)oi.texture, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb);
+    assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glViewport(0, 0, oi.width, oi.height);
+    glClearBufferfv(GL_COLOR, 0, oi.clear_color);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(prog);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "mv"), 1, GL_FALSE, model);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "proj"), 1, GL_FALSE, g_proj);
+    glUniform4fv(glGetUniformLocation(prog, "fogvol_mrt"), 2, oi.uniforms);
+    glBindVertexArray(g_engine->vao);
+    glDrawElements(GL_TRIANGLES, 36, GL_UNSIGNED_INT, NULL);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)bound);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteRenderbuffers(1, &rb);
+    glDeleteProgram(prog);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+}
 
 /* The frame desc of viewport vp (view = identity, the scene moved by g_model) and the volume, and
    the occluder unless the engine's depth holds it (occluder 0: nothing occludes). */
@@ -534,6 +600,7 @@ static void fv_begin(fv_scene *s, const int vp[4], int occluder, float *debug)
     fd.engine_depth_texture = g_depth == DEPTH_TEXTURE && g_engine ? g_engine->tex_depth : 0;
     assert_int_equal(fogvol_begin_frame(s->fv, &fd), FOGVOL_SUCCESS);
     if (!g_depth && occluder) assert_int_equal(fogvol_add_occluder(s->fv, s->occ, model), FOGVOL_SUCCESS);
+    if (g_depth == DEPTH_ENGINE_O && occluder) engine_o(s, model);
     memset(&vd, 0, sizeof vd);
     vd.mesh = s->vol;
     memcpy(vd.model, model, sizeof model);
@@ -732,6 +799,9 @@ static const tcase g_cases[] = {
      3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_BY_NAME},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, "PS20+enginedepth texture", 3, FOGVOL_COMPOSITE_FULLSCREEN,
      DEPTH_TEXTURE},
+    /* the engine draws the occluder into fogvol's O (fogvol_occluder_prepare), per sample */
+    {FOGVOL_TIER_FLOAT, 0, "FLOAT engine-drawn O", 3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_ENGINE_O},
+    {FOGVOL_TIER_PS20, 0, "PS20 engine-drawn O", 3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_ENGINE_O},
 };
 #define NCASES ((int)(sizeof g_cases / sizeof g_cases[0]))
 
@@ -1206,6 +1276,37 @@ static void test_refusals(void **state)
     engine_create(&e, W, H, NS);
     engine_draw(&e);
     engine_resolve(&e, ref);
+
+    /* the engine drew its occluders into O prepared for the 4x framebuffer, then binds a single-sample one
+       for end_frame: refused, logged, nothing drawn (O would be made again empty) */
+    {
+        engine e1;
+        const int vp[4] = {0, 0, W, H};
+        engine_create(&e1, W, H, 1);
+        engine_draw(&e1);
+        engine_resolve(&e1, img);
+        assert_int_equal(fv_create(&s, FOGVOL_TIER_FLOAT, 0, FOGVOL_GLSL_AUTO, FOGVOL_MSAA_AUTO), 0);
+        g_depth = DEPTH_ENGINE_O;
+        g_engine = &e;
+        glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
+        fv_begin(&s, vp, 1, NULL);
+        glBindFramebuffer(GL_FRAMEBUFFER, e1.fbo);
+        g_log[0] = 0;
+        assert_int_equal(fogvol_end_frame(s.fv, &st), FOGVOL_ERROR_INVALID_STATE);
+        assert_non_null(strstr(g_log, "occluder_prepare with 4"));
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        {
+            unsigned char *after = (unsigned char *)malloc((size_t)W * H * 4);
+            engine_resolve(&e1, after);
+            assert_memory_equal(after, img, (size_t)W * H * 4);
+            free(after);
+        }
+        g_depth = DEPTH_NONE;
+        g_engine = NULL;
+        fv_destroy(&s);
+        engine_destroy(&e1);
+        engine_draw(&e);
+    }
 
     /* GLSL 130 has no sampler2DMS / gl_SampleID */
     assert_int_equal(fv_create(&s, FOGVOL_TIER_FLOAT, 0, FOGVOL_GLSL_130, FOGVOL_MSAA_AUTO), 0);
