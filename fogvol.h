@@ -11743,7 +11743,8 @@ enum {
     FOGVOL__GL_TEXTURE_MAG_FILTER = 0x2800, FOGVOL__GL_TEXTURE_MIN_FILTER = 0x2801,
     FOGVOL__GL_TEXTURE_WRAP_S = 0x2802, FOGVOL__GL_TEXTURE_WRAP_T = 0x2803, FOGVOL__GL_REPEAT = 0x2901,
     FOGVOL__GL_POLYGON_OFFSET_FILL = 0x8037, FOGVOL__GL_RGBA8 = 0x8058, FOGVOL__GL_TEXTURE_BINDING_2D = 0x8069,
-    FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
+    FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_ALPHA_TO_ONE = 0x809F, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
+    FOGVOL__GL_CLAMP_FRAGMENT_COLOR = 0x891B, FOGVOL__GL_MAX_VIEWPORTS = 0x825B,
     FOGVOL__GL_CONSTANT_COLOR = 0x8001, FOGVOL__GL_BLEND_COLOR = 0x8005,
     FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
     FOGVOL__GL_BLEND_SRC_ALPHA = 0x80CB, FOGVOL__GL_FUNC_ADD = 0x8006, FOGVOL__GL_BLEND_EQUATION_RGB = 0x8009,
@@ -11945,6 +11946,15 @@ enum {
     X(void, DepthRangef, (fogvol__GLfloat, fogvol__GLfloat)) \
     X(void, GetShaderPrecisionFormat, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint *, fogvol__GLint *))
 
+/* Optional, desktop: viewport arrays (GL 4.1, ARB_viewport_array): fogvol's passes and its restore write
+   index 0 alone (glViewport, glScissor, glDepthRange and the scissor enable would write every index);
+   colour clamping (GL 3.0 compatibility profiles: glClampColor(GL_CLAMP_FRAGMENT_COLOR)). */
+#define FOGVOL__GL_VIEWPORT_ARRAY(X) \
+    X(void, ViewportIndexedf, (fogvol__GLuint, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
+    X(void, ScissorIndexed, (fogvol__GLuint, fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
+    X(void, DepthRangeIndexed, (fogvol__GLuint, fogvol__GLdouble, fogvol__GLdouble))
+#define FOGVOL__GL_CLAMP(X) X(void, ClampColor, (fogvol__GLenum, fogvol__GLenum))
+
 /* Optional: clip control (GL 4.5, ARB_clip_control; GLES: EXT_clip_control as glClipControlEXT). */
 #define FOGVOL__GL_CLIP_CONTROL(X) X(void, ClipControl, (fogvol__GLenum, fogvol__GLenum))
 
@@ -11961,7 +11971,7 @@ enum {
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
             FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_QUERY(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X) \
-                FOGVOL__GL_QUERY(X)
+                FOGVOL__GL_QUERY(X) FOGVOL__GL_VIEWPORT_ARRAY(X) FOGVOL__GL_CLAMP(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -12001,6 +12011,14 @@ FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
      undefined there;
    - DEPTH_CLAMP: disables the near/far clipping that the thickness passes rely on;
    - SAMPLE_SHADING, SAMPLE_MASK: per-sample shading / dropped samples on a multisampled engine target;
+   - SAMPLE_ALPHA_TO_ONE: on a multisampled engine target, every fogvol fragment's alpha forced to 1
+     before blending (opaque fog, and the alpha digit of the RGBA8 sums);
+   - CLAMP_FRAGMENT_COLOR (GL 3.0+ compatibility profiles, glClampColor; fogvol__gl_values): GL_TRUE
+     clamps the signed float sums; fogvol's passes set GL_FALSE;
+   - viewport arrays (GL 4.1): glViewport, glScissor, glDepthRange and glDisable(GL_SCISSOR_TEST)
+     write every index, so fogvol writes index 0 alone (fogvol__gl_viewport, fogvol__gl_scissor,
+     fogvol__gl_depth_range) and turns the scissor test off for every index in its passes, putting each
+     index's enable back (fogvol__gl_state.scissor_enables: a GL may apply any index's enable to all);
    - POLYGON_SMOOTH, POLYGON_STIPPLE (compatibility): coverage-scaled or stippled fragments;
    - an active, unpaused transform feedback: paused and resumed by fogvol__gl_host_enter/leave (GL 4.0,
      GLES 3.0; on GL 3.x it cannot be queried: do not call fogvol inside glBeginTransformFeedback).
@@ -12027,6 +12045,7 @@ FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
     X(FOGVOL__GL_DITHER, ALL, OFF) \
     X(FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE, ALL, OFF) \
     X(FOGVOL__GL_SAMPLE_COVERAGE, ALL, OFF) \
+    X(FOGVOL__GL_SAMPLE_ALPHA_TO_ONE, DESKTOP, OFF) \
     X(FOGVOL__GL_POLYGON_OFFSET_FILL, ALL, OFF) \
     X(FOGVOL__GL_RASTERIZER_DISCARD, DISCARD, OFF) \
     X(FOGVOL__GL_COLOR_LOGIC_OP, DESKTOP, OFF) \
@@ -12062,7 +12081,8 @@ typedef struct fogvol__gl_state {
     fogvol__GLfloat min_sample_shading;
     /* the rows of fogvol__gl_values */
     fogvol__GLint viewport[4], scissor_box[4], blend_func[4], blend_eq[2], depth_func, cull_mode, front_face,
-        polygon_mode[2];
+        polygon_mode[2], clamp_fragment;
+    unsigned long scissor_enables; /* viewport arrays: the scissor test of each index (bit i) */
     fogvol__GLint st_func[3], st_op[3], st_wmask, stb_func[3], stb_op[3], stb_wmask, st_clear; /* stb: back */
     fogvol__GLint pixel_align[2], unpack_rows[3], pack_rows[3]; /* row length, skip rows, skip pixels */
     fogvol__GLboolean depth_mask, color_mask[4];
@@ -12131,6 +12151,7 @@ typedef struct fogvol__gl {
 #undef FOGVOL__GL_MEMBER_MSAA
     int has_indexed_mask, has_indexed_blend, has_tf_pause, max_draw_buffers, n_clip;
     int has_restart, has_restart_fixed, has_depth_clamp, has_sample_shading, has_sample_mask;
+    int n_viewports; /* viewport arrays (gl->ViewportIndexedf): the scissor enables saved per index, up to 32 */
     int host_depth, host_n, tf_paused;                  /* fogvol__gl_host_enter / leave */
     fogvol__GLenum host_errors[4];                      /* the engine's pending GL errors, raised again */
     fogvol__GLuint err_shader, err_fbo;                 /* objects that make GL raise a chosen error (err_fbo:
@@ -12170,15 +12191,42 @@ static int fogvol__has_ext(const char *list, const char *name)
 
 static void fogvol__gl_enable(fogvol__gl *gl, fogvol__GLenum cap, int on)
 {
-    if (on) gl->Enable(cap);
-    else gl->Disable(cap);
+    if (cap == FOGVOL__GL_SCISSOR_TEST && gl->ViewportIndexedf && on) {
+        gl->Enablei(cap, 0); /* (viewport arrays: on for index 0 alone; off for every index, since a GL may
+                                apply any index's enable to every viewport, put back by index at the end) */
+    } else if (on) {
+        gl->Enable(cap);
+    } else {
+        gl->Disable(cap);
+    }
+}
+
+/* glViewport, glScissor and glDepthRange of index 0 alone where the context has viewport arrays. */
+static void fogvol__gl_viewport(fogvol__gl *gl, fogvol__GLint x, fogvol__GLint y, fogvol__GLsizei w, fogvol__GLsizei h)
+{
+    if (gl->ViewportIndexedf)
+        gl->ViewportIndexedf(0, (fogvol__GLfloat)x, (fogvol__GLfloat)y, (fogvol__GLfloat)w, (fogvol__GLfloat)h);
+    else gl->Viewport(x, y, w, h);
+}
+
+static void fogvol__gl_scissor(fogvol__gl *gl, fogvol__GLint x, fogvol__GLint y, fogvol__GLsizei w, fogvol__GLsizei h)
+{
+    if (gl->ViewportIndexedf) gl->ScissorIndexed(0, x, y, w, h);
+    else gl->Scissor(x, y, w, h);
+}
+
+static void fogvol__gl_depth_range(fogvol__gl *gl, fogvol__GLdouble n, fogvol__GLdouble f)
+{
+    if (gl->gles) gl->DepthRangef((fogvol__GLfloat)n, (fogvol__GLfloat)f);
+    else if (gl->ViewportIndexedf) gl->DepthRangeIndexed(0, n, f);
+    else gl->DepthRange(n, f);
 }
 
 /* Which contexts have a piece of state (the W column of FOGVOL__GL_ENABLES, when of fogvol__gl_values). */
 enum {
     FOGVOL__GLW_ALL, FOGVOL__GLW_DESKTOP, FOGVOL__GLW_COMPAT, FOGVOL__GLW_ROW_LENGTH, FOGVOL__GLW_DISCARD,
     FOGVOL__GLW_MSAA, FOGVOL__GLW_RESTART, FOGVOL__GLW_RESTART_FIXED, FOGVOL__GLW_CLIP, FOGVOL__GLW_DEPTH_CLAMP,
-    FOGVOL__GLW_SAMPLE_SHADING, FOGVOL__GLW_SAMPLE_MASK
+    FOGVOL__GLW_SAMPLE_SHADING, FOGVOL__GLW_SAMPLE_MASK, FOGVOL__GLW_CLAMP
 };
 enum { FOGVOL__GLP_SET, FOGVOL__GLP_OFF };
 
@@ -12196,6 +12244,7 @@ static int fogvol__gl_has(const fogvol__gl *gl, int when, fogvol__GLenum name)
     case FOGVOL__GLW_DEPTH_CLAMP: return gl->has_depth_clamp;
     case FOGVOL__GLW_SAMPLE_SHADING: return gl->has_sample_shading;
     case FOGVOL__GLW_SAMPLE_MASK: return gl->has_sample_mask;
+    case FOGVOL__GLW_CLAMP: return gl->ClampColor != NULL;
     default: return 1;
     }
 }
@@ -12216,7 +12265,8 @@ enum {
     FOGVOL__GLV_PIXEL_STORE, FOGVOL__GLV_VIEWPORT, FOGVOL__GLV_SCISSOR, FOGVOL__GLV_BLEND_FUNC, FOGVOL__GLV_BLEND_EQ,
     FOGVOL__GLV_DEPTH_FUNC, FOGVOL__GLV_CULL_FACE, FOGVOL__GLV_FRONT_FACE, FOGVOL__GLV_POLYGON_MODE,
     FOGVOL__GLV_DEPTH_MASK, FOGVOL__GLV_COLOR_MASK, FOGVOL__GLV_CLEAR_COLOR, FOGVOL__GLV_STENCIL_FUNC,
-    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL, FOGVOL__GLV_BLEND_COLOR
+    FOGVOL__GLV_STENCIL_OP, FOGVOL__GLV_STENCIL_MASK, FOGVOL__GLV_CLEAR_STENCIL, FOGVOL__GLV_BLEND_COLOR,
+    FOGVOL__GLV_CLAMP_COLOR
 };
 
 /* Plain values: each name of a row is read with glGet<type>v into per consecutive values from the row's
@@ -12257,6 +12307,8 @@ static const fogvol__gl_value_row fogvol__gl_values[] = {
     {FOGVOL__GLV_STENCIL_MASK, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(stb_wmask), FOGVOL__GL_BACK,
      {FOGVOL__GL_STENCIL_BACK_WRITEMASK}},
     {FOGVOL__GLV_CLEAR_STENCIL, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(st_clear), 0, {FOGVOL__GL_STENCIL_CLEAR_VALUE}},
+    {FOGVOL__GLV_CLAMP_COLOR, 'i', FOGVOL__GLW_CLAMP, 1, FOGVOL__GL_AT(clamp_fragment), 0,
+     {FOGVOL__GL_CLAMP_FRAGMENT_COLOR}},
     {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ALL, 1, FOGVOL__GL_AT(pixel_align), 4,
      {FOGVOL__GL_UNPACK_ALIGNMENT, FOGVOL__GL_PACK_ALIGNMENT}},
     {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(unpack_rows), 0,
@@ -12273,8 +12325,9 @@ static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const 
     const fogvol__GLfloat *f = (const fogvol__GLfloat *)p;
     int k;
     switch (r->put) {
-    case FOGVOL__GLV_VIEWPORT: gl->Viewport(v[0], v[1], v[2], v[3]); break;
-    case FOGVOL__GLV_SCISSOR: gl->Scissor(v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_VIEWPORT: fogvol__gl_viewport(gl, v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_SCISSOR: fogvol__gl_scissor(gl, v[0], v[1], v[2], v[3]); break;
+    case FOGVOL__GLV_CLAMP_COLOR: gl->ClampColor(FOGVOL__GL_CLAMP_FRAGMENT_COLOR, (fogvol__GLenum)v[0]); break;
     case FOGVOL__GLV_BLEND_FUNC:
         gl->BlendFuncSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2], (fogvol__GLenum)v[3]);
         break;
@@ -12321,6 +12374,9 @@ static void fogvol__gl_save_tables(fogvol__gl *gl, fogvol__gl_state *s)
     for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
         if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
             s->enabled[i] = gl->IsEnabled(fogvol__gl_enables[i].cap);
+    s->scissor_enables = 0;
+    for (i = 0; gl->ViewportIndexedf && i < gl->n_viewports; ++i)
+        if (gl->IsEnabledi(FOGVOL__GL_SCISSOR_TEST, (fogvol__GLuint)i)) s->scissor_enables |= 1ul << i;
 }
 
 static void fogvol__gl_restore_tables(fogvol__gl *gl, const fogvol__gl_state *s)
@@ -12332,6 +12388,10 @@ static void fogvol__gl_restore_tables(fogvol__gl *gl, const fogvol__gl_state *s)
     for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
         if (fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
             fogvol__gl_enable(gl, fogvol__gl_enables[i].cap, s->enabled[i]);
+    for (i = 0; gl->ViewportIndexedf && i < gl->n_viewports; ++i) {
+        if (s->scissor_enables >> i & 1ul) gl->Enablei(FOGVOL__GL_SCISSOR_TEST, (fogvol__GLuint)i);
+        else gl->Disablei(FOGVOL__GL_SCISSOR_TEST, (fogvol__GLuint)i);
+    }
 }
 
 /* Every pass: the capabilities marked OFF turned off (fogvol__gl_begin_pass sets the others). */
@@ -12341,7 +12401,8 @@ static void fogvol__gl_pass_enables(fogvol__gl *gl)
     for (i = 0; i < FOGVOL__GL_N_ENABLES; ++i)
         if (fogvol__gl_enables[i].pass == FOGVOL__GLP_OFF &&
             fogvol__gl_has(gl, fogvol__gl_enables[i].when, fogvol__gl_enables[i].cap))
-            gl->Disable(fogvol__gl_enables[i].cap);
+            fogvol__gl_enable(gl, fogvol__gl_enables[i].cap, 0);
+    if (gl->ClampColor) gl->ClampColor(FOGVOL__GL_CLAMP_FRAGMENT_COLOR, 0); /* (signed sums, float targets) */
 }
 
 /* Multisample texture bindings of fogvol's units, multisampling and sample shading. */
@@ -12660,10 +12721,10 @@ static void fogvol__gl_restore_depth(fogvol__gl *gl, const fogvol__gl_state *s)
 {
     if (gl->gles) {
         gl->ClearDepthf(s->clear_depth);
-        gl->DepthRangef(s->depth_range[0], s->depth_range[1]);
+        fogvol__gl_depth_range(gl, s->depth_range[0], s->depth_range[1]);
     } else {
         gl->ClearDepth(s->clear_depth_d);
-        gl->DepthRange(s->depth_range_d[0], s->depth_range_d[1]);
+        fogvol__gl_depth_range(gl, s->depth_range_d[0], s->depth_range_d[1]);
     }
     if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)s->clip_origin, (fogvol__GLenum)s->clip_depth);
 }
@@ -12760,8 +12821,7 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     info->depth_range[0] = gl->saved.depth_range[0];
     info->depth_range[1] = gl->saved.depth_range[1];
     if (gl->ClipControl) gl->ClipControl((fogvol__GLenum)gl->saved.clip_origin, FOGVOL__GL_NEGATIVE_ONE_TO_ONE);
-    if (gl->gles) gl->DepthRangef(0.0f, 1.0f);
-    else gl->DepthRange(0.0, 1.0);
+    fogvol__gl_depth_range(gl, 0.0, 1.0);
     return FOGVOL_SUCCESS;
 }
 
@@ -13333,7 +13393,7 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
     gl->BindFramebuffer(FOGVOL__GL_FRAMEBUFFER, t ? t->fbo : (fogvol__GLuint)gl->saved.draw_fbo);
     fogvol__gl_attach_read(gl, t, p);
     if (t && p->depth_texture) fogvol__gl_attach_depth(gl, t, p);
-    gl->Viewport(p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
+    fogvol__gl_viewport(gl, p->viewport[0], p->viewport[1], p->viewport[2], p->viewport[3]);
     fogvol__gl_pass_enables(gl);
     if (!gl->gles) gl->PolygonMode(FOGVOL__GL_FRONT_AND_BACK, FOGVOL__GL_FILL);
     if (!t && (gl->saved.n_draw_buffers > 1 || p->draw_buffer > 0)) { /* only the named engine buffer */
@@ -13342,8 +13402,8 @@ static void fogvol__gl_begin_pass(void *u, const fogvol_pass *p)
         gl->saved.draw_buffers_set = 1;
     }
     if (p->scissor[2] > 0 && p->scissor[3] > 0) {
-        gl->Enable(FOGVOL__GL_SCISSOR_TEST);
-        gl->Scissor(p->scissor[0], p->scissor[1], p->scissor[2], p->scissor[3]);
+        fogvol__gl_enable(gl, FOGVOL__GL_SCISSOR_TEST, 1);
+        fogvol__gl_scissor(gl, p->scissor[0], p->scissor[1], p->scissor[2], p->scissor[3]);
     }
     gl->ColorMask(1, 1, 1, 1);
     if (p->read_target && t) gl->ColorMaski(1, 0, 0, 0, 0); /* read, never written (nor cleared) */
@@ -13559,7 +13619,7 @@ static fogvol_result fogvol__gl_copy_depth(void *u, fogvol_native framebuffer, i
     }
     fogvol__gl_depth_target(gl, format, x1, y1, samples > 1 ? samples : 0);
     gl->BindFramebuffer(FOGVOL__GL_DRAW_FRAMEBUFFER, gl->depth_fbo); /* every copy names its destination */
-    gl->Disable(FOGVOL__GL_SCISSOR_TEST);
+    fogvol__gl_enable(gl, FOGVOL__GL_SCISSOR_TEST, 0);
     if (gl->has_discard) gl->Disable(FOGVOL__GL_RASTERIZER_DISCARD);
     /* the same rectangle on both sides: required to resolve a multisampled source */
     gl->BlitFramebuffer(rect[0], rect[1], x1, y1, rect[0], rect[1], x1, y1, FOGVOL__GL_DEPTH_BUFFER_BIT,
@@ -13746,6 +13806,11 @@ static void fogvol__gl_raster_caps(fogvol__gl *gl)
     gl->has_depth_clamp = !es && v >= 32;
     gl->has_sample_shading = (es ? v >= 32 : v >= 40) || gl->has_msaa; /* GL 3.2 + ARB_sample_shading */
     gl->has_sample_mask = es ? v >= 31 : v >= 32;
+    if (gl->ViewportIndexedf) {
+        n = 0;
+        gl->GetIntegerv(FOGVOL__GL_MAX_VIEWPORTS, &n);
+        gl->n_viewports = n < 1 ? 1 : n > 32 ? 32 : n;
+    }
 }
 
 /* Parse "M.m" at the first digit of s. */
@@ -13804,6 +13869,19 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
         return FOGVOL_ERROR_UNSUPPORTED;
     }
     return FOGVOL_SUCCESS;
+}
+
+/* Desktop, optional: viewport arrays (GL 4.1 or ARB_viewport_array, with glEnablei for the scissor
+   test; all or none) and glClampColor where colour clamping exists (GL 3.0+ compatibility profiles). */
+static void fogvol__gl_load_desktop_extras(fogvol__gl *gl, const fogvol_gl_desc *desc)
+{
+    if (gl->major >= 3 && (gl->major > 4 || (gl->major == 4 && gl->minor >= 1) ||
+                           fogvol__gl_has_ext3(gl, "GL_ARB_viewport_array"))) {
+        FOGVOL__GL_VIEWPORT_ARRAY(FOGVOL__GL_LOAD)
+        if (!gl->ViewportIndexedf || !gl->ScissorIndexed || !gl->DepthRangeIndexed || !gl->Enablei || !gl->Disablei)
+            gl->ViewportIndexedf = NULL; /* (fogvol__gl_viewport and the others test this one) */
+    }
+    if (gl->major >= 3 && !gl->core) FOGVOL__GL_CLAMP(FOGVOL__GL_LOAD)
 }
 
 /* Loads gl<nm><suffix> (locals: char name[64], const char *suffix: "" for the core name, "EXT", "ARB" or
@@ -13961,6 +14039,7 @@ static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_d
     } else {
         FOGVOL__GL_DESKTOP(FOGVOL__GL_LOAD)
         FOGVOL__GL_DESKTOP(FOGVOL__GL_REQUIRE)
+        fogvol__gl_load_desktop_extras(gl, desc);
     }
     return FOGVOL_SUCCESS;
 }

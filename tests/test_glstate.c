@@ -928,6 +928,158 @@ static void resources_case(fx *x)
 static void test_core_resources(void **state) { resources_case((fx *)*state); }
 static void test_compat21_resources(void **state) { resources_case((fx *)*state); }
 
+/* (e) Engine state beyond the GL 2.0 list that changes what fogvol draws, set by an engine and left
+   set: GL_SAMPLE_ALPHA_TO_ONE on a 4x framebuffer (the fragment alpha forced to 1 before blending:
+   opaque fog), a colour clamp in a compatibility profile (glClampColor(GL_CLAMP_FRAGMENT_COLOR,
+   GL_TRUE): the signed float sums clamped), and viewport, scissor and depth-range arrays (index 1,
+   which glViewport, glScissor, glDepthRange and glDisable(GL_SCISSOR_TEST) would overwrite). A sphere
+   of radius 1 at view depth 5 (the centre pixel's thickness 2, analytic), its centre pixel against
+   rgb (1 - a) + fog a with a = 1 - exp(-density t); every piece of that state the same after the
+   frame. (Before: opaque fog, 255 for 152 and 255 for 152, and index 1 rewritten.) */
+typedef void (*pfn_viewport_indexedf)(GLuint, GLfloat, GLfloat, GLfloat, GLfloat);
+typedef void (*pfn_scissor_indexed)(GLuint, GLint, GLint, GLsizei, GLsizei);
+typedef void (*pfn_depth_range_indexed)(GLuint, GLdouble, GLdouble);
+typedef void (*pfn_enablei)(GLenum, GLuint);
+typedef GLboolean (*pfn_is_enabledi)(GLenum, GLuint);
+typedef void (*pfn_get_integeri_v)(GLenum, GLuint, GLint *);
+typedef void (*pfn_get_doublei_v)(GLenum, GLuint, GLdouble *);
+typedef void (*pfn_clamp_color)(GLenum, GLenum);
+typedef void (*pfn_rb_storage_ms)(GLenum, GLsizei, GLenum, GLsizei, GLsizei);
+typedef void (*pfn_blit)(GLint, GLint, GLint, GLint, GLint, GLint, GLint, GLint, GLbitfield, GLenum);
+
+static void extras_centre(int compat, int samples, int clamp, int arrays)
+{
+    glu_ctx g;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *mesh;
+    fogvol_ramp_desc rd;
+    fogvol_ramp *ramp;
+    fogvol_frame_desc fd;
+    fogvol_volume_desc vd;
+    shp_mesh sph = shp_sphere(1.0f, 48, 96);
+    GLuint fbo, rb[2], rfbo, rrb;
+    unsigned char px[4];
+    const double density = 0.5, t = 2.0, a = 1.0 - exp(-density * t), bg[3] = {0.2, 0.3, 0.4};
+    int ch, maxd = 0;
+    assert_true(glu_create(&g, W, H, compat ? 0 : 1));
+    load_gl();
+    gf.GenRenderbuffers(2, rb);
+    gf.GenFramebuffers(1, &fbo);
+    gf.BindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+    ((pfn_rb_storage_ms)glu_proc("glRenderbufferStorageMultisample", NULL))(GL_RENDERBUFFER, samples, GL_RGBA8, W, H);
+    gf.BindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+    ((pfn_rb_storage_ms)glu_proc("glRenderbufferStorageMultisample", NULL))(GL_RENDERBUFFER, samples, GL_DEPTH24_STENCIL8,
+                                                                         W, H);
+    gf.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    gf.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+    gf.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+    assert_int_equal(gf.CheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    glViewport(0, 0, W, H);
+    glClearColor((float)bg[0], (float)bg[1], (float)bg[2], 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (samples > 1) glEnable(GL_SAMPLE_ALPHA_TO_ONE);
+    if (clamp) ((pfn_clamp_color)glu_proc("glClampColor", NULL))(GL_CLAMP_FRAGMENT_COLOR, GL_TRUE);
+    if (arrays) {
+        ((pfn_viewport_indexedf)glu_proc("glViewportIndexedf", NULL))(1, 32.0f, 0.0f, 32.0f, 64.0f);
+        ((pfn_scissor_indexed)glu_proc("glScissorIndexed", NULL))(1, 5, 6, 7, 8);
+        ((pfn_enablei)glu_proc("glEnablei", NULL))(GL_SCISSOR_TEST, 1);
+        ((pfn_depth_range_indexed)glu_proc("glDepthRangeIndexed", NULL))(1, 0.25, 0.75);
+    }
+    memset(&cd, 0, sizeof cd);
+    cd.gl.get_proc_address = glu_proc;
+    cd.logger.func = fv_log;
+    cd.tier = FOGVOL_TIER_FLOAT;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    {
+        fogvol_mesh_desc md;
+        fx_mesh_desc(&md, &sph, 0);
+        assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+    }
+    memset(&rd, 0, sizeof rd);
+    rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+    rd.density = (float)density;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+    memset(&fd, 0, sizeof fd);
+    glu_identity(fd.view);
+    glu_perspective(fd.projection, 45.0, 1.0, 0.5, 50.0);
+    fd.znear = 0.5f;
+    fd.zfar = 50.0f;
+    fd.viewport[2] = W;
+    fd.viewport[3] = H;
+    memset(&vd, 0, sizeof vd);
+    vd.mesh = mesh;
+    vd.ramp = ramp;
+    glu_identity(vd.model);
+    vd.model[14] = -5.0f;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+    expect_no_gl_error("the frame");
+    /* the engine's state, as it set it */
+    if (samples > 1) assert_true(glIsEnabled(GL_SAMPLE_ALPHA_TO_ONE));
+    if (clamp) {
+        GLint v = 0;
+        glGetIntegerv(GL_CLAMP_FRAGMENT_COLOR, &v);
+        assert_int_equal(v, GL_TRUE);
+        ((pfn_clamp_color)glu_proc("glClampColor", NULL))(GL_CLAMP_FRAGMENT_COLOR, GL_FIXED_ONLY);
+    }
+    if (arrays) {
+        GLint v[4];
+        GLdouble d[2];
+        ((pfn_get_integeri_v)glu_proc("glGetIntegeri_v", NULL))(GL_VIEWPORT, 1, v);
+        assert_true(v[0] == 32 && v[1] == 0 && v[2] == 32 && v[3] == 64);
+        ((pfn_get_integeri_v)glu_proc("glGetIntegeri_v", NULL))(GL_SCISSOR_BOX, 1, v);
+        assert_true(v[0] == 5 && v[1] == 6 && v[2] == 7 && v[3] == 8);
+        assert_true(((pfn_is_enabledi)glu_proc("glIsEnabledi", NULL))(GL_SCISSOR_TEST, 1));
+        ((pfn_get_doublei_v)glu_proc("glGetDoublei_v", NULL))(GL_DEPTH_RANGE, 1, d);
+        assert_true(d[0] == 0.25 && d[1] == 0.75);
+        glGetIntegerv(GL_VIEWPORT, v);
+        assert_true(v[0] == 0 && v[1] == 0 && v[2] == W && v[3] == H);
+    }
+    if (samples > 1) glDisable(GL_SAMPLE_ALPHA_TO_ONE);
+    /* the centre pixel, resolved */
+    gf.GenFramebuffers(1, &rfbo);
+    gf.GenRenderbuffers(1, &rrb);
+    gf.BindRenderbuffer(GL_RENDERBUFFER, rrb);
+    gf.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
+    gf.BindFramebuffer(GL_DRAW_FRAMEBUFFER, rfbo);
+    gf.FramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rrb);
+    gf.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    if (arrays) ((pfn_enablei)glu_proc("glDisablei", NULL))(GL_SCISSOR_TEST, 1);
+    ((pfn_blit)glu_proc("glBlitFramebuffer", NULL))(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gf.BindFramebuffer(GL_READ_FRAMEBUFFER, rfbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(W / 2, H / 2, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    for (ch = 0; ch < 3; ++ch) {
+        int want = (int)((bg[ch] * (1.0 - a) + 0.8 * a) * 255.0 + 0.5), d = abs((int)px[ch] - want);
+        if (d > maxd) maxd = d;
+    }
+    print_message("# %s, %d samples: centre %d %d %d, want %d (%s%s%s)\n", compat ? "compatibility" : "core", samples, px[0],
+                  px[1], px[2], (int)((bg[0] * (1.0 - a) + 0.8 * a) * 255.0 + 0.5), samples > 1 ? "alpha to one " : "",
+                  clamp ? "colour clamp " : "", arrays ? "viewport arrays" : "");
+    assert_true(maxd <= 3); /* (the sphere's tessellation: its chord at the centre is 2 within 0.1%) */
+    expect_no_gl_error("the checks");
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_mesh(fv, mesh);
+    fogvol_destroy_context(fv);
+    glu_destroy(&g);
+    shp_free(&sph);
+}
+
+static void test_core_engine_extras(void **state)
+{
+    (void)state;
+    extras_centre(0, 4, 0, 1);
+    extras_centre(0, 0, 0, 1);
+}
+
+static void test_compat_colour_clamp(void **state)
+{
+    (void)state;
+    extras_centre(1, 0, 1, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -942,6 +1094,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_compat21_fullscreen, setup_compat, teardown),
         cmocka_unit_test_setup_teardown(test_compat21_read_framebuffer, setup_compat, teardown),
         cmocka_unit_test_setup_teardown(test_compat21_resources, setup_compat, teardown),
+        cmocka_unit_test(test_core_engine_extras),
+        cmocka_unit_test(test_compat_colour_clamp),
     };
     cmocka_set_message_output(CM_OUTPUT_TAP);
     return cmocka_run_group_tests_name("fogvol GL state", tests, NULL, NULL);
