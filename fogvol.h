@@ -10530,6 +10530,7 @@ static fogvol_result fogvol__ensure_checks(fogvol_context *ctx)
         td.width = ctx->gpu.target_w;
         td.height = ctx->gpu.target_h;
         td.depth = fogvol__has(ctx, FOGVOL_VARIANT_SINGLE_TARGET);
+        td.samples = ctx->cur.samples; /* (the per-sample composite reads V per sample) */
         td.label = "fogvol V (overflow mask)";
         r = ctx->be.create_target(ctx->be.user_data, &td, &ctx->gpu.tgt_v);
         if (r != FOGVOL_SUCCESS) ctx->gpu.tgt_v = 0;

@@ -315,6 +315,118 @@ static void test_combo(void **state)
     run_combo(p[0], p[1]);
 }
 
+/* show_overflow on a 4x engine framebuffer: PS20 + SINGLE_TARGET summing digits (no integer sums, no
+   framebuffer fetch, no depth-tested COUNT frames, every check pass), 12 nested spheres of radius
+   0.3 .. 1.4 16 units away, whose 24 faces on the centre ray run the single biased sum past its digits: the centre
+   pixel is magenta on a single-sample framebuffer and on a 4x one, frame after frame with the two
+   alternating. (The overflow mask V, which SINGLE_TARGET's check writes at the sum's peak, was
+   single-sample, and the per-sample composite read it as 0: no magenta at 4x.) */
+static void test_show_overflow_msaa(void **state)
+{
+    glu_ctx g;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *m[12];
+    fogvol_ramp *ramp;
+    fogvol_ramp_desc rd;
+    GLuint fbo[2], rb[4], rfbo, rrb;
+    int i, f, k;
+    (void)state;
+    assert_true(glu_create(&g, 64, 64, 1));
+    glGenFramebuffers(2, fbo);
+    glGenRenderbuffers(4, rb);
+    for (k = 0; k < 2; ++k) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo[k]);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[2 * k]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, k ? 4 : 0, GL_RGBA8, 64, 64);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[2 * k]);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[2 * k + 1]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, k ? 4 : 0, GL_DEPTH24_STENCIL8, 64, 64);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[2 * k + 1]);
+        assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+    }
+    glGenRenderbuffers(1, &rrb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rrb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, 64, 64);
+    glGenFramebuffers(1, &rfbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, rfbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rrb);
+    {
+        memset(&cd, 0, sizeof cd);
+        cd.gl.get_proc_address = glu_proc;
+        cd.tier = FOGVOL_TIER_PS20;
+        cd.variants = FOGVOL_VARIANT_SINGLE_TARGET;
+        cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
+        cd.disable_speedups = FOGVOL_SPEEDUP_FRAMEBUFFER_FETCH | FOGVOL_SPEEDUP_EXACT_SUM | FOGVOL_SPEEDUP_DEPTH_TEST |
+                              FOGVOL_SPEEDUP_SKIP_CHECK;
+        assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+        for (i = 0; i < 12; ++i) {
+            shp_mesh s = shp_sphere(0.3f + 0.1f * (float)i, 16, 8);
+            fogvol_mesh_desc md;
+            memset(&md, 0, sizeof md);
+            md.positions = s.pos;
+            md.vertex_count = s.vcount;
+            md.indices = (const uint32_t *)s.idx;
+            md.index_count = s.icount;
+            assert_int_equal(fogvol_create_mesh(fv, &md, &m[i], NULL), FOGVOL_SUCCESS);
+            shp_free(&s);
+        }
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = 1.0f;
+        rd.color[1] = 0.8f;
+        rd.color[2] = 0.5f;
+        rd.density = 0.05f;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+        for (f = 0; f < 4; ++f) {
+            fogvol_frame_desc fd;
+            fogvol_volume_desc vd;
+            fogvol_frame_stats st;
+            unsigned char c[4];
+            double eye[3] = {0, 0, 5}, at[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+            k = f & 1;
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo[k]);
+            glViewport(0, 0, 64, 64);
+            glClearColor(0, 0, 0, 1);
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            memset(&fd, 0, sizeof fd);
+            glu_look_at(fd.view, eye, at, up);
+            glu_perspective(fd.projection, 60.0, 1.0, 0.5, 20.0);
+            fd.znear = 0.5f;
+            fd.zfar = 20.0f;
+            fd.viewport[2] = fd.viewport[3] = 64;
+            fd.show_overflow = 1;
+            assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+            memset(&vd, 0, sizeof vd);
+            vd.ramp = ramp;
+            glu_identity(vd.model);
+            vd.model[14] = -11.0f; /* (16 units away: deep digits, which the 24 faces overflow) */
+            for (i = 0; i < 12; ++i) {
+                vd.mesh = m[i];
+                assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+            }
+            (void)fogvol_end_frame(fv, &st); /* (FOGVOL_ERROR_DEPTH_OVERFLOW once counted) */
+            assert_int_equal(st.samples, k ? 4 : 1);
+            glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo[k]);
+            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, rfbo);
+            glBlitFramebuffer(0, 0, 64, 64, 0, 0, 64, 64, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+            glBindFramebuffer(GL_READ_FRAMEBUFFER, rfbo);
+            glReadPixels(32, 32, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, c);
+            print_message("# show_overflow, PS20+single, %s framebuffer: centre %d %d %d\n",
+                          k ? "4x" : "single-sample", c[0], c[1], c[2]);
+            assert_true(c[0] == 255 && c[1] == 0 && c[2] == 255);
+            assert_int_equal(glGetError(), GL_NO_ERROR);
+        }
+        for (i = 0; i < 12; ++i) fogvol_destroy_mesh(fv, m[i]);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+    }
+    glDeleteFramebuffers(2, fbo);
+    glDeleteFramebuffers(1, &rfbo);
+    glDeleteRenderbuffers(4, rb);
+    glDeleteRenderbuffers(1, &rrb);
+    glu_destroy(&g);
+}
+
 /* ---- policies on the GPU -------------------------------------------------- */
 /* The policy tests' rig: a W x H OSMesa context, fogvol (PS20 unless cd says otherwise) with the 20
    shells (they overflow at L = 4) and a ramp; cd may hold what a test changes (policy, bits ...). */
@@ -1461,7 +1573,7 @@ int main(void)
             cmocka_unit_test(test_lower_bits), cmocka_unit_test(test_exact_sum), cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
             cmocka_unit_test(test_overflow_sequence), cmocka_unit_test(test_lower_bits_sequence),
-            cmocka_unit_test(test_bands_sequence),
+            cmocka_unit_test(test_bands_sequence), cmocka_unit_test(test_show_overflow_msaa),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {
             if (n >= (int)(sizeof tests / sizeof tests[0])) {
