@@ -11746,6 +11746,7 @@ enum {
     FOGVOL__GL_POLYGON_OFFSET_FILL = 0x8037, FOGVOL__GL_RGBA8 = 0x8058, FOGVOL__GL_TEXTURE_BINDING_2D = 0x8069,
     FOGVOL__GL_SAMPLE_ALPHA_TO_COVERAGE = 0x809E, FOGVOL__GL_SAMPLE_ALPHA_TO_ONE = 0x809F, FOGVOL__GL_SAMPLE_COVERAGE = 0x80A0,
     FOGVOL__GL_CLAMP_FRAGMENT_COLOR = 0x891B, FOGVOL__GL_MAX_VIEWPORTS = 0x825B,
+    FOGVOL__GL_TEXTURE_FIXED_SAMPLE_LOCATIONS = 0x9107,
     FOGVOL__GL_CONSTANT_COLOR = 0x8001, FOGVOL__GL_BLEND_COLOR = 0x8005,
     FOGVOL__GL_BLEND_DST_RGB = 0x80C8, FOGVOL__GL_BLEND_SRC_RGB = 0x80C9, FOGVOL__GL_BLEND_DST_ALPHA = 0x80CA,
     FOGVOL__GL_BLEND_SRC_ALPHA = 0x80CB, FOGVOL__GL_FUNC_ADD = 0x8006, FOGVOL__GL_BLEND_EQUATION_RGB = 0x8009,
@@ -11984,7 +11985,8 @@ FOGVOL__GL_ALL(FOGVOL__GL_PFN)
                                     fogvol__GLsizei, fogvol__GLboolean)) \
     X(void, RenderbufferStorageMultisample, (fogvol__GLenum, fogvol__GLsizei, fogvol__GLenum, fogvol__GLsizei, \
                                              fogvol__GLsizei)) \
-    X(void, MinSampleShading, (fogvol__GLfloat))
+    X(void, MinSampleShading, (fogvol__GLfloat)) \
+    X(void, GetTexLevelParameteriv, (fogvol__GLenum, fogvol__GLint, fogvol__GLenum, fogvol__GLint *))
 #define FOGVOL__GL_PFN_MSAA(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_MSAA(FOGVOL__GL_PFN_MSAA)
 #undef FOGVOL__GL_PFN_MSAA
@@ -12119,6 +12121,7 @@ typedef struct fogvol__gl_target {
     int owns_depth; /* 0 when depth is another target's renderbuffer */
     fogvol__GLuint read_tex; /* fogvol_pass.read_target's texture at colour attachment 1 (0: none) */
     fogvol_format format;
+    int unfixed; /* multisample: storage made with fixedsamplelocations GL_FALSE (an engine depth's, attached) */
     struct fogvol__gl_target *second; /* WIDE: attachment 1 as a target of its own (own FBO) */
 } fogvol__gl_target;
 
@@ -12869,16 +12872,23 @@ static fogvol__GLuint fogvol__gl_new_texture(fogvol__gl *gl, int w, int h, fogvo
     return tex;
 }
 
+/* The storage of multisample colour texture tex (RGBA8, R32F or RG32F), bound on the active unit. */
+static void fogvol__gl_ms_storage(fogvol__gl *gl, fogvol__GLuint tex, fogvol_format format, int samples, int w, int h,
+                                  int fixed)
+{
+    fogvol__GLenum f = format == FOGVOL_FORMAT_R32F    ? (fogvol__GLenum)FOGVOL__GL_R32F
+                       : format == FOGVOL_FORMAT_RG32F ? (fogvol__GLenum)FOGVOL__GL_RG32F
+                                                       : (fogvol__GLenum)FOGVOL__GL_RGBA8;
+    gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
+    gl->TexImage2DMultisample(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, samples, f, w, h, (fogvol__GLboolean)(fixed != 0));
+}
+
 /* A new multisample colour texture (RGBA8, R32F or RG32F, fixed sample locations) bound on the active unit. */
 static fogvol__GLuint fogvol__gl_new_texture_ms(fogvol__gl *gl, const fogvol_target_desc *d)
 {
     fogvol__GLuint tex = 0;
-    fogvol__GLenum f = d->format == FOGVOL_FORMAT_R32F    ? (fogvol__GLenum)FOGVOL__GL_R32F
-                       : d->format == FOGVOL_FORMAT_RG32F ? (fogvol__GLenum)FOGVOL__GL_RG32F
-                                                          : (fogvol__GLenum)FOGVOL__GL_RGBA8;
     gl->GenTextures(1, &tex);
-    gl->BindTexture(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, tex);
-    gl->TexImage2DMultisample(FOGVOL__GL_TEXTURE_2D_MULTISAMPLE, d->samples, f, d->width, d->height, 1);
+    fogvol__gl_ms_storage(gl, tex, d->format, d->samples, d->width, d->height, 1);
     return tex;
 }
 
@@ -13365,6 +13375,16 @@ static void fogvol__gl_attach_depth(fogvol__gl *gl, fogvol__gl_target *t, const 
     fogvol__GLuint tex = fogvol__gl_native(gl, (fogvol__GLuint)p->depth_texture);
     fogvol__GLenum target = t->base.samples > 1 ? (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D_MULTISAMPLE
                                                 : (fogvol__GLenum)FOGVOL__GL_TEXTURE_2D;
+    if (tex && t->base.samples > 1) { /* the attachments' fixedsamplelocations must agree: the colour's follows */
+        fogvol__GLint fixed = 1;
+        gl->BindTexture(target, tex);
+        gl->GetTexLevelParameteriv(target, 0, FOGVOL__GL_TEXTURE_FIXED_SAMPLE_LOCATIONS, &fixed);
+        if ((fixed == 0) != t->unfixed) {
+            fogvol__gl_ms_storage(gl, t->base.tex, t->format, t->base.samples, t->width, t->height, fixed != 0);
+            t->unfixed = fixed == 0;
+        }
+        gl->BindTexture(target, 0);
+    }
     gl->FramebufferTexture2D(FOGVOL__GL_FRAMEBUFFER, FOGVOL__GL_DEPTH_ATTACHMENT, target, tex, 0);
     gl->depth_attached = t->fbo;
     gl->depth_attached_target = target;
@@ -13784,7 +13804,10 @@ static int fogvol__gl_load_msaa(fogvol__gl *gl, const fogvol_gl_desc *desc)
         "glRenderbufferStorageMultisample", desc->user_data);
     gl->MinSampleShading = (fogvol__PFN_MinSampleShading)desc->get_proc_address(
         v4 ? "glMinSampleShading" : "glMinSampleShadingARB", desc->user_data);
-    gl->has_msaa = gl->TexImage2DMultisample && gl->RenderbufferStorageMultisample && gl->MinSampleShading;
+    gl->GetTexLevelParameteriv = (fogvol__PFN_GetTexLevelParameteriv)desc->get_proc_address(
+        "glGetTexLevelParameteriv", desc->user_data);
+    gl->has_msaa = gl->TexImage2DMultisample && gl->RenderbufferStorageMultisample && gl->MinSampleShading &&
+                   gl->GetTexLevelParameteriv;
     return gl->has_msaa;
 }
 

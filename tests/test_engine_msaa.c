@@ -302,7 +302,7 @@ static double centre_slack(double x, double y, double cx, double cy, int w, int 
 
 /* ---- the engine ------------------------------------------------------------ */
 typedef struct engine {
-    GLuint fbo, rb_color, rb_depth, tex_depth, resolve_fbo, rb_resolve, prog, vao, vbo, ibo;
+    GLuint fbo, rb_color, rb_depth, tex_depth, tex_color, resolve_fbo, rb_resolve, prog, vao, vbo, ibo;
     int w, h, samples;
     float pos[2][3];
 } engine;
@@ -318,7 +318,9 @@ static GLuint compile(GLenum type, const char *src)
     return s;
 }
 
-/* depth_texture: the depth buffer is a (multisample) depth texture instead of a renderbuffer */
+/* depth_texture: the depth buffer is a (multisample) depth texture instead of a renderbuffer; 2: made with
+   fixedsamplelocations GL_FALSE, and the colour buffer a multisample texture made so too (a framebuffer
+   whose textures do not agree on it, or that mixes such textures with renderbuffers, is incomplete) */
 static void engine_create_ex(engine *e, int w, int h, int samples, int depth_texture)
 {
     static const char *vs = "#version 330 core\nlayout(location = 0) in vec3 p;\nuniform mat4 mvp;\n"
@@ -332,18 +334,27 @@ static void engine_create_ex(engine *e, int w, int h, int samples, int depth_tex
     e->w = w;
     e->h = h;
     e->samples = samples;
-    glGenRenderbuffers(1, &e->rb_color);
-    glBindRenderbuffer(GL_RENDERBUFFER, e->rb_color);
-    if (samples > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
-    else glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
     glGenFramebuffers(1, &e->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e->rb_color);
+    if (depth_texture == 2 && samples > 1) {
+        glGenTextures(1, &e->tex_color);
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, e->tex_color);
+        glTexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, samples, GL_RGBA8, w, h, GL_FALSE);
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D_MULTISAMPLE, e->tex_color, 0);
+    } else {
+        glGenRenderbuffers(1, &e->rb_color);
+        glBindRenderbuffer(GL_RENDERBUFFER, e->rb_color);
+        if (samples > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+        else glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e->rb_color);
+    }
     if (depth_texture) {
         GLenum target = samples > 1 ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
         glGenTextures(1, &e->tex_depth);
         glBindTexture(target, e->tex_depth);
-        if (samples > 1) glTexImage2DMultisample(target, samples, GL_DEPTH24_STENCIL8, w, h, GL_TRUE);
+        if (samples > 1)
+            glTexImage2DMultisample(target, samples, GL_DEPTH24_STENCIL8, w, h, depth_texture == 2 ? GL_FALSE : GL_TRUE);
         else glTexImage2D(target, 0, GL_DEPTH24_STENCIL8, w, h, 0, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, NULL);
         glBindTexture(target, 0);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, target, e->tex_depth, 0);
@@ -392,7 +403,8 @@ static void engine_destroy(engine *e)
 {
     glDeleteFramebuffers(1, &e->fbo);
     glDeleteFramebuffers(1, &e->resolve_fbo);
-    glDeleteRenderbuffers(1, &e->rb_color);
+    if (e->rb_color) glDeleteRenderbuffers(1, &e->rb_color);
+    if (e->tex_color) glDeleteTextures(1, &e->tex_color);
     if (e->rb_depth) glDeleteRenderbuffers(1, &e->rb_depth);
     if (e->tex_depth) glDeleteTextures(1, &e->tex_depth);
     glDeleteRenderbuffers(1, &e->rb_resolve);
@@ -508,7 +520,10 @@ static void fv_destroy(fv_scene *s)
 
 static fogvol_composite g_composite; /* of the next frames */
 /* ENGINE_DEPTH cases: where the engine's depth comes from (else fogvol draws the occluder) */
-enum { DEPTH_NONE, DEPTH_BOUND, DEPTH_BY_NAME, DEPTH_TEXTURE, DEPTH_ENGINE_O };
+enum { DEPTH_NONE, DEPTH_BOUND, DEPTH_BY_NAME, DEPTH_TEXTURE, DEPTH_ENGINE_O, DEPTH_TEXTURE_UNFIXED };
+/* the engine framebuffer's kind of depth buffer for engine_create_ex: a renderbuffer, a multisample depth texture
+   (DEPTH_TEXTURE), the same made with fixedsamplelocations GL_FALSE (DEPTH_TEXTURE_UNFIXED) */
+#define DEPTH_KIND(d) ((d) == DEPTH_TEXTURE ? 1 : (d) == DEPTH_TEXTURE_UNFIXED ? 2 : 0)
 static int g_depth; /* (DEPTH_ENGINE_O: no ENGINE_DEPTH; the engine draws the occluder into fogvol's O) */
 static const engine *g_engine; /* whose depth */
 
@@ -597,7 +612,7 @@ static void fv_begin(fv_scene *s, const int vp[4], int occluder, float *debug)
     if (g_depth == DEPTH_BOUND) fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_BOUND_FRAMEBUFFER;
     if (g_depth == DEPTH_BY_NAME) fd.engine_depth_source = FOGVOL_DEPTH_SOURCE_FRAMEBUFFER_OBJECT;
     fd.engine_depth_framebuffer = g_engine ? g_engine->fbo : 0;
-    fd.engine_depth_texture = g_depth == DEPTH_TEXTURE && g_engine ? g_engine->tex_depth : 0;
+    fd.engine_depth_texture = DEPTH_KIND(g_depth) && g_engine ? g_engine->tex_depth : 0;
     assert_int_equal(fogvol_begin_frame(s->fv, &fd), FOGVOL_SUCCESS);
     if (!g_depth && occluder) assert_int_equal(fogvol_add_occluder(s->fv, s->occ, model), FOGVOL_SUCCESS);
     if (g_depth == DEPTH_ENGINE_O && occluder) engine_o(s, model);
@@ -799,6 +814,8 @@ static const tcase g_cases[] = {
      3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_BY_NAME},
     {FOGVOL_TIER_PS20, FOGVOL_VARIANT_ENGINE_DEPTH, "PS20+enginedepth texture", 3, FOGVOL_COMPOSITE_FULLSCREEN,
      DEPTH_TEXTURE},
+    {FOGVOL_TIER_FLOAT, FOGVOL_VARIANT_ENGINE_DEPTH, "FLOAT+enginedepth texture, unfixed", 3,
+     FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_TEXTURE_UNFIXED},
     /* the engine draws the occluder into fogvol's O (fogvol_occluder_prepare), per sample */
     {FOGVOL_TIER_FLOAT, 0, "FLOAT engine-drawn O", 3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_ENGINE_O},
     {FOGVOL_TIER_PS20, 0, "PS20 engine-drawn O", 3, FOGVOL_COMPOSITE_FULLSCREEN, DEPTH_ENGINE_O},
@@ -817,7 +834,7 @@ static void test_tier(void **state)
     errs eb, ea;
     assert_true(glu_create(&g, 16, 16, 1));
     scene_init(W, H);
-    engine_create_ex(&e, W, H, NS, tc->depth == DEPTH_TEXTURE);
+    engine_create_ex(&e, W, H, NS, DEPTH_KIND(tc->depth));
     if (!g_truth) build_truth(&e);
     g_composite = tc->composite;
     g_depth = tc->depth;
@@ -826,7 +843,7 @@ static void test_tier(void **state)
     /* before: single-sample targets, one fog value per pixel (opt-in fallback; with the engine's
        depth, resolved to one sample per pixel; a multisample depth texture has no single-sample
        reading: before this version such frames were refused) */
-    if (tc->depth != DEPTH_TEXTURE) {
+    if (!DEPTH_KIND(tc->depth)) {
         assert_int_equal(fv_create(&s, tc->tier, tc->variants, FOGVOL_GLSL_AUTO, FOGVOL_MSAA_SINGLE_SAMPLE), 0);
         engine_draw(&e);
         g_log[0] = 0;
@@ -863,7 +880,7 @@ static void test_tier(void **state)
     }
     fv_destroy(&s);
 
-    if (tc->depth == DEPTH_TEXTURE) memcpy(before, after, (size_t)W * H * 4);
+    if (DEPTH_KIND(tc->depth)) memcpy(before, after, (size_t)W * H * 4);
     eb = compare(before);
     ea = compare(after);
     print_message("# %-31s %d occluder-edge pixels in fog | before: edges mean %.2f max %d, silhouettes max %d, "
@@ -873,7 +890,7 @@ static void test_tier(void **state)
                   ea.max_edge, ea.max_sil, ea.mean_all, ea.max_all);
     if (tc->tier == FOGVOL_TIER_FLOAT) write_png(before, after);
     assert_true(ea.edges > 50); /* the scene has occluder edges inside the fog */
-    if (tc->depth != DEPTH_TEXTURE) {
+    if (!DEPTH_KIND(tc->depth)) {
         assert_true(eb.mean_edge > 10.0); /* single-sample targets get edges wrong */
         assert_true(eb.max_edge > 40);
     }
@@ -1002,8 +1019,8 @@ static void run_mseq(const tcase *tc, const sq_step *steps, int n, const char *w
     assert_int_equal(obox_contains(&g_vol, origin), !(tc->variants & FOGVOL_VARIANT_COUNT));
     assert_false(obox_contains(&g_occ, origin));
     scene_init(W, H);
-    engine_create_ex(&m.e, W, H, NS, tc->depth == DEPTH_TEXTURE);
-    engine_create_ex(&m.e1, W, H, 1, tc->depth == DEPTH_TEXTURE);
+    engine_create_ex(&m.e, W, H, NS, DEPTH_KIND(tc->depth));
+    engine_create_ex(&m.e1, W, H, 1, DEPTH_KIND(tc->depth));
     g_composite = tc->composite;
     g_depth = tc->depth;
     g_engine = &m.e;
@@ -1523,7 +1540,7 @@ static void test_cost(void **state)
 
 int main(void)
 {
-    static struct CMUnitTest tests[40];
+    static struct CMUnitTest tests[3 * NCASES + 8]; /* each case, its sequence, the walks, the rest */
     int n = 0, i;
     for (i = 0; i < NCASES; ++i) {
         tests[n].name = g_cases[i].name;
