@@ -9390,26 +9390,39 @@ static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_d
 /* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
    is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
    window depth -> view depth through the inverse view-projection). */
+/* The greatest normalised depth d = (e - znear) / (zfar - znear) of mesh m's bounds under model, or dmax. */
+static double fogvol__mesh_dmax(const fogvol_context *ctx, const fogvol_mesh *m, const float model[16], double dmax)
+{
+    const fogvol_frame_desc *fd = &ctx->cur.frame;
+    double range = (double)fd->zfar - fd->znear;
+    int j, c;
+    for (c = 0; c < 8; ++c) {
+        double e = ctx->cur.eyerow[3], p[3];
+        p[0] = (c & 1) ? m->bmax[0] : m->bmin[0];
+        p[1] = (c & 2) ? m->bmax[1] : m->bmin[1];
+        p[2] = (c & 4) ? m->bmax[2] : m->bmin[2];
+        for (j = 0; j < 3; ++j)
+            e += ctx->cur.eyerow[j] * (model[j] * p[0] + model[4 + j] * p[1] + model[8 + j] * p[2] + model[12 + j]);
+        if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
+    }
+    return dmax;
+}
+
 static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
     double range = (double)fd->zfar - fd->znear, k = 1.0, dmax = 0.0;
-    int i, j, c;
+    int i;
     if (ctx->cur.wscale > 0.0) {
         k = 2.0 * ctx->cur.wscale * range; /* k d <= 2 s (e - near) <= 2 w */
-    } else {                           /* orthographic: w is constant, bound d over the volumes */
-        for (i = 0; i < ctx->cur.nvol; ++i)
-            for (c = 0; c < 8; ++c) {
-                const fogvol__volume *v = &ctx->cur.vols[i];
-                double e = ctx->cur.eyerow[3], p[3];
-                p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
-                p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
-                p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
-                for (j = 0; j < 3; ++j)
-                    e += ctx->cur.eyerow[j] * (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] +
-                                           v->model[12 + j]);
-                if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
-            }
+    } else { /* orthographic: w is constant, bound d over what fogvol draws: the volumes and, with lights,
+                the lights and the occluders that hide them (an engine-drawn occluder: the whole range) */
+        for (i = 0; i < ctx->cur.nvol; ++i) dmax = fogvol__mesh_dmax(ctx, ctx->cur.vols[i].mesh, ctx->cur.vols[i].model, dmax);
+        for (i = 0; i < ctx->cur.nlight; ++i)
+            dmax = fogvol__mesh_dmax(ctx, ctx->cur.lights[i].mesh, ctx->cur.lights[i].model, dmax);
+        for (i = 0; ctx->cur.nlight > 0 && i < ctx->cur.nocc; ++i)
+            dmax = ctx->cur.occ[i].fn ? (dmax > 1.0 ? dmax : 1.0)
+                                      : fogvol__mesh_dmax(ctx, ctx->cur.occ[i].mesh, ctx->cur.occ[i].model, dmax);
         if (dmax > 0.0) k = 1.98 * ctx->cur.wconst / dmax;
     }
     /* the whole [0, 1] depth range: a 16-bit depth buffer (GLES2, WebGL1) orders the occluders'

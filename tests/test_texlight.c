@@ -404,14 +404,19 @@ static double box_margin(const double p[3])
 static int light_reference(const float view[16], const float proj[16], int x, int y)
 {
     double ndc[2] = {2.0 * (x + 0.5) / TW - 1.0, 2.0 * (y + 0.5) / TH - 1.0}, dir[3], t = 1e30, p[3], oc[3], b, c, h;
-    int k;
-    /* view-space ray (ndc.x / P0, ndc.y / P5, -1), to world through the view's rotation (rows) */
+    double eye[3];
+    int k, ortho = proj[15] == 1.0f;
+    /* view-space ray (ndc.x / P0, ndc.y / P5, -1) from the eye, or orthographic (0, 0, -1) from
+       (ndc.x / P0, ndc.y / P5, 0); to world through the view's rotation (rows) */
     double v[3] = {ndc[0] / proj[0], ndc[1] / proj[5], -1.0};
-    for (k = 0; k < 3; ++k) dir[k] = view[k * 4 + 0] * v[0] + view[k * 4 + 1] * v[1] + view[k * 4 + 2] * v[2];
-    if (dir[1] < 0) t = -g_eye[1] / dir[1]; /* ground y = 0 */
-    for (k = 0; k < 3; ++k) p[k] = g_eye[k] + t * dir[k];
+    for (k = 0; k < 3; ++k) {
+        dir[k] = ortho ? -view[k * 4 + 2] : view[k * 4 + 0] * v[0] + view[k * 4 + 1] * v[1] + view[k * 4 + 2] * v[2];
+        eye[k] = g_eye[k] + (ortho ? view[k * 4 + 0] * v[0] + view[k * 4 + 1] * v[1] : 0.0);
+    }
+    if (dir[1] < 0) t = -eye[1] / dir[1]; /* ground y = 0 */
+    for (k = 0; k < 3; ++k) p[k] = eye[k] + t * dir[k];
     if (t < 1e29 && (fabs(p[0]) > 6 || fabs(p[2]) > 6)) t = 1e30;
-    for (k = 0; k < 3; ++k) oc[k] = g_eye[k] - g_sph[k];
+    for (k = 0; k < 3; ++k) oc[k] = eye[k] - g_sph[k];
     b = oc[0] * dir[0] + oc[1] * dir[1] + oc[2] * dir[2];
     c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - g_sph[3] * g_sph[3];
     h = b * b - c * (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
@@ -421,12 +426,14 @@ static int light_reference(const float view[16], const float proj[16], int x, in
         if (ts > 0 && ts < t) t = ts;
     }
     if (t > 1e29) return 0;
-    for (k = 0; k < 3; ++k) p[k] = g_eye[k] + t * dir[k];
+    for (k = 0; k < 3; ++k) p[k] = eye[k] + t * dir[k];
     if (fabs(box_margin(p)) < 0.03) return -1;
     return box_margin(p) < 0;
 }
 
-static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect dialect, const char *name)
+/* ortho: an orthographic camera, with a small fog volume off screen 2 units from the eye (so that
+   fogvol's clip-z scale, from the volumes alone, clipped the lights and occluders beyond it) */
+static void light_case_ex(fogvol_tier tier, unsigned variants, fogvol_dialect dialect, const char *name, int ortho)
 {
     static const float rgb[3] = {0.8f, 0.6f, 0.2f};
     glu_ctx g;
@@ -434,12 +441,18 @@ static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect diale
     fogvol_mesh_report rep;
     fogvol_mesh *ground = mesh_of(fv, shp_box(6, 0.5f, 6), NULL), *sphere = mesh_of(fv, shp_sphere(1, 48, 24), NULL);
     fogvol_mesh *lbox = mesh_of(fv, shp_box((float)g_half[0], (float)g_half[1], (float)g_half[2]), &rep);
+    fogvol_mesh *fog = mesh_of(fv, shp_box(0.25f, 0.25f, 0.25f), NULL);
+    fogvol_ramp *ramp = NULL;
+    fogvol_ramp_desc rd;
     fogvol_frame_desc fd;
     fogvol_light_desc ld;
     fogvol_frame_stats st;
     float gm[16], sm[16];
     int x, y, lit = 0, wrong = 0, checked = 0;
     assert_int_equal(rep.convex, 1);
+    memset(&rd, 0, sizeof rd);
+    rd.density = 0.5f;
+    assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
     memset(&fd, 0, sizeof fd);
     glu_look_at(fd.view, g_eye, g_at, (const double[3]){0, 1, 0});
     glu_perspective(fd.projection, 55.0, 1.0, 0.5, 30.0);
@@ -447,6 +460,13 @@ static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect diale
     fd.zfar = 30.0f;
     fd.viewport[2] = TW;
     fd.viewport[3] = TH;
+    if (ortho) {
+        memset(fd.projection, 0, sizeof fd.projection);
+        fd.projection[0] = fd.projection[5] = 1.0f / 4.0f;
+        fd.projection[10] = -2.0f / (30.0f - 0.5f);
+        fd.projection[14] = -(30.0f + 0.5f) / (30.0f - 0.5f);
+        fd.projection[15] = 1.0f;
+    }
     glu_translate_scale(gm, 0, -0.5f, 0, 1);
     glu_translate_scale(sm, (float)g_sph[0], (float)g_sph[1], (float)g_sph[2], (float)g_sph[3]);
     glClearColor(0, 0, 0, 1);
@@ -459,6 +479,17 @@ static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect diale
     light_model(ld.model);
     memcpy(ld.color, rgb, sizeof rgb);
     assert_int_equal(fogvol_add_light(fv, &ld), FOGVOL_SUCCESS);
+    if (ortho) { /* 2 units from the eye, 10 to its left along the view's x: off screen */
+        fogvol_volume_desc vd;
+        int k;
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = fog;
+        vd.ramp = ramp;
+        glu_identity(vd.model);
+        for (k = 0; k < 3; ++k)
+            vd.model[12 + k] = (float)(g_eye[k] - 2.0 * fd.view[k * 4 + 2] - 10.0 * fd.view[k * 4 + 0]);
+        assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+    }
     assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
     assert_int_equal(st.lights, 1);
     png(name, glu_pixels(&g));
@@ -479,14 +510,22 @@ static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect diale
     fogvol_destroy_mesh(fv, ground);
     fogvol_destroy_mesh(fv, sphere);
     fogvol_destroy_mesh(fv, lbox);
+    fogvol_destroy_mesh(fv, fog);
+    fogvol_destroy_ramp(fv, ramp);
     fogvol_destroy_context(fv);
     glu_destroy(&g);
+}
+
+static void light_case(fogvol_tier tier, unsigned variants, fogvol_dialect dialect, const char *name)
+{
+    light_case_ex(tier, variants, dialect, name, 0);
 }
 
 static void test_light_float(void **state)
 {
     (void)state;
     light_case(FOGVOL_TIER_FLOAT, 0, FOGVOL_GLSL_AUTO, "light_float");
+    light_case_ex(FOGVOL_TIER_FLOAT, 0, FOGVOL_GLSL_AUTO, "light_float_ortho", 1);
 }
 
 static void test_light_ps20(void **state)
