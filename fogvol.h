@@ -8524,9 +8524,14 @@ static void fogvol__ramp_colors(fogvol_context *ctx, const fogvol_ramp_desc *des
 {
     const float *ec = desc->extinction_color;
     int c, unset = ec[0] == 0.0f && ec[1] == 0.0f && ec[2] == 0.0f;
+    double s[3], top = 0.0;
     rp->colors = desc->model == FOGVOL_RAMP_EXTINCTION && desc->blend == FOGVOL_BLEND_FOG && desc->softness == 0.0f;
-    for (c = 0; c < 3; ++c) {
-        rp->sigma[c] = desc->density * (unset ? 1.0f : ec[c]);
+    for (c = 0; c < 3; ++c) { /* (in double: a finite density times a finite colour may pass FLT_MAX) */
+        s[c] = (double)desc->density * (unset ? 1.0 : (double)ec[c]);
+        if (s[c] > top) top = s[c];
+    }
+    for (c = 0; c < 3; ++c) { /* scaled alike down to 1e30 per unit, opaque at any thickness: same hue */
+        rp->sigma[c] = (float)(top > 1e30 ? s[c] * (1e30 / top) : s[c]);
         rp->emit[c] = desc->color[c] < 0.0f ? 0.0f : desc->color[c] > 1.0f ? 1.0f : desc->color[c];
     }
     rp->grey = rp->sigma[0] == rp->sigma[1] && rp->sigma[1] == rp->sigma[2];
@@ -10901,7 +10906,7 @@ static void fogvol__light_passes(fogvol_context *ctx, fogvol__run *run)
 static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
 {
     fogvol_pass ps = run->base;
-    double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear;
+    double range = (double)ctx->cur.frame.zfar - ctx->cur.frame.znear, top, scale;
     int i, c, grey = 1;
     ps.program = ctx->gpu.prog[FOGVOL_PROGRAM_COLOR_FACE];
     ps.uniforms[FOGVOL_U_MISC][3] = run->p.near_clamp;
@@ -10918,9 +10923,14 @@ static int fogvol__color_sums(fogvol_context *ctx, fogvol__run *run)
         if (!fogvol__color_member(ctx, v->ramp)) continue;
         fogvol__draw_for(ctx, v->model, &dr);
         if (v->negative) dr.sign = -1.0f;
+        for (top = 0.0, c = 0; c < 3; ++c)
+            if ((double)v->ramp->sigma[c] * range > top) top = (double)v->ramp->sigma[c] * range;
+        /* optical depths past 2^64 per depth range are opaque at any thickness a depth can hold: the channels
+           scaled alike to it, so that the signed sums stay finite (emission / extinction, the hue, kept) */
+        scale = top > 18446744073709551616.0 ? 18446744073709551616.0 / top : 1.0;
         for (c = 0; c < 3; ++c) {
-            dr.extinction[c] = (float)(v->ramp->sigma[c] * range);
-            dr.emission[c] = (float)(v->ramp->sigma[c] * range * v->ramp->emit[c]);
+            dr.extinction[c] = (float)(v->ramp->sigma[c] * range * scale);
+            dr.emission[c] = (float)(v->ramp->sigma[c] * range * scale * v->ramp->emit[c]);
         }
         grey &= v->ramp->grey;
         ctx->be.draw_mesh(ctx->be.user_data, v->mesh->handle, &dr);

@@ -43,6 +43,7 @@ typedef struct cscene {
     float color[NV][3], ext[NV][3], density[NV];
     int coloured_ext; /* 1: extinction colours that are not grey */
     int overlap;      /* 1: rays cross two volumes of different colours */
+    int opaque;       /* 1: every volume opaque (then the extinction's colour does not show) */
 } cscene;
 
 static void hsv(double h, float out[3])
@@ -333,7 +334,7 @@ static void run_scene(const cscene *s, fogvol_composite comp)
     if (!s->coloured_ext) {
         assert_true(d_ramps_exact <= 2.0); /* grey extinction, back to front: the per-ramp groups are exact */
         if (!s->overlap) assert_true(d_one_ramps <= 2.0); /* exact case: the same picture */
-    } else {
+    } else if (!s->opaque) {
         assert_true(d_ramps_exact > 2.0); /* the per-ramp path cannot colour the extinction */
     }
     free(ramps);
@@ -367,6 +368,22 @@ static void test_coloured_extinction(void **state)
     (void)state;
     build_scene(&s, "coloured_extinction_16", 1, 1);
     run_scene(&s, FOGVOL_COMPOSITE_GEOMETRY);
+}
+
+/* Densities that pass FLT_MAX times an extinction colour or times the depth range (1e38 and 1e36 per
+   unit), each ramp's extinction colours different, the volumes apart: every volume is
+   opaque, its colour its own emission, against the same model in double precision. (The one-pass
+   colour group's float optical depths overflowed to inf and their signed sums to NaN: the volumes
+   vanished.) */
+static void test_huge_densities(void **state)
+{
+    cscene s;
+    int i;
+    (void)state;
+    build_scene(&s, "huge_density_16", 0, 1); /* (apart: one pass is exact where volumes do not overlap) */
+    for (i = 0; i < NV; ++i) s.density[i] = i % 2 ? 1e36f : 1e38f;
+    s.opaque = 1;
+    run_scene(&s, FOGVOL_COMPOSITE_FULLSCREEN);
 }
 
 /* The thickness of volume i of the scene per pixel, ray-cast (rows bottom to top). */
@@ -684,7 +701,7 @@ int main(void)
         cmocka_unit_test(test_refused),
         cmocka_unit_test(test_separate),
         cmocka_unit_test(test_overlapping),
-        cmocka_unit_test(test_coloured_extinction),
+        cmocka_unit_test(test_coloured_extinction), cmocka_unit_test(test_huge_densities),
         cmocka_unit_test(test_textures_and_debug),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
