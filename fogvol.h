@@ -783,7 +783,8 @@ typedef struct fogvol_frame_stats {
        discards the pixels whose sums did not saturate, and an occlusion query counts the rest; the
        result is read a frame or more later, when the GPU has it (up to 4 frames in flight; a frame
        that finds all 4 still waiting, or with more than 32 check passes, is not counted).
-       overflow_pixels_late: pixels with a saturated sum in frame overflow_frame, summed over the
+       overflow_pixels_late: pixels with a saturated sum in frame overflow_frame (multisampled: its
+       saturated samples over the sample count, rounded up), summed over the
        colour-ramp groups (GLES 3: 1 = some), -1 = none known yet or no queries (FOGVOL_OVERFLOW_OFF,
        or a backend without them); FLOAT: always 0 for this frame. With FOGVOL_SPEEDUP_OVERFLOW_BANDS
        (the default) a frame checks one of FOGVOL_OVERFLOW_BANDS horizontal bands of each group's
@@ -7252,6 +7253,7 @@ typedef struct fogvol__spec_program {
     unsigned bits;
     int ms;
     fogvol_handle handle;
+    int64_t serial; /* the frame (fogvol__frame_state.serial) it was last built in */
 } fogvol__spec_program;
 
 struct fogvol_ramp {
@@ -7320,6 +7322,7 @@ typedef struct fogvol__qframe {
     int64_t frame;
     int used, ok, pending;
     int band; /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: the band checked, 0 .. FOGVOL_OVERFLOW_BANDS-1; -1: all */
+    int samples; /* the frame's samples per pixel (0: single-sample): its check passes count samples */
 } fogvol__qframe;
 
 /* The configuration resolved at fogvol_create_context (count_broken: learned when a COUNT program
@@ -7760,7 +7763,13 @@ static fogvol_result fogvol__make_program(fogvol_context *ctx, fogvol_program p,
         pd.samplers[FOGVOL__UNIT_OPAQUE] = NULL;
     pd.label = labels[p];
     (void)fogvol_dialect_layout(ctx->be.dialect, &pd.layout); /* (GL dialects: all -1) */
-    return ctx->be.create_program(ctx->be.user_data, &pd, out);
+    r = ctx->be.create_program(ctx->be.user_data, &pd, out);
+    if (r != FOGVOL_SUCCESS) {
+        *out = 0;
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: the backend did not build the %s program%s: %s", labels[p],
+                    sd.samples ? " (per sample)" : "", fogvol_result_string(r));
+    }
+    return r;
 }
 
 /* Whether the backend can run tier t with variants v: the combination exists in its dialect, and it
@@ -8053,21 +8062,25 @@ FOGVOL_API fogvol_result fogvol_set_dither(fogvol_context *ctx, int enabled)
     return FOGVOL_SUCCESS;
 }
 
-/* Make ctx->gpu.prog the per-sample set (ms = 1) or the single-sample set, building
-   the per-sample programs on first use. */
+/* Make ctx->gpu.prog the per-sample set (ms = 1) or the single-sample set, building its programs on
+   first use and any that an earlier frame could not build. */
 static fogvol_result fogvol__msaa_programs(fogvol_context *ctx, int ms)
 {
     fogvol_handle t[FOGVOL_PROGRAM_COUNT];
     fogvol_result r = FOGVOL_SUCCESS;
     int i;
-    if (ms == ctx->gpu.prog_ms) return FOGVOL_SUCCESS;
-    memcpy(t, ctx->gpu.prog, sizeof t);
-    memcpy(ctx->gpu.prog, ctx->gpu.prog_alt, sizeof t);
-    memcpy(ctx->gpu.prog_alt, t, sizeof t);
-    ctx->gpu.prog_ms = ms;
+    if (ms != ctx->gpu.prog_ms) {
+        memcpy(t, ctx->gpu.prog, sizeof t);
+        memcpy(ctx->gpu.prog, ctx->gpu.prog_alt, sizeof t);
+        memcpy(ctx->gpu.prog_alt, t, sizeof t);
+        ctx->gpu.prog_ms = ms;
+    }
+    /* every frame: a program an earlier frame could not build is tried again (not left 0, drawn as none) */
     ctx->gpu.compile_samples = ms ? 2 : 0;
+    /* (single-sample: CHECK, LIGHT and the mesh composite are made when first used, as at creation) */
     for (i = 0; i < FOGVOL_PROGRAM_COUNT && r == FOGVOL_SUCCESS; ++i)
-        if (!ctx->gpu.prog[i] && fogvol__uses_program(ctx, (fogvol_program)i))
+        if (!ctx->gpu.prog[i] && fogvol__uses_program(ctx, (fogvol_program)i) &&
+            (ms || (i != FOGVOL_PROGRAM_COMPOSITE_MESH && i != FOGVOL_PROGRAM_CHECK && i != FOGVOL_PROGRAM_LIGHT)))
             r = fogvol__make_program(ctx, (fogvol_program)i, 0, &ctx->gpu.prog[i]);
     ctx->gpu.compile_samples = 0;
     return r;
@@ -8098,8 +8111,14 @@ static fogvol_handle fogvol__program_set(fogvol_context *ctx, fogvol_program p, 
     if (!bits) return general;
     for (i = 0; i < ctx->gpu.nspec; ++i) {
         sp = &ctx->gpu.spec[i];
-        if (sp->program == p && sp->bits == bits && sp->ms == ms)
-            return sp->handle ? sp->handle : (bits & none) ? 0 : general;
+        if (sp->program != p || sp->bits != bits || sp->ms != ms) continue;
+        if (!sp->handle && (bits & FOGVOL_SPECIALIZE_DOWNSAMPLE) && sp->serial != ctx->cur.serial) {
+            sp->serial = ctx->cur.serial; /* no stand-in, no other way: built again in each later frame */
+            ctx->gpu.compile_samples = ms ? 2 : 0;
+            if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) sp->handle = 0;
+            ctx->gpu.compile_samples = 0;
+        }
+        return sp->handle ? sp->handle : (bits & none) ? 0 : general;
     }
     if (ctx->gpu.nspec == FOGVOL__SPEC_MAX) {
         if ((bits & FOGVOL_SPECIALIZE_COUNT) && !(bits & FOGVOL_SPECIALIZE_BLEND_COLOR)) ctx->cfg.count_broken = 1;
@@ -8109,6 +8128,7 @@ static fogvol_handle fogvol__program_set(fogvol_context *ctx, fogvol_program p, 
     sp->program = p;
     sp->bits = bits;
     sp->ms = ms;
+    sp->serial = ctx->cur.serial;
     ctx->gpu.compile_samples = ms ? 2 : 0;
     if (fogvol__make_program(ctx, p, bits, &sp->handle) != FOGVOL_SUCCESS) {
         int retried = (bits & FOGVOL_SPECIALIZE_BLEND_COLOR) != 0;
@@ -9814,8 +9834,8 @@ static void fogvol__debug_upsample(fogvol_context *ctx, const float *lo, double 
 
 /* Decoded thickness per pixel (world units) from the sum targets, and the
    count of pixels whose sums saturated (peak: SINGLE_TARGET's marks or NULL). */
-static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const fogvol__run *run, const unsigned char *peak,
-                                           int *overflow)
+static fogvol_result fogvol__debug_read(fogvol_context *ctx, const fogvol__run *run, const unsigned char *peak,
+                                        int *overflow)
 {
     size_t n = (size_t)ctx->gpu.target_w * (size_t)ctx->gpu.target_h, i;
     unsigned char *b, *f, *o;
@@ -9875,6 +9895,17 @@ static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const fogvol__ru
         ctx->cur.frame.debug_thickness[i] = (float)(t * range);
     }
     fogvol__free(&ctx->alloc, b);
+    return r;
+}
+
+/* The debug read-back, a failure logged (debug_thickness is then not written). */
+static fogvol_result fogvol__debug_capture(fogvol_context *ctx, const fogvol__run *run, const unsigned char *peak,
+                                           int *overflow)
+{
+    fogvol_result r = fogvol__debug_read(ctx, run, peak, overflow);
+    if (r != FOGVOL_SUCCESS)
+        fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: debug read-back failed (%s): debug_thickness not written",
+                    fogvol_result_string(r));
     return r;
 }
 
@@ -10398,8 +10429,10 @@ static void fogvol__composite_pass(fogvol_context *ctx, fogvol__run *run, fogvol
     }
     if (!ps->program) {
         if (!run->xsum)
-            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s composite program: group not drawn",
-                        run->p.engine_test ? "depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST)" : "half-resolution");
+            fogvol__log(&ctx->log, FOGVOL_LOG_ERROR, "fogvol: no %s composite program: group not drawn%s",
+                        run->p.engine_test ? "depth-tested (FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST)" : "half-resolution",
+                        run->p.engine_test ? "; the faces read the engine's depth from the next frame" : "");
+        if (run->p.engine_test) ctx->cfg.engine_test = 0; /* (off from then on, as for its face program) */
         run->r = FOGVOL_ERROR_BACKEND;
         return;
     }
@@ -10446,6 +10479,7 @@ static void fogvol__overflow_init(fogvol_context *ctx, fogvol_overflow_policy po
 static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f, uint64_t sum)
 {
     int k;
+    if (f->samples > 1) sum = (sum + (uint64_t)f->samples - 1u) / (uint64_t)f->samples; /* samples -> pixels */
     if (f->band >= 0) {
         if (f->frame <= ctx->ovf.band_frame[f->band] || f->frame < ctx->ovf.overflow_epoch) return 0;
         ctx->ovf.band_frame[f->band] = f->frame;
@@ -10459,23 +10493,30 @@ static int fogvol__overflow_arrived(fogvol_context *ctx, const fogvol__qframe *f
     if (f->frame <= ctx->ovf.overflow_frame) return 0;
     ctx->ovf.overflow_frame = f->frame;
     ctx->ovf.overflow_late = sum > 0x7fffffffu ? 0x7fffffff : (int)sum;
+    for (k = 0; k < FOGVOL_OVERFLOW_BANDS; ++k) { /* the whole picture supersedes every band before it */
+        ctx->ovf.band_frame[k] = f->frame;
+        ctx->ovf.band_count[k] = -1;
+    }
     return 1;
 }
 
-/* Reads the queries of earlier frames without waiting; a frame counts when all its queries are
-   done. Returns 1 when a newer frame's count arrived. */
+/* Reads the queries of earlier frames without waiting, in the order of their frames (the records are
+   reused in any order), up to the first frame whose queries are not all done. Returns 1 when a newer
+   frame's count arrived. */
 static int fogvol__overflow_poll(fogvol_context *ctx)
 {
     int i, k, fresh = 0;
-    for (i = 0; i < FOGVOL__QFRAMES; ++i) {
-        fogvol__qframe *f = &ctx->ovf.qf[i];
+    for (;;) {
+        fogvol__qframe *f = NULL;
         uint64_t sum = 0, v = 0;
-        if (!f->pending) continue;
+        for (i = 0; i < FOGVOL__QFRAMES; ++i)
+            if (ctx->ovf.qf[i].pending && (!f || ctx->ovf.qf[i].frame < f->frame)) f = &ctx->ovf.qf[i];
+        if (!f) break;
         for (k = 0; k < f->used; ++k) {
             if (!ctx->be.query_result(ctx->be.user_data, f->q[k], &v)) break;
             sum += v;
         }
-        if (k < f->used) continue;
+        if (k < f->used) break;
         f->pending = 0;
         fresh |= fogvol__overflow_arrived(ctx, f, sum);
     }
@@ -10496,6 +10537,7 @@ static int fogvol__overflow_open(fogvol_context *ctx)
             ctx->ovf.qf[i].used = 0;
             ctx->ovf.qf[i].ok = 1;
             ctx->ovf.qf[i].frame = ctx->ovf.frame_no;
+            ctx->ovf.qf[i].samples = ctx->cur.samples;
             ctx->ovf.qf[i].band = (ctx->cfg.speedups_off & FOGVOL_SPEEDUP_OVERFLOW_BANDS) || ctx->cur.frame.show_overflow
                                   ? -1
                                   : (int)(ctx->ovf.frame_no % FOGVOL_OVERFLOW_BANDS);

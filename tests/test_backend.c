@@ -3471,6 +3471,93 @@ static void test_engine_depth_no_rg32f(void **state)
     shp_free(&s);
 }
 
+/* A program the backend does not build once, in the first frame: that frame fails with an error logged,
+   and every later frame draws again, each of its passes with a program. FLOAT + ENGINE_DEPTH on the null
+   backend in three configurations: 4x frames (the per-sample programs), single-sample frames that fit
+   FOGVOL_SPEEDUP_ENGINE_DEPTH_TEST (its faces and composite; later frames may read the depth per face),
+   and half-resolution frames (the half-resolution composite, built again); the k-th create call of the
+   first frame fails, for every k. (The per-sample set kept its gap and drew with program 0, with no
+   error logged; a depth-tested or half-resolution composite that failed once failed every later frame.)
+   The half-resolution frames: plain FLOAT (downsample takes no ENGINE_DEPTH). */
+static void test_failed_builds_recover(void **state)
+{
+    static const char *const names[3] = {"4x", "depth-tested", "half resolution"};
+    shp_mesh s = shp_box(1.0f, 1.0f, 1.0f);
+    int cfg, k, f, i, failed, nfailed;
+    (void)state;
+    for (cfg = 0; cfg < 3; ++cfg) {
+        for (k = 1, nfailed = 0; k <= 12; ++k) {
+            fogvol_null_backend nb;
+            fogvol_backend be;
+            fogvol_logger lg;
+            fogvol_context *fv;
+            fogvol_mesh *box;
+            fogvol_ramp *ramp;
+            logcap lc;
+            log_reset(&lc);
+            lg = cap_logger(&lc);
+            fogvol_null_backend_init(&nb, &be);
+            be.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_SOFTWARE_RENDERER | FOGVOL_CAP_MULTISAMPLE |
+                       FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE;
+            if (cfg < 2) {
+                ed_context(&be, &lg, &s, &fv, &box, &ramp);
+            } else { /* (half resolution: FLOAT without ENGINE_DEPTH) */
+                fogvol_context_desc cd;
+                fogvol_mesh_desc md;
+                fogvol_ramp_desc rd;
+                memset(&cd, 0, sizeof cd);
+                cd.backend = be;
+                cd.logger = lg;
+                cd.tier = FOGVOL_TIER_FLOAT;
+                assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+                fx_mesh_desc(&md, &s, 0);
+                assert_int_equal(fogvol_create_mesh(fv, &md, &box, NULL), FOGVOL_SUCCESS);
+                memset(&rd, 0, sizeof rd);
+                rd.density = 0.5f;
+                assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
+            }
+            for (f = 0; f < 4; ++f) {
+                fogvol_frame_desc fd;
+                fogvol_volume_desc vd;
+                fogvol_result r;
+                a_frame_desc(&fd);
+                fd.viewport[0] = fd.viewport[1] = 0;
+                fd.engine_depth_texture = cfg < 2 ? 77 : 0;
+                fd.downsample = cfg == 2 ? 2 : 0;
+                nb.samples = cfg == 0 ? 4 : 0;
+                memset(&vd, 0, sizeof vd);
+                vd.mesh = box;
+                vd.ramp = ramp;
+                glu_identity(vd.model);
+                assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+                assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+                nb.fail_create_at = f == 0 ? nb.create_calls + k : 0;
+                lc.errors = 0;
+                r = fogvol_end_frame(fv, NULL);
+                if (f == 0) {
+                    failed = r != FOGVOL_SUCCESS;
+                    nfailed += failed;
+                    if (failed && !lc.errors) fail_msg("%s, create %d: frame 0 %s, no error logged", names[cfg], k,
+                                                      fogvol_result_string(r));
+                    continue;
+                }
+                if (r != FOGVOL_SUCCESS || nb.pass_count < 2)
+                    fail_msg("%s, create %d failed in frame 0: frame %d %s, %d passes (%s)", names[cfg], k, f,
+                             fogvol_result_string(r), nb.pass_count, lc.count ? lc.msg[lc.count - 1] : "");
+                for (i = 0; i < nb.pass_count; ++i)
+                    if (!nb.passes[i].program)
+                        fail_msg("%s, create %d failed in frame 0: frame %d pass %d has no program", names[cfg], k, f, i);
+            }
+            ed_free(fv, box, ramp);
+            assert_int_equal(nb.creates, nb.destroys);
+        }
+        print_message("# %s: creates 1 .. 12 of the first frame failed in turn (%d of them failed the frame), every "
+                      "later frame drawn\n", names[cfg], nfailed);
+        assert_true(nfailed >= 2);
+    }
+    shp_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest null_tests[] = {
@@ -3496,6 +3583,7 @@ int main(void)
         cmocka_unit_test(test_targets_made_once_per_size),
         cmocka_unit_test(test_engine_depth_attached),
         cmocka_unit_test(test_engine_depth_no_rg32f),
+        cmocka_unit_test(test_failed_builds_recover),
     };
     const struct CMUnitTest gl_tests[] = {
         cmocka_unit_test_setup_teardown(test_gl_missing_entry_core33, setup_core, teardown_gl),

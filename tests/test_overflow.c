@@ -1181,6 +1181,114 @@ static void null_close(nullrig *n)
     assert_int_equal(n->nb.query_active, 0);
 }
 
+/* Query results over time on the null backend. (a) A multisampled frame's check pass counts samples:
+   12 saturated samples at 4 samples per pixel are reported as 3 pixels (as 12 at one sample).
+   (b) Records read in the order of their frames: PS20, COUNT_ONLY, bands on; frame f's query counts
+   10 (f + 1) samples, frame 2 checks the whole picture (show_overflow) and counts 500; the GPU answers
+   frame 0's query at frame 2 and frames 1 and 2 at frame 3, where frame 2's record is the one frame 0
+   left. Frame 3 reports 500 of frame 2, frame 4 the same. (Read in array order, frame 1's older band came
+   last and frame 3 reported bands 0 + 1, 30, as frame 2's count.) */
+static fogvol_backend g_q_inner;
+static int g_q_frames;                 /* backend begin_frame calls */
+static fogvol_handle g_q_handle[64];   /* each query begun, and the frame it was begun in */
+static int g_q_frame[64], g_q_n;
+
+static fogvol_result q_begin_frame(void *u, fogvol_frame_info *info)
+{
+    g_q_frames++;
+    return g_q_inner.begin_frame(u, info);
+}
+
+static int q_begin_query(void *u, fogvol_handle q)
+{
+    int i;
+    for (i = 0; i < g_q_n && g_q_handle[i] != q; ++i) {
+    }
+    if (i == g_q_n && g_q_n < 64) g_q_handle[g_q_n++] = q;
+    if (i < 64) g_q_frame[i] = g_q_frames - 1;
+    return g_q_inner.begin_query(u, q);
+}
+
+static int q_result(void *u, fogvol_handle q, uint64_t *samples)
+{
+    int i, f, now = g_q_frames - 1;
+    (void)u;
+    for (i = 0; i < g_q_n && g_q_handle[i] != q; ++i) {
+    }
+    if (i == g_q_n) return 0;
+    f = g_q_frame[i];
+    if (now < (f == 0 ? 2 : f <= 2 ? 3 : f + 2)) return 0; /* frame 0 at frame 2, frames 1 and 2 at frame 3 */
+    *samples = f == 2 ? 500u : 10u * (uint64_t)(f + 1);
+    return 1;
+}
+
+static void test_null_query_results_over_time(void **state)
+{
+    nullrig n;
+    fogvol_frame_stats st;
+    fogvol_context_desc cd;
+    int f, ms;
+    (void)state;
+    for (ms = 0; ms < 2; ++ms) { /* (a) */
+        null_open(&n, FOGVOL_TIER_PS20, 0, FOGVOL_CAP_HIGHP_FRAGMENT | FOGVOL_CAP_MULTISAMPLE, 1,
+                  FOGVOL_OVERFLOW_COUNT_ONLY);
+        n.nb.samples = ms ? 4 : 0;
+        n.nb.query_samples = 12;
+        assert_int_equal(null_frame(&n, 0, 1, &st), FOGVOL_SUCCESS);
+        assert_int_equal(st.samples, ms ? 4 : 1);
+        (void)null_frame(&n, 0, 1, &st); /* (FOGVOL_ERROR_DEPTH_OVERFLOW once the count is in) */
+        assert_int_equal(st.overflow_frame, 0);
+        assert_int_equal(st.overflow_pixels_late, ms ? 3 : 12);
+        null_close(&n);
+    }
+    /* (b): the null backend's table, wrapped (its user_data: the null backend's state); bands on */
+    memset(&n, 0, sizeof n);
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&n.nb, &g_q_inner);
+    g_q_inner.caps = FOGVOL_CAP_HIGHP_FRAGMENT;
+    n.nb.queries = 1;
+    cd.backend = g_q_inner;
+    cd.backend.begin_frame = q_begin_frame;
+    cd.backend.begin_query = q_begin_query;
+    cd.backend.query_result = q_result;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
+    cd.disable_speedups = FOGVOL_SPEEDUP_SKIP_CHECK;
+    cd.logger.func = logger;
+    cd.logger.user_data = &n.lc;
+    g_q_frames = g_q_n = 0;
+    assert_int_equal(fogvol_create_context(&cd, &n.fv), FOGVOL_SUCCESS);
+    {
+        static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+        static const uint32_t idx[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+        fogvol_mesh_desc md;
+        fogvol_ramp_desc rd;
+        memset(&md, 0, sizeof md);
+        md.positions = pos;
+        md.vertex_count = 4;
+        md.indices = idx;
+        md.index_count = 12;
+        assert_int_equal(fogvol_create_mesh(n.fv, &md, &n.mesh, NULL), FOGVOL_SUCCESS);
+        memset(&rd, 0, sizeof rd);
+        rd.density = 0.5f;
+        assert_int_equal(fogvol_create_ramp(n.fv, &rd, &n.ramp), FOGVOL_SUCCESS);
+    }
+    for (f = 0; f < 5; ++f) {
+        (void)null_frame(&n, f == 2, 1, &st);
+        print_message("# frame %d%s: overflow_pixels_late %d of frame %lld\n", f, f == 2 ? " (whole picture)" : "",
+                      st.overflow_pixels_late, (long long)st.overflow_frame);
+        if (f == 2) { /* frame 0's band 0 */
+            assert_int_equal(st.overflow_pixels_late, 10);
+            assert_int_equal(st.overflow_frame, 0);
+        }
+        if (f >= 3) {
+            assert_int_equal(st.overflow_pixels_late, 500);
+            assert_int_equal(st.overflow_frame, 2);
+        }
+    }
+    null_close(&n);
+}
+
 static void test_null_plumbing(void **state)
 {
     nullrig n;
@@ -1573,7 +1681,7 @@ int main(void)
             cmocka_unit_test(test_lower_bits), cmocka_unit_test(test_exact_sum), cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
             cmocka_unit_test(test_overflow_sequence), cmocka_unit_test(test_lower_bits_sequence),
-            cmocka_unit_test(test_bands_sequence), cmocka_unit_test(test_show_overflow_msaa),
+            cmocka_unit_test(test_bands_sequence), cmocka_unit_test(test_show_overflow_msaa), cmocka_unit_test(test_null_query_results_over_time),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {
             if (n >= (int)(sizeof tests / sizeof tests[0])) {
