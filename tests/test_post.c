@@ -761,6 +761,45 @@ static void test_bad_input(void **state)
     assert_int_equal(fogvol_cancel_frame(x->fv), FOGVOL_SUCCESS);
     assert_true(x->logged - before >= 11); /* every refusal with a context says why */
     assert_int_equal(glGetError(), GL_NO_ERROR);
+    { /* a multisample depth texture (a 4x framebuffer's), with a 2D texture of the engine's left on a unit:
+         refused before drawing, nothing drawn, no GL error left (the pass bound neither, drew fog from the
+         texture left on the unit, then failed) */
+        static const float left_depth = 0.999f;
+        unsigned char *a = (unsigned char *)malloc((size_t)W * H * 4), *b = (unsigned char *)malloc((size_t)W * H * 4);
+        fogvol_ramp_desc rd;
+        fogvol_ramp *ramp;
+        GLuint ms, t2;
+        int u;
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = 1.0f;
+        rd.density = 0.5f;
+        assert_int_equal(fogvol_create_ramp(x->fv, &rd, &ramp), FOGVOL_SUCCESS);
+        glGenTextures(1, &ms);
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, ms);
+        glTexImage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, 4, GL_DEPTH_COMPONENT24, W, H, GL_TRUE);
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+        glGenTextures(1, &t2);
+        for (u = 0; u < 4; ++u) { /* (on every unit fogvol might use) */
+            glActiveTexture((GLenum)(GL_TEXTURE0 + u));
+            glBindTexture(GL_TEXTURE_2D, t2);
+        }
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, 1, 1, 0, GL_RED, GL_FLOAT, &left_depth);
+        glActiveTexture(GL_TEXTURE0);
+        fd.engine_depth_texture = ms;
+        gd.ramp = ramp;
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, a);
+        before = x->logged;
+        assert_int_equal(fogvol_post_distance_fog(x->fv, &gd), FOGVOL_ERROR_INVALID_ARGUMENT);
+        assert_true(x->logged > before);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, b);
+        assert_memory_equal(a, b, (size_t)W * H * 4);
+        glDeleteTextures(1, &ms);
+        glDeleteTextures(1, &t2);
+        fogvol_destroy_ramp(x->fv, ramp);
+        free(a);
+        free(b);
+    }
 }
 
 /* backends that cannot: no highp fragment shaders, no depth textures, an unknown dialect */
