@@ -9416,9 +9416,6 @@ static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_d
     ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
 }
 
-/* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
-   is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
-   window depth -> view depth through the inverse view-projection). */
 /* The greatest normalised depth d = (e - znear) / (zfar - znear) of mesh m's bounds under model, or dmax. */
 static double fogvol__mesh_dmax(const fogvol_context *ctx, const fogvol_mesh *m, const float model[16], double dmax)
 {
@@ -9437,6 +9434,9 @@ static double fogvol__mesh_dmax(const fogvol_context *ctx, const fogvol_mesh *m,
     return dmax;
 }
 
+/* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
+   is clipped, k d <= 2 w everywhere) and .z (near-clamp w); fv_lin, fv_lin2 (engine depth:
+   window depth -> view depth through the inverse view-projection). */
 static void fogvol__clip_uniforms(const fogvol_context *ctx, const fogvol_frame_info *info, fogvol_pass *ps)
 {
     const fogvol_frame_desc *fd = &ctx->cur.frame;
