@@ -11899,6 +11899,7 @@ enum {
     X(void, FrontFace, (fogvol__GLenum)) \
     X(void, BlendFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
     X(void, BlendEquationSeparate, (fogvol__GLenum, fogvol__GLenum)) \
+    X(void, BlendEquation, (fogvol__GLenum)) \
     X(void, BlendColor, (fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
     X(void, StencilFuncSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLint, fogvol__GLuint)) \
     X(void, StencilOpSeparate, (fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
@@ -12000,7 +12001,8 @@ enum {
    (3.0/3.1 + OES_ or EXT_draw_buffers_indexed: ...iOES, ...iEXT, like the masks above). */
 #define FOGVOL__GL_INDEXED_BLEND(X) \
     X(void, BlendFuncSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum, fogvol__GLenum)) \
-    X(void, BlendEquationSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum))
+    X(void, BlendEquationSeparatei, (fogvol__GLuint, fogvol__GLenum, fogvol__GLenum)) \
+    X(void, BlendEquationi, (fogvol__GLuint, fogvol__GLenum))
 /* Pausing the engine's transform feedback: GL 4.0 (or 3.x + ARB_transform_feedback2, same names), GLES 3.0. */
 #define FOGVOL__GL_TF_PAUSE(X) X(void, PauseTransformFeedback, (void)) X(void, ResumeTransformFeedback, (void))
 
@@ -12024,6 +12026,7 @@ enum {
     X(void, ViewportIndexedf, (fogvol__GLuint, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat, fogvol__GLfloat)) \
     X(void, ScissorIndexed, (fogvol__GLuint, fogvol__GLint, fogvol__GLint, fogvol__GLsizei, fogvol__GLsizei)) \
     X(void, DepthRangeIndexed, (fogvol__GLuint, fogvol__GLdouble, fogvol__GLdouble))
+#define FOGVOL__GL_VIEWPORT_ARRAY_ES(X) X(void, DepthRangeIndexedf, (fogvol__GLuint, fogvol__GLfloat, fogvol__GLfloat))
 #define FOGVOL__GL_CLAMP(X) X(void, ClampColor, (fogvol__GLenum, fogvol__GLenum))
 
 /* Optional: clip control (GL 4.5, ARB_clip_control; GLES: EXT_clip_control as glClipControlEXT). */
@@ -12042,7 +12045,7 @@ enum {
     FOGVOL__GL_BASE(X) FOGVOL__GL_FBO(X) FOGVOL__GL_VAO(X) FOGVOL__GL_SAMPLER(X) FOGVOL__GL_BLIT(X) FOGVOL__GL_3(X) \
         FOGVOL__GL_DRAW_BUFFERS(X) FOGVOL__GL_3_DESKTOP(X) FOGVOL__GL_DESKTOP(X) FOGVOL__GL_ES(X) \
             FOGVOL__GL_CLIP_CONTROL(X) FOGVOL__GL_INDEXED_QUERY(X) FOGVOL__GL_INDEXED_MASK(X) FOGVOL__GL_INDEXED_BLEND(X) FOGVOL__GL_TF_PAUSE(X) \
-                FOGVOL__GL_QUERY(X) FOGVOL__GL_VIEWPORT_ARRAY(X) FOGVOL__GL_CLAMP(X)
+                FOGVOL__GL_QUERY(X) FOGVOL__GL_VIEWPORT_ARRAY(X) FOGVOL__GL_VIEWPORT_ARRAY_ES(X) FOGVOL__GL_CLAMP(X)
 
 #define FOGVOL__GL_PFN(ret, name, params) typedef ret(FOGVOL_GLAPIENTRY *fogvol__PFN_##name) params;
 FOGVOL__GL_ALL(FOGVOL__GL_PFN)
@@ -12216,6 +12219,8 @@ typedef struct fogvol__gl {
     fogvol_logger log;
     int major, minor, gles, core;
     int has_vao, has_sampler, has_split_fbo, has_pixel_buffers, has_row_length, has_discard, has_uint_index;
+    int has_pack_rows; /* PACK_ROW_LENGTH, PACK_SKIP_*: GL, GLES 3, GLES 2 + NV_pack_subimage (has_row_length:
+                          the UNPACK_ ones, GLES 2 + EXT_unpack_subimage) */
     int has_msaa; /* multisample textures and per-sample shading */
     int float_linear; /* R32F textures can be filtered (GL 3.0; GLES 3 + OES_texture_float_linear) */
     int mrt_highp;    /* fogvol_gl_desc.mrt_highp */
@@ -12290,14 +12295,16 @@ static void fogvol__gl_scissor(fogvol__gl *gl, fogvol__GLint x, fogvol__GLint y,
 
 static void fogvol__gl_depth_range(fogvol__gl *gl, fogvol__GLdouble n, fogvol__GLdouble f)
 {
-    if (gl->gles) gl->DepthRangef((fogvol__GLfloat)n, (fogvol__GLfloat)f);
+    if (gl->gles && gl->ViewportIndexedf) gl->DepthRangeIndexedf(0, (fogvol__GLfloat)n, (fogvol__GLfloat)f);
+    else if (gl->gles) gl->DepthRangef((fogvol__GLfloat)n, (fogvol__GLfloat)f);
     else if (gl->ViewportIndexedf) gl->DepthRangeIndexed(0, n, f);
     else gl->DepthRange(n, f);
 }
 
 /* Which contexts have a piece of state (the W column of FOGVOL__GL_ENABLES, when of fogvol__gl_values). */
 enum {
-    FOGVOL__GLW_ALL, FOGVOL__GLW_DESKTOP, FOGVOL__GLW_COMPAT, FOGVOL__GLW_ROW_LENGTH, FOGVOL__GLW_DISCARD,
+    FOGVOL__GLW_ALL, FOGVOL__GLW_DESKTOP, FOGVOL__GLW_COMPAT, FOGVOL__GLW_ROW_LENGTH, FOGVOL__GLW_PACK_ROWS,
+    FOGVOL__GLW_DISCARD,
     FOGVOL__GLW_MSAA, FOGVOL__GLW_RESTART, FOGVOL__GLW_RESTART_FIXED, FOGVOL__GLW_CLIP, FOGVOL__GLW_DEPTH_CLAMP,
     FOGVOL__GLW_SAMPLE_SHADING, FOGVOL__GLW_SAMPLE_MASK, FOGVOL__GLW_CLAMP
 };
@@ -12309,6 +12316,7 @@ static int fogvol__gl_has(const fogvol__gl *gl, int when, fogvol__GLenum name)
     case FOGVOL__GLW_DESKTOP: return !gl->gles;
     case FOGVOL__GLW_COMPAT: return !gl->gles && !gl->core;
     case FOGVOL__GLW_ROW_LENGTH: return gl->has_row_length;
+    case FOGVOL__GLW_PACK_ROWS: return gl->has_pack_rows;
     case FOGVOL__GLW_DISCARD: return gl->has_discard;
     case FOGVOL__GLW_MSAA: return gl->has_msaa;
     case FOGVOL__GLW_RESTART: return gl->has_restart;
@@ -12386,7 +12394,7 @@ static const fogvol__gl_value_row fogvol__gl_values[] = {
      {FOGVOL__GL_UNPACK_ALIGNMENT, FOGVOL__GL_PACK_ALIGNMENT}},
     {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(unpack_rows), 0,
      {FOGVOL__GL_UNPACK_ROW_LENGTH, FOGVOL__GL_UNPACK_SKIP_ROWS, FOGVOL__GL_UNPACK_SKIP_PIXELS}},
-    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_ROW_LENGTH, 1, FOGVOL__GL_AT(pack_rows), 0,
+    {FOGVOL__GLV_PIXEL_STORE, 'i', FOGVOL__GLW_PACK_ROWS, 1, FOGVOL__GL_AT(pack_rows), 0,
      {FOGVOL__GL_PACK_ROW_LENGTH, FOGVOL__GL_PACK_SKIP_ROWS, FOGVOL__GL_PACK_SKIP_PIXELS}}};
 #undef FOGVOL__GL_AT
 #define FOGVOL__GL_N_VALUES (int)(sizeof fogvol__gl_values / sizeof fogvol__gl_values[0])
@@ -12404,7 +12412,10 @@ static void fogvol__gl_put(fogvol__gl *gl, const fogvol__gl_value_row *r, const 
     case FOGVOL__GLV_BLEND_FUNC:
         gl->BlendFuncSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1], (fogvol__GLenum)v[2], (fogvol__GLenum)v[3]);
         break;
-    case FOGVOL__GLV_BLEND_EQ: gl->BlendEquationSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1]); break;
+    case FOGVOL__GLV_BLEND_EQ: /* (one equation for both: the advanced ones, KHR_blend_equation_advanced, */
+        if (v[0] == v[1]) gl->BlendEquation((fogvol__GLenum)v[0]); /* which the Separate call refuses) */
+        else gl->BlendEquationSeparate((fogvol__GLenum)v[0], (fogvol__GLenum)v[1]);
+        break;
     case FOGVOL__GLV_DEPTH_FUNC: gl->DepthFunc((fogvol__GLenum)v[0]); break;
     case FOGVOL__GLV_CULL_FACE: gl->CullFace((fogvol__GLenum)v[0]); break;
     case FOGVOL__GLV_FRONT_FACE: gl->FrontFace((fogvol__GLenum)v[0]); break;
@@ -12575,7 +12586,8 @@ static void fogvol__gl_restore_draw_buffers(fogvol__gl *gl, const fogvol__gl_sta
         if (gl->has_indexed_blend) {
             gl->BlendFuncSeparatei(u, (fogvol__GLenum)s->bi_src_rgb[i], (fogvol__GLenum)s->bi_dst_rgb[i],
                                    (fogvol__GLenum)s->bi_src_a[i], (fogvol__GLenum)s->bi_dst_a[i]);
-            gl->BlendEquationSeparatei(u, (fogvol__GLenum)s->bi_eq_rgb[i], (fogvol__GLenum)s->bi_eq_a[i]);
+            if (s->bi_eq_rgb[i] == s->bi_eq_a[i]) gl->BlendEquationi(u, (fogvol__GLenum)s->bi_eq_rgb[i]);
+            else gl->BlendEquationSeparatei(u, (fogvol__GLenum)s->bi_eq_rgb[i], (fogvol__GLenum)s->bi_eq_a[i]);
         }
         gl->ColorMaski(u, s->bi_mask[i][0], s->bi_mask[i][1], s->bi_mask[i][2], s->bi_mask[i][3]);
         if (s->bi_blend[i]) gl->Enablei(FOGVOL__GL_BLEND, u);
@@ -12880,8 +12892,8 @@ static fogvol_result fogvol__gl_begin_frame(void *u, fogvol_frame_info *info)
     }
     gl->in_frame = 1;
     fogvol__gl_pixel_defaults(gl);
-    if (gl->has_msaa) { /* of the engine's draw framebuffer, still bound */
-        fogvol__GLint buffers = 0, samples = 0;
+    if (gl->has_msaa || gl->major >= 3) { /* of the engine's draw framebuffer, still bound (GL 3.0, GLES 3: */
+        fogvol__GLint buffers = 0, samples = 0; /* multisample framebuffers without per-sample shading) */
         gl->GetIntegerv(FOGVOL__GL_SAMPLE_BUFFERS, &buffers);
         gl->GetIntegerv(FOGVOL__GL_SAMPLES, &samples);
         info->samples = buffers ? samples : 0;
@@ -13862,7 +13874,8 @@ static unsigned fogvol__gl_caps(fogvol__gl *gl, const char *ext)
             }
             gl->float_linear = fogvol__gl_has_ext3(gl, "GL_OES_texture_float_linear");
             if (gl->float_linear) caps |= FOGVOL_CAP_FILTER_FLOAT;
-        } else if (fogvol__has_ext(ext, "GL_OES_depth_texture")) {
+        } else if (fogvol__has_ext(ext, "GL_OES_depth_texture") || fogvol__has_ext(ext, "GL_WEBGL_depth_texture") ||
+                   fogvol__has_ext(ext, "WEBGL_depth_texture")) { /* (WebGL 1 under emscripten: the WEBGL names) */
             caps |= FOGVOL_CAP_DEPTH_TEXTURE;
         }
     } else {
@@ -13982,6 +13995,19 @@ static fogvol_result fogvol__gl_version(fogvol__gl *gl, const fogvol_gl_desc *de
     return FOGVOL_SUCCESS;
 }
 
+/* GLES, optional: viewport arrays (OES_viewport_array, glViewportIndexedfOES ...; with glEnablei). */
+static void fogvol__gl_load_es_viewport_array(fogvol__gl *gl, const fogvol_gl_desc *desc)
+{
+    if (gl->major < 3 || !fogvol__gl_has_ext3(gl, "GL_OES_viewport_array")) return;
+    gl->ViewportIndexedf = (fogvol__PFN_ViewportIndexedf)desc->get_proc_address("glViewportIndexedfOES", desc->user_data);
+    gl->ScissorIndexed = (fogvol__PFN_ScissorIndexed)desc->get_proc_address("glScissorIndexedOES", desc->user_data);
+    gl->DepthRangeIndexedf =
+        (fogvol__PFN_DepthRangeIndexedf)desc->get_proc_address("glDepthRangeIndexedfOES", desc->user_data);
+    if (!gl->ViewportIndexedf || !gl->ScissorIndexed || !gl->DepthRangeIndexedf || !gl->Enablei || !gl->Disablei ||
+        !gl->IsEnabledi)
+        gl->ViewportIndexedf = NULL; /* (fogvol__gl_viewport and the others test this one) */
+}
+
 /* Desktop, optional: viewport arrays (GL 4.1 or ARB_viewport_array, with glEnablei for the scissor
    test; all or none) and glClampColor where colour clamping exists (GL 3.0+ compatibility profiles). */
 static void fogvol__gl_load_desktop_extras(fogvol__gl *gl, const fogvol_gl_desc *desc)
@@ -13989,7 +14015,8 @@ static void fogvol__gl_load_desktop_extras(fogvol__gl *gl, const fogvol_gl_desc 
     if (gl->major >= 3 && (gl->major > 4 || (gl->major == 4 && gl->minor >= 1) ||
                            fogvol__gl_has_ext3(gl, "GL_ARB_viewport_array"))) {
         FOGVOL__GL_VIEWPORT_ARRAY(FOGVOL__GL_LOAD)
-        if (!gl->ViewportIndexedf || !gl->ScissorIndexed || !gl->DepthRangeIndexed || !gl->Enablei || !gl->Disablei)
+        if (!gl->ViewportIndexedf || !gl->ScissorIndexed || !gl->DepthRangeIndexed || !gl->Enablei || !gl->Disablei ||
+            !gl->IsEnabledi)
             gl->ViewportIndexedf = NULL; /* (fogvol__gl_viewport and the others test this one) */
     }
     if (gl->major >= 3 && !gl->core) FOGVOL__GL_CLAMP(FOGVOL__GL_LOAD)
@@ -14017,10 +14044,15 @@ static fogvol_result fogvol__gl_features(fogvol__gl *gl, const fogvol_gl_desc *d
     gl->has_vao = gl->major >= 3;
     gl->has_sampler = gl->gles ? gl->major >= 3 : (gl->major > 3 || (gl->major == 3 && gl->minor >= 3));
     gl->has_pixel_buffers = gl->gles ? gl->major >= 3 : (gl->major > 2 || (gl->major == 2 && gl->minor >= 1));
-    gl->has_row_length = !gl->gles || gl->major >= 3;
+    gl->has_row_length = gl->has_pack_rows = !gl->gles || gl->major >= 3;
     gl->has_discard = gl->major >= 3;
     gl->has_uint_index = !gl->gles || gl->major >= 3;
     if (gl->major < 3) *ext = (const char *)gl->GetString(FOGVOL__GL_EXTENSIONS);
+    if (gl->gles && gl->major < 3) { /* GLES 2's pixel-transfer extensions: the same state as GLES 3's, saved too */
+        gl->has_row_length = fogvol__has_ext(*ext, "GL_EXT_unpack_subimage");
+        gl->has_pack_rows = fogvol__has_ext(*ext, "GL_NV_pack_subimage");
+        gl->has_pixel_buffers = fogvol__has_ext(*ext, "GL_NV_pixel_buffer_object");
+    }
     if (gl->gles && gl->major < 3) gl->has_uint_index = fogvol__has_ext(*ext, "GL_OES_element_index_uint");
     if (!gl->gles && gl->major < 3 && !fogvol__has_ext(*ext, "GL_ARB_framebuffer_object")) {
         if (!fogvol__has_ext(*ext, "GL_EXT_framebuffer_object")) {
@@ -14136,6 +14168,8 @@ static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_d
     if (!gl->gles || gl->major >= 3) {
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_LOAD)
         FOGVOL__GL_DRAW_BUFFERS(FOGVOL__GL_REQUIRE)
+    } else if (fogvol__has_ext(ext, "GL_EXT_draw_buffers")) { /* GLES 2: the engine's list, saved and narrowed */
+        gl->DrawBuffers = (fogvol__PFN_DrawBuffers)desc->get_proc_address("glDrawBuffersEXT", desc->user_data);
     }
     if ((r = fogvol__gl_load_indexed(gl, desc)) != FOGVOL_SUCCESS) return r;
     if (!gl->gles || gl->major >= 3) { /* optional */
@@ -14147,6 +14181,7 @@ static fogvol_result fogvol__gl_load_versioned(fogvol__gl *gl, const fogvol_gl_d
     if (gl->gles) {
         FOGVOL__GL_ES(FOGVOL__GL_LOAD)
         FOGVOL__GL_ES(FOGVOL__GL_REQUIRE)
+        fogvol__gl_load_es_viewport_array(gl, desc);
     } else {
         FOGVOL__GL_DESKTOP(FOGVOL__GL_LOAD)
         FOGVOL__GL_DESKTOP(FOGVOL__GL_REQUIRE)

@@ -121,6 +121,16 @@ static int asked(const proc_log *pl, const char *name)
 static int has_ext(const char *name)
 {
     GLint i, n = 0;
+    const char *v = (const char *)glGetString(GL_VERSION);
+    if (v && strncmp(v, "OpenGL ES 2", 11) == 0) { /* (ES 2: one string, no glGetStringi) */
+        const char *e = (const char *)glGetString(GL_EXTENSIONS), *p = e;
+        size_t len = strlen(name);
+        while (p && (p = strstr(p, name)) != NULL) {
+            if ((p == e || p[-1] == ' ') && (p[len] == ' ' || p[len] == 0)) return 1;
+            p += len;
+        }
+        return 0;
+    }
     glGetIntegerv(GL_NUM_EXTENSIONS, &n);
     for (i = 0; i < n; ++i)
         if (strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i), name) == 0) return 1;
@@ -914,6 +924,205 @@ static void test_drawbuffers(void **state)
     eglu_destroy(&c);
 }
 
+/* Engine state and framebuffers that the context's extensions add, each part where the context has the
+   extension (PS20, the sphere scene): an advanced blend equation (KHR_blend_equation_advanced, core in
+   ES 3.2) left set by the engine is restored, with no GL error; viewport array index 1 (OES_viewport_array)
+   keeps its viewport, depth range, scissor box and enable; on ES 2, unpack rows and skips
+   (EXT_unpack_subimage) and pack rows (NV_pack_subimage) left by the engine change neither the ramp's upload
+   (the picture equals the one drawn with the clean state) nor the debug read-back (no overflow of its
+   buffer: ASan), and EXT_draw_buffers' second buffer stays untouched; on ES 3 a 4x framebuffer is refused
+   (FOGVOL_ERROR_UNSUPPORTED: no per-sample path on GLES), not drawn single-sample. (Before: a GL error and
+   FUNC_ADD; index 1 rewritten; a shifted ramp and heap overflows; buffer 1 fogged; SUCCESS with one fog
+   value per pixel.) */
+static fogvol_result ext_frame(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp, float *dbg)
+{
+    fogvol_frame_desc fd;
+    fx_frame_desc(&fd, &s->cam, W, H);
+    fd.debug_thickness = dbg;
+    assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+    add_scene(fv, s, meshes, ramp, 1);
+    return fogvol_end_frame(fv, NULL);
+}
+
+static void ext_scene(const tscene *s, fogvol_context **fv, fogvol_mesh **meshes, fogvol_ramp **ramp)
+{
+    static const tier_combo cb = {FOGVOL_TIER_PS20, 0, "PS20", 0};
+    *fv = scene_context(&cb, s, meshes, ramp);
+}
+
+static void ext_free(fogvol_context *fv, const tscene *s, fogvol_mesh **meshes, fogvol_ramp *ramp)
+{
+    int i;
+    for (i = 0; i < s->n; ++i) fogvol_destroy_mesh(fv, meshes[i]);
+    fogvol_destroy_ramp(fv, ramp);
+    fogvol_destroy_context(fv);
+}
+
+static void test_engine_extensions(void **state)
+{
+    int ci = (int)(intptr_t)*state, i, parts = 0;
+    const tscene *s = &g_scenes[scene_index("sphere")];
+    unsigned char *clean = (unsigned char *)malloc((size_t)W * H * 4), *px = (unsigned char *)malloc((size_t)W * H * 4);
+    float *dbg = (float *)malloc(sizeof(float) * W * H), *dbg2 = (float *)malloc(sizeof(float) * W * H * 2);
+    fogvol_context *fv;
+    fogvol_mesh *meshes[MAX_OBJ];
+    fogvol_ramp *ramp;
+    eglu_ctx c;
+    context_up(ci, &c);
+    /* the picture and read-back with the clean state */
+    glClearColor(0.2f, 0.4f, 0.6f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    ext_scene(s, &fv, meshes, &ramp);
+    assert_int_equal(ext_frame(fv, s, meshes, ramp, dbg), FOGVOL_SUCCESS);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, clean);
+    if (c.major > 3 || (c.major == 3 && c.minor >= 2) || has_ext("GL_KHR_blend_equation_advanced")) {
+        GLint rgb = 0, a = 0;
+        glBlendEquation(GL_MULTIPLY_KHR);
+        assert_int_equal(ext_frame(fv, s, meshes, ramp, NULL), FOGVOL_SUCCESS);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        glGetIntegerv(GL_BLEND_EQUATION_RGB, &rgb);
+        glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &a);
+        assert_int_equal(rgb, GL_MULTIPLY_KHR);
+        assert_int_equal(a, GL_MULTIPLY_KHR);
+        glBlendEquation(GL_FUNC_ADD);
+        print_message("  %s: advanced blend equation restored\n", g_ctx[ci].name);
+        ++parts;
+    }
+    if (has_ext("GL_OES_viewport_array")) {
+        PFNGLVIEWPORTINDEXEDFOESPROC vp = (PFNGLVIEWPORTINDEXEDFOESPROC)eglu_proc("glViewportIndexedfOES", NULL);
+        PFNGLSCISSORINDEXEDOESPROC sc = (PFNGLSCISSORINDEXEDOESPROC)eglu_proc("glScissorIndexedOES", NULL);
+        PFNGLDEPTHRANGEINDEXEDFOESPROC dr = (PFNGLDEPTHRANGEINDEXEDFOESPROC)eglu_proc("glDepthRangeIndexedfOES", NULL);
+        PFNGLENABLEIOESPROC en = (PFNGLENABLEIOESPROC)eglu_proc("glEnableiOES", NULL);
+        PFNGLDISABLEIOESPROC dis = (PFNGLDISABLEIOESPROC)eglu_proc("glDisableiOES", NULL);
+        PFNGLISENABLEDIOESPROC is = (PFNGLISENABLEDIOESPROC)eglu_proc("glIsEnablediOES", NULL);
+        PFNGLGETFLOATI_VOESPROC getf = (PFNGLGETFLOATI_VOESPROC)eglu_proc("glGetFloati_vOES", NULL);
+        GLint box[4];
+        GLfloat v[4], d[2];
+        assert_true(vp && sc && dr && en && dis && is && getf);
+        vp(1, 40.0f, 40.0f, 24.0f, 24.0f);
+        dr(1, 0.25f, 0.5f);
+        sc(1, 41, 42, 20, 21);
+        en(GL_SCISSOR_TEST, 1);
+        assert_int_equal(ext_frame(fv, s, meshes, ramp, NULL), FOGVOL_SUCCESS);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        getf(GL_VIEWPORT, 1, v);
+        getf(GL_DEPTH_RANGE, 1, d);
+        glGetIntegeri_v(GL_SCISSOR_BOX, 1, box);
+        assert_true(v[0] == 40.0f && v[1] == 40.0f && v[2] == 24.0f && v[3] == 24.0f);
+        assert_true(d[0] == 0.25f && d[1] == 0.5f);
+        assert_true(box[0] == 41 && box[1] == 42 && box[2] == 20 && box[3] == 21);
+        assert_true(is(GL_SCISSOR_TEST, 1));
+        assert_false(glIsEnabled(GL_SCISSOR_TEST));
+        dis(GL_SCISSOR_TEST, 1);
+        print_message("  %s: viewport array index 1 kept\n", g_ctx[ci].name);
+        ++parts;
+    }
+    if (c.major == 2 && has_ext("GL_EXT_unpack_subimage")) { /* a ramp made under the engine's unpack state */
+        fogvol_ramp *r2;
+        fogvol_ramp_desc rd;
+        GLint rows = 0;
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 4096);
+        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 200);
+        memset(&rd, 0, sizeof rd);
+        rd.color[0] = rd.color[1] = rd.color[2] = 0.8f;
+        rd.density = s->density;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &r2), FOGVOL_SUCCESS);
+        glGetIntegerv(GL_UNPACK_ROW_LENGTH, &rows);
+        assert_int_equal(rows, 4096);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        assert_int_equal(ext_frame(fv, s, meshes, r2, NULL), FOGVOL_SUCCESS);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        assert_memory_equal(px, clean, (size_t)W * H * 4);
+        fogvol_destroy_ramp(fv, r2);
+        print_message("  %s: a ramp uploaded under the engine's unpack rows and skips\n", g_ctx[ci].name);
+        ++parts;
+    }
+    if (c.major == 2 && has_ext("GL_NV_pack_subimage")) { /* the debug read-back under the engine's pack rows */
+        GLint rows = 0;
+        glPixelStorei(GL_PACK_ROW_LENGTH /* = _NV */, 2 * W);
+        for (i = 0; i < W * H; ++i) dbg2[i] = -1.0f;
+        assert_int_equal(ext_frame(fv, s, meshes, ramp, dbg2), FOGVOL_SUCCESS);
+        glGetIntegerv(GL_PACK_ROW_LENGTH /* = _NV */, &rows);
+        assert_int_equal(rows, 2 * W);
+        glPixelStorei(GL_PACK_ROW_LENGTH /* = _NV */, 0);
+        assert_memory_equal(dbg2, dbg, sizeof(float) * W * H);
+        print_message("  %s: the debug read-back under the engine's pack rows\n", g_ctx[ci].name);
+        ++parts;
+    }
+    if (c.major == 2 && has_ext("GL_EXT_draw_buffers")) { /* the engine's second draw buffer untouched */
+        static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1_EXT};
+        PFNGLDRAWBUFFERSEXTPROC db = (PFNGLDRAWBUFFERSEXTPROC)eglu_proc("glDrawBuffersEXT", NULL);
+        GLuint fbo, rfbo, tex[2];
+        int changed = 0, fogged = 0;
+        glGenTextures(2, tex);
+        glGenFramebuffers(1, &fbo);
+        glGenFramebuffers(1, &rfbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        for (i = 0; i < 2; ++i) {
+            glBindTexture(GL_TEXTURE_2D, tex[i]);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, W, H, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, tex[i], 0);
+        }
+        glBindTexture(GL_TEXTURE_2D, 0);
+        db(2, bufs);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        assert_int_equal(ext_frame(fv, s, meshes, ramp, NULL), FOGVOL_SUCCESS);
+        glBindFramebuffer(GL_FRAMEBUFFER, rfbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex[1], 0);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, clean);
+        for (i = 0; i < W * H * 4; ++i) changed += clean[i] != px[i];
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex[0], 0);
+        glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, clean);
+        for (i = 0; i < W * H * 4; ++i) fogged += clean[i] != px[i];
+        print_message("  %s: EXT_draw_buffers, %d values fogged in buffer 0, %d changed in buffer 1\n", g_ctx[ci].name,
+                      fogged, changed);
+        assert_true(fogged > 1000);
+        assert_int_equal(changed, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteFramebuffers(1, &rfbo);
+        glDeleteTextures(2, tex);
+        ++parts;
+    }
+    if (c.major >= 3) { /* a 4x framebuffer: refused, nothing drawn */
+        GLuint fbo, rb[2];
+        fogvol_frame_stats st;
+        fogvol_frame_desc fd;
+        glGenFramebuffers(1, &fbo);
+        glGenRenderbuffers(2, rb);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, 4, GL_RGBA8, W, H);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, 4, GL_DEPTH24_STENCIL8, W, H);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+        assert_int_equal(glCheckFramebufferStatus(GL_FRAMEBUFFER), GL_FRAMEBUFFER_COMPLETE);
+        fx_frame_desc(&fd, &s->cam, W, H);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        add_scene(fv, s, meshes, ramp, 1);
+        memset(&st, 0, sizeof st);
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_ERROR_UNSUPPORTED);
+        assert_int_equal(glGetError(), GL_NO_ERROR);
+        glBindFramebuffer(GL_FRAMEBUFFER, c.fbo);
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteRenderbuffers(2, rb);
+        print_message("  %s: a 4x framebuffer refused\n", g_ctx[ci].name);
+        ++parts;
+    }
+    print_message("  %s: %d of the parts ran\n", g_ctx[ci].name, parts);
+    assert_true(parts >= 1);
+    ext_free(fv, s, meshes, ramp);
+    free(clean);
+    free(px);
+    free(dbg);
+    free(dbg2);
+    eglu_destroy(&c);
+}
+
 /* An extension listed without all its functions (WebGL 2 lists OES_draw_buffers_indexed without
    IsEnablediOES): the backend takes the context as without it, says so at INFO, and still draws. */
 static char g_info[256];
@@ -997,8 +1206,8 @@ static int add_ctx_test(struct CMUnitTest *tests, char (*names)[64], int n, int 
 static int run_context(int ci)
 {
     static tcase cases[NTIER_COMBO];
-    static struct CMUnitTest tests[NTIER_COMBO + 6];
-    static char names[NTIER_COMBO + 6][64], group[32];
+    static struct CMUnitTest tests[NTIER_COMBO + 8];
+    static char names[NTIER_COMBO + 8][64], group[32];
     fogvol_dialect d = g_ctx[ci].major >= 3 ? FOGVOL_GLSL_300ES : FOGVOL_GLSL_100;
     int k, n = 0, nc = 0;
     g_cur = ci;
@@ -1015,6 +1224,7 @@ static int run_context(int ci)
         ++n;
     }
     n = add_ctx_test(tests, names, n, ci, "overflow", test_overflow);
+    n = add_ctx_test(tests, names, n, ci, "engine_extensions", test_engine_extensions);
     if (g_ctx[ci].major >= 3) {
         n = add_ctx_test(tests, names, n, ci, "drawbuffers", test_drawbuffers);
         n = add_ctx_test(tests, names, n, ci, "half_resolution", test_half_resolution);
