@@ -7327,6 +7327,8 @@ typedef struct fogvol__qframe {
     int used, ok, pending;
     int band; /* FOGVOL_SPEEDUP_OVERFLOW_BANDS: the band checked, 0 .. FOGVOL_OVERFLOW_BANDS-1; -1: all */
     int samples; /* the frame's samples per pixel (0: single-sample): its check passes count samples */
+    int discard; /* the frame is not counted (more check passes than queries, or a query refused), but the
+                    queries it began still wait for the GPU before the record and they are used again */
 } fogvol__qframe;
 
 /* The configuration resolved at fogvol_create_context (count_broken: learned when a COUNT program
@@ -8888,6 +8890,11 @@ static const char *fogvol__camera_axes(fogvol_context *ctx, const fogvol_frame_d
         ctx->cur.eyerow[i] = -v[i * 4 + 2];
     }
     ctx->cur.eyerow[3] = -v[14];
+    /* a mirrored view (det < 0, a planar reflection's): Y turned so that X, Y, F have the handedness of
+       the frame built above (X . (Y x F) < 0), and fogvol__camera_why sees the mirroring on screen */
+    if (ax[1][0] * (ax[2][1] * ax[3][2] - ax[2][2] * ax[3][1]) - ax[1][1] * (ax[2][0] * ax[3][2] - ax[2][2] * ax[3][0]) +
+            ax[1][2] * (ax[2][0] * ax[3][1] - ax[2][1] * ax[3][0]) > 0.0)
+        for (i = 0; i < 3; ++i) ax[2][i] = -ax[2][i];
     return NULL;
 }
 
@@ -10522,7 +10529,7 @@ static int fogvol__overflow_poll(fogvol_context *ctx)
         }
         if (k < f->used) break;
         f->pending = 0;
-        fresh |= fogvol__overflow_arrived(ctx, f, sum);
+        if (!f->discard) fresh |= fogvol__overflow_arrived(ctx, f, sum);
     }
     return fresh;
 }
@@ -10578,9 +10585,9 @@ static void fogvol__overflow_close(fogvol_context *ctx)
     if (ctx->ovf.qcur < 0) return;
     f = &ctx->ovf.qf[ctx->ovf.qcur];
     ctx->ovf.qcur = -1;
-    if (!f->ok) return;
-    if (f->used > 0) f->pending = 1;
-    else fogvol__overflow_arrived(ctx, f, 0);
+    f->discard = !f->ok;
+    if (f->used > 0) f->pending = 1; /* (a backend may reset a query only once the GPU is done with it) */
+    else if (f->ok) fogvol__overflow_arrived(ctx, f, 0);
 }
 
 /* The program and the mask target of the check passes, made on first use. */

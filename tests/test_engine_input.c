@@ -559,6 +559,57 @@ static void test_engine_depth_copy_recovers(void **state)
     free(thick);
 }
 
+/* A mirrored view matrix (a planar reflection's, its x row negated) given as view + projection: the
+   thickness is the unmirrored ray cast read at the mirrored pixel, on FLOAT and PS20, the occluder drawn
+   by fogvol. (Front and back faces were swapped: the thickness came out negated, the fog gone.) */
+static void test_mirrored_view(void **state)
+{
+    static const fogvol_tier tiers[2] = {FOGVOL_TIER_FLOAT, FOGVOL_TIER_PS20};
+    rc_camera c = camera();
+    tobj o[2];
+    int n = scene(o), k, x, y, pixels;
+    double *gt = (double *)malloc(sizeof(double) * W * H), range = c.zfar - c.znear, err, bound;
+    unsigned char *interior = (unsigned char *)malloc((size_t)W * H);
+    float *thick = (float *)calloc((size_t)W * H, sizeof(float));
+    glu_ctx g;
+    (void)state;
+    assert_true(glu_create(&g, W, H, 1));
+    truth(&c, o, n, gt, interior);
+    for (k = 0; k < 2; ++k) {
+        fogvol_context *fv = make_ctx(tiers[k], 0);
+        fogvol_mesh *vol = mesh_of(fv, &o[0].m, 0), *occ = mesh_of(fv, &o[1].m, 1);
+        fogvol_ramp *ramp = ramp_of(fv);
+        fogvol_frame_desc fd;
+        frame_of(&fd, &c, thick);
+        for (x = 0; x < 4; ++x) fd.view[x * 4] = -fd.view[x * 4]; /* view-space x negated */
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        add_volume(fv, vol, o[0].model, ramp);
+        assert_int_equal(fogvol_add_occluder(fv, occ, o[1].model), FOGVOL_SUCCESS);
+        assert_int_equal(fogvol_end_frame(fv, NULL), FOGVOL_SUCCESS);
+        for (err = 0.0, pixels = 0, y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                int m = y * W + (W - 1 - x);
+                if (!interior[m]) continue;
+                if (fabs(thick[y * W + x] - gt[m]) > err) err = fabs(thick[y * W + x] - gt[m]);
+                pixels += gt[m] > 0.0;
+            }
+        bound = tiers[k] == FOGVOL_TIER_FLOAT ? 1e-4 * range : 2.0 * range / 4096.0;
+        print_message("  %s, mirrored view: max |error| %.3g of the range (bound %.3g), %d fogged pixels\n",
+                      fogvol_tier_name(tiers[k]), err / range, bound / range, pixels);
+        assert_true(pixels > 1000);
+        assert_true(err <= bound);
+        fogvol_destroy_mesh(fv, vol);
+        fogvol_destroy_mesh(fv, occ);
+        fogvol_destroy_ramp(fv, ramp);
+        fogvol_destroy_context(fv);
+    }
+    glu_destroy(&g);
+    free_objs(o, n);
+    free(gt);
+    free(interior);
+    free(thick);
+}
+
 /* refusals: no depth buffer, unknown source, a texture source without a texture */
 static void test_engine_depth_refusals(void **state)
 {
@@ -1804,6 +1855,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_engine_depth_buffers),     cmocka_unit_test(test_engine_depth_refusals),
         cmocka_unit_test(test_engine_depth_copy_recovers),
+        cmocka_unit_test(test_mirrored_view),
         cmocka_unit_test(test_engine_depth_walk),
         cmocka_unit_test(test_engine_occluders),         cmocka_unit_test(test_engine_occluders_sequence),
         cmocka_unit_test(test_engine_occluder_refusals), cmocka_unit_test(test_cancelled_frames),

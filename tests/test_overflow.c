@@ -1289,6 +1289,95 @@ static void test_null_query_results_over_time(void **state)
     null_close(&n);
 }
 
+/* A frame with more check passes than its record holds queries (40 ramp groups, 32 queries) is not
+   counted, but the queries it began are in the GPU's work: its record waits for them like any other,
+   so the next frames take other records and no query is begun again before its result is read (a
+   Vulkan backend resets a query on the host when it begins it). The GPU never answers here: frames 1-3
+   take the 3 other records, frame 4 finds none free and begins no query. (The record was reused at once:
+   frame 1 began frame 0's queries again.) */
+static int g_r_begun[64], g_r_frame_of[64], g_r_reused; /* per query handle: begun in which frame */
+static int g_r_frame;
+static int r_begin_query(void *u, fogvol_handle q)
+{
+    if (q < 64) {
+        if (g_r_begun[q] && g_r_frame_of[q] != g_r_frame) g_r_reused++;
+        g_r_begun[q] = 1;
+        g_r_frame_of[q] = g_r_frame;
+    }
+    return g_q_inner.begin_query(u, q);
+}
+
+static void test_null_uncounted_frame_waits(void **state)
+{
+    fogvol_null_backend nb;
+    fogvol_context_desc cd;
+    fogvol_context *fv;
+    fogvol_mesh *mesh;
+    fogvol_ramp *ramps[40];
+    fogvol_frame_stats st;
+    logcap lc;
+    static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t idx[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    fogvol_mesh_desc md;
+    int i, f;
+    (void)state;
+    memset(&lc, 0, sizeof lc);
+    memset(&cd, 0, sizeof cd);
+    fogvol_null_backend_init(&nb, &g_q_inner);
+    g_q_inner.caps = FOGVOL_CAP_HIGHP_FRAGMENT;
+    nb.queries = 1;
+    nb.query_not_ready = 1000000; /* the GPU never answers */
+    cd.backend = g_q_inner;
+    cd.backend.begin_query = r_begin_query;
+    cd.tier = FOGVOL_TIER_PS20;
+    cd.overflow_policy = FOGVOL_OVERFLOW_COUNT_ONLY;
+    cd.disable_speedups = NULL_OFF;
+    cd.logger.func = logger;
+    cd.logger.user_data = &lc;
+    assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
+    memset(&md, 0, sizeof md);
+    md.positions = pos;
+    md.vertex_count = 4;
+    md.indices = idx;
+    md.index_count = 12;
+    assert_int_equal(fogvol_create_mesh(fv, &md, &mesh, NULL), FOGVOL_SUCCESS);
+    for (i = 0; i < 40; ++i) {
+        fogvol_ramp_desc rd;
+        memset(&rd, 0, sizeof rd);
+        rd.density = 0.1f + 0.01f * (float)i;
+        assert_int_equal(fogvol_create_ramp(fv, &rd, &ramps[i]), FOGVOL_SUCCESS);
+    }
+    memset(g_r_begun, 0, sizeof g_r_begun);
+    g_r_reused = 0;
+    for (f = 0; f < 6; ++f) {
+        fogvol_frame_desc fd;
+        fogvol_volume_desc vd;
+        int begun = nb.queries_begun;
+        g_r_frame = f;
+        frame_at(&fd, 60, 16, 16);
+        assert_int_equal(fogvol_begin_frame(fv, &fd), FOGVOL_SUCCESS);
+        memset(&vd, 0, sizeof vd);
+        vd.mesh = mesh;
+        glu_translate_scale(vd.model, 0, 0, -3, 1);
+        for (i = 0; i < (f == 0 ? 40 : 1); ++i) {
+            vd.ramp = ramps[i];
+            assert_int_equal(fogvol_add_volume(fv, &vd), FOGVOL_SUCCESS);
+        }
+        assert_int_equal(fogvol_end_frame(fv, &st), FOGVOL_SUCCESS);
+        print_message("# frame %d: %d check passes, %d queries begun\n", f, st.overflow_passes,
+                      nb.queries_begun - begun);
+        if (f == 0) assert_int_equal(nb.queries_begun - begun, 32);
+        else if (f <= 3) assert_int_equal(nb.queries_begun - begun, 1);
+        else assert_int_equal(nb.queries_begun - begun, 0); /* every record waits */
+        assert_int_equal(st.overflow_pixels_late, -1);
+    }
+    assert_int_equal(g_r_reused, 0);
+    for (i = 0; i < 40; ++i) fogvol_destroy_ramp(fv, ramps[i]);
+    fogvol_destroy_mesh(fv, mesh);
+    fogvol_destroy_context(fv);
+    assert_int_equal(nb.creates, nb.destroys);
+}
+
 static void test_null_plumbing(void **state)
 {
     nullrig n;
@@ -1656,7 +1745,7 @@ static void test_bad_policy(void **state)
 int main(void)
 {
     static int params[NCOMBO * 3][2];
-    static struct CMUnitTest tests[NCOMBO * 3 + 16]; /* zeroed: the unused entries are skipped */
+    static struct CMUnitTest tests[NCOMBO * 3 + 24]; /* zeroed: the unused entries are skipped */
     int n = 0, i, j, fails;
     char *names[NCOMBO * 3];
     build_scenes(); /* scenes.h keeps its scenes; the shells are added after them */
@@ -1681,7 +1770,7 @@ int main(void)
             cmocka_unit_test(test_lower_bits), cmocka_unit_test(test_exact_sum), cmocka_unit_test(test_warn_once),
             cmocka_unit_test(test_engine_query_active), cmocka_unit_test(test_gles3_any_samples),
             cmocka_unit_test(test_overflow_sequence), cmocka_unit_test(test_lower_bits_sequence),
-            cmocka_unit_test(test_bands_sequence), cmocka_unit_test(test_show_overflow_msaa), cmocka_unit_test(test_null_query_results_over_time),
+            cmocka_unit_test(test_bands_sequence), cmocka_unit_test(test_show_overflow_msaa), cmocka_unit_test(test_null_query_results_over_time), cmocka_unit_test(test_null_uncounted_frame_waits),
         };
         for (i = 0; i < (int)(sizeof more / sizeof more[0]); ++i) {
             if (n >= (int)(sizeof tests / sizeof tests[0])) {
