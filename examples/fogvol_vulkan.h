@@ -399,7 +399,7 @@ static void fogvk__use(VkCommandBuffer cmd, fogvk_image *im, VkImageLayout layou
                        VkAccessFlags access)
 {
     const VkAccessFlags writes = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
-                                 VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+                                 VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
     VkImageMemoryBarrier b;
     if (im->layout == layout && !(im->access & writes) && !(access & writes)) { /* read after read */
         im->stage |= stage;
@@ -415,6 +415,10 @@ static void fogvk__use(VkCommandBuffer cmd, fogvk_image *im, VkImageLayout layou
     b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = im->image;
     b.subresourceRange.aspectMask = im->aspect;
+    if (im->aspect == VK_IMAGE_ASPECT_DEPTH_BIT &&
+        (im->format == VK_FORMAT_D16_UNORM_S8_UINT || im->format == VK_FORMAT_D24_UNORM_S8_UINT ||
+         im->format == VK_FORMAT_D32_SFLOAT_S8_UINT)) /* (a layout is both aspects' without separateDepthStencilLayouts) */
+        b.subresourceRange.aspectMask |= VK_IMAGE_ASPECT_STENCIL_BIT;
     b.subresourceRange.levelCount = 1;
     b.subresourceRange.layerCount = 1;
     vkCmdPipelineBarrier(cmd, im->stage ? im->stage : (VkPipelineStageFlags)VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, stage, 0,
@@ -483,8 +487,10 @@ void fogvk_set_frame(fogvol_backend *backend, const fogvk_frame *frame)
     vk->engine_color.width = frame->width;
     vk->engine_color.height = frame->height;
     vk->engine_color.layout = frame->color_layout;
-    vk->engine_color.stage = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    vk->engine_color.access = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT; /* the engine's scene, drawn before */
+    /* the engine's last write to each image is not known (a draw, a resolve or blit, a compute pass): the
+       first barrier waits for every earlier command's writes */
+    vk->engine_color.stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    vk->engine_color.access = VK_ACCESS_MEMORY_WRITE_BIT;
     memset(&vk->engine_depth, 0, sizeof vk->engine_depth);
     vk->engine_depth.image = frame->depth_image;
     vk->engine_depth.format = frame->depth_format;
@@ -492,8 +498,8 @@ void fogvk_set_frame(fogvol_backend *backend, const fogvk_frame *frame)
     vk->engine_depth.width = frame->width;
     vk->engine_depth.height = frame->height;
     vk->engine_depth.layout = frame->depth_layout;
-    vk->engine_depth.stage = VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT;
-    vk->engine_depth.access = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+    vk->engine_depth.stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    vk->engine_depth.access = VK_ACCESS_MEMORY_WRITE_BIT;
 }
 
 VkCommandBuffer fogvk_frame_command(const fogvol_backend *backend)
