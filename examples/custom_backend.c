@@ -42,12 +42,13 @@ enum {
     E_BEGIN_FRAME, E_END_FRAME, E_CREATE_TEXTURE, E_DESTROY_TEXTURE, E_CREATE_TARGET, E_DESTROY_TARGET,
     E_CREATE_PROGRAM, E_DESTROY_PROGRAM, E_CREATE_MESH, E_DESTROY_MESH, E_BEGIN_PASS, E_SET_DRAW, E_DRAW_MESH,
     E_DRAW_FULLSCREEN, E_END_PASS, E_READ_TARGET, E_DESTROY, E_NATIVE_TEXTURE, E_TARGET_ATTACHMENT, E_TAKE_ERROR,
-    E_COUNT
+    E_COPY_DEPTH, E_CREATE_QUERY, E_DESTROY_QUERY, E_BEGIN_QUERY, E_END_QUERY, E_QUERY_RESULT, E_COUNT
 };
 static const char *const k_entry[E_COUNT] = {
     "begin_frame", "end_frame", "create_texture", "destroy_texture", "create_target", "destroy_target",
     "create_program", "destroy_program", "create_mesh", "destroy_mesh", "begin_pass", "set_draw", "draw_mesh",
-    "draw_fullscreen", "end_pass", "read_target", "destroy", "native_texture", "target_attachment", "take_error"};
+    "draw_fullscreen", "end_pass", "read_target", "destroy", "native_texture", "target_attachment", "take_error",
+    "copy_depth", "create_query", "destroy_query", "begin_query", "end_query", "query_result"};
 
 typedef struct rec_pass {
     fogvol_pass pass; /* a copy of what begin_pass received */
@@ -98,11 +99,12 @@ static void engine_state(GLint s[8])
     s[7] = glIsEnabled(GL_DEPTH_TEST);
 }
 
-/* begin_frame (optional). Called first by fogvol_end_frame (and fogvol_mrt_prepare),
-   before any pass. Must save every piece of engine state the passes will change and
-   report the engine framebuffer (the one bound now, "target 0" of the passes) in
-   info (its samples and depth conventions). On failure it must leave everything unchanged: the frame is
-   dropped and end_frame is not called. */
+/* begin_frame (optional). Called first by fogvol_end_frame (and fogvol_mrt_prepare,
+   fogvol_occluder_prepare), before any pass. Must save every piece of engine state the passes will
+   change and report the engine framebuffer (the one bound now, "target 0" of the passes) in info (its
+   samples and depth conventions). info->draw_buffer is an input: the engine draw buffer the composite
+   writes; a backend that cannot write that one returns an error. On failure it must leave everything
+   unchanged: the frame is dropped and end_frame is not called. */
 static fogvol_result rec_begin_frame(void *u, fogvol_frame_info *info)
 {
     recorder *r = (recorder *)u;
@@ -151,12 +153,15 @@ static void rec_destroy_texture(void *u, fogvol_handle h)
     r->inner.destroy_texture(r->inner.user_data, h);
 }
 
-/* create_target. A render target: a colour texture (NEAREST, CLAMP) in desc->format
-   (RGBA8, or R32F that additive blending must work on), two colour attachments drawn
-   together when desc->color_count == 2, a depth buffer when desc->depth, or the depth
-   buffer of desc->share_depth. The handle must also work as a texture in
-   fogvol_pass.textures (sampled as its colour texture). An incomplete framebuffer is
-   FOGVOL_ERROR_FRAMEBUFFER. Engine state unchanged outside a frame. */
+/* create_target. A render target: a colour texture (NEAREST, CLAMP; LINEAR when desc->linear, with
+   FOGVOL_CAP_FILTER_FLOAT) in desc->format (RGBA8; R32F and RGBA32F that additive blending must work on;
+   RG32F with FOGVOL_CAP_ATTACH_DEPTH), two colour attachments drawn together when desc->color_count == 2,
+   desc->samples per pixel (multisampled, with FOGVOL_CAP_MULTISAMPLE), a depth buffer when desc->depth,
+   or the depth buffer of desc->share_depth. The handle must also work as a texture in
+   fogvol_pass.textures (sampled as its colour texture). A format or sample count it cannot make is
+   FOGVOL_ERROR_UNSUPPORTED (the core then takes another way where it has one); an incomplete
+   framebuffer is FOGVOL_ERROR_FRAMEBUFFER. Engine state unchanged outside a frame. The header's
+   "backend table" section is the whole contract; this wrapper forwards to a backend that keeps it. */
 static fogvol_result rec_create_target(void *u, const fogvol_target_desc *d, fogvol_handle *out)
 {
     recorder *r = (recorder *)u;
@@ -199,9 +204,10 @@ static void rec_destroy_program(void *u, fogvol_handle h)
     r->inner.destroy_program(r->inner.user_data, h);
 }
 
-/* create_mesh. Upload data->positions (tightly packed xyz floats) and data->indices
-   (uint32 triangles; NULL = non-indexed) for drawing with the position in attribute 0.
-   The data is only valid during the call. Engine vertex state unchanged. */
+/* create_mesh. Upload data->positions (xyz floats; with FOGVOL_CAP_MESH_LAYOUT at data's stride and
+   offset) and data->indices (uint32 triangles, or 16-bit with the layout cap; NULL = non-indexed) for
+   drawing with the position in attribute 0. The data is only valid during the call. Engine vertex state
+   unchanged. */
 static fogvol_result rec_create_mesh(void *u, const fogvol_mesh_data *d, fogvol_handle *out)
 {
     recorder *r = (recorder *)u;
@@ -219,11 +225,15 @@ static void rec_destroy_mesh(void *u, fogvol_handle h)
 }
 
 /* begin_pass. Make the pass current: render into pass->target (0 = the framebuffer that
-   was bound at begin_frame), viewport, clear colour (and depth to 1 when the target has
-   its own depth) if pass->clear, blend mode, culling (front faces counter-clockwise),
-   depth test LESS and depth writes as given, no stencil test, pass->program with the
-   pass->uniforms, textures[i] (or native_textures[i]) on unit i. Everything else in a
-   neutral state: no scissor, full colour mask, no dithering, filled polygons. */
+   was bound at begin_frame, at info->draw_buffer), viewport, the scissor rectangle when
+   pass->scissor[2] > 0, clear colour (and depth to 1 when the target has its own depth) if
+   pass->clear, blend mode (the blend constant when pass->blend_constant), culling (front faces
+   counter-clockwise), depth test LESS (GREATER with pass->depth_greater) and depth writes as given,
+   pass->depth_texture attached as the depth buffer (FOGVOL_CAP_ATTACH_DEPTH), pass->read_target at
+   colour attachment 1 for framebuffer fetch, per-sample shading for pass->per_sample 1 (2: tested
+   per sample, shaded once per pixel), no stencil test, pass->program with the pass->uniforms,
+   textures[i] (or native_textures[i]) on unit i. Everything else in a neutral state: full colour mask,
+   no dithering, filled polygons. The fields a backend's caps do not announce never come set. */
 static void rec_begin_pass(void *u, const fogvol_pass *p)
 {
     recorder *r = (recorder *)u;
@@ -235,8 +245,8 @@ static void rec_begin_pass(void *u, const fogvol_pass *p)
     r->inner.begin_pass(r->inner.user_data, p);
 }
 
-/* set_draw. Per-draw uniforms of the current program: fv_mvp, fv_depth, fv_sign, and
-   the front-face winding (d->front_cw). fogvol calls it for the engine's own draws in
+/* set_draw. Per-draw uniforms of the current program: fv_mvp, fv_depth, fv_sign (fv_ext and
+   fv_emit for the colour programs of FOGVOL_VARIANT_COLORS), and the front-face winding (d->front_cw). fogvol calls it for the engine's own draws in
    an occluder callback: it must not touch the engine's vertex state. */
 static void rec_set_draw(void *u, const fogvol_draw *d)
 {
@@ -274,8 +284,8 @@ static void rec_end_pass(void *u)
 }
 
 /* read_target (optional: debug read-back). The whole target into rgba, rows bottom to
-   top: RGBA8 bytes, or one float per pixel for R32F (size >= w*h*4). May be called
-   inside a frame between passes; engine state unchanged. */
+   top: RGBA8 bytes, one float per pixel for R32F (size >= w*h*4), four for RGBA32F (w*h*16). May be
+   called inside a frame between passes; engine state unchanged. */
 static fogvol_result rec_read_target(void *u, fogvol_handle t, unsigned char *rgba, size_t size)
 {
     recorder *r = (recorder *)u;
@@ -325,7 +335,54 @@ static fogvol_result rec_take_error(void *u)
     return r->inner.take_error ? r->inner.take_error(r->inner.user_data) : FOGVOL_SUCCESS;
 }
 
-/* The table: the recorder's entries, the wrapped backend's dialect and capabilities. */
+/* copy_depth (ENGINE_DEPTH from a framebuffer's depth buffer) and the occlusion queries (overflow counts):
+   forwarded as they are, each call counted; a wrapper that left them out would switch those features off
+   (the core tests for the entries, not the caps). */
+static fogvol_result rec_copy_depth(void *u, fogvol_native framebuffer, int bound, const int rect[4], int samples,
+                                   fogvol_native *texture)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_COPY_DEPTH]++;
+    return r->inner.copy_depth(r->inner.user_data, framebuffer, bound, rect, samples, texture);
+}
+
+static fogvol_result rec_create_query(void *u, fogvol_handle *out)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_CREATE_QUERY]++;
+    return r->inner.create_query(r->inner.user_data, out);
+}
+
+static void rec_destroy_query(void *u, fogvol_handle q)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_DESTROY_QUERY]++;
+    r->inner.destroy_query(r->inner.user_data, q);
+}
+
+static int rec_begin_query(void *u, fogvol_handle q)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_BEGIN_QUERY]++;
+    return r->inner.begin_query(r->inner.user_data, q);
+}
+
+static void rec_end_query(void *u, fogvol_handle q)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_END_QUERY]++;
+    r->inner.end_query(r->inner.user_data, q);
+}
+
+static int rec_query_result(void *u, fogvol_handle q, uint64_t *samples)
+{
+    recorder *r = (recorder *)u;
+    r->calls[E_QUERY_RESULT]++;
+    return r->inner.query_result(r->inner.user_data, q, samples);
+}
+
+/* The table: the recorder's entries, the wrapped backend's dialect and capabilities; the optional entries
+   the wrapped backend lacks stay NULL here too. */
 static fogvol_backend recorder_table(recorder *r)
 {
     fogvol_backend t;
@@ -353,12 +410,21 @@ static fogvol_backend recorder_table(recorder *r)
     t.native_texture = rec_native_texture;
     t.target_attachment = rec_target_attachment;
     t.take_error = rec_take_error;
+    if (r->inner.copy_depth) t.copy_depth = rec_copy_depth;
+    if (r->inner.create_query && r->inner.destroy_query && r->inner.begin_query && r->inner.end_query &&
+        r->inner.query_result) {
+        t.create_query = rec_create_query;
+        t.destroy_query = rec_destroy_query;
+        t.begin_query = rec_begin_query;
+        t.end_query = rec_end_query;
+        t.query_result = rec_query_result;
+    }
     return t;
 }
 
 static void print_log(const recorder *r, fogvol_context *fv)
 {
-    static const char *const blend[5] = {"none", "add", "fog", "light", "subtract"};
+    static const char *const blend[7] = {"none", "add", "fog", "light", "subtract", "multiply", "emit"};
     static const char *const cull[3] = {"none", "back", "front"};
     int i;
     printf("call counts (tier %s, GLSL %s):\n", fogvol_tier_name(fogvol_context_tier(fv, NULL)),
@@ -373,7 +439,7 @@ static void print_log(const recorder *r, fogvol_context *fv)
         if (r->passes[i].fullscreens) snprintf(draws, sizeof draws, "%d full-screen", r->passes[i].fullscreens);
         else snprintf(draws, sizeof draws, "%d mesh%s", r->passes[i].meshes, r->passes[i].meshes == 1 ? "" : "es");
         printf("  %-2d  %-32s %-5s %-8s %-5s %-10s %-28s %s\n", i, name_of(r, p->target), p->clear ? "yes" : "no",
-               (unsigned)p->blend < 5 ? blend[p->blend] : "?", (unsigned)p->cull < 3 ? cull[p->cull] : "?",
+               (unsigned)p->blend < 7 ? blend[p->blend] : "?", (unsigned)p->cull < 3 ? cull[p->cull] : "?",
                p->depth_test ? (p->depth_write ? "test+write" : "test") : "-", name_of(r, p->program), draws);
     }
 }

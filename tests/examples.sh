@@ -132,6 +132,7 @@ fi
 run "custom_backend: recording backend renders, logs, writes a PNG" "$out/custom_backend" "$out/custom_backend.png"
 note '^  (begin_pass|draw_mesh|draw_fullscreen) |^  [0-9]+ |differ|violations'
 expect "custom_backend: same pixels as the default GL backend" ' 0 of [0-9]+ pixels differ'
+expect "custom_backend: the occlusion queries forwarded (overflow counts through the wrapper)" '^  create_query +[1-9]'
 run "custom_backend --tier float" "$out/custom_backend" --tier float "$out/custom_backend_float.png"
 
 fi # the examples
