@@ -9423,22 +9423,30 @@ static void fogvol__lin_uniforms(const fogvol_context *ctx, const fogvol_frame_d
     ps->uniforms[FOGVOL_U_LINEAR_W][3] = (float)(dn[3] - dn[0] - sy * dn[1] + b * dn[2]);
 }
 
-/* The greatest normalised depth d = (e - znear) / (zfar - znear) of mesh m's bounds under model, or dmax. */
-static double fogvol__mesh_dmax(const fogvol_context *ctx, const fogvol_mesh *m, const float model[16], double dmax)
+/* The view depths of the 8 corners of mesh m's bounds under model: their least and greatest. */
+static void fogvol__mesh_depths(const fogvol_context *ctx, const fogvol_mesh *m, const float model[16], double *emin,
+                                double *emax)
 {
-    const fogvol_frame_desc *fd = &ctx->cur.frame;
-    double range = (double)fd->zfar - fd->znear;
-    int j, c;
+    int c, j;
     for (c = 0; c < 8; ++c) {
-        double e = ctx->cur.eyerow[3], p[3];
+        double p[3], e = ctx->cur.eyerow[3];
         p[0] = (c & 1) ? m->bmax[0] : m->bmin[0];
         p[1] = (c & 2) ? m->bmax[1] : m->bmin[1];
         p[2] = (c & 4) ? m->bmax[2] : m->bmin[2];
         for (j = 0; j < 3; ++j)
             e += ctx->cur.eyerow[j] * (model[j] * p[0] + model[4 + j] * p[1] + model[8 + j] * p[2] + model[12 + j]);
-        if ((e - fd->znear) / range > dmax) dmax = (e - fd->znear) / range;
+        if (c == 0 || e < *emin) *emin = e;
+        if (c == 0 || e > *emax) *emax = e;
     }
-    return dmax;
+}
+
+/* The greatest normalised depth d = (e - znear) / (zfar - znear) of mesh m's bounds under model, or dmax. */
+static double fogvol__mesh_dmax(const fogvol_context *ctx, const fogvol_mesh *m, const float model[16], double dmax)
+{
+    double emin = 0.0, emax = 0.0, d;
+    fogvol__mesh_depths(ctx, m, model, &emin, &emax);
+    d = (emax - ctx->cur.frame.znear) / ((double)ctx->cur.frame.zfar - ctx->cur.frame.znear);
+    return d > dmax ? d : dmax;
 }
 
 /* fv_misc.x (clip z = k d - w: the near plane clips exactly, nothing beyond the far plane
@@ -9520,18 +9528,7 @@ FOGVOL_API fogvol_result fogvol_occluder_prepare(fogvol_context *ctx, fogvol_occ
 /* The view depths of the 8 corners of volume v's bounds: their least and greatest. */
 static void fogvol__volume_depths(const fogvol_context *ctx, const fogvol__volume *v, double *emin, double *emax)
 {
-    int c, j;
-    for (c = 0; c < 8; ++c) {
-        double p[3], e = ctx->cur.eyerow[3];
-        p[0] = (c & 1) ? v->mesh->bmax[0] : v->mesh->bmin[0];
-        p[1] = (c & 2) ? v->mesh->bmax[1] : v->mesh->bmin[1];
-        p[2] = (c & 4) ? v->mesh->bmax[2] : v->mesh->bmin[2];
-        for (j = 0; j < 3; ++j)
-            e += ctx->cur.eyerow[j] *
-                 (v->model[j] * p[0] + v->model[4 + j] * p[1] + v->model[8 + j] * p[2] + v->model[12 + j]);
-        if (c == 0 || e < *emin) *emin = e;
-        if (c == 0 || e > *emax) *emax = e;
-    }
+    fogvol__mesh_depths(ctx, v->mesh, v->model, emin, emax);
 }
 
 /* COUNT adds the opaque depth once per back face without its front face, so it
