@@ -3303,9 +3303,9 @@ static void ed_frame(fogvol_context *fv, const fogvol_mesh *box, const fogvol_ra
 }
 
 /* A FLOAT + ENGINE_DEPTH context on backend table be (logger lg: may be NULL), with the box s as a mesh
-   and one ramp; ed_free frees them. */
-static void ed_context(const fogvol_backend *be, const fogvol_logger *lg, const shp_mesh *s, fogvol_context **fv,
-                       fogvol_mesh **box, fogvol_ramp **ramp)
+   and one ramp; ed_free frees them. ed_context_v: FLOAT with other variants. */
+static void ed_context_v(const fogvol_backend *be, const fogvol_logger *lg, unsigned variants, const shp_mesh *s,
+                         fogvol_context **fv, fogvol_mesh **box, fogvol_ramp **ramp)
 {
     fogvol_context_desc cd;
     fogvol_mesh_desc md;
@@ -3314,7 +3314,7 @@ static void ed_context(const fogvol_backend *be, const fogvol_logger *lg, const 
     cd.backend = *be;
     if (lg) cd.logger = *lg;
     cd.tier = FOGVOL_TIER_FLOAT;
-    cd.variants = FOGVOL_VARIANT_ENGINE_DEPTH;
+    cd.variants = variants;
     assert_int_equal(fogvol_create_context(&cd, fv), FOGVOL_SUCCESS);
     fx_mesh_desc(&md, s, 0);
     assert_int_equal(fogvol_create_mesh(*fv, &md, box, NULL), FOGVOL_SUCCESS);
@@ -3322,6 +3322,12 @@ static void ed_context(const fogvol_backend *be, const fogvol_logger *lg, const 
     rd.color[0] = 1.0f;
     rd.density = 0.5f;
     assert_int_equal(fogvol_create_ramp(*fv, &rd, ramp), FOGVOL_SUCCESS);
+}
+
+static void ed_context(const fogvol_backend *be, const fogvol_logger *lg, const shp_mesh *s, fogvol_context **fv,
+                       fogvol_mesh **box, fogvol_ramp **ramp)
+{
+    ed_context_v(be, lg, FOGVOL_VARIANT_ENGINE_DEPTH, s, fv, box, ramp);
 }
 
 static void ed_free(fogvol_context *fv, fogvol_mesh *box, fogvol_ramp *ramp)
@@ -3499,23 +3505,8 @@ static void test_failed_builds_recover(void **state)
             fogvol_null_backend_init(&nb, &be);
             be.caps |= FOGVOL_CAP_FLOAT_BLEND | FOGVOL_CAP_SOFTWARE_RENDERER | FOGVOL_CAP_MULTISAMPLE |
                        FOGVOL_CAP_ATTACH_DEPTH_MULTISAMPLE;
-            if (cfg < 2) {
-                ed_context(&be, &lg, &s, &fv, &box, &ramp);
-            } else { /* (half resolution: FLOAT without ENGINE_DEPTH) */
-                fogvol_context_desc cd;
-                fogvol_mesh_desc md;
-                fogvol_ramp_desc rd;
-                memset(&cd, 0, sizeof cd);
-                cd.backend = be;
-                cd.logger = lg;
-                cd.tier = FOGVOL_TIER_FLOAT;
-                assert_int_equal(fogvol_create_context(&cd, &fv), FOGVOL_SUCCESS);
-                fx_mesh_desc(&md, &s, 0);
-                assert_int_equal(fogvol_create_mesh(fv, &md, &box, NULL), FOGVOL_SUCCESS);
-                memset(&rd, 0, sizeof rd);
-                rd.density = 0.5f;
-                assert_int_equal(fogvol_create_ramp(fv, &rd, &ramp), FOGVOL_SUCCESS);
-            }
+            /* (half resolution: FLOAT without ENGINE_DEPTH) */
+            ed_context_v(&be, &lg, cfg < 2 ? (unsigned)FOGVOL_VARIANT_ENGINE_DEPTH : 0u, &s, &fv, &box, &ramp);
             for (f = 0; f < 4; ++f) {
                 fogvol_frame_desc fd;
                 fogvol_volume_desc vd;

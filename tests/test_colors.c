@@ -552,6 +552,24 @@ static void test_textures_and_debug(void **state)
         print_message("# COLORS, debug_ramp destroyed in the frame: read-back 0, max |picture - model without it| "
                       "%.2f/255\n", d);
         assert_true(d <= 2.0);
+        /* the next frame's debug_ramp is read back again (nothing of the destroyed one is kept) */
+        fd.debug_ramp = c.ramp[9];
+        for (k = 0; k < CW * CH; ++k) dbg[k] = -1.0f;
+        assert_int_equal(fogvol_begin_frame(c.fv, &fd), FOGVOL_SUCCESS);
+        for (i = 0; i < NV; ++i) {
+            if (i == 3) continue;
+            memset(&vd, 0, sizeof vd);
+            vd.mesh = c.mesh;
+            vd.ramp = c.ramp[i];
+            memcpy(vd.model, s.model[i], sizeof vd.model);
+            assert_int_equal(fogvol_add_volume(c.fv, &vd), FOGVOL_SUCCESS);
+        }
+        assert_int_equal(fogvol_end_frame(c.fv, NULL), FOGVOL_SUCCESS);
+        trace_volume(&s, 9, t);
+        reference(&s, ref, exact, nhit, interior); /* (the interior mask of the scene) */
+        d = max_thickness_diff(dbg, t, interior);
+        print_message("# COLORS, the frame after: debug_ramp of volume 9 read back, max |read-back - ray cast| %.3g\n", d);
+        assert_true(d <= 3e-5 * (s.cam.zfar - s.cam.znear));
     }
     fogvol_destroy_volume_texture(c.fv, dens);
     fogvol_destroy_volume_texture(c.fv, col);

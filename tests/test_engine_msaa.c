@@ -878,6 +878,28 @@ static void test_tier(void **state)
             assert_memory_equal(again, after, (size_t)W * H * 4);
         free(again);
     }
+    if (tc->depth == DEPTH_TEXTURE_UNFIXED) { /* one sum attached to fixed and unfixed engine depths in turn */
+        unsigned char *img = (unsigned char *)malloc((size_t)W * H * 4);
+        engine e2;
+        int k;
+        engine_create_ex(&e2, W, H, NS, 1);
+        for (k = 0; k < 4; ++k) {
+            engine *ek = k & 1 ? &e : &e2;
+            errs er;
+            g_engine = ek;
+            engine_draw(ek);
+            assert_int_equal(fv_frame(&s, W, H, &st, NULL), FOGVOL_SUCCESS);
+            assert_int_equal(st.engine_depth_tested, 1);
+            engine_resolve(ek, img);
+            er = compare(img);
+            print_message("#   frame %d, the %s engine depth: all max %d, edges mean %.2f [/255]\n", k,
+                          k & 1 ? "unfixed" : "fixed", er.max_all, er.mean_edge);
+            assert_true(er.max_all <= tc->bound);
+        }
+        g_engine = &e;
+        engine_destroy(&e2);
+        free(img);
+    }
     fv_destroy(&s);
 
     if (DEPTH_KIND(tc->depth)) memcpy(before, after, (size_t)W * H * 4);
